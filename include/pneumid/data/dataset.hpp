@@ -1,0 +1,79 @@
+// Dataset: measured input/output data of one experiment (the `iddata` of pneumid).
+//
+// Layout (N samples, nu inputs, ny outputs):
+//   time     N        seconds, strictly increasing
+//   inputs   N x nu   one column per input channel
+//   outputs  N x ny   one column per output channel
+// Names and units describe each channel; `source` names the file the data came
+// from so that later errors can point at it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace pneumid {
+
+/// Name and unit of one measured signal, e.g. {"F", "N"} or {"u", "%"}.
+struct Channel {
+  std::string name;
+  std::string unit;
+};
+
+class Dataset {
+ public:
+  Dataset() = default;
+
+  /// Builds a dataset from columns. Throws InvalidArgument when lengths differ,
+  /// a value is not finite, or time is not strictly increasing.
+  Dataset(Eigen::VectorXd time, Eigen::MatrixXd inputs, Eigen::MatrixXd outputs,
+          std::vector<Channel> input_channels = {}, std::vector<Channel> output_channels = {});
+
+  /// Uniformly sampled SISO dataset starting at t = t0.
+  static Dataset FromUniform(double Ts, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                             double t0 = 0.0, Channel input = {"u", ""},
+                             Channel output = {"y", ""});
+
+  Eigen::Index size() const { return time_.size(); }
+  int num_inputs() const { return static_cast<int>(inputs_.cols()); }
+  int num_outputs() const { return static_cast<int>(outputs_.cols()); }
+
+  const Eigen::VectorXd& time() const { return time_; }
+  const Eigen::MatrixXd& inputs() const { return inputs_; }
+  const Eigen::MatrixXd& outputs() const { return outputs_; }
+  /// Column i of the inputs / outputs (throws InvalidArgument when out of range).
+  Eigen::VectorXd u(int i = 0) const;
+  Eigen::VectorXd y(int i = 0) const;
+
+  const std::vector<Channel>& input_channels() const { return input_channels_; }
+  const std::vector<Channel>& output_channels() const { return output_channels_; }
+  Channel time_channel() const { return time_channel_; }
+  void set_time_channel(Channel c) { time_channel_ = std::move(c); }
+
+  /// Where the data came from (file name), used in error messages.
+  const std::string& source() const { return source_; }
+  void set_source(std::string s) { source_ = std::move(s); }
+
+  /// Mean sample interval (t_end - t_0) / (N - 1) in seconds; throws when N < 2.
+  double SampleTime() const;
+  /// True when every interval is within `rel_tol` * SampleTime() of the mean.
+  bool IsUniform(double rel_tol = 1e-3) const;
+  /// Throws DataError naming the source and the first offending sample when the
+  /// sampling is not uniform within `rel_tol` (suggesting resampling).
+  void RequireUniform(double rel_tol = 1e-3) const;
+  /// Throws DataError naming the source when fewer than `n` samples are present;
+  /// `what` names the method that needs them.
+  void RequireSamples(Eigen::Index n, const std::string& what) const;
+
+ private:
+  Eigen::VectorXd time_;
+  Eigen::MatrixXd inputs_;
+  Eigen::MatrixXd outputs_;
+  std::vector<Channel> input_channels_;
+  std::vector<Channel> output_channels_;
+  Channel time_channel_{"t", "s"};
+  std::string source_;
+};
+
+}  // namespace pneumid

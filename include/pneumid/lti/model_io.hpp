@@ -1,0 +1,35 @@
+// Model specifications shared by every command and binding:
+//   * built-in names:   arx-paper     the paper's ARX(3,3,1) force model, Ts = 0.01 (Eq. 5)
+//                       arx-paper-ct  its zoh d2c continuous equivalent (Eq. 6)
+//                       fopdt-paper   1.6 exp(-0.001 s) / (0.245 s + 1) (Eq. 2)
+//   * inline specs:     fopdt:K=1.6,tau=0.245,theta=0.001
+//                       sopdt:K=..,tau1=..,tau2=..,theta=..
+//                       tf:num=1 2,den=1 3 2[,Ts=0.01][,delay=0]   (space- or ;-separated)
+//   * a model JSON file written by pneumid (`pneumid identify --json`, a single
+//     model object, or an object {"num","den","Ts","delay"}); for a list of
+//     models the first (best) one is taken, or `FILE.json#method` selects one.
+// JSON form of a transfer function: {"num": [...], "den": [...], "Ts": x, "delay": s}.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "pneumid/lti/transfer_function.hpp"
+
+namespace pneumid {
+
+/// Parses a model spec (see above). Throws InvalidArgument naming the spec and
+/// the offending field, or DataError for an unreadable file.
+TransferFunction ParseModelSpec(const std::string& spec);
+
+/// {"num", "den", "Ts", "delay"} with a monic denominator.
+nlohmann::json ToJson(const TransferFunction& g);
+/// Inverse of ToJson; throws InvalidArgument naming the missing/invalid key.
+TransferFunction TransferFunctionFromJson(const nlohmann::json& j);
+
+/// The paper's models (../shared/reference/paper-values.md sections 2-4).
+TransferFunction PaperArxModel();
+TransferFunction PaperFopdtModel();
+
+}  // namespace pneumid

@@ -1,0 +1,77 @@
+// Time responses and step-response metrics (python-control timeresp.py,
+// MATLAB step/impulse/lsim/stepinfo).
+//
+// Continuous models are simulated exactly on the sample grid for inputs held
+// constant between samples (zero-order hold discretization with the input
+// delay, see conversion.hpp); discrete models are run as difference equations
+// at their own sample time.
+#pragma once
+
+#include <limits>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "pneumid/lti/state_space.hpp"
+#include "pneumid/lti/transfer_function.hpp"
+
+namespace pneumid {
+
+struct TimeResponse {
+  Eigen::VectorXd t;  ///< seconds
+  Eigen::VectorXd y;  ///< output at t
+};
+
+/// Unit step response on t = 0, dt, ..., >= t_final. dt = 0 chooses Ts for a
+/// discrete model, otherwise about 1/200 of the slowest time constant (plus
+/// delay); t_final = 0 chooses about 7 slowest time constants (plus delay).
+TimeResponse Step(const TransferFunction& g, double t_final = 0.0, double dt = 0.0);
+/// Unit impulse response (a discrete impulse of area 1 for discrete models).
+TimeResponse Impulse(const TransferFunction& g, double t_final = 0.0, double dt = 0.0);
+
+/// Response to samples u[k] at t = k dt held constant over each interval,
+/// starting from rest (zero state, and u = 0 for t < 0 in the delay line).
+/// For a discrete model dt must equal Ts (throws InvalidArgument otherwise).
+Eigen::VectorXd Lsim(const TransferFunction& g, const Eigen::VectorXd& u, double dt);
+/// State-space version: u is N x nu, returns N x ny; x0 has nx entries (or is
+/// empty for zero). Input delay in the delay line starts at zero input.
+Eigen::MatrixXd Lsim(const StateSpace& g, const Eigen::MatrixXd& u, double dt,
+                     const Eigen::VectorXd& x0 = Eigen::VectorXd());
+
+/// MATLAB stepinfo definitions
+/// (https://www.mathworks.com/help/control/ref/dynamicsystem.stepinfo.html):
+///   rise_time      time from 10 % to 90 % of the way from y0 to y_final
+///   settling_time  first time after which |y - y_final| <= 2 % of |y_final - y0| (from t0)
+///   overshoot      percent over y_final relative to |y_final - y0|
+///   undershoot     percent below y0 in the opposite direction
+///   peak, peak_time  max |y| and when it occurs
+struct StepInfo {
+  double rise_time = 0.0;
+  double settling_time = 0.0;
+  double settling_min = 0.0;
+  double settling_max = 0.0;
+  double overshoot = 0.0;   ///< percent
+  double undershoot = 0.0;  ///< percent
+  double peak = 0.0;
+  double peak_time = 0.0;
+  double steady_state = 0.0;  ///< y_final used
+};
+
+struct StepInfoOptions {
+  double settling_threshold = 0.02;  ///< fraction of the step
+  double rise_low = 0.1;             ///< fraction
+  double rise_high = 0.9;            ///< fraction
+  /// Initial value y0 and final value; NaN means y(0) / last sample.
+  double y_initial = std::numeric_limits<double>::quiet_NaN();
+  double y_final = std::numeric_limits<double>::quiet_NaN();
+  bool IsValid(std::string* error) const;
+};
+
+/// Metrics of a sampled response; crossing times are linearly interpolated
+/// between samples.
+StepInfo ComputeStepInfo(const Eigen::VectorXd& t, const Eigen::VectorXd& y,
+                         const StepInfoOptions& options = {});
+/// Metrics of the model's unit step response (final value = DcGain()).
+StepInfo ComputeStepInfo(const TransferFunction& g, const StepInfoOptions& options = {});
+
+}  // namespace pneumid
