@@ -1,0 +1,163 @@
+// Figures: a small plotting API on top of PLplot's cairo driver.
+//
+// A Figure holds 1..3 subplots stacked vertically that share the page width.
+// Each subplot (Axes) holds line series with legend labels, horizontal
+// reference lines (set-points, limits) and confidence bands (shaded areas or
+// dashed bounds), axis labels with units, a title and a grid. A figure is
+// written as PNG ("pngcairo") or SVG ("svgcairo"), chosen by the file
+// extension, or rendered to an in-memory SVG string for HTML reports.
+//
+//   pneumid::Figure fig(2);
+//   fig.title = "Closed loop";
+//   auto& ax = fig.axes(0);
+//   ax.ylabel = "Force F [N]";
+//   ax.AddLine(t, y, "output");
+//   ax.AddHorizontalLine(100.0, "set-point", pneumid::LineStyle::kDashed);
+//   fig.axes(1).AddStairs(t, u, "duty cycle");
+//   fig.Save("loop.png");
+//
+// Text uses PLplot's escape sequences: "#u" / "#d" start super- / subscripts
+// and "##" prints a literal '#'. Labels are plain text otherwise.
+// [1] PLplot 5.15 reference manual, plstream API (plenv, plbox, pllegend, plfill).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace pneumid {
+
+/// Line styles (PLplot plstyl patterns 1..3).
+enum class LineStyle { kSolid, kDashed, kDotted };
+/// "solid", "dashed", "dotted".
+std::string ToString(LineStyle style);
+/// Inverse of ToString; throws InvalidArgument listing the valid names.
+LineStyle LineStyleFromString(const std::string& name);
+
+/// Output formats of Figure::Save.
+enum class ImageFormat { kPng, kSvg };
+/// "png", "svg".
+std::string ToString(ImageFormat format);
+/// Inverse of ToString (case-insensitive); throws InvalidArgument.
+ImageFormat ImageFormatFromString(const std::string& name);
+/// Format implied by a file name's extension (.png, .svg; case-insensitive).
+/// Throws InvalidArgument for any other extension.
+ImageFormat ImageFormatFromPath(const std::string& path);
+
+/// An RGB colour, components 0..255.
+struct Color {
+  int r = 0, g = 0, b = 0;
+};
+/// The i-th colour of the default palette (Tableau 10; wraps around).
+Color PaletteColor(int i);
+
+/// One curve y(x). `label` empty = not listed in the legend.
+struct Series {
+  Eigen::VectorXd x;
+  Eigen::VectorXd y;
+  std::string label;
+  LineStyle style = LineStyle::kSolid;
+  std::optional<Color> color;  ///< default: next palette colour of its axes
+  double width = 2.0;          ///< line width in PLplot units (about pixels / 1)
+  bool stairs = false;         ///< drawn as a zero-order-hold staircase
+};
+
+/// A horizontal reference line at y (set-point, confidence limit, ...).
+struct HorizontalLine {
+  double y = 0.0;
+  std::string label;
+  LineStyle style = LineStyle::kDashed;
+  Color color{90, 90, 90};
+};
+
+/// A band lower(x) <= y <= upper(x): a translucent shaded area (`shaded`) or
+/// two dashed bounds.
+struct Band {
+  Eigen::VectorXd x;
+  Eigen::VectorXd lower;
+  Eigen::VectorXd upper;
+  std::string label;
+  bool shaded = true;
+  Color color{31, 119, 180};
+  double alpha = 0.25;  ///< fill opacity 0..1 (shaded bands)
+};
+
+/// Legend placement inside the axes.
+enum class LegendPosition { kNone, kTopRight, kBottomRight, kTopLeft, kBottomLeft };
+
+/// One subplot.
+struct Axes {
+  std::string title;
+  std::string xlabel;  ///< with unit, e.g. "Time t [s]"
+  std::string ylabel;  ///< with unit, e.g. "Force F [N]"
+  bool grid = true;
+  bool log_x = false;  ///< logarithmic x axis (Bode plots); x values must be > 0
+  LegendPosition legend = LegendPosition::kBottomRight;
+  /// Axis limits; unset = data range (y with a 5 % margin).
+  std::optional<double> xmin, xmax, ymin, ymax;
+
+  std::vector<Series> series;
+  std::vector<HorizontalLine> hlines;
+  std::vector<Band> bands;
+
+  /// Adds a line. Throws InvalidArgument when x and y differ in length or are
+  /// empty. Returns the new series for further styling.
+  Series& AddLine(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label = {},
+                  LineStyle style = LineStyle::kSolid);
+  /// Adds a zero-order-hold staircase (sampled inputs). Same checks as AddLine.
+  Series& AddStairs(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label = {});
+  /// Adds a horizontal reference line (dashed by default).
+  HorizontalLine& AddHorizontalLine(double y, std::string label = {},
+                                    LineStyle style = LineStyle::kDashed);
+  /// Adds a confidence band; throws InvalidArgument when the lengths differ.
+  Band& AddBand(const Eigen::VectorXd& x, const Eigen::VectorXd& lower,
+                const Eigen::VectorXd& upper, std::string label = {}, bool shaded = true);
+};
+
+/// Page options of a figure.
+struct FigureOptions {
+  int width = 960;          ///< pixels (PNG) / points (SVG)
+  int height_per_axes = 0;  ///< pixels per subplot; 0 = 420 for one, 330 for more
+  double font_scale = 1.0;  ///< multiplies PLplot's default character height
+  bool IsValid(std::string* error) const;
+};
+
+class Figure {
+ public:
+  /// A figure with `rows` stacked subplots (1..3). Throws InvalidArgument otherwise.
+  explicit Figure(int rows = 1, FigureOptions options = {});
+
+  int rows() const { return static_cast<int>(axes_.size()); }
+  /// Subplot i (0 = top). Throws InvalidArgument when out of range.
+  Axes& axes(int i);
+  const Axes& axes(int i) const;
+  FigureOptions& options() { return options_; }
+  const FigureOptions& options() const { return options_; }
+
+  /// Figure title drawn above the first subplot.
+  std::string title;
+
+  /// Writes the figure to `path`, PNG or SVG by extension (ImageFormatFromPath).
+  /// Throws InvalidArgument for an unknown extension, an empty figure or invalid
+  /// options, and DataError when the file cannot be written.
+  void Save(const std::string& path) const;
+  /// Writes the figure in the given format regardless of the extension.
+  void Save(const std::string& path, ImageFormat format) const;
+  /// The figure as an SVG document (no XML prolog). Element ids are prefixed
+  /// with `id_prefix` so that several figures can be inlined in one HTML page.
+  /// The SVG carries <title> and <desc> elements listing the title, axis labels
+  /// and legend entries (text is drawn as glyph outlines by cairo).
+  std::string ToSvg(const std::string& id_prefix = "fig") const;
+
+ private:
+  std::vector<Axes> axes_;
+  FigureOptions options_;
+};
+
+/// Plain-text description of a figure (title, axis labels, legend entries),
+/// one item per line; used for the SVG <desc> element and the HTML alt text.
+std::string DescribeFigure(const Figure& figure);
+
+}  // namespace pneumid
