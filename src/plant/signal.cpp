@@ -1,0 +1,499 @@
+// Experiment and set-point signals (see include/pneumid/plant/signal.hpp).
+#include "pneumid/plant/signal.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/plant/prbs.hpp"
+
+namespace pneumid {
+
+Eigen::VectorXd Signal::Sample(double Ts, Eigen::Index n, double t0) const {
+  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
+  PNEUMID_CHECK(n >= 0, "number of samples must be non-negative, got n = {}", n);
+  Eigen::VectorXd v(n);
+  for (Eigen::Index k = 0; k < n; ++k) v[k] = (*this)(t0 + static_cast<double>(k) * Ts);
+  return v;
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Edges are compared with a small tolerance so that t = k Ts lands on the
+// intended side of an edge at t = at despite rounding of k * Ts.
+constexpr double kEdgeTol = 1e-9;
+bool Reached(double t, double edge) { return t >= edge - kEdgeTol * std::max(1.0, std::abs(edge)); }
+
+std::string Num(double v) { return fmt::format("{:g}", v); }
+
+std::string Trim(const std::string& s) {
+  auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return "";
+  auto e = s.find_last_not_of(" \t\r\n");
+  return s.substr(b, e - b + 1);
+}
+
+/// Common post-processing: value = clamp(raw + offset, min, max).
+struct Shaping {
+  double offset = 0.0;
+  double min = -kInf;
+  double max = kInf;
+  double Apply(double raw) const { return std::clamp(raw + offset, min, max); }
+  std::string Suffix() const {
+    std::string s;
+    if (offset != 0.0) s += ",offset=" + Num(offset);
+    if (min > -kInf) s += ",min=" + Num(min);
+    if (max < kInf) s += ",max=" + Num(max);
+    return s;
+  }
+};
+
+/// key=value pairs of one spec, consumed one by one so unknown keys can be reported.
+class Params {
+ public:
+  Params(std::string spec, std::string kind) : spec_(std::move(spec)), kind_(std::move(kind)) {}
+
+  void Add(const std::string& key, const std::string& value) {
+    PNEUMID_CHECK(!key.empty(), "signal '{}': empty key in '{}={}'", spec_, key, value);
+    PNEUMID_CHECK(values_.count(key) == 0, "signal '{}': key '{}' given twice", spec_, key);
+    values_[key] = value;
+  }
+  bool Has(const std::string& key) const { return values_.count(key) != 0; }
+
+  double Number(const std::string& key) {
+    auto it = values_.find(key);
+    PNEUMID_CHECK(it != values_.end(), "signal '{}': {} needs '{}=' (see --help for the syntax)",
+                  spec_, kind_, key);
+    double v = Parse(key, it->second);
+    values_.erase(it);
+    return v;
+  }
+  double Number(const std::string& key, double fallback) {
+    return Has(key) ? Number(key) : fallback;
+  }
+  std::vector<double> List(const std::string& key) {
+    auto it = values_.find(key);
+    PNEUMID_CHECK(it != values_.end(), "signal '{}': {} needs '{}=' (see --help for the syntax)",
+                  spec_, kind_, key);
+    std::string text = it->second;
+    values_.erase(it);
+    std::replace(text.begin(), text.end(), ';', ' ');
+    std::istringstream in(text);
+    std::vector<double> out;
+    std::string tok;
+    while (in >> tok) out.push_back(Parse(key, tok));
+    PNEUMID_CHECK(!out.empty(), "signal '{}': '{}' needs at least one value", spec_, key);
+    return out;
+  }
+  std::string Text(const std::string& key, const std::string& fallback) {
+    auto it = values_.find(key);
+    if (it == values_.end()) return fallback;
+    std::string v = it->second;
+    values_.erase(it);
+    return v;
+  }
+  Shaping TakeShaping() {
+    Shaping s;
+    s.offset = Number("offset", 0.0);
+    s.min = Number("min", -kInf);
+    s.max = Number("max", kInf);
+    PNEUMID_CHECK(s.min <= s.max, "signal '{}': min = {} exceeds max = {}", spec_, s.min, s.max);
+    return s;
+  }
+  /// Throws when keys are left that the kind does not know.
+  void Finish(const std::string& allowed) const {
+    if (values_.empty()) return;
+    PNEUMID_CHECK(false, "signal '{}': unknown key '{}' for {} (allowed: {})", spec_,
+                  values_.begin()->first, kind_, allowed);
+  }
+  const std::string& spec() const { return spec_; }
+
+ private:
+  double Parse(const std::string& key, const std::string& text) const {
+    std::string t = Trim(text);
+    double v = 0.0;
+    auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    PNEUMID_CHECK(ec == std::errc() && ptr == t.data() + t.size() && !t.empty(),
+                  "signal '{}': '{}' is not a number: '{}'", spec_, key, text);
+    PNEUMID_CHECK(std::isfinite(v) || key == "min" || key == "max",
+                  "signal '{}': '{}' must be finite, got '{}'", spec_, key, text);
+    return v;
+  }
+
+  std::string spec_;
+  std::string kind_;
+  std::map<std::string, std::string> values_;
+};
+
+// ---------------------------------------------------------------------------
+
+class StepSignal final : public Signal {
+ public:
+  StepSignal(double from, double to, double at, Shaping s) : from_(from), to_(to), at_(at), s_(s) {}
+  double operator()(double t) const override { return s_.Apply(Reached(t, at_) ? to_ : from_); }
+  std::string ToString() const override {
+    return "step:from=" + Num(from_) + ",to=" + Num(to_) + ",at=" + Num(at_) + s_.Suffix();
+  }
+
+ private:
+  double from_, to_, at_;
+  Shaping s_;
+};
+
+class StaircaseSignal final : public Signal {
+ public:
+  StaircaseSignal(std::vector<double> levels, double dwell, double at, Shaping s)
+      : levels_(std::move(levels)), dwell_(dwell), at_(at), s_(s) {}
+  double operator()(double t) const override {
+    if (!Reached(t, at_)) return s_.Apply(levels_.front());
+    // Index of the current level, with the same edge tolerance as Reached().
+    double pos = (t - at_) / dwell_;
+    auto k = static_cast<long long>(std::floor(pos + kEdgeTol * std::max(1.0, std::abs(pos))));
+    k = std::clamp<long long>(k, 0, static_cast<long long>(levels_.size()) - 1);
+    return s_.Apply(levels_[static_cast<std::size_t>(k)]);
+  }
+  std::string ToString() const override {
+    std::string lv;
+    for (std::size_t i = 0; i < levels_.size(); ++i) lv += (i ? " " : "") + Num(levels_[i]);
+    return "staircase:levels=" + lv + ",dwell=" + Num(dwell_) + ",at=" + Num(at_) + s_.Suffix();
+  }
+
+ private:
+  std::vector<double> levels_;
+  double dwell_, at_;
+  Shaping s_;
+};
+
+class PrbsSignal final : public Signal {
+ public:
+  PrbsSignal(double low, double high, int order, double clock, std::uint64_t seed, double at,
+             Shaping s)
+      : low_(low),
+        high_(high),
+        order_(order),
+        clock_(clock),
+        seed_(seed),
+        at_(at),
+        s_(s),
+        gen_(order, seed) {}
+  double operator()(double t) const override {
+    if (!Reached(t, at_)) return s_.Apply(low_);
+    double pos = (t - at_) / clock_;
+    auto k = static_cast<long long>(std::floor(pos + kEdgeTol * std::max(1.0, std::abs(pos))));
+    k = std::max<long long>(k, 0) % static_cast<long long>(gen_.period());
+    // Bits are generated on demand (a full period of a high order is huge).
+    while (static_cast<long long>(bits_.size()) <= k) bits_.push_back(gen_.Next());
+    return s_.Apply(bits_[static_cast<std::size_t>(k)] ? high_ : low_);
+  }
+  std::string ToString() const override {
+    return "prbs:low=" + Num(low_) + ",high=" + Num(high_) + ",order=" + std::to_string(order_) +
+           ",clock=" + Num(clock_) + ",seed=" + std::to_string(seed_) + ",at=" + Num(at_) +
+           s_.Suffix();
+  }
+
+ private:
+  double low_, high_;
+  int order_;
+  double clock_;
+  std::uint64_t seed_;
+  double at_;
+  Shaping s_;
+  mutable MaxLengthSequenceGenerator gen_;
+  mutable std::vector<std::uint8_t> bits_;
+};
+
+class ChirpSignal final : public Signal {
+ public:
+  ChirpSignal(double from, double to, double f0, double f1, double at, double duration, Shaping s)
+      : from_(from), to_(to), f0_(f0), f1_(f1), at_(at), duration_(duration), s_(s) {}
+  double operator()(double t) const override {
+    const double mid = 0.5 * (from_ + to_);
+    const double amp = 0.5 * (to_ - from_);
+    const double tau = t - at_;
+    if (tau < 0.0 || tau > duration_) return s_.Apply(mid);
+    // Linear sweep: f(tau) = f0 + (f1 - f0) tau / D, phase = 2 pi int_0^tau f.
+    const double phase =
+        2.0 * std::numbers::pi * (f0_ * tau + 0.5 * (f1_ - f0_) * tau * tau / duration_);
+    return s_.Apply(mid + amp * std::sin(phase));
+  }
+  std::string ToString() const override {
+    return "chirp:from=" + Num(from_) + ",to=" + Num(to_) + ",f0=" + Num(f0_) + ",f1=" + Num(f1_) +
+           ",at=" + Num(at_) + ",duration=" + Num(duration_) + s_.Suffix();
+  }
+
+ private:
+  double from_, to_, f0_, f1_, at_, duration_;
+  Shaping s_;
+};
+
+class RampSignal final : public Signal {
+ public:
+  RampSignal(double from, double to, double at, double duration, Shaping s)
+      : from_(from), to_(to), at_(at), duration_(duration), s_(s) {}
+  double operator()(double t) const override {
+    if (t <= at_) return s_.Apply(from_);
+    if (t >= at_ + duration_) return s_.Apply(to_);
+    return s_.Apply(from_ + (to_ - from_) * (t - at_) / duration_);
+  }
+  std::string ToString() const override {
+    return "ramp:from=" + Num(from_) + ",to=" + Num(to_) + ",at=" + Num(at_) +
+           ",duration=" + Num(duration_) + s_.Suffix();
+  }
+
+ private:
+  double from_, to_, at_, duration_;
+  Shaping s_;
+};
+
+/// Input read from a delimited text file: a header line with column names
+/// (the first column is time unless a column named t/time exists), then rows.
+class FileSignal final : public Signal {
+ public:
+  FileSignal(std::string path, std::string column, Shaping s)
+      : path_(std::move(path)), column_(std::move(column)), s_(s) {
+    Load();
+  }
+  double operator()(double t) const override {
+    // Zero-order hold: the last sample at or before t (first value before the start).
+    auto it =
+        std::upper_bound(time_.begin(), time_.end(), t + kEdgeTol * std::max(1.0, std::abs(t)));
+    if (it == time_.begin()) return s_.Apply(value_.front());
+    return s_.Apply(value_[static_cast<std::size_t>(it - time_.begin() - 1)]);
+  }
+  std::string ToString() const override {
+    return "file:" + path_ + ",col=" + column_ + s_.Suffix();
+  }
+
+ private:
+  static std::vector<std::string> SplitRow(const std::string& line) {
+    std::vector<std::string> out;
+    std::string cur;
+    for (char c : line) {
+      if (c == ',' || c == ';' || c == '\t' || c == ' ') {
+        if (!cur.empty()) out.push_back(cur);
+        cur.clear();
+      } else if (c != '\r' && c != '"') {
+        cur += c;
+      }
+    }
+    if (!cur.empty()) out.push_back(cur);
+    return out;
+  }
+
+  void Load() {
+    std::ifstream in(path_);
+    if (!in) throw DataError(fmt::format("{}: cannot open file for reading", path_));
+    std::string line;
+    std::size_t line_no = 0;
+    std::vector<std::string> header;
+    while (std::getline(in, line)) {
+      ++line_no;
+      std::string t = Trim(line);
+      if (t.empty() || t[0] == '#' || t[0] == '%') continue;
+      header = SplitRow(t);
+      break;
+    }
+    if (header.empty()) throw DataError(fmt::format("{}: no header line with column names", path_));
+    // Strip units in brackets, e.g. "F [N]" -> "F" (the split on spaces leaves "[N]" apart).
+    std::vector<std::string> names;
+    for (const auto& h : header)
+      if (!(h.front() == '[' || h.front() == '(')) names.push_back(h);
+    auto find = [&](const std::string& name) -> int {
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        std::string n = names[i];
+        auto bracket = n.find_first_of("[(");
+        if (bracket != std::string::npos) n = n.substr(0, bracket);
+        if (n == name) return static_cast<int>(i);
+      }
+      return -1;
+    };
+    int tcol = find("t");
+    if (tcol < 0) tcol = find("time");
+    if (tcol < 0) tcol = 0;
+    int ucol = find(column_);
+    if (ucol < 0) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+      throw DataError(
+          fmt::format("{}:{}: no column '{}' (columns: {})", path_, line_no, column_, list));
+    }
+    while (std::getline(in, line)) {
+      ++line_no;
+      std::string t = Trim(line);
+      if (t.empty() || t[0] == '#' || t[0] == '%') continue;
+      auto cells = SplitRow(t);
+      auto cell = [&](int col) {
+        if (col >= static_cast<int>(cells.size()))
+          throw DataError(fmt::format("{}:{}: column {} ('{}') missing, row has {} values", path_,
+                                      line_no, col + 1, names[static_cast<std::size_t>(col)],
+                                      cells.size()));
+        const std::string& c = cells[static_cast<std::size_t>(col)];
+        double v = 0.0;
+        auto [ptr, ec] = std::from_chars(c.data(), c.data() + c.size(), v);
+        if (ec != std::errc() || ptr != c.data() + c.size() || !std::isfinite(v))
+          throw DataError(fmt::format("{}:{}: column {} ('{}'): not a finite number: '{}'", path_,
+                                      line_no, col + 1, names[static_cast<std::size_t>(col)], c));
+        return v;
+      };
+      double tv = cell(tcol);
+      double uv = cell(ucol);
+      if (!time_.empty() && !(tv > time_.back()))
+        throw DataError(fmt::format("{}:{}: time {} is not greater than the previous {}", path_,
+                                    line_no, tv, time_.back()));
+      time_.push_back(tv);
+      value_.push_back(uv);
+    }
+    if (time_.empty()) throw DataError(fmt::format("{}: no data rows", path_));
+  }
+
+  std::string path_;
+  std::string column_;
+  Shaping s_;
+  std::vector<double> time_;
+  std::vector<double> value_;
+};
+
+}  // namespace
+
+std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
+  const std::string spec = Trim(spec_in);
+  PNEUMID_CHECK(!spec.empty(), "empty signal spec (expected e.g. 'step:from=0,to=1,at=1')");
+  const auto colon = spec.find(':');
+  std::string kind = Trim(spec.substr(0, colon));
+  std::transform(kind.begin(), kind.end(), kind.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string rest = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  static const std::set<std::string> kinds = {"step",  "staircase", "multistep", "prbs",
+                                              "chirp", "ramp",      "file"};
+  PNEUMID_CHECK(kinds.count(kind) != 0,
+                "signal '{}': unknown kind '{}' (expected step, staircase, multistep, prbs, "
+                "chirp, ramp or file)",
+                spec, kind);
+
+  Params p(spec, kind);
+  std::string file_path;
+  {
+    std::vector<std::string> items;
+    std::string cur;
+    std::istringstream in(rest);
+    while (std::getline(in, cur, ',')) items.push_back(cur);
+    std::size_t first = 0;
+    if (kind == "file") {
+      PNEUMID_CHECK(!items.empty() && !Trim(items[0]).empty(),
+                    "signal '{}': file needs a path, e.g. 'file:data.csv,col=u'", spec);
+      file_path = Trim(items[0]);
+      first = 1;
+    }
+    for (std::size_t i = first; i < items.size(); ++i) {
+      std::string item = Trim(items[i]);
+      if (item.empty()) continue;
+      auto eq = item.find('=');
+      PNEUMID_CHECK(eq != std::string::npos, "signal '{}': expected key=value, got '{}'", spec,
+                    item);
+      p.Add(Trim(item.substr(0, eq)), Trim(item.substr(eq + 1)));
+    }
+  }
+
+  std::unique_ptr<Signal> out;
+  if (kind == "step") {
+    double from = p.Number("from", 0.0);
+    double to = p.Number("to");
+    double at = p.Number("at", 0.0);
+    Shaping s = p.TakeShaping();
+    p.Finish("from, to, at, offset, min, max");
+    out = std::make_unique<StepSignal>(from, to, at, s);
+  } else if (kind == "staircase" || kind == "multistep") {
+    auto levels = p.List("levels");
+    double dwell = p.Number("dwell");
+    PNEUMID_CHECK(dwell > 0.0, "signal '{}': dwell must be positive, got {}", spec, dwell);
+    double at = p.Number("at", 0.0);
+    Shaping s = p.TakeShaping();
+    p.Finish("levels, dwell, at, offset, min, max");
+    out = std::make_unique<StaircaseSignal>(std::move(levels), dwell, at, s);
+  } else if (kind == "prbs") {
+    double low = p.Number("low", 0.0);
+    double high = p.Number("high", 1.0);
+    double order_d = p.Number("order", 7.0);
+    PNEUMID_CHECK(order_d == std::floor(order_d) && order_d >= 2 && order_d <= 32,
+                  "signal '{}': order must be an integer in 2..32, got {}", spec, order_d);
+    int order = static_cast<int>(order_d);
+    double clock = p.Number("clock");
+    PNEUMID_CHECK(clock > 0.0, "signal '{}': clock must be positive, got {}", spec, clock);
+    const double all_ones = std::ldexp(1.0, order) - 1.0;
+    double seed_d = p.Number("seed", all_ones);
+    PNEUMID_CHECK(seed_d == std::floor(seed_d) && seed_d >= 1 && seed_d <= all_ones,
+                  "signal '{}': seed must be an integer in 1..2^order-1 = {}, got {}", spec,
+                  all_ones, seed_d);
+    double at = p.Number("at", 0.0);
+    Shaping s = p.TakeShaping();
+    p.Finish("low, high, order, clock, seed, at, offset, min, max");
+    out = std::make_unique<PrbsSignal>(low, high, order, clock, static_cast<std::uint64_t>(seed_d),
+                                       at, s);
+  } else if (kind == "chirp") {
+    double from = p.Number("from");
+    double to = p.Number("to");
+    double f0 = p.Number("f0");
+    double f1 = p.Number("f1");
+    PNEUMID_CHECK(f0 >= 0.0 && f1 >= 0.0, "signal '{}': frequencies must be >= 0, got {} and {}",
+                  spec, f0, f1);
+    double at = p.Number("at", 0.0);
+    double duration = p.Number("duration", 10.0);
+    PNEUMID_CHECK(duration > 0.0, "signal '{}': duration must be positive, got {}", spec, duration);
+    Shaping s = p.TakeShaping();
+    p.Finish("from, to, f0, f1, at, duration, offset, min, max");
+    out = std::make_unique<ChirpSignal>(from, to, f0, f1, at, duration, s);
+  } else if (kind == "ramp") {
+    double from = p.Number("from", 0.0);
+    double to = p.Number("to");
+    double at = p.Number("at", 0.0);
+    double duration = p.Number("duration");
+    PNEUMID_CHECK(duration > 0.0, "signal '{}': duration must be positive, got {}", spec, duration);
+    Shaping s = p.TakeShaping();
+    p.Finish("from, to, at, duration, offset, min, max");
+    out = std::make_unique<RampSignal>(from, to, at, duration, s);
+  } else {  // file
+    std::string col = p.Text("col", "u");
+    Shaping s = p.TakeShaping();
+    p.Finish("col, offset, min, max");
+    out = std::make_unique<FileSignal>(file_path, col, s);
+  }
+  return out;
+}
+
+std::string SignalSyntaxHelp() {
+  return R"(Signal specs (times in s, frequencies in Hz, amplitudes in input units):
+  step:from=A,to=B,at=T                 A before T, B from T on (from defaults to 0, at to 0)
+  staircase:levels=L0 L1 ...,dwell=D[,at=T]
+                                        each level held D seconds from T on, the last held
+                                        (alias multistep; levels separated by spaces or ';')
+  prbs:low=A,high=B,order=N,clock=C[,seed=S][,at=T]
+                                        maximal-length binary sequence from an N-bit LFSR
+                                        (N = 2..32, period 2^N-1 clock periods of C seconds,
+                                        seed = initial register 1..2^N-1, default all ones;
+                                        same taps as scipy.signal.max_len_seq), repeated
+  chirp:from=A,to=B,f0=F0,f1=F1[,at=T][,duration=D]
+                                        sine between A and B, frequency swept linearly from
+                                        F0 to F1 over D seconds (default 10), (A+B)/2 outside
+  ramp:from=A,to=B,at=T,duration=D      A until T, linear to B over D seconds, then B
+  file:PATH[,col=NAME]                  column NAME (default u) of a CSV/whitespace file with
+                                        a header line, against its time column (t, time or
+                                        the first column), held between samples
+Every kind also takes offset=O, min=LO, max=HI: value = clamp(signal + O, LO, HI).
+Example: --input step:from=0.61,to=82,at=1.0
+)";
+}
+
+}  // namespace pneumid
