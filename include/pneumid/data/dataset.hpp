@@ -66,6 +66,19 @@ class Dataset {
   /// `what` names the method that needs them.
   void RequireSamples(Eigen::Index n, const std::string& what) const;
 
+  /// Line (1-based) of `source()` that holds sample `i`, or 0 when unknown (the
+  /// dataset was not read from a text file, or was derived from one by
+  /// resampling, filtering, ...). Throws InvalidArgument when i is out of range.
+  long SourceLine(Eigen::Index i) const;
+  /// Where sample `i` is, for error messages: "data.csv:12" when the line is
+  /// known, "data.mat: sample 11" otherwise ("sample 11" without a source).
+  std::string Where(Eigen::Index i) const;
+  /// Records the file lines of the samples as break points: sample
+  /// `first_samples[j] + k` lies on line `first_lines[j] + k` until the next
+  /// break point. Both vectors have equal length, first_samples starts at 0 and
+  /// increases. An empty map clears the information.
+  void set_source_lines(std::vector<Eigen::Index> first_samples, std::vector<long> first_lines);
+
  private:
   Eigen::VectorXd time_;
   Eigen::MatrixXd inputs_;
@@ -74,6 +87,8 @@ class Dataset {
   std::vector<Channel> output_channels_;
   Channel time_channel_{"t", "s"};
   std::string source_;
+  std::vector<Eigen::Index> line_samples_;
+  std::vector<long> line_numbers_;
 };
 
 }  // namespace pneumid

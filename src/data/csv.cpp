@@ -1,0 +1,435 @@
+#include "pneumid/data/csv.hpp"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "column_spec.hpp"
+#include "pneumid/common/check.hpp"
+
+namespace pneumid {
+namespace {
+
+/// Read-only view of a whole file, memory-mapped (or empty for an empty file).
+class MappedFile {
+ public:
+  explicit MappedFile(const std::string& path) {
+    fd_ = ::open(path.c_str(), O_RDONLY);
+    if (fd_ < 0) {
+      throw DataError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+    }
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0) {
+      const int e = errno;
+      ::close(fd_);
+      throw DataError(fmt::format("{}: cannot read: {}", path, std::strerror(e)));
+    }
+    if (S_ISDIR(st.st_mode)) {
+      ::close(fd_);
+      throw DataError(fmt::format("{}: is a directory, not a data file", path));
+    }
+    size_ = static_cast<std::size_t>(st.st_size);
+    if (size_ > 0) {
+      void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd_, 0);
+      if (p == MAP_FAILED) {
+        const int e = errno;
+        ::close(fd_);
+        throw DataError(fmt::format("{}: cannot map: {}", path, std::strerror(e)));
+      }
+      ::madvise(p, size_, MADV_SEQUENTIAL);
+      data_ = static_cast<const char*>(p);
+    }
+  }
+  ~MappedFile() {
+    if (data_ != nullptr) ::munmap(const_cast<char*>(data_), size_);
+    if (fd_ >= 0) ::close(fd_);
+  }
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+
+  std::string_view view() const { return {data_ == nullptr ? "" : data_, size_}; }
+
+ private:
+  int fd_ = -1;
+  const char* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+inline bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+inline std::string_view Trim(std::string_view s) {
+  while (!s.empty() && IsBlank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && IsBlank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+inline std::string_view StripQuotes(std::string_view s) {
+  if (s.size() >= 2 && s.front() == '"' && s.back() == '"') {
+    s = Trim(s.substr(1, s.size() - 2));
+  }
+  return s;
+}
+
+/// The content of a line without comment and surrounding blanks.
+inline std::string_view LineContent(std::string_view line, char comment) {
+  if (comment != '\0') {
+    const void* hash = std::memchr(line.data(), comment, line.size());
+    if (hash != nullptr) line = line.substr(0, static_cast<const char*>(hash) - line.data());
+  }
+  return Trim(line);
+}
+
+char DetectDelimiter(std::string_view header) {
+  std::size_t best_count = 0;
+  char best = ' ';
+  for (char c : {',', ';', '\t'}) {
+    std::size_t n = 0;
+    for (char h : header) n += (h == c);
+    if (n > best_count) {
+      best_count = n;
+      best = c;
+    }
+  }
+  return best;
+}
+
+/// Splits `content` at the delimiter (runs of blanks when delimiter is ' ') and
+/// calls f(index, cell) for every cell; returns the number of cells.
+template <typename F>
+inline std::size_t ForEachCell(std::string_view content, char delimiter, F&& f) {
+  std::size_t index = 0;
+  const char* p = content.data();
+  const char* end = p + content.size();
+  if (delimiter == ' ') {
+    while (p < end) {
+      while (p < end && IsBlank(*p)) ++p;
+      if (p == end) break;
+      const char* start = p;
+      while (p < end && !IsBlank(*p)) ++p;
+      f(index++, std::string_view(start, static_cast<std::size_t>(p - start)));
+    }
+    return index;
+  }
+  while (true) {
+    const void* d = std::memchr(p, delimiter, static_cast<std::size_t>(end - p));
+    const char* cell_end = d == nullptr ? end : static_cast<const char*>(d);
+    f(index++, std::string_view(p, static_cast<std::size_t>(cell_end - p)));
+    if (d == nullptr) break;
+    p = cell_end + 1;
+  }
+  return index;
+}
+
+std::string DelimiterName(char d) {
+  switch (d) {
+    case ',':
+      return "','";
+    case ';':
+      return "';'";
+    case '\t':
+      return "tab";
+    case ' ':
+      return "blanks";
+    default:
+      return fmt::format("'{}'", d);
+  }
+}
+
+}  // namespace
+
+bool CsvReadOptions::IsValid(std::string* error) const {
+  auto fail = [&](std::string message) {
+    if (error != nullptr) *error = std::move(message);
+    return false;
+  };
+  if (delimiter != '\0' && delimiter != ',' && delimiter != ';' && delimiter != '\t' &&
+      delimiter != ' ') {
+    return fail(
+        fmt::format("CsvReadOptions: delimiter must be ',', ';', tab or ' ', got '{}'", delimiter));
+  }
+  if (comment != '\0' && (comment == delimiter || comment == '.' || comment == '-' ||
+                          comment == '+' || (comment >= '0' && comment <= '9'))) {
+    return fail(fmt::format("CsvReadOptions: comment character '{}' would hide data", comment));
+  }
+  if (!std::isfinite(sample_time) || sample_time < 0) {
+    return fail(fmt::format("CsvReadOptions: sample_time must be >= 0, got {}", sample_time));
+  }
+  if (!std::isfinite(start_time)) {
+    return fail(fmt::format("CsvReadOptions: start_time must be finite, got {}", start_time));
+  }
+  if (sample_time == 0 && time_column.empty()) {
+    return fail("CsvReadOptions: give a time column or a sample time > 0");
+  }
+  if (input_columns.empty() && output_columns.empty()) {
+    return fail("CsvReadOptions: select at least one input or output column");
+  }
+  for (const auto& c : input_columns) {
+    if (c.empty()) return fail("CsvReadOptions: empty input column name");
+  }
+  for (const auto& c : output_columns) {
+    if (c.empty()) return fail("CsvReadOptions: empty output column name");
+  }
+  return true;
+}
+
+Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "ReadCsv: {}", error);
+  MappedFile file(path);
+  std::string_view text = file.view();
+  if (text.size() >= 3 && std::memcmp(text.data(), "\xEF\xBB\xBF", 3) == 0) {
+    text.remove_prefix(3);  // UTF-8 byte order mark
+  }
+  if (text.empty()) throw DataError(fmt::format("{}:1: empty file (expected a header row)", path));
+
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  long line = 0;
+  // Returns the next line (without '\n') and advances p; line counts from 1.
+  auto next_line = [&]() {
+    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
+    const char* line_end = nl == nullptr ? end : static_cast<const char*>(nl);
+    std::string_view l(p, static_cast<std::size_t>(line_end - p));
+    p = nl == nullptr ? end : line_end + 1;
+    ++line;
+    return l;
+  };
+
+  // Header row: the first line with content.
+  std::string_view header;
+  while (p < end) {
+    header = LineContent(next_line(), options.comment);
+    if (!header.empty()) break;
+  }
+  if (header.empty()) {
+    throw DataError(
+        fmt::format("{}:{}: empty file: no header row (only blank or comment lines)", path, line));
+  }
+  const long header_line = line;
+  const char delimiter = options.delimiter != '\0' ? options.delimiter : DetectDelimiter(header);
+  std::vector<internal::ColumnName> columns;
+  ForEachCell(header, delimiter, [&](std::size_t, std::string_view cell) {
+    columns.push_back(internal::ParseColumnName(std::string(StripQuotes(Trim(cell)))));
+  });
+  const std::size_t num_columns = columns.size();
+
+  // Resolve the selected columns into slots: time (optional), inputs, outputs.
+  auto where = [&](long l) { return fmt::format("{}:{}", path, l); };
+  const bool has_time = options.sample_time <= 0;
+  std::vector<std::size_t> slot_column;
+  if (has_time) {
+    slot_column.push_back(
+        internal::ResolveColumn(options.time_column, columns, where(header_line), "time"));
+  }
+  for (const auto& s : options.input_columns) {
+    slot_column.push_back(internal::ResolveColumn(s, columns, where(header_line), "input"));
+  }
+  for (const auto& s : options.output_columns) {
+    slot_column.push_back(internal::ResolveColumn(s, columns, where(header_line), "output"));
+  }
+  const std::size_t num_slots = slot_column.size();
+  // column -> first slot reading it (a column may feed several slots).
+  std::vector<int> column_slot(num_columns, -1);
+  for (std::size_t s = num_slots; s-- > 0;) column_slot[slot_column[s]] = static_cast<int>(s);
+
+  // Estimate the number of rows from the size of the first data line.
+  std::vector<std::vector<double>> values(num_slots);
+  {
+    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
+    const std::size_t first_len =
+        std::max<std::size_t>(4, (nl == nullptr ? end : static_cast<const char*>(nl)) - p + 1);
+    const std::size_t estimate = static_cast<std::size_t>(end - p) / first_len + 16;
+    for (auto& v : values) v.reserve(estimate + estimate / 8);
+  }
+  std::vector<double> row(num_slots);
+  std::vector<Eigen::Index> break_samples;
+  std::vector<long> break_lines;
+  long previous_line = -1;
+  Eigen::Index n = 0;
+  double previous_time = 0.0;
+
+  auto cell_error = [&](std::size_t column, const std::string& what) {
+    return DataError(
+        fmt::format("{}:{}: column '{}': {}", path, line, columns[column].label, what));
+  };
+
+  while (p < end) {
+    const std::string_view content = LineContent(next_line(), options.comment);
+    if (content.empty()) continue;
+    const std::size_t cells =
+        ForEachCell(content, delimiter, [&](std::size_t c, std::string_view cell) {
+          if (c >= num_columns) return;
+          const int slot = column_slot[c];
+          if (slot < 0) return;
+          cell = StripQuotes(Trim(cell));
+          if (cell.empty()) throw cell_error(c, "missing value (empty cell)");
+          const char* first = cell.data();
+          const char* last = first + cell.size();
+          if (*first == '+') ++first;
+          double v = 0.0;
+          const auto [ptr, ec] = std::from_chars(first, last, v);
+          if (ec == std::errc::result_out_of_range) {
+            throw cell_error(c, fmt::format("number out of range: '{}'", cell));
+          }
+          if (ec != std::errc() || ptr != last) {
+            throw cell_error(c, fmt::format("not a number: '{}'", cell));
+          }
+          if (std::isnan(v)) throw cell_error(c, fmt::format("NaN value '{}'", cell));
+          if (std::isinf(v)) throw cell_error(c, fmt::format("infinite value '{}'", cell));
+          row[static_cast<std::size_t>(slot)] = v;
+        });
+    if (cells != num_columns) {
+      throw DataError(fmt::format(
+          "{}:{}: row has {} cells but the header (line {}) has {} columns (ragged row or "
+          "missing cells; delimiter {})",
+          path, line, cells, header_line, num_columns, DelimiterName(delimiter)));
+    }
+    for (std::size_t s = 0; s < num_slots; ++s) {
+      const int source_slot = column_slot[slot_column[s]];
+      values[s].push_back(row[static_cast<std::size_t>(source_slot)]);
+    }
+    if (has_time) {
+      const double t = row[0];
+      if (n > 0 && !(t > previous_time)) {
+        throw DataError(fmt::format(
+            "{}:{}: column '{}': time is not strictly increasing: t = {} after t = {} on line {}",
+            path, line, columns[slot_column[0]].label, t, previous_time, previous_line));
+      }
+      previous_time = t;
+    }
+    if (line != previous_line + 1) {
+      break_samples.push_back(n);
+      break_lines.push_back(line);
+    }
+    previous_line = line;
+    ++n;
+  }
+  if (n == 0) {
+    throw DataError(
+        fmt::format("{}:{}: header row only, the file has no data rows", path, header_line));
+  }
+
+  Eigen::VectorXd time(n);
+  std::size_t s = 0;
+  if (has_time) {
+    time = Eigen::Map<const Eigen::VectorXd>(values[s++].data(), n);
+  } else {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      time[i] = options.start_time + static_cast<double>(i) * options.sample_time;
+    }
+  }
+  auto fill = [&](const std::vector<std::string>& specs, std::vector<Channel>& channels) {
+    Eigen::MatrixXd m(n, static_cast<Eigen::Index>(specs.size()));
+    for (Eigen::Index c = 0; c < m.cols(); ++c, ++s) {
+      m.col(c) = Eigen::Map<const Eigen::VectorXd>(values[s].data(), n);
+      const auto& col = columns[slot_column[s]];
+      channels.push_back({col.name, col.unit});
+      std::vector<double>().swap(values[s]);
+    }
+    return m;
+  };
+  Channel time_channel{"t", "s"};
+  if (has_time) {
+    const auto& col = columns[slot_column[0]];
+    time_channel = {col.name, col.unit.empty() ? "s" : col.unit};
+  }
+  std::vector<Channel> input_channels, output_channels;
+  Eigen::MatrixXd inputs = fill(options.input_columns, input_channels);
+  Eigen::MatrixXd outputs = fill(options.output_columns, output_channels);
+  Dataset data(std::move(time), std::move(inputs), std::move(outputs), std::move(input_channels),
+               std::move(output_channels));
+  data.set_time_channel(time_channel);
+  data.set_source(path);
+  data.set_source_lines(std::move(break_samples), std::move(break_lines));
+  return data;
+}
+
+bool CsvWriteOptions::IsValid(std::string* error) const {
+  if (delimiter != ',' && delimiter != ';' && delimiter != '\t' && delimiter != ' ') {
+    if (error != nullptr) {
+      *error = fmt::format("CsvWriteOptions: delimiter must be ',', ';', tab or ' ', got '{}'",
+                           delimiter);
+    }
+    return false;
+  }
+  for (const auto& c : comments) {
+    if (c.find('\n') != std::string::npos) {
+      if (error != nullptr) *error = "CsvWriteOptions: a comment line contains a newline";
+      return false;
+    }
+  }
+  return true;
+}
+
+void WriteCsv(const Dataset& data, const std::string& path, const std::vector<CsvColumn>& extra,
+              const CsvWriteOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "WriteCsv: {}", error);
+  for (const auto& c : extra) {
+    PNEUMID_CHECK(c.values.size() == data.size(),
+                  "WriteCsv: extra column '{}' has {} values, the dataset has {} samples",
+                  c.channel.name, c.values.size(), data.size());
+  }
+  std::vector<Channel> channels;
+  std::vector<const double*> columns;
+  channels.push_back(data.time_channel());
+  columns.push_back(data.time().data());
+  for (int i = 0; i < data.num_inputs(); ++i) {
+    channels.push_back(data.input_channels()[static_cast<std::size_t>(i)]);
+    columns.push_back(data.inputs().col(i).data());
+  }
+  for (int i = 0; i < data.num_outputs(); ++i) {
+    channels.push_back(data.output_channels()[static_cast<std::size_t>(i)]);
+    columns.push_back(data.outputs().col(i).data());
+  }
+  for (const auto& c : extra) {
+    channels.push_back(c.channel);
+    columns.push_back(c.values.data());
+  }
+
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "wb"), &std::fclose);
+  if (!f) throw DataError(fmt::format("{}: cannot write: {}", path, std::strerror(errno)));
+  fmt::memory_buffer buf;
+  for (const auto& c : options.comments) fmt::format_to(std::back_inserter(buf), "# {}\n", c);
+  for (std::size_t c = 0; c < channels.size(); ++c) {
+    if (c > 0) buf.push_back(options.delimiter);
+    const auto& ch = channels[c];
+    if (ch.unit.empty()) {
+      fmt::format_to(std::back_inserter(buf), "{}", ch.name);
+    } else {
+      fmt::format_to(std::back_inserter(buf), "{} [{}]", ch.name, ch.unit);
+    }
+  }
+  buf.push_back('\n');
+  auto flush = [&]() {
+    if (std::fwrite(buf.data(), 1, buf.size(), f.get()) != buf.size()) {
+      throw DataError(fmt::format("{}: write failed: {}", path, std::strerror(errno)));
+    }
+    buf.clear();
+  };
+  for (Eigen::Index i = 0; i < data.size(); ++i) {
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      if (c > 0) buf.push_back(options.delimiter);
+      fmt::format_to(std::back_inserter(buf), "{}", columns[c][i]);
+    }
+    buf.push_back('\n');
+    if (buf.size() > (1u << 20)) flush();
+  }
+  flush();
+  if (std::fclose(f.release()) != 0) {
+    throw DataError(fmt::format("{}: write failed: {}", path, std::strerror(errno)));
+  }
+}
+
+}  // namespace pneumid

@@ -1,0 +1,170 @@
+#include "pneumid/data/dataset.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "pneumid/common/check.hpp"
+
+namespace pneumid {
+namespace {
+
+std::vector<Channel> DefaultChannels(const std::string& prefix, Eigen::Index n) {
+  std::vector<Channel> channels;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    channels.push_back({n == 1 ? prefix : fmt::format("{}{}", prefix, i + 1), ""});
+  }
+  return channels;
+}
+
+void CheckFinite(const Eigen::MatrixXd& m, const char* what) {
+  for (Eigen::Index c = 0; c < m.cols(); ++c) {
+    for (Eigen::Index r = 0; r < m.rows(); ++r) {
+      PNEUMID_CHECK(std::isfinite(m(r, c)), "Dataset: {} ({}, {}) is not finite: {}", what, r, c,
+                    m(r, c));
+    }
+  }
+}
+
+std::string SourcePrefix(const std::string& source) {
+  return source.empty() ? std::string("dataset") : source;
+}
+
+}  // namespace
+
+Dataset::Dataset(Eigen::VectorXd time, Eigen::MatrixXd inputs, Eigen::MatrixXd outputs,
+                 std::vector<Channel> input_channels, std::vector<Channel> output_channels)
+    : time_(std::move(time)),
+      inputs_(std::move(inputs)),
+      outputs_(std::move(outputs)),
+      input_channels_(std::move(input_channels)),
+      output_channels_(std::move(output_channels)) {
+  const Eigen::Index n = time_.size();
+  // A matrix without columns carries no samples; give it the right shape.
+  if (inputs_.cols() == 0) inputs_.resize(n, 0);
+  if (outputs_.cols() == 0) outputs_.resize(n, 0);
+  PNEUMID_CHECK(inputs_.rows() == n,
+                "Dataset: inputs have {} rows but time has {} samples (length mismatch)",
+                inputs_.rows(), n);
+  PNEUMID_CHECK(outputs_.rows() == n,
+                "Dataset: outputs have {} rows but time has {} samples (length mismatch)",
+                outputs_.rows(), n);
+  if (input_channels_.empty()) input_channels_ = DefaultChannels("u", inputs_.cols());
+  if (output_channels_.empty()) output_channels_ = DefaultChannels("y", outputs_.cols());
+  PNEUMID_CHECK(static_cast<Eigen::Index>(input_channels_.size()) == inputs_.cols(),
+                "Dataset: {} input channel names for {} input columns", input_channels_.size(),
+                inputs_.cols());
+  PNEUMID_CHECK(static_cast<Eigen::Index>(output_channels_.size()) == outputs_.cols(),
+                "Dataset: {} output channel names for {} output columns", output_channels_.size(),
+                outputs_.cols());
+  CheckFinite(time_, "time");
+  CheckFinite(inputs_, "input");
+  CheckFinite(outputs_, "output");
+  for (Eigen::Index i = 1; i < n; ++i) {
+    PNEUMID_CHECK(time_[i] > time_[i - 1],
+                  "Dataset: time is not strictly increasing at sample {}: t[{}] = {} <= t[{}] = {}",
+                  i, i, time_[i], i - 1, time_[i - 1]);
+  }
+}
+
+Dataset Dataset::FromUniform(double Ts, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                             double t0, Channel input, Channel output) {
+  PNEUMID_CHECK(std::isfinite(Ts) && Ts > 0,
+                "Dataset::FromUniform: sample time must be > 0, got {}", Ts);
+  PNEUMID_CHECK(std::isfinite(t0), "Dataset::FromUniform: start time must be finite, got {}", t0);
+  PNEUMID_CHECK(u.size() == y.size(),
+                "Dataset::FromUniform: u has {} samples but y has {} (length mismatch)", u.size(),
+                y.size());
+  Eigen::VectorXd t(u.size());
+  for (Eigen::Index i = 0; i < t.size(); ++i) t[i] = t0 + static_cast<double>(i) * Ts;
+  return Dataset(std::move(t), u, y, {std::move(input)}, {std::move(output)});
+}
+
+Eigen::VectorXd Dataset::u(int i) const {
+  PNEUMID_CHECK(i >= 0 && i < num_inputs(), "Dataset::u: input {} out of range [0, {})", i,
+                num_inputs());
+  return inputs_.col(i);
+}
+
+Eigen::VectorXd Dataset::y(int i) const {
+  PNEUMID_CHECK(i >= 0 && i < num_outputs(), "Dataset::y: output {} out of range [0, {})", i,
+                num_outputs());
+  return outputs_.col(i);
+}
+
+double Dataset::SampleTime() const {
+  PNEUMID_CHECK(size() >= 2, "Dataset::SampleTime: needs at least 2 samples, {} has {}",
+                SourcePrefix(source_), size());
+  return (time_[size() - 1] - time_[0]) / static_cast<double>(size() - 1);
+}
+
+bool Dataset::IsUniform(double rel_tol) const {
+  PNEUMID_CHECK(rel_tol >= 0, "Dataset::IsUniform: tolerance must be >= 0, got {}", rel_tol);
+  if (size() < 3) return true;
+  const double Ts = SampleTime();
+  for (Eigen::Index i = 1; i < size(); ++i) {
+    if (std::abs((time_[i] - time_[i - 1]) - Ts) > rel_tol * Ts) return false;
+  }
+  return true;
+}
+
+void Dataset::RequireUniform(double rel_tol) const {
+  PNEUMID_CHECK(rel_tol >= 0, "Dataset::RequireUniform: tolerance must be >= 0, got {}", rel_tol);
+  if (size() < 3) return;
+  const double Ts = SampleTime();
+  for (Eigen::Index i = 1; i < size(); ++i) {
+    const double dt = time_[i] - time_[i - 1];
+    if (std::abs(dt - Ts) > rel_tol * Ts) {
+      throw DataError(fmt::format(
+          "{}: column '{}': sampling is not uniform: interval {:g} s between t = {:g} and t = {:g} "
+          "differs from the mean interval {:g} s by {:.3g} % (tolerance {:g} %); resample the data "
+          "to a uniform grid first (pneumid::Resample, or `pneumid info {} --resample {:g} --save "
+          "FILE`)",
+          Where(i), time_channel_.name, dt, time_[i - 1], time_[i], Ts,
+          100.0 * std::abs(dt - Ts) / Ts, 100.0 * rel_tol,
+          source_.empty() ? std::string("DATA") : source_, Ts));
+    }
+  }
+}
+
+void Dataset::RequireSamples(Eigen::Index n, const std::string& what) const {
+  if (size() < n) {
+    throw DataError(fmt::format("{}: {} needs at least {} samples, the data has {}",
+                                SourcePrefix(source_), what, n, size()));
+  }
+}
+
+long Dataset::SourceLine(Eigen::Index i) const {
+  PNEUMID_CHECK(i >= 0 && i < size(), "Dataset::SourceLine: sample {} out of range [0, {})", i,
+                size());
+  if (line_samples_.empty()) return 0;
+  auto it = std::upper_bound(line_samples_.begin(), line_samples_.end(), i);
+  const auto j = static_cast<std::size_t>(std::distance(line_samples_.begin(), it)) - 1;
+  return line_numbers_[j] + static_cast<long>(i - line_samples_[j]);
+}
+
+std::string Dataset::Where(Eigen::Index i) const {
+  const long line = (i >= 0 && i < size()) ? SourceLine(i) : 0;
+  if (line > 0) return fmt::format("{}:{}", SourcePrefix(source_), line);
+  if (source_.empty()) return fmt::format("sample {}", i);
+  return fmt::format("{}: sample {}", source_, i);
+}
+
+void Dataset::set_source_lines(std::vector<Eigen::Index> first_samples,
+                               std::vector<long> first_lines) {
+  PNEUMID_CHECK(first_samples.size() == first_lines.size(),
+                "Dataset::set_source_lines: {} sample break points but {} lines",
+                first_samples.size(), first_lines.size());
+  PNEUMID_CHECK(first_samples.empty() || first_samples.front() == 0,
+                "Dataset::set_source_lines: the first break point must be sample 0, got {}",
+                first_samples.empty() ? 0 : first_samples.front());
+  for (std::size_t j = 1; j < first_samples.size(); ++j) {
+    PNEUMID_CHECK(first_samples[j] > first_samples[j - 1],
+                  "Dataset::set_source_lines: break points must increase");
+  }
+  line_samples_ = std::move(first_samples);
+  line_numbers_ = std::move(first_lines);
+}
+
+}  // namespace pneumid
