@@ -1,0 +1,247 @@
+// Physics simulator of the Intelligent Pneumatic Actuator (IPA): a
+// double-acting cylinder whose chamber A is filled and vented by two 2/2 on/off
+// solenoid valves driven by one PWM signal, while chamber B is held at the
+// regulated supply pressure.
+//
+// Convention (used everywhere in pneumid; the paper's text and its Eq. 1 swap
+// the indices):
+//   chamber A  the regulated chamber on the full-bore (cap) side, area A_a = pi/4 bore^2,
+//              volume V_a = V_a0 + A_a x; filled by the inlet valve from the
+//              supply and vented by the exhaust valve to atmosphere ("chamber 1",
+//              pressure "P_2" in the paper's text)
+//   chamber B  the supply chamber on the rod side, area A_b = A_a - pi/4 rod^2,
+//              volume V_b = V_b0 + A_b (stroke - x); connected to the pressure
+//              regulator through a supply line
+//   x          piston position from the chamber-A end (m); positive force pushes
+//              the rod out (x increasing)
+//   F_rod      = A_a (p_a - p_atm) - A_b (p_b - p_atm), the force on the rod
+//   F          (force-mode output) = A_a (p_a,meas - p_atm) + force_offset: the
+//              rod force with the constant supply-chamber term A_b (p_s - p_atm)
+//              tared out, as the paper computes its force from the chamber-A
+//              pressure with the supply pressure taken as constant. F = 0 with
+//              chamber A vented (duty in the dead band, e.g. 0.61 %), F ~ 129 N
+//              at 82 % duty with the default parameters.
+//   u          PWM duty cycle in percent (0..100): in each PWM period of length
+//              T_pwm the inlet valve is commanded open for u/100 T_pwm and the
+//              exhaust valve for the rest of the period (complementary drive).
+//
+// Physics:
+// [1] E. Richer, Y. Hurmuzlu, A high performance pneumatic force actuator
+//     system: Part I - nonlinear mathematical model, ASME J. Dyn. Sys. Meas.
+//     Control 122(3), 2000, eq. 8 (chamber energy equation):
+//       dp/dt = (R T_s / V) (alpha_in m_in - alpha_out m_out) - alpha p (dV/dt) / V
+//     with alpha_in = gamma (adiabatic charging), alpha_out ~ 1, alpha ~ 1.2.
+// [2] ISO 6358-1:2013, Pneumatic fluid power - Determination of flow-rate
+//     characteristics of components using compressible fluids, eq. 1-2:
+//       r = p_down / p_up
+//       m = C rho_0 p_up sqrt(T_0 / T_up)                         r <= b (choked)
+//       m = C rho_0 p_up sqrt(T_0 / T_up) sqrt(1 - ((r - b)/(1 - b))^2)   b < r < 1
+//     rho_0 = 1.185 kg/m^3, T_0 = 293.15 K (ISO 8778 reference atmosphere).
+//     Above r = laminar_ratio the flow is continued linearly to zero at r = 1
+//     (laminar region), so that dm/dp stays finite and the ODE well behaved.
+// [3] Valve dynamics: the valve opens open_delay after the command edge and
+//     closes close_delay after the falling edge; command pulses shorter than
+//     min_pulse_width do not open the valve (dead band at small and large duty).
+// [4] Friction: Stribeck curve with a smoothed sign, B. Armstrong-Helouvry,
+//     Control of Machines with Friction, 1991:
+//       F_f = (F_c + (F_s - F_c) exp(-(v/v_s)^2)) tanh(v/v_eps) + b v
+// Sensors: pressure transducer with Gaussian noise, 0..full scale -> 0..10 V,
+// read by a bipolar 16-bit ADC over +-10 V (NI PCI-6221: 20 V / 2^16 = 0.305 mV
+// per code), output delayed by transport_delay_samples sample periods.
+// Integration: Boost.Odeint runge_kutta_dopri5 with error control, restarted
+// at every valve switching instant (switching mode) or sample (averaged mode).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <random>
+#include <string>
+
+#include "pneumid/plant/plant.hpp"
+
+namespace pneumid {
+
+/// Force mode: rod fixed, output force in N (the paper's identification setup).
+/// Position mode: piston and load move, output position in m.
+enum class IpaMode { kForce, kPosition };
+/// "force", "position".
+std::string ToString(IpaMode mode);
+/// Inverse of ToString; throws InvalidArgument listing the valid names.
+IpaMode IpaModeFromString(const std::string& name);
+
+/// Switching: every valve switching event of the PWM signal is simulated
+/// (pressure ripple, PWM latch, exact dead band); the default, because it is
+/// what the real valves do and it still runs thousands of times faster than
+/// real time. Averaged: valve flows multiplied by the effective open fraction
+/// of the period (no ripple, duty applied at once), faster.
+enum class PwmMode { kSwitching, kAveraged };
+/// "switching" (also accepted: "pwm"), "averaged".
+std::string ToString(PwmMode mode);
+PwmMode PwmModeFromString(const std::string& name);
+
+/// All physical parameters of the IPA. Defaults: the calibrated actuator of
+/// docs/simulator.md (config/ipa_default.toml lists the same values).
+/// Pressures are absolute unless named gauge.
+struct IpaParameters {
+  IpaMode mode = IpaMode::kForce;
+  PwmMode pwm_mode = PwmMode::kSwitching;
+
+  // [cylinder]
+  double bore = 0.017;   ///< m, piston diameter (effective; calibrated)
+  double rod = 0.006;    ///< m, rod diameter (chamber B side)
+  double stroke = 0.10;  ///< m
+  double piston_position =
+      0.05;  ///< m from the chamber-A end (fixed in force mode, initial otherwise)
+  double dead_volume_a = 18.1e-6;  ///< m^3, chamber A ports and tubing to the valves (calibrated)
+  double dead_volume_b = 10.0e-6;  ///< m^3, chamber B ports and tubing
+
+  // [supply]
+  double supply_pressure = 0.6e6;           ///< Pa gauge, regulated supply
+  double atmospheric_pressure = 101325.0;   ///< Pa
+  double temperature = 293.15;              ///< K, supply (and chamber) gas temperature
+  double supply_line_conductance = 1.0e-8;  ///< m^3/(s Pa), regulator + line to chamber B
+  double supply_line_critical_ratio = 0.3;  ///< -
+
+  // [gas]
+  double gas_constant = 287.0;  ///< J/(kg K), air
+  double alpha_in = 1.4;        ///< charging coefficient [1] (gamma: adiabatic)
+  double alpha_out = 1.0;       ///< discharging coefficient [1] (1: isothermal)
+  double alpha = 1.2;           ///< coefficient of the volume-change term [1]
+
+  // [valves]  sonic conductance in m^3/(s Pa): 1 dm^3/(s bar) = 1e-8 m^3/(s Pa)
+  double inlet_conductance = 0.08e-8;    ///< m^3/(s Pa), C of the inlet valve
+  double inlet_critical_ratio = 0.3;     ///< -, b of the inlet valve
+  double exhaust_conductance = 0.24e-8;  ///< m^3/(s Pa), C of the exhaust valve (calibrated)
+  double exhaust_critical_ratio = 0.3;   ///< -, b of the exhaust valve
+  double laminar_ratio = 0.999;          ///< -, pressure ratio above which flow is linear in dp
+  double open_delay = 0.002;             ///< s, command rising edge -> valve open
+  double close_delay = 0.001;            ///< s, command falling edge -> valve closed
+  double min_pulse_width = 0.002;        ///< s, shorter command pulses do not open the valve
+
+  // [pwm]
+  double pwm_frequency = 50.0;  ///< Hz
+
+  // [mechanics] (position mode)
+  double mass = 1.0;                            ///< kg, piston + rod + load
+  double viscous_friction = 40.0;               ///< N s/m
+  double coulomb_friction = 6.0;                ///< N
+  double static_friction = 9.0;                 ///< N (Stribeck peak)
+  double stribeck_velocity = 0.01;              ///< m/s
+  double friction_smoothing_velocity = 1.0e-3;  ///< m/s, width of the smoothed sign
+  double end_stop_stiffness = 1.0e6;            ///< N/m
+  double end_stop_damping = 1000.0;             ///< N s/m
+
+  // [sensors]
+  double pressure_noise = 150.0;       ///< Pa, standard deviation of the transducer noise
+  double pressure_full_scale = 1.0e6;  ///< Pa gauge at 10 V transducer output
+  double position_noise = 1.0e-5;      ///< m, standard deviation (position mode)
+  int adc_bits = 16;                   ///< ADC resolution; 0 disables quantization
+  double adc_range = 10.0;             ///< V, bipolar input range +-adc_range
+  int transport_delay_samples = 1;     ///< sample periods between reading and output
+  double force_offset = 0.0;           ///< N added to the force output
+
+  // [simulation]
+  double relative_tolerance = 1e-6;  ///< odeint error control (states scaled to bar, mm, g)
+  double absolute_tolerance = 1e-6;
+
+  /// Derived areas (m^2).
+  double AreaA() const;
+  double AreaB() const;
+
+  /// False (with a message naming the parameter and its value) when a value is
+  /// out of its physical range.
+  bool IsValid(std::string* error) const;
+};
+
+/// Reads parameters from a TOML file (keys as in config/ipa_default.toml, every
+/// key optional, defaults as above). Throws DataError naming the file, the key
+/// and (for syntax errors) line and column, for unknown keys, wrong types and
+/// values that fail IsValid().
+IpaParameters LoadIpaParameters(const std::string& path);
+
+/// ISO 6358 mass flow (kg/s) through a restriction of sonic conductance C
+/// (m^3/(s Pa)) and critical ratio b from p_up to p_down (Pa, absolute), with
+/// upstream temperature T_up (K) and the laminar continuation above
+/// laminar_ratio (see [2]). Zero when p_down >= p_up.
+double Iso6358MassFlow(double C, double b, double p_up, double p_down, double T_up,
+                       double laminar_ratio = 0.999);
+
+/// The IPA as a Plant. Input: PWM duty in percent (clamped to 0..100).
+/// Output: force in N (force mode) or position in m (position mode), through
+/// the sensor model.
+class IpaSimulator final : public Plant {
+ public:
+  /// Throws InvalidArgument when the parameters are not valid or Ts <= 0.
+  IpaSimulator(IpaParameters parameters, double Ts, std::uint64_t seed = 1);
+
+  void Reset() override;
+  double Measure() override;
+  void Advance(double u) override;
+  double Ts() const override { return Ts_; }
+  double time() const override { return t_; }
+  /// "p_a [Pa]", "p_b [Pa]" (absolute, true values now); in position mode also
+  /// "x [m]" and "v [m/s]".
+  std::map<std::string, double> Extras() const override;
+  std::string Describe() const override;
+
+  /// Holds the valve commands (true = energized/open) for one sample period,
+  /// bypassing the PWM generator; valve delays still apply.
+  void AdvanceValves(bool inlet_open, bool exhaust_open);
+
+  const IpaParameters& parameters() const { return p_; }
+  /// True (noise-free) state now.
+  double pressure_a() const;  ///< Pa absolute
+  double pressure_b() const;  ///< Pa absolute
+  double position() const;    ///< m
+  double velocity() const;    ///< m/s
+  /// Force output without sensor effects: A_a (p_a - p_atm) + force_offset (N).
+  double force() const;
+  /// Rod force A_a (p_a - p_atm) - A_b (p_b - p_atm) (N).
+  double rod_force() const;
+  /// Gas mass in chamber A by the ideal gas law p V / (R T) (kg).
+  double chamber_mass_a() const;
+  /// Mass that has flowed into / out of chamber A through its valves since Reset (kg).
+  double mass_in_a() const;
+  double mass_out_a() const;
+  /// Number of odeint steps taken since Reset (for benchmarks).
+  long long steps() const { return steps_; }
+
+  /// Internal state, scaled for the error control: p_a, p_b [bar], x [mm],
+  /// v [m/s], m_in_a, m_out_a [g].
+  using State = std::array<double, 6>;
+
+ private:
+  struct Valve {
+    bool open = false;                            // physical state
+    bool command = false;                         // command state
+    std::deque<std::pair<double, bool>> pending;  // (time, new physical state)
+  };
+  void Command(Valve& valve, bool on, double t);
+  void Integrate(double t0, double t1, double open_in, double open_out);
+  void Rhs(const State& x, State& dxdt, double open_in, double open_out) const;
+  double SenseOutput();
+  double Quantize(double volts) const;
+  void AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaust_cmd);
+
+  IpaParameters p_;
+  double Ts_;
+  std::uint64_t seed_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+
+  State x_{};
+  double t_ = 0.0;
+  double dt_ = 1e-4;  // last accepted step size
+  long long steps_ = 0;
+  long long sample_ = 0;
+  Valve inlet_, exhaust_;
+  double duty_ = 0.0;           // input held now (fraction 0..1)
+  double period_start_ = 0.0;   // start of the next PWM period
+  double falling_edge_ = -1.0;  // pending inlet->exhaust command switch in this period
+  bool exhaust_pulse_ = false;  // the exhaust valve is pulsed in this period
+  std::deque<double> readings_;
+};
+
+}  // namespace pneumid

@@ -1,0 +1,409 @@
+// IPA physics simulator (see include/pneumid/plant/ipa_simulator.hpp).
+#include "pneumid/plant/ipa_simulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <boost/numeric/odeint.hpp>
+
+#include "pneumid/common/check.hpp"
+
+namespace pneumid {
+
+namespace {
+
+constexpr double kRho0 = 1.185;     // kg/m^3, ISO 8778 reference atmosphere
+constexpr double kT0 = 293.15;      // K
+constexpr double kBar = 1e5;        // state scaling: pressures in bar
+constexpr double kMm = 1e-3;        // positions in mm
+constexpr double kGram = 1e-3;      // masses in g
+constexpr double kEventTol = 1e-9;  // s, events closer than this are simultaneous
+
+}  // namespace
+
+std::string ToString(IpaMode mode) { return mode == IpaMode::kForce ? "force" : "position"; }
+
+IpaMode IpaModeFromString(const std::string& name) {
+  if (name == "force") return IpaMode::kForce;
+  if (name == "position") return IpaMode::kPosition;
+  PNEUMID_CHECK(false, "unknown IPA mode '{}' (expected force or position)", name);
+  return IpaMode::kForce;
+}
+
+std::string ToString(PwmMode mode) {
+  return mode == PwmMode::kSwitching ? "switching" : "averaged";
+}
+
+PwmMode PwmModeFromString(const std::string& name) {
+  if (name == "switching" || name == "pwm") return PwmMode::kSwitching;
+  if (name == "averaged" || name == "average") return PwmMode::kAveraged;
+  PNEUMID_CHECK(false, "unknown PWM mode '{}' (expected switching (or pwm) or averaged)", name);
+  return PwmMode::kSwitching;
+}
+
+double IpaParameters::AreaA() const { return std::numbers::pi / 4.0 * bore * bore; }
+double IpaParameters::AreaB() const { return std::numbers::pi / 4.0 * (bore * bore - rod * rod); }
+
+bool IpaParameters::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& msg) {
+    if (error) *error = msg;
+    return false;
+  };
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  struct Check {
+    double value;
+    const char* name;
+    const char* unit;
+  };
+  for (const Check& c : {Check{bore, "cylinder.bore", "m"},
+                         Check{stroke, "cylinder.stroke", "m"},
+                         Check{dead_volume_a, "cylinder.dead_volume_a", "m^3"},
+                         Check{dead_volume_b, "cylinder.dead_volume_b", "m^3"},
+                         Check{supply_pressure, "supply.pressure", "Pa"},
+                         Check{atmospheric_pressure, "supply.atmospheric_pressure", "Pa"},
+                         Check{temperature, "supply.temperature", "K"},
+                         Check{supply_line_conductance, "supply.line_conductance", "m^3/(s Pa)"},
+                         Check{gas_constant, "gas.gas_constant", "J/(kg K)"},
+                         Check{alpha_in, "gas.alpha_in", ""},
+                         Check{alpha_out, "gas.alpha_out", ""},
+                         Check{alpha, "gas.alpha", ""},
+                         Check{inlet_conductance, "valves.inlet_conductance", "m^3/(s Pa)"},
+                         Check{exhaust_conductance, "valves.exhaust_conductance", "m^3/(s Pa)"},
+                         Check{pwm_frequency, "pwm.frequency", "Hz"},
+                         Check{mass, "mechanics.mass", "kg"},
+                         Check{stribeck_velocity, "mechanics.stribeck_velocity", "m/s"},
+                         Check{friction_smoothing_velocity, "mechanics.smoothing_velocity", "m/s"},
+                         Check{pressure_full_scale, "sensors.pressure_full_scale", "Pa"},
+                         Check{adc_range, "sensors.adc_range", "V"},
+                         Check{relative_tolerance, "simulation.relative_tolerance", ""},
+                         Check{absolute_tolerance, "simulation.absolute_tolerance", ""}}) {
+    if (!positive(c.value))
+      return fail(fmt::format("{} must be positive, got {} {}", c.name, c.value, c.unit));
+  }
+  for (const Check& c :
+       {Check{open_delay, "valves.open_delay", "s"}, Check{close_delay, "valves.close_delay", "s"},
+        Check{min_pulse_width, "valves.min_pulse_width", "s"},
+        Check{viscous_friction, "mechanics.viscous_friction", "N s/m"},
+        Check{coulomb_friction, "mechanics.coulomb_friction", "N"},
+        Check{static_friction, "mechanics.static_friction", "N"},
+        Check{end_stop_stiffness, "mechanics.end_stop_stiffness", "N/m"},
+        Check{end_stop_damping, "mechanics.end_stop_damping", "N s/m"},
+        Check{pressure_noise, "sensors.pressure_noise", "Pa"},
+        Check{position_noise, "sensors.position_noise", "m"}, Check{rod, "cylinder.rod", "m"}}) {
+    if (!(std::isfinite(c.value) && c.value >= 0.0))
+      return fail(fmt::format("{} must be >= 0, got {} {}", c.name, c.value, c.unit));
+  }
+  if (!(rod < bore))
+    return fail(
+        fmt::format("cylinder.rod = {} m must be smaller than cylinder.bore = {} m", rod, bore));
+  if (!(piston_position >= 0.0 && piston_position <= stroke))
+    return fail(fmt::format("cylinder.piston_position = {} m must be within the stroke 0..{} m",
+                            piston_position, stroke));
+  for (const Check& c : {Check{inlet_critical_ratio, "valves.inlet_critical_ratio", ""},
+                         Check{exhaust_critical_ratio, "valves.exhaust_critical_ratio", ""},
+                         Check{supply_line_critical_ratio, "supply.line_critical_ratio", ""}}) {
+    if (!(c.value >= 0.0 && c.value < laminar_ratio))
+      return fail(fmt::format("{} must be in [0, valves.laminar_ratio = {}), got {}", c.name,
+                              laminar_ratio, c.value));
+  }
+  if (!(laminar_ratio > 0.0 && laminar_ratio < 1.0))
+    return fail(fmt::format("valves.laminar_ratio must be in (0, 1), got {}", laminar_ratio));
+  if (!std::isfinite(force_offset))
+    return fail(fmt::format("sensors.force_offset must be finite, got {}", force_offset));
+  if (adc_bits < 0 || adc_bits > 32)
+    return fail(
+        fmt::format("sensors.adc_bits must be in 0..32 (0 = no quantization), got {}", adc_bits));
+  if (transport_delay_samples < 0 || transport_delay_samples > 1000)
+    return fail(fmt::format("sensors.transport_delay_samples must be in 0..1000, got {}",
+                            transport_delay_samples));
+  return true;
+}
+
+double Iso6358MassFlow(double C, double b, double p_up, double p_down, double T_up,
+                       double laminar_ratio) {
+  if (!(p_up > 0.0) || !(p_down < p_up)) return 0.0;
+  const double base = C * kRho0 * p_up * std::sqrt(kT0 / T_up);
+  const double r = std::max(p_down, 0.0) / p_up;
+  if (r <= b) return base;  // choked (sonic) flow
+  auto subsonic = [b](double ratio) {
+    const double s = (ratio - b) / (1.0 - b);
+    return std::sqrt(std::max(0.0, 1.0 - s * s));
+  };
+  if (r > laminar_ratio) return base * subsonic(laminar_ratio) * (1.0 - r) / (1.0 - laminar_ratio);
+  return base * subsonic(r);
+}
+
+// ---------------------------------------------------------------------------
+
+IpaSimulator::IpaSimulator(IpaParameters parameters, double Ts, std::uint64_t seed)
+    : p_(std::move(parameters)), Ts_(Ts), seed_(seed) {
+  std::string error;
+  PNEUMID_CHECK(p_.IsValid(&error), "invalid IPA parameters: {}", error);
+  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
+  Reset();
+}
+
+void IpaSimulator::Reset() {
+  rng_.seed(seed_);
+  normal_.reset();
+  x_ = {p_.atmospheric_pressure / kBar,
+        (p_.supply_pressure + p_.atmospheric_pressure) / kBar,
+        p_.piston_position / kMm,
+        0.0,
+        0.0,
+        0.0};
+  t_ = 0.0;
+  dt_ = 1e-4;
+  steps_ = 0;
+  sample_ = 0;
+  inlet_ = Valve{};
+  exhaust_ = Valve{};
+  duty_ = 0.0;
+  period_start_ = 0.0;
+  falling_edge_ = -1.0;
+  exhaust_pulse_ = false;
+  load_disturbance_ = 0.0;
+  readings_.clear();
+  for (int i = 0; i <= p_.transport_delay_samples; ++i) readings_.push_back(SenseOutput());
+}
+
+double IpaSimulator::Measure() { return readings_.front(); }
+
+double IpaSimulator::pressure_a() const { return x_[0] * kBar; }
+double IpaSimulator::pressure_b() const { return x_[1] * kBar; }
+double IpaSimulator::position() const { return x_[2] * kMm; }
+double IpaSimulator::velocity() const { return x_[3]; }
+double IpaSimulator::force() const {
+  return p_.AreaA() * (pressure_a() - p_.atmospheric_pressure) + p_.force_offset;
+}
+double IpaSimulator::rod_force() const {
+  return p_.AreaA() * (pressure_a() - p_.atmospheric_pressure) -
+         p_.AreaB() * (pressure_b() - p_.atmospheric_pressure);
+}
+double IpaSimulator::chamber_mass_a() const {
+  const double V = p_.dead_volume_a + p_.AreaA() * position();
+  return pressure_a() * V / (p_.gas_constant * p_.temperature);
+}
+double IpaSimulator::mass_in_a() const { return x_[4] * kGram; }
+double IpaSimulator::mass_out_a() const { return x_[5] * kGram; }
+
+std::map<std::string, double> IpaSimulator::Extras() const {
+  std::map<std::string, double> e{{"p_a [Pa]", pressure_a()}, {"p_b [Pa]", pressure_b()}};
+  if (p_.mode == IpaMode::kPosition) {
+    e["x [m]"] = position();
+    e["v [m/s]"] = velocity();
+  }
+  return e;
+}
+
+std::string IpaSimulator::Describe() const {
+  return fmt::format("ipa ({} mode, {} PWM {:g} Hz, bore {:g} mm)", ToString(p_.mode),
+                     ToString(p_.pwm_mode), p_.pwm_frequency, p_.bore * 1e3);
+}
+
+double IpaSimulator::Quantize(double volts) const {
+  if (p_.adc_bits == 0) return volts;
+  const double codes = std::ldexp(1.0, p_.adc_bits);
+  const double lsb = 2.0 * p_.adc_range / codes;
+  const double code = std::clamp(std::round(volts / lsb), -codes / 2.0, codes / 2.0 - 1.0);
+  return code * lsb;
+}
+
+double IpaSimulator::SenseOutput() {
+  const double n = normal_(rng_);
+  if (p_.mode == IpaMode::kForce) {
+    const double gauge = pressure_a() + p_.pressure_noise * n - p_.atmospheric_pressure;
+    const double volts = Quantize(gauge / p_.pressure_full_scale * p_.adc_range);
+    return p_.AreaA() * volts / p_.adc_range * p_.pressure_full_scale + p_.force_offset +
+           load_disturbance_;
+  }
+  const double pos = position() + p_.position_noise * n;
+  const double volts = Quantize(pos / p_.stroke * p_.adc_range);
+  return volts / p_.adc_range * p_.stroke + load_disturbance_;
+}
+
+void IpaSimulator::Rhs(const State& x, State& dxdt, double open_in, double open_out) const {
+  const double pa = x[0] * kBar;
+  const double pb = x[1] * kBar;
+  const bool moving = p_.mode == IpaMode::kPosition;
+  const double pos = moving ? x[2] * kMm : p_.piston_position;
+  const double v = moving ? x[3] : 0.0;
+  const double ps = p_.supply_pressure + p_.atmospheric_pressure;
+  const double patm = p_.atmospheric_pressure;
+  const double T = p_.temperature;
+  const double rl = p_.laminar_ratio;
+  const double Aa = p_.AreaA();
+  const double Ab = p_.AreaB();
+  const double Va = std::max(p_.dead_volume_a + Aa * pos, 0.1 * p_.dead_volume_a);
+  const double Vb = std::max(p_.dead_volume_b + Ab * (p_.stroke - pos), 0.1 * p_.dead_volume_b);
+
+  // Chamber A: inlet valve (supply <-> A) and exhaust valve (A <-> atmosphere).
+  double in_a = 0.0, out_a = 0.0;  // mass flows entering / leaving chamber A, kg/s
+  if (open_in > 0.0) {
+    const double C = p_.inlet_conductance, b = p_.inlet_critical_ratio;
+    in_a += open_in * Iso6358MassFlow(C, b, ps, pa, T, rl);
+    out_a += open_in * Iso6358MassFlow(C, b, pa, ps, T, rl);
+  }
+  if (open_out > 0.0) {
+    const double C = p_.exhaust_conductance, b = p_.exhaust_critical_ratio;
+    out_a += open_out * Iso6358MassFlow(C, b, pa, patm, T, rl);
+    in_a += open_out * Iso6358MassFlow(C, b, patm, pa, T, rl);
+  }
+  // Chamber B: supply line through the (relieving) regulator.
+  const double C = p_.supply_line_conductance, b = p_.supply_line_critical_ratio;
+  const double in_b = Iso6358MassFlow(C, b, ps, pb, T, rl);
+  const double out_b = Iso6358MassFlow(C, b, pb, ps, T, rl);
+
+  const double RT = p_.gas_constant * T;
+  const double dVa = Aa * v;
+  const double dVb = -Ab * v;
+  const double dpa =
+      RT / Va * (p_.alpha_in * in_a - p_.alpha_out * out_a) - p_.alpha * pa * dVa / Va;
+  const double dpb =
+      RT / Vb * (p_.alpha_in * in_b - p_.alpha_out * out_b) - p_.alpha * pb * dVb / Vb;
+  dxdt[0] = dpa / kBar;
+  dxdt[1] = dpb / kBar;
+  dxdt[4] = in_a / kGram;
+  dxdt[5] = out_a / kGram;
+  if (!moving) {
+    dxdt[2] = 0.0;
+    dxdt[3] = 0.0;
+    return;
+  }
+  // Piston and load: pressure force, Stribeck friction, end stops (penalty).
+  const double Fp = Aa * (pa - patm) - Ab * (pb - patm);
+  const double vs = p_.stribeck_velocity;
+  const double Ff = (p_.coulomb_friction +
+                     (p_.static_friction - p_.coulomb_friction) * std::exp(-(v / vs) * (v / vs))) *
+                        std::tanh(v / p_.friction_smoothing_velocity) +
+                    p_.viscous_friction * v;
+  double Fstop = 0.0;
+  if (pos < 0.0) Fstop = -p_.end_stop_stiffness * pos - p_.end_stop_damping * std::min(v, 0.0);
+  if (pos > p_.stroke)
+    Fstop = -p_.end_stop_stiffness * (pos - p_.stroke) - p_.end_stop_damping * std::max(v, 0.0);
+  dxdt[2] = v / kMm;
+  dxdt[3] = (Fp - Ff + Fstop) / p_.mass;
+}
+
+void IpaSimulator::Integrate(double t0, double t1, double open_in, double open_out) {
+  if (!(t1 > t0)) return;
+  namespace odeint = boost::numeric::odeint;
+  using Stepper = odeint::runge_kutta_dopri5<State>;
+  auto stepper = odeint::make_controlled<Stepper>(p_.absolute_tolerance, p_.relative_tolerance);
+  auto system = [this, open_in, open_out](const State& x, State& dxdt, double /*t*/) {
+    Rhs(x, dxdt, open_in, open_out);
+  };
+  State dxdt;
+  system(x_, dxdt, t0);
+  double t = t0;
+  double dt = dt_;
+  int failures = 0;
+  while (t1 - t > 1e-15 * std::max(1.0, t1)) {
+    double step = std::min(dt, t1 - t);
+    const bool clipped = step < dt;
+    if (stepper.try_step(system, x_, dxdt, t, step) == odeint::success) {
+      ++steps_;
+      failures = 0;
+      dt = clipped ? std::max(dt, step) : step;
+    } else {
+      dt = step;
+      if (++failures > 200 || dt < 1e-14)
+        throw std::runtime_error(fmt::format(
+            "IPA simulation: step size underflow at t = {} s (p_a = {} Pa)", t, pressure_a()));
+    }
+  }
+  dt_ = std::min(dt, 1e-3);
+  for (double v : x_)
+    if (!std::isfinite(v))
+      throw std::runtime_error(fmt::format("IPA simulation: non-finite state at t = {} s", t1));
+}
+
+void IpaSimulator::Command(Valve& valve, bool on, double t) {
+  if (valve.command == on) return;
+  valve.command = on;
+  const double t_phys = t + (on ? p_.open_delay : p_.close_delay);
+  while (!valve.pending.empty() && valve.pending.back().first >= t_phys) valve.pending.pop_back();
+  valve.pending.emplace_back(t_phys, on);
+}
+
+void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaust_cmd) {
+  const double T = 1.0 / p_.pwm_frequency;
+  if (!pwm) {
+    Command(inlet_, inlet_cmd, t_);
+    Command(exhaust_, exhaust_cmd, t_);
+    falling_edge_ = -1.0;
+  } else if (period_start_ < t_ - kEventTol) {
+    period_start_ = t_;  // restart the PWM generator after manual valve commands
+  }
+  while (true) {
+    // Events due now.
+    if (pwm && std::abs(t_ - period_start_) <= kEventTol) {
+      // A new PWM period latches the duty held now.
+      const double d = duty_;
+      const double w_in = d * T, w_out = (1.0 - d) * T;
+      const bool in_pulse = d >= 1.0 || (d > 0.0 && w_in >= p_.min_pulse_width);
+      exhaust_pulse_ = d <= 0.0 || (d < 1.0 && w_out >= p_.min_pulse_width);
+      Command(inlet_, in_pulse, t_);
+      Command(exhaust_, d <= 0.0 && exhaust_pulse_, t_);
+      falling_edge_ = (d > 0.0 && d < 1.0) ? t_ + w_in : -1.0;
+      period_start_ += T;
+    }
+    if (pwm && falling_edge_ >= 0.0 && std::abs(t_ - falling_edge_) <= kEventTol) {
+      Command(inlet_, false, t_);
+      Command(exhaust_, exhaust_pulse_, t_);
+      falling_edge_ = -1.0;
+    }
+    for (Valve* v : {&inlet_, &exhaust_}) {
+      while (!v->pending.empty() && v->pending.front().first <= t_ + kEventTol) {
+        v->open = v->pending.front().second;
+        v->pending.pop_front();
+      }
+    }
+    if (t_ >= t_end - kEventTol) break;
+    double t_next = t_end;
+    if (pwm) {
+      t_next = std::min(t_next, period_start_);
+      if (falling_edge_ > t_) t_next = std::min(t_next, falling_edge_);
+    }
+    for (const Valve* v : {&inlet_, &exhaust_})
+      if (!v->pending.empty()) t_next = std::min(t_next, v->pending.front().first);
+    Integrate(t_, t_next, inlet_.open ? 1.0 : 0.0, exhaust_.open ? 1.0 : 0.0);
+    t_ = t_next;
+  }
+  t_ = t_end;
+}
+
+void IpaSimulator::Advance(double u) {
+  PNEUMID_CHECK(std::isfinite(u), "IPA input (PWM duty, %) must be finite, got {}", u);
+  duty_ = std::clamp(u, 0.0, 100.0) / 100.0;
+  ++sample_;
+  const double t_end = static_cast<double>(sample_) * Ts_;
+  if (p_.pwm_mode == PwmMode::kSwitching) {
+    AdvanceTo(t_end, true, false, false);
+  } else {
+    // Effective open fraction of each valve over a PWM period.
+    const double T = 1.0 / p_.pwm_frequency;
+    auto fraction = [&](double w) {
+      if (w >= T) return 1.0;
+      if (w <= 0.0 || w < p_.min_pulse_width) return 0.0;
+      return std::clamp((w - p_.open_delay + p_.close_delay) / T, 0.0, 1.0);
+    };
+    Integrate(t_, t_end, fraction(duty_ * T), fraction((1.0 - duty_) * T));
+    t_ = t_end;
+  }
+  readings_.push_back(SenseOutput());
+  readings_.pop_front();
+}
+
+void IpaSimulator::AdvanceValves(bool inlet_open, bool exhaust_open) {
+  ++sample_;
+  AdvanceTo(static_cast<double>(sample_) * Ts_, false, inlet_open, exhaust_open);
+  readings_.push_back(SenseOutput());
+  readings_.pop_front();
+}
+
+}  // namespace pneumid

@@ -1,0 +1,295 @@
+// Physical checks of the IPA simulator (include/pneumid/plant/ipa_simulator.hpp).
+#include "pneumid/plant/ipa_simulator.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/plant/signal.hpp"
+
+namespace pneumid {
+namespace {
+
+using ::testing::HasSubstr;
+
+constexpr double kRho0 = 1.185;  // kg/m^3, ISO 8778
+constexpr double kT0 = 293.15;   // K
+
+IpaParameters Quiet() {
+  IpaParameters p;
+  p.pressure_noise = 0.0;
+  p.position_noise = 0.0;
+  p.adc_bits = 0;
+  return p;
+}
+
+// Mean of the true force over the last `average` seconds after `duration` s at duty u.
+double SteadyForce(IpaParameters p, double u, double duration = 3.0, double average = 0.5) {
+  IpaSimulator sim(p, 0.001);
+  const int n = static_cast<int>(duration / 0.001);
+  const int m = static_cast<int>(average / 0.001);
+  double sum = 0.0;
+  for (int k = 0; k < n; ++k) {
+    sim.Advance(u);
+    if (k >= n - m) sum += sim.force();
+  }
+  return sum / m;
+}
+
+TEST(Iso6358Test, MatchesTheStandardFormula) {
+  const double C = 0.08e-8, b = 0.3, T = 293.15, p1 = 7.0e5;
+  // Choked: r <= b.
+  EXPECT_DOUBLE_EQ(Iso6358MassFlow(C, b, p1, 1.0e5, T), C * kRho0 * p1);
+  EXPECT_DOUBLE_EQ(Iso6358MassFlow(C, b, p1, b * p1, T), C * kRho0 * p1);
+  // Temperature correction sqrt(T0 / T1).
+  EXPECT_NEAR(Iso6358MassFlow(C, b, p1, 1.0e5, 330.0), C * kRho0 * p1 * std::sqrt(kT0 / 330.0),
+              1e-18);
+  // Subsonic: elliptic law.
+  const double r = 0.6;
+  const double phi = std::sqrt(1.0 - std::pow((r - b) / (1.0 - b), 2));
+  EXPECT_NEAR(Iso6358MassFlow(C, b, p1, r * p1, T), C * kRho0 * p1 * phi, 1e-18);
+  // Laminar continuation: continuous at the laminar ratio, linear to zero at r = 1.
+  const double rl = 0.999;
+  const double at_rl = Iso6358MassFlow(C, b, p1, rl * p1, T, rl);
+  EXPECT_NEAR(Iso6358MassFlow(C, b, p1, (rl + 1e-12) * p1, T, rl), at_rl, 1e-8 * at_rl);
+  EXPECT_NEAR(Iso6358MassFlow(C, b, p1, 0.9995 * p1, T, rl), 0.5 * at_rl, 1e-9 * at_rl);
+  EXPECT_EQ(Iso6358MassFlow(C, b, p1, p1, T), 0.0);
+  EXPECT_EQ(Iso6358MassFlow(C, b, p1, 1.1 * p1, T), 0.0);
+}
+
+TEST(IpaSimulatorTest, ChokedFillingFlowEqualsIso6358) {
+  IpaParameters p = Quiet();
+  p.open_delay = 0.0;
+  p.close_delay = 0.0;
+  IpaSimulator sim(p, 1e-3);
+  sim.AdvanceValves(true, false);  // 1 ms of filling from atmosphere: p_a / p_s < b, choked
+  const double ps = p.supply_pressure + p.atmospheric_pressure;
+  ASSERT_LT(sim.pressure_a() / ps, p.inlet_critical_ratio);
+  const double expected = p.inlet_conductance * kRho0 * ps * 1e-3;
+  EXPECT_NEAR(sim.mass_in_a(), expected, 1e-9 * expected);
+  EXPECT_EQ(sim.mass_out_a(), 0.0);
+  // Energy equation: dp = R T / V alpha_in m_in (rod fixed).
+  const double V = p.dead_volume_a + p.AreaA() * p.piston_position;
+  const double dp = p.gas_constant * p.temperature / V * p.alpha_in * expected;
+  EXPECT_NEAR(sim.pressure_a() - p.atmospheric_pressure, dp, 1e-6 * dp);
+}
+
+TEST(IpaSimulatorTest, PressureHoldsWithBothValvesClosed) {
+  IpaSimulator sim(Quiet(), 0.01);
+  for (int k = 0; k < 100; ++k) sim.Advance(50.0);
+  sim.AdvanceValves(false, false);  // closing delays pass within this sample
+  const double held = sim.pressure_a();
+  ASSERT_GT(held, 2.0e5);
+  for (int k = 0; k < 200; ++k) sim.AdvanceValves(false, false);
+  EXPECT_NEAR(sim.pressure_a(), held, 1e-9 * held);
+  EXPECT_NEAR(sim.pressure_b(), 0.6e6 + 101325.0, 1e-6);
+}
+
+TEST(IpaSimulatorTest, FullDutyReachesSupplyPressure) {
+  IpaParameters p = Quiet();
+  IpaSimulator sim(p, 0.01);
+  for (int k = 0; k < 300; ++k) sim.Advance(100.0);
+  const double ps = p.supply_pressure + p.atmospheric_pressure;
+  EXPECT_NEAR(sim.pressure_a(), ps, 1e-3 * p.supply_pressure);
+  // And zero duty vents the chamber to atmosphere.
+  for (int k = 0; k < 300; ++k) sim.Advance(0.0);
+  EXPECT_NEAR(sim.pressure_a(), p.atmospheric_pressure, 1e-3 * p.supply_pressure);
+}
+
+TEST(IpaSimulatorTest, SteadyForceRisesMonotonicallyWithDuty) {
+  for (PwmMode mode : {PwmMode::kSwitching, PwmMode::kAveraged}) {
+    IpaParameters p = Quiet();
+    p.pwm_mode = mode;
+    double previous = -1.0;
+    for (double u = 0.0; u <= 100.0; u += 10.0) {
+      const double f = SteadyForce(p, u);
+      if (u >= 20.0 && u <= 90.0) {
+        EXPECT_GT(f, previous + 0.5) << ToString(mode) << " duty " << u;
+      } else {
+        EXPECT_GE(f, previous - 1e-6) << ToString(mode) << " duty " << u;
+      }
+      previous = f;
+    }
+    // Dead band: a 0.61 % or 5 % duty pulse (0.12 ms, 1 ms) is shorter than the
+    // minimum pulse width, the inlet never opens.
+    EXPECT_NEAR(SteadyForce(p, 0.61), 0.0, 1e-9);
+    EXPECT_NEAR(SteadyForce(p, 5.0), 0.0, 1e-9);
+    // 100 %: the whole supply pressure on the piston.
+    EXPECT_NEAR(SteadyForce(p, 100.0), p.AreaA() * p.supply_pressure, 0.2);
+  }
+}
+
+TEST(IpaSimulatorTest, MassBalanceHoldsWithMovingPiston) {
+  // Isothermal coefficients: then the energy equation is exactly the mass
+  // balance d(p V)/dt = R T (m_in - m_out), also while the piston moves.
+  IpaParameters p = Quiet();
+  p.mode = IpaMode::kPosition;
+  p.alpha_in = p.alpha_out = p.alpha = 1.0;
+  IpaSimulator sim(p, 0.01);
+  const double m0 = sim.chamber_mass_a();
+  auto u = ParseSignal("prbs:low=30,high=95,order=6,clock=0.05");
+  double travel = 0.0, x_prev = sim.position();
+  for (int k = 0; k < 300; ++k) {
+    sim.Advance((*u)(k * 0.01));
+    travel += std::abs(sim.position() - x_prev);
+    x_prev = sim.position();
+    const double balance = sim.chamber_mass_a() - m0 - (sim.mass_in_a() - sim.mass_out_a());
+    ASSERT_NEAR(balance, 0.0, 1e-5 * sim.chamber_mass_a()) << "t = " << sim.time();
+  }
+  EXPECT_GT(travel, 0.02);  // the piston really moved (m)
+  EXPECT_GT(sim.mass_in_a(), 10 * m0);
+}
+
+TEST(IpaSimulatorTest, DefaultStepReproducesThePaperForceStep) {
+  // paper-values.md section 4: duty 0.61 -> 82 % at t = 1 s, force 0 -> 129 N,
+  // Kp = 1.585 N/%, tau (time to 63.2 %) = 0.245 s.
+  IpaSimulator sim(IpaParameters{}, 0.01, 7);
+  std::vector<double> y;
+  for (int k = 0; k < 500; ++k) {
+    y.push_back(sim.Measure());
+    sim.Advance(k < 100 ? 0.61 : 82.0);
+  }
+  double y0 = 0.0, yf = 0.0;
+  for (int k = 50; k < 100; ++k) y0 += y[k] / 50.0;
+  for (int k = 450; k < 500; ++k) yf += y[k] / 50.0;
+  EXPECT_NEAR(y0, 0.0, 0.5);
+  EXPECT_NEAR(yf, 129.0, 4.0);
+  const double gain = (yf - y0) / (82.0 - 0.61);
+  EXPECT_GT(gain, 1.5);
+  EXPECT_LT(gain, 1.7);
+  int k = 100;
+  const double level = y0 + 0.632 * (yf - y0);
+  while (k < 500 && y[k] < level) ++k;
+  const double t63 = k * 0.01 - 1.0;
+  EXPECT_GE(t63, 0.2);
+  EXPECT_LE(t63, 0.3);
+  EXPECT_NEAR(t63, 0.245, 0.02);
+}
+
+TEST(IpaSimulatorTest, SeedsReproduceRuns) {
+  auto run = [](std::uint64_t seed, IpaSimulator* reuse = nullptr) {
+    IpaSimulator local(IpaParameters{}, 0.01, seed);
+    IpaSimulator& sim = reuse ? *reuse : local;
+    if (reuse) sim.Reset();
+    std::vector<double> y;
+    for (int k = 0; k < 100; ++k) {
+      y.push_back(sim.Measure());
+      sim.Advance(k < 20 ? 0.0 : 60.0);
+    }
+    return y;
+  };
+  EXPECT_EQ(run(3), run(3));
+  EXPECT_NE(run(3), run(4));
+  IpaSimulator sim(IpaParameters{}, 0.01, 3);
+  EXPECT_EQ(run(3, &sim), run(3));
+  EXPECT_EQ(run(3, &sim), run(3));  // Reset restores the noise generator
+}
+
+TEST(IpaSimulatorTest, SensorQuantizesLikeA16BitAdcAndDelaysOneSample) {
+  IpaParameters p = Quiet();
+  p.adc_bits = 16;
+  IpaSimulator sim(p, 0.01);
+  // One code of a +-10 V 16-bit ADC is 20/65536 V, with 10 V = 1 MPa: 30.52 Pa.
+  const double lsb_force = p.AreaA() * 20.0 / 65536.0 / 10.0 * 1.0e6;
+  double previous_true = sim.force();
+  for (int k = 0; k < 60; ++k) {
+    sim.Advance(70.0);
+    const double y = sim.Measure();
+    EXPECT_NEAR(y / lsb_force, std::round(y / lsb_force), 1e-6);
+    EXPECT_NEAR(y, previous_true, 0.5 * lsb_force + 1e-9);  // one sample late
+    previous_true = sim.force();
+  }
+  EXPECT_GT(previous_true, 50.0);
+}
+
+TEST(IpaSimulatorTest, PositionModeDrivesThePistonToTheEndStops) {
+  IpaParameters p = Quiet();
+  p.mode = IpaMode::kPosition;
+  IpaSimulator sim(p, 0.01);
+  for (int k = 0; k < 200; ++k) sim.Advance(0.0);
+  EXPECT_NEAR(sim.position(), 0.0, 1e-3);  // supply chamber pushes it home
+  for (int k = 0; k < 300; ++k) sim.Advance(100.0);
+  EXPECT_NEAR(sim.position(), p.stroke, 1e-3);  // A_a > A_b at equal pressures
+  EXPECT_NEAR(sim.Measure(), p.stroke, 1e-3);
+  EXPECT_EQ(sim.Extras().count("x [m]"), 1u);
+}
+
+TEST(IpaSimulatorTest, RejectsBadParametersAndInputs) {
+  IpaParameters p;
+  p.rod = 0.02;
+  std::string error;
+  EXPECT_FALSE(p.IsValid(&error));
+  EXPECT_THAT(error, HasSubstr("cylinder.rod"));
+  EXPECT_THROW(IpaSimulator(p, 0.01), InvalidArgument);
+  EXPECT_THROW(IpaSimulator(IpaParameters{}, 0.0), InvalidArgument);
+  IpaSimulator sim(IpaParameters{}, 0.01);
+  EXPECT_THROW(sim.Advance(std::nan("")), InvalidArgument);
+  EXPECT_THROW(PwmModeFromString("fast"), InvalidArgument);
+  EXPECT_EQ(PwmModeFromString("pwm"), PwmMode::kSwitching);
+  EXPECT_EQ(IpaModeFromString(ToString(IpaMode::kPosition)), IpaMode::kPosition);
+}
+
+TEST(IpaParametersTest, DefaultConfigFileEqualsTheBuiltInDefaults) {
+  const IpaParameters d;
+  const IpaParameters f =
+      LoadIpaParameters(std::string(PNEUMID_SOURCE_DIR) + "/config/ipa_default.toml");
+  EXPECT_EQ(f.bore, d.bore);
+  EXPECT_EQ(f.rod, d.rod);
+  EXPECT_EQ(f.stroke, d.stroke);
+  EXPECT_EQ(f.dead_volume_a, d.dead_volume_a);
+  EXPECT_EQ(f.dead_volume_b, d.dead_volume_b);
+  EXPECT_EQ(f.inlet_conductance, d.inlet_conductance);
+  EXPECT_EQ(f.exhaust_conductance, d.exhaust_conductance);
+  EXPECT_EQ(f.open_delay, d.open_delay);
+  EXPECT_EQ(f.close_delay, d.close_delay);
+  EXPECT_EQ(f.min_pulse_width, d.min_pulse_width);
+  EXPECT_EQ(f.pwm_frequency, d.pwm_frequency);
+  EXPECT_EQ(f.supply_pressure, d.supply_pressure);
+  EXPECT_EQ(f.pressure_noise, d.pressure_noise);
+  EXPECT_EQ(f.adc_bits, d.adc_bits);
+  EXPECT_EQ(f.transport_delay_samples, d.transport_delay_samples);
+  EXPECT_EQ(f.mass, d.mass);
+  EXPECT_EQ(f.static_friction, d.static_friction);
+  EXPECT_EQ(f.alpha_in, d.alpha_in);
+  EXPECT_EQ(f.mode, d.mode);
+  EXPECT_EQ(f.pwm_mode, d.pwm_mode);
+}
+
+TEST(IpaParametersTest, BadFilesNameTheKey) {
+  const std::string path = std::string(PNEUMID_BINARY_DIR) + "/ipa_params_test.toml";
+  auto load_error = [&](const std::string& text) -> std::string {
+    {
+      std::ofstream out(path);
+      out << text;
+    }
+    try {
+      LoadIpaParameters(path);
+    } catch (const DataError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_THAT(load_error("[valves]\nopen_dely = 0.003\n"),
+              HasSubstr("ipa_params_test.toml:2:13: unknown key 'valves.open_dely'"));
+  EXPECT_THAT(load_error("[cylinder]\nbore = \"big\"\n"),
+              HasSubstr("key 'cylinder.bore': expected a number"));
+  EXPECT_THAT(load_error("[cylinder]\nbore = 0.01\nrod = 0.02\n"), HasSubstr("cylinder.rod"));
+  EXPECT_THAT(load_error("[simulation]\nmode = \"speed\"\n"), HasSubstr("simulation.mode"));
+  EXPECT_THAT(load_error("[cylinder\nbore = 1\n"), HasSubstr("ipa_params_test.toml:1:"));
+  EXPECT_THAT(load_error("[sensors]\nadc_bits = 12.5\n"), HasSubstr("expected an integer"));
+  const std::string ok =
+      load_error("[pwm]\nfrequency = 100\n[simulation]\npwm_mode = \"averaged\"\n");
+  EXPECT_EQ(ok, "no error");
+  EXPECT_EQ(LoadIpaParameters(path).pwm_frequency, 100.0);
+  EXPECT_THROW(LoadIpaParameters("/nonexistent/ipa.toml"), DataError);
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace pneumid
