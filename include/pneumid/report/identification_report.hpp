@@ -1,0 +1,82 @@
+// The identification report of `pneumid report DATA [--methods ...] -o DIR`:
+// identifies models of one input/output pair of a dataset by several methods
+// and writes DIR/report.html, a self-contained page (html.hpp) with
+//   * the dataset (source, samples, sample time, channels) and a step summary,
+//   * a parameter table (one row per model: structure, parameters, transfer
+//     function) and a metric table (NRMSE fit [%], IAE, RMSE, max error),
+//   * figures: measured data with every model simulated on its input
+//     (Figure 5 of [1]), step responses of the models (Figure 4), Bode
+//     diagram, and residual correlations of the best model with a 99 % band,
+//   * the command lines that reproduce the report,
+// Axis labels come from the dataset's channel names and units.
+// and DIR/models.json with the models in the form of `pneumid identify --json`.
+//
+// Methods (names of `pneumid identify --method`):
+//   reaction-curve   FOPDT by the process reaction curve [1, Eq. 2]
+//   tangent          FOPDT from the inflection tangent (Ziegler-Nichols)
+//   ptn              PTn by the tangent-line method [1, Eq. 3], order request.order
+//   arx iv4 armax oe bj n4sid ...   polynomial/subspace methods (parametric.hpp)
+// A method that fails on the data (e.g. no step for reaction-curve) is listed
+// with its error message in the report and in the summary; it does not stop
+// the others.
+//
+// [1] A. A. M. Emhemed, R. Mamat, A. A. M. Faudzi, Jurnal Teknologi 77:20
+//     (2015) 115-119.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pneumid/data/dataset.hpp"
+#include "pneumid/identify/identified_model.hpp"
+
+namespace pneumid {
+
+/// Identifies with one method by name (see above) and fills fit_percent and
+/// iae from the model simulated on the data (deviation variables).
+/// @throws InvalidArgument for an unknown method; DataError / InvalidArgument
+///         from the method itself.
+IdentifiedModel IdentifyByName(const std::string& method, const Dataset& data,
+                               const IdentifyRequest& request = {});
+
+/// The method names IdentifyByName accepts.
+std::vector<std::string> ReportMethodNames();
+
+struct ReportOptions {
+  /// Methods in table order (default: the paper's three).
+  std::vector<std::string> methods = {"reaction-curve", "ptn", "arx"};
+  IdentifyRequest request;  ///< channels and orders (default ARX(3,3,1), PTn n = 2)
+  std::string title;        ///< default "Identification report: <data source>"
+  int residual_max_lag = 25;
+  double residual_confidence = 0.99;
+  /// Command lines shown in the "Reproduce" section (empty = none given).
+  std::vector<std::string> commands;
+  bool IsValid(std::string* error) const;
+};
+
+enum class ReportTermination { kSuccess, kPartial, kFailure };
+/// "success", "partial", "failure".
+std::string ToString(ReportTermination t);
+
+struct ReportSummary {
+  /// kSuccess: every method gave a model; kPartial: some failed;
+  /// kFailure: none did (the report is still written, listing the errors).
+  ReportTermination termination = ReportTermination::kSuccess;
+  std::string message;
+  std::vector<IdentifiedModel> models;
+  std::vector<std::pair<std::string, std::string>> failures;  ///< method, error
+  std::string html_path;
+  std::string models_path;
+  int num_figures = 0;
+  int num_tables = 0;
+  std::string BriefReport() const;
+};
+
+/// Runs the methods and writes DIR/report.html and DIR/models.json (DIR is
+/// created when missing).
+/// @throws InvalidArgument for invalid options or channels; DataError when DIR
+///         cannot be created or written.
+ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions& options,
+                                        const std::string& dir);
+
+}  // namespace pneumid

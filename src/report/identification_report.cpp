@@ -1,0 +1,302 @@
+#include "pneumid/report/identification_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/parametric.hpp"
+#include "pneumid/identify/step_analysis.hpp"
+#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/report/figures.hpp"
+#include "pneumid/report/html.hpp"
+
+namespace pneumid {
+
+namespace {
+
+std::string Num(double v) {
+  if (!std::isfinite(v)) return std::isnan(v) ? "n/a" : (v > 0 ? "inf" : "-inf");
+  return fmt::format("{:.5g}", v);
+}
+
+// Compact text of a JSON parameter value: numbers with 5 significant digits,
+// arrays in brackets.
+std::string ParamText(const nlohmann::json& v) {
+  if (v.is_number()) return Num(v.get<double>());
+  if (v.is_array()) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + ParamText(v[i]);
+    return s + "]";
+  }
+  if (v.is_string()) return v.get<std::string>();
+  return v.dump();
+}
+
+std::string ChannelLabel(const Channel& c, const std::string& fallback) {
+  std::string name = c.name.empty() ? fallback : c.name;
+  return c.unit.empty() ? name : name + " [" + c.unit + "]";
+}
+
+}  // namespace
+
+std::vector<std::string> ReportMethodNames() {
+  std::vector<std::string> names = StepMethodNames();
+  for (const auto& m : ParametricMethodNames()) names.push_back(m);
+  return names;
+}
+
+IdentifiedModel IdentifyByName(const std::string& method, const Dataset& data,
+                               const IdentifyRequest& request) {
+  if (IsStepMethod(method)) return IdentifyStepMethod(method, data, request);
+  if (IsParametricMethod(method)) return IdentifyParametric(method, data, request);
+  PNEUMID_CHECK(false, "unknown identification method '{}' (valid: {})", method,
+                fmt::join(ReportMethodNames(), ", "));
+  return {};
+}
+
+bool ReportOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error) *error = m;
+    return false;
+  };
+  if (methods.empty()) return fail("ReportOptions::methods is empty");
+  const auto valid = ReportMethodNames();
+  for (const auto& m : methods) {
+    if (std::find(valid.begin(), valid.end(), m) == valid.end())
+      return fail(
+          fmt::format("unknown identification method '{}' (valid: {})", m, fmt::join(valid, ", ")));
+  }
+  if (!request.IsValid(error)) return false;
+  if (residual_max_lag < 1 || residual_max_lag > 10000)
+    return fail(fmt::format("ReportOptions::residual_max_lag must be in [1, 10000], got {}",
+                            residual_max_lag));
+  if (!(residual_confidence > 0.0 && residual_confidence < 1.0))
+    return fail(fmt::format("ReportOptions::residual_confidence must be in (0, 1), got {}",
+                            residual_confidence));
+  return true;
+}
+
+std::string ToString(ReportTermination t) {
+  switch (t) {
+    case ReportTermination::kSuccess:
+      return "success";
+    case ReportTermination::kPartial:
+      return "partial";
+    case ReportTermination::kFailure:
+      return "failure";
+  }
+  return "failure";
+}
+
+std::string ReportSummary::BriefReport() const {
+  return fmt::format("report {}: {} model(s), {} failed, {} figure(s), {} table(s) -> {}",
+                     ToString(termination), models.size(), failures.size(), num_figures, num_tables,
+                     html_path);
+}
+
+ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions& options,
+                                        const std::string& dir) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "{}", error);
+  const int in = options.request.input, out = options.request.output;
+  PNEUMID_CHECK(in >= 0 && in < data.num_inputs(),
+                "input channel {} does not exist (the data have {} input(s))", in,
+                data.num_inputs());
+  PNEUMID_CHECK(out >= 0 && out < data.num_outputs(),
+                "output channel {} does not exist (the data have {} output(s))", out,
+                data.num_outputs());
+  data.RequireSamples(4, "the identification report");
+  data.RequireUniform();
+
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw DataError(dir + ": cannot create the directory: " + ec.message());
+
+  ReportSummary summary;
+  for (const auto& method : options.methods) {
+    try {
+      summary.models.push_back(IdentifyByName(method, data, options.request));
+    } catch (const InvalidArgument& e) {
+      summary.failures.emplace_back(method, e.what());
+    } catch (const DataError& e) {
+      summary.failures.emplace_back(method, e.what());
+    }
+  }
+
+  const std::string source = data.source().empty() ? "(in-memory data)" : data.source();
+  HtmlDocument doc(options.title.empty() ? "Identification report: " + source : options.title);
+  const Channel uc = in < static_cast<int>(data.input_channels().size()) ? data.input_channels()[in]
+                                                                         : Channel{"u", ""};
+  const Channel yc = out < static_cast<int>(data.output_channels().size())
+                         ? data.output_channels()[out]
+                         : Channel{"y", ""};
+  SignalLabels labels;
+  labels.time = ChannelLabel(data.time_channel(), "t");
+  if (data.time_channel().unit.empty()) labels.time = "Time t [s]";
+  labels.input = ChannelLabel(uc, "u");
+  labels.output = ChannelLabel(yc, "y");
+
+  // Data section.
+  doc.AddHeading("Data");
+  Table dt;
+  dt.caption = "Dataset";
+  dt.header = {"property", "value"};
+  dt.rows = {{"source", source},
+             {"samples", std::to_string(data.size())},
+             {"sample time [s]", Num(data.SampleTime())},
+             {"duration [s]", Num(data.time()[data.size() - 1] - data.time()[0])},
+             {"input", labels.input},
+             {"output", labels.output}};
+  try {
+    const StepAnalysis s = AnalyzeStep(data, in, out);
+    dt.rows.push_back({"step", s.BriefReport()});
+  } catch (const DataError& e) {
+    dt.rows.push_back({"step", std::string("no single step: ") + e.what()});
+  }
+  doc.AddTable(dt);
+
+  // Models.
+  doc.AddHeading("Models");
+  if (!summary.models.empty()) {
+    Table pt;
+    pt.caption = "Identified parameters";
+    pt.header = {"method", "structure", "parameters", "transfer function"};
+    for (const auto& m : summary.models) {
+      std::string params;
+      for (const auto& [k, v] : m.params.items()) {
+        if (!params.empty()) params += ", ";
+        params += k + " = " + ParamText(v);
+        if (m.param_std.contains(k)) params += " ± " + ParamText(m.param_std[k]);
+      }
+      pt.rows.push_back({m.method, m.structure, params, m.tf.ToString(5)});
+    }
+    doc.AddTable(pt);
+
+    Table mt;
+    mt.caption = "Fit to the data (model simulated on the measured input)";
+    mt.header = {"method", "NRMSE fit [%]", "IAE [" + (yc.unit.empty() ? "" : yc.unit + " ") + "s]",
+                 "RMSE",   "max |error|",   "notes"};
+    for (const auto& m : summary.models) {
+      FitMetrics fm;
+      fm.fit_percent = m.fit_percent;
+      fm.iae = m.iae;
+      fm.rmse = fm.max_abs_error = std::numeric_limits<double>::quiet_NaN();
+      try {
+        const TransferFunction& g = m.discrete ? *m.discrete : m.tf;
+        const Eigen::VectorXd yhat = SimulateOnData(g, data, in, out);
+        if (yhat.allFinite()) fm = ComputeFitMetrics(data.time(), data.y(out), yhat);
+      } catch (const InvalidArgument&) {
+      }
+      std::string notes;
+      for (const auto& n : m.notes) notes += (notes.empty() ? "" : "; ") + n;
+      mt.rows.push_back(
+          {m.method, Num(fm.fit_percent), Num(fm.iae), Num(fm.rmse), Num(fm.max_abs_error), notes});
+    }
+    doc.AddTable(mt);
+  }
+  if (!summary.failures.empty()) {
+    doc.AddHeading("Methods that gave no model", 3);
+    std::vector<std::string> items;
+    for (const auto& [m, e] : summary.failures) items.push_back(m + ": " + e);
+    doc.AddList(items);
+  }
+
+  // Figures.
+  if (!summary.models.empty()) {
+    std::vector<NamedModel> named;
+    for (const auto& m : summary.models) {
+      named.push_back({m.method + " (" + m.structure + ")", m.discrete ? *m.discrete : m.tf});
+    }
+    doc.AddHeading("Figures");
+    ComparisonFigureOptions co;
+    co.labels = labels;
+    co.input = in;
+    co.output = out;
+    co.title = "Measured data and simulated models";
+    doc.AddFigure(ModelComparisonFigure(data, named, co),
+                  "Measured output and each model driven by the measured input (deviation "
+                  "from the initial operating point), with the input below.");
+
+    StepFigureOptions so;
+    so.labels = labels;
+    so.title = "Step responses of the models";
+    double du = 1.0;
+    try {
+      du = AnalyzeStep(data, in, out).du;
+    } catch (const DataError&) {
+    }
+    so.amplitude = du;
+    so.t_final = data.time()[data.size() - 1] - data.time()[0];
+    doc.AddFigure(
+        StepResponseFigure(named, so),
+        fmt::format("Responses of the models to an input step of {} (input units).", Num(du)));
+
+    doc.AddFigure(BodeFigure(named), "Frequency responses of the models.");
+
+    // Residuals of the best model.
+    const auto best = std::max_element(summary.models.begin(), summary.models.end(),
+                                       [](const IdentifiedModel& a, const IdentifiedModel& b) {
+                                         return a.fit_percent < b.fit_percent;
+                                       });
+    try {
+      const TransferFunction& g = best->discrete ? *best->discrete : best->tf;
+      const Eigen::VectorXd e = data.y(out) - SimulateOnData(g, data, in, out);
+      const int lag = std::min<int>(options.residual_max_lag, static_cast<int>(data.size()) - 2);
+      const ResidualCorrelation rc =
+          ComputeResidualCorrelation(e, data.u(in), lag, options.residual_confidence);
+      doc.AddFigure(ResidualFigure(rc, "Residuals of " + best->method),
+                    fmt::format("Residual analysis of the best model ({}): {:.0f} % of the "
+                                "autocorrelation lags and {:.0f} % of the cross-correlation "
+                                "lags lie outside the {:g} % band.",
+                                best->method, 100.0 * rc.auto_outside, 100.0 * rc.cross_outside,
+                                100.0 * rc.confidence));
+    } catch (const InvalidArgument& e) {
+      doc.AddParagraph(std::string("Residual analysis not available: ") + e.what());
+    }
+  }
+
+  doc.AddHeading("Reproduce");
+  if (options.commands.empty()) {
+    doc.AddParagraph("No command lines were recorded for this report.");
+  } else {
+    doc.AddParagraph("The commands that reproduce this report:");
+    doc.AddCommands(options.commands);
+  }
+
+  summary.html_path = (std::filesystem::path(dir) / "report.html").string();
+  summary.models_path = (std::filesystem::path(dir) / "models.json").string();
+  doc.Write(summary.html_path);
+  nlohmann::json j;
+  j["data"] = source;
+  j["models"] = nlohmann::json::array();
+  for (const auto& m : summary.models) j["models"].push_back(m.ToJson());
+  j["failures"] = nlohmann::json::array();
+  for (const auto& [m, e] : summary.failures)
+    j["failures"].push_back({{"method", m}, {"error", e}});
+  {
+    std::ofstream f(summary.models_path);
+    if (!f) throw DataError(summary.models_path + ": cannot open the file for writing");
+    f << j.dump(2) << "\n";
+  }
+  summary.num_figures = doc.num_figures();
+  summary.num_tables = doc.num_tables();
+  if (summary.models.empty()) {
+    summary.termination = ReportTermination::kFailure;
+    summary.message = "no method gave a model";
+  } else if (!summary.failures.empty()) {
+    summary.termination = ReportTermination::kPartial;
+    summary.message =
+        fmt::format("{} of {} methods failed", summary.failures.size(), options.methods.size());
+  } else {
+    summary.termination = ReportTermination::kSuccess;
+    summary.message = "all methods gave a model";
+  }
+  return summary;
+}
+
+}  // namespace pneumid
