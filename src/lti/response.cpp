@@ -1,0 +1,310 @@
+#include "pneumid/lti/response.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/lti/conversion.hpp"
+
+namespace pneumid {
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr Eigen::Index kMaxDefaultSamples = 200000;
+
+void CheckDiscreteStep(double Ts, double dt) {
+  PNEUMID_CHECK(std::abs(dt - Ts) <= 1e-9 * Ts,
+                "lsim: a discrete model runs at its own sample time Ts = {} s, got dt = {} s", Ts,
+                dt);
+}
+
+// Runs x[k+1] = A x[k] + B u[k-d], y[k] = C x[k] + D u[k-d] for a SISO model.
+// Plain loops over preallocated buffers: O(N nx^2), no allocation per sample.
+VectorXd SimulateSiso(const StateSpace& g, const VectorXd& u, int d, const VectorXd& x0) {
+  const Eigen::Index n = g.num_states();
+  const Eigen::Index N = u.size();
+  VectorXd y(N);
+  // Row-major copy of A for cache-friendly row dot products.
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> A = g.A();
+  const VectorXd b = g.B().col(0);
+  const VectorXd c = g.C().row(0).transpose();
+  const double dd = g.D()(0, 0);
+  VectorXd x = x0.size() == n ? x0 : VectorXd::Zero(n);
+  VectorXd xn(n);
+  const double* Ap = A.data();
+  for (Eigen::Index k = 0; k < N; ++k) {
+    const double uk = k >= d ? u[k - d] : 0.0;
+    double yk = dd * uk;
+    for (Eigen::Index i = 0; i < n; ++i) yk += c[i] * x[i];
+    y[k] = yk;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double* row = Ap + i * n;
+      double acc = b[i] * uk;
+      for (Eigen::Index j = 0; j < n; ++j) acc += row[j] * x[j];
+      xn[i] = acc;
+    }
+    x.swap(xn);
+  }
+  return y;
+}
+
+// Time scales of a model in seconds: the slowest (1/|Re p|, largest) and the
+// fastest (1/|p|, smallest), with discrete poles mapped by s = ln(z) / Ts.
+void TimeScales(const TransferFunction& g, double* slow, double* fast) {
+  const Eigen::VectorXcd poles = g.Poles();
+  double s_max = 0.0, f_min = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < poles.size(); ++i) {
+    std::complex<double> p = poles[i];
+    if (g.IsDiscrete()) {
+      if (std::abs(p) == 0.0) continue;
+      p = std::log(p) / g.Ts();
+    }
+    const double re = std::abs(p.real());
+    if (re > 1e-12 * std::max(1.0, std::abs(p))) s_max = std::max(s_max, 1.0 / re);
+    if (std::abs(p) > 0.0) f_min = std::min(f_min, 1.0 / std::abs(p));
+  }
+  if (s_max == 0.0)
+    s_max = std::isfinite(f_min) ? 10.0 * f_min : (g.IsDiscrete() ? 10 * g.Ts() : 1.0);
+  if (!std::isfinite(f_min)) f_min = s_max;
+  *slow = s_max;
+  *fast = f_min;
+}
+
+void ChooseGrid(const TransferFunction& g, double* t_final, double* dt) {
+  PNEUMID_CHECK(std::isfinite(*t_final) && *t_final >= 0.0,
+                "time response: t_final must be >= 0 s (0 = automatic), got {}", *t_final);
+  PNEUMID_CHECK(std::isfinite(*dt) && *dt >= 0.0,
+                "time response: dt must be >= 0 s (0 = automatic), got {}", *dt);
+  double slow = 1.0, fast = 1.0;
+  if (*t_final == 0.0 || *dt == 0.0) TimeScales(g, &slow, &fast);
+  if (*t_final == 0.0) *t_final = 7.0 * slow + g.delay();
+  if (*dt == 0.0) {
+    if (g.IsDiscrete()) {
+      *dt = g.Ts();
+    } else {
+      *dt = std::min(slow / 200.0, fast / 20.0);
+      if (*t_final / *dt > kMaxDefaultSamples) *dt = *t_final / kMaxDefaultSamples;
+    }
+  }
+  if (g.IsDiscrete()) CheckDiscreteStep(g.Ts(), *dt);
+  PNEUMID_CHECK(*t_final / *dt < 1e8,
+                "time response: t_final / dt = {} samples is too many (t_final = {}, dt = {})",
+                *t_final / *dt, *t_final, *dt);
+}
+
+Eigen::Index NumSamples(double t_final, double dt) {
+  return static_cast<Eigen::Index>(std::ceil(t_final / dt - 1e-9)) + 1;
+}
+
+}  // namespace
+
+Eigen::MatrixXd Lsim(const StateSpace& g, const Eigen::MatrixXd& u, double dt,
+                     const Eigen::VectorXd& x0) {
+  PNEUMID_CHECK(std::isfinite(dt) && dt > 0.0, "lsim: dt must be > 0 s, got {}", dt);
+  PNEUMID_CHECK(u.cols() == g.num_inputs(), "lsim: u must have nu = {} columns, got {}",
+                g.num_inputs(), u.cols());
+  PNEUMID_CHECK(u.allFinite(), "lsim: the input contains NaN or Inf");
+  PNEUMID_CHECK(x0.size() == 0 || x0.size() == g.num_states(),
+                "lsim: x0 must have nx = {} entries (or none), got {}", g.num_states(), x0.size());
+  StateSpace gd = g;
+  if (g.IsDiscrete()) {
+    CheckDiscreteStep(g.Ts(), dt);
+  } else {
+    gd = C2D(g, dt, DiscretizationMethod::kZoh);
+  }
+  const int d = static_cast<int>(std::lround(gd.delay() / dt));
+  const Eigen::Index n = gd.num_states();
+  VectorXd x = VectorXd::Zero(n);
+  if (x0.size() > 0) x.head(x0.size()) = x0;  // extra delay states start at rest
+  if (gd.num_inputs() == 1 && gd.num_outputs() == 1) {
+    return SimulateSiso(gd, u.col(0), d, x);
+  }
+  const Eigen::Index N = u.rows();
+  MatrixXd y(N, gd.num_outputs());
+  VectorXd xn(n), uk(gd.num_inputs());
+  for (Eigen::Index k = 0; k < N; ++k) {
+    if (k >= d) {
+      uk = u.row(k - d).transpose();
+    } else {
+      uk.setZero();
+    }
+    y.row(k).noalias() = (gd.C() * x + gd.D() * uk).transpose();
+    xn.noalias() = gd.A() * x;
+    xn.noalias() += gd.B() * uk;
+    x.swap(xn);
+  }
+  return y;
+}
+
+Eigen::VectorXd Lsim(const TransferFunction& g, const Eigen::VectorXd& u, double dt) {
+  return Lsim(ToStateSpace(g), MatrixXd(u), dt).col(0);
+}
+
+TimeResponse Step(const TransferFunction& g, double t_final, double dt) {
+  ChooseGrid(g, &t_final, &dt);
+  const Eigen::Index N = NumSamples(t_final, dt);
+  TimeResponse r;
+  r.t = VectorXd::LinSpaced(N, 0.0, (N - 1) * dt);
+  r.y = Lsim(g, VectorXd::Ones(N), dt);
+  return r;
+}
+
+TimeResponse Impulse(const TransferFunction& g, double t_final, double dt) {
+  ChooseGrid(g, &t_final, &dt);
+  const Eigen::Index N = NumSamples(t_final, dt);
+  TimeResponse r;
+  r.t = VectorXd::LinSpaced(N, 0.0, (N - 1) * dt);
+  if (g.IsDiscrete()) {
+    VectorXd u = VectorXd::Zero(N);
+    u[0] = 1.0;
+    r.y = Lsim(g, u, dt);
+    return r;
+  }
+  // Continuous: the impulse response of the strictly proper part G - D is the
+  // step response of s (G - D), exact on the grid; the D delta(t) term is dropped.
+  const VectorXd den = poly::TrimLeading(g.den());
+  const VectorXd nt = poly::TrimLeading(g.num());
+  VectorXd num = VectorXd::Zero(den.size());
+  num.tail(nt.size()) = nt;
+  num -= (num[0] / den[0]) * den;
+  VectorXd snum = VectorXd::Zero(den.size());
+  snum.head(den.size() - 1) = num.tail(den.size() - 1);
+  r.y = Lsim(TransferFunction(snum, den, 0.0, g.delay()), VectorXd::Ones(N), dt);
+  return r;
+}
+
+bool StepInfoOptions::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& m) {
+    if (error != nullptr) *error = m;
+    return false;
+  };
+  if (!(settling_threshold > 0.0 && settling_threshold < 1.0)) {
+    return fail(fmt::format("settling_threshold must be in (0, 1), got {}", settling_threshold));
+  }
+  if (!(rise_low >= 0.0 && rise_low < rise_high && rise_high <= 1.0)) {
+    return fail(
+        fmt::format("rise limits must satisfy 0 <= rise_low < rise_high <= 1, got {} and {}",
+                    rise_low, rise_high));
+  }
+  if (std::isinf(y_initial) || std::isinf(y_final)) {
+    return fail("y_initial and y_final must be finite or NaN (automatic)");
+  }
+  return true;
+}
+
+StepInfo ComputeStepInfo(const Eigen::VectorXd& t, const Eigen::VectorXd& y,
+                         const StepInfoOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "stepinfo: invalid options: {}", error);
+  PNEUMID_CHECK(t.size() == y.size(), "stepinfo: t has {} samples but y has {}", t.size(),
+                y.size());
+  PNEUMID_CHECK(t.size() >= 2, "stepinfo: need at least 2 samples, got {}", t.size());
+  PNEUMID_CHECK(t.allFinite(), "stepinfo: t contains NaN or Inf");
+  PNEUMID_CHECK(y.allFinite(), "stepinfo: y contains NaN or Inf");
+  for (Eigen::Index k = 1; k < t.size(); ++k) {
+    PNEUMID_CHECK(t[k] > t[k - 1],
+                  "stepinfo: t must be strictly increasing, t[{}] = {} <= t[{}] = {}", k, t[k],
+                  k - 1, t[k - 1]);
+  }
+  const Eigen::Index N = y.size();
+  const double y0 = std::isnan(options.y_initial) ? y[0] : options.y_initial;
+  const double yf = std::isnan(options.y_final) ? y[N - 1] : options.y_final;
+  const double step = yf - y0;
+  StepInfo info;
+  info.steady_state = yf;
+  Eigen::Index ipeak = 0;
+  y.cwiseAbs().maxCoeff(&ipeak);
+  info.peak = std::abs(y[ipeak]);
+  info.peak_time = t[ipeak] - t[0];
+  if (step == 0.0) {
+    info.rise_time = info.settling_time = kNaN;
+    info.settling_min = y.minCoeff();
+    info.settling_max = y.maxCoeff();
+    info.overshoot = info.undershoot = 0.0;
+    return info;
+  }
+  const double mag = std::abs(step);
+  const double sign = step > 0 ? 1.0 : -1.0;
+  // Normalized response r = (y - y0) / step rises from 0 towards 1.
+  auto r = [&](Eigen::Index k) { return (y[k] - y0) / step; };
+  auto first_crossing = [&](double level, Eigen::Index* index) -> double {
+    if (r(0) >= level) {
+      *index = 0;
+      return t[0];
+    }
+    for (Eigen::Index k = 1; k < N; ++k) {
+      if (r(k) >= level) {
+        *index = k;
+        const double f = (level - r(k - 1)) / (r(k) - r(k - 1));
+        return t[k - 1] + f * (t[k] - t[k - 1]);
+      }
+    }
+    *index = N;
+    return kNaN;
+  };
+  Eigen::Index ilow = 0, ihigh = 0;
+  const double t_low = first_crossing(options.rise_low, &ilow);
+  const double t_high = first_crossing(options.rise_high, &ihigh);
+  info.rise_time = t_high - t_low;
+
+  // Settling: last sample outside the band, then the interpolated band entry.
+  const double band = options.settling_threshold * mag;
+  Eigen::Index last_out = -1;
+  for (Eigen::Index k = N - 1; k >= 0; --k) {
+    if (std::abs(y[k] - yf) > band) {
+      last_out = k;
+      break;
+    }
+  }
+  if (last_out < 0) {
+    info.settling_time = 0.0;
+  } else if (last_out == N - 1) {
+    info.settling_time = kNaN;
+  } else {
+    const double e0 = y[last_out] - yf, e1 = y[last_out + 1] - yf;
+    const double level = e0 > 0 ? band : -band;
+    const double f = (level - e0) / (e1 - e0);
+    info.settling_time = t[last_out] + f * (t[last_out + 1] - t[last_out]) - t[0];
+  }
+  if (ihigh < N) {
+    info.settling_min = y.tail(N - ihigh).minCoeff();
+    info.settling_max = y.tail(N - ihigh).maxCoeff();
+  } else {
+    info.settling_min = y.minCoeff();
+    info.settling_max = y.maxCoeff();
+  }
+  const double over = (sign * (y.array() - yf)).maxCoeff();
+  const double under = (-sign * (y.array() - y0)).maxCoeff();
+  info.overshoot = 100.0 * std::max(0.0, over) / mag;
+  info.undershoot = 100.0 * std::max(0.0, under) / mag;
+  return info;
+}
+
+StepInfo ComputeStepInfo(const TransferFunction& g, const StepInfoOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "stepinfo: invalid options: {}", error);
+  const double dc = g.DcGain();
+  if (!g.IsStable() || !std::isfinite(dc)) {
+    StepInfo info;
+    info.rise_time = info.settling_time = info.settling_min = info.settling_max = kNaN;
+    info.overshoot = info.undershoot = info.peak = info.peak_time = kNaN;
+    info.steady_state = dc;
+    return info;
+  }
+  const TimeResponse r = Step(g);
+  StepInfoOptions o = options;
+  if (std::isnan(o.y_initial)) o.y_initial = 0.0;
+  if (std::isnan(o.y_final)) o.y_final = dc;
+  return ComputeStepInfo(r.t, r.y, o);
+}
+
+}  // namespace pneumid

@@ -1,0 +1,105 @@
+// Model specs and the JSON form of a transfer function.
+#include "pneumid/lti/model_io.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+
+namespace pneumid {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = std::string(PNEUMID_BINARY_DIR) + "/lti_model_io_" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(ModelIoTest, BuiltIns) {
+  const TransferFunction arx = ParseModelSpec("arx-paper");
+  EXPECT_DOUBLE_EQ(arx.Ts(), 0.01);
+  EXPECT_DOUBLE_EQ(arx.num()[1], 0.03938);
+  EXPECT_DOUBLE_EQ(arx.den()[3], -0.06021);
+  const TransferFunction ct = ParseModelSpec("arx-paper-ct").Normalized();
+  EXPECT_TRUE(ct.IsContinuous());
+  EXPECT_NEAR(ct.den()[3] / 325421.7, 1.0, 2e-6);
+  const TransferFunction f = ParseModelSpec(" fopdt-paper ");
+  EXPECT_DOUBLE_EQ(f.DcGain(), 1.6);
+  EXPECT_DOUBLE_EQ(f.delay(), 0.001);
+  EXPECT_DOUBLE_EQ(f.den()[0], 0.245);
+}
+
+TEST(ModelIoTest, InlineSpecs) {
+  const TransferFunction f = ParseModelSpec("fopdt:K=1.6,tau=0.245,theta=0.001");
+  EXPECT_DOUBLE_EQ(f.DcGain(), 1.6);
+  EXPECT_DOUBLE_EQ(f.delay(), 0.001);
+  const TransferFunction s = ParseModelSpec("sopdt:K=2,tau1=1,tau2=0.5,theta=0.1");
+  EXPECT_DOUBLE_EQ(s.DcGain(), 2.0);
+  EXPECT_DOUBLE_EQ(s.den()[0], 0.5);
+  const TransferFunction t = ParseModelSpec("tf:num=1 2,den=1;3;2");
+  EXPECT_EQ(t.den().size(), 3);
+  EXPECT_DOUBLE_EQ(t.DcGain(), 1.0);
+  const TransferFunction d = ParseModelSpec("tf:num=0 0.5,den=1 -0.5,Ts=0.1,delay=0.2");
+  EXPECT_EQ(d.DelaySamples(), 2);
+  EXPECT_DOUBLE_EQ(d.DcGain(), 1.0);
+}
+
+TEST(ModelIoTest, JsonRoundTripIsMonic) {
+  const TransferFunction g = TransferFunction::Continuous({2.0, 4.0}, {2.0, 6.0, 4.0}, 0.5);
+  const nlohmann::json j = ToJson(g);
+  EXPECT_EQ(j.at("den")[0], 1.0);
+  EXPECT_EQ(j.at("num")[0], 1.0);
+  EXPECT_EQ(j.at("Ts"), 0.0);
+  EXPECT_EQ(j.at("delay"), 0.5);
+  const TransferFunction back = TransferFunctionFromJson(j);
+  EXPECT_DOUBLE_EQ(back.DcGain(), 1.0);
+  EXPECT_DOUBLE_EQ(back.delay(), 0.5);
+  EXPECT_THAT([] { TransferFunctionFromJson({{"num", {1}}}); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("missing key 'den'")));
+  EXPECT_THAT([] { TransferFunctionFromJson({{"num", {1}}, {"den", {"a"}}}); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("'den' must contain only numbers")));
+}
+
+TEST(ModelIoTest, JsonFiles) {
+  const std::string bare =
+      WriteTemp("bare.json", R"({"num": [2], "den": [1, 1], "Ts": 0, "delay": 0.1})");
+  EXPECT_DOUBLE_EQ(ParseModelSpec(bare).DcGain(), 2.0);
+  const std::string list = WriteTemp("list.json", R"({"models": [
+    {"method": "reaction-curve", "tf": {"num": [1.6], "den": [0.245, 1], "Ts": 0, "delay": 0.001}},
+    {"method": "arx", "tf": {"num": [0, 0.5], "den": [1, -0.5], "Ts": 0.01, "delay": 0}}]})");
+  EXPECT_DOUBLE_EQ(ParseModelSpec(list).DcGain(), 1.6);
+  EXPECT_DOUBLE_EQ(ParseModelSpec(list + "#arx").Ts(), 0.01);
+  EXPECT_THAT([&] { ParseModelSpec(list + "#oe"); },
+              ThrowsMessage<DataError>(HasSubstr("no model with method 'oe'")));
+  const std::string broken = WriteTemp("broken.json", "{\n  \"num\": [1,\n}");
+  EXPECT_THAT([&] { ParseModelSpec(broken); },
+              ThrowsMessage<DataError>(HasSubstr("broken.json:3:")));
+  EXPECT_THAT([] { ParseModelSpec("/nonexistent/model.json"); },
+              ThrowsMessage<DataError>(HasSubstr("/nonexistent/model.json: cannot open")));
+}
+
+TEST(ModelIoTest, BadSpecsNameTheField) {
+  EXPECT_THAT([] { ParseModelSpec("fopdt:K=1.6,tau=abc"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("field 'tau': not a finite number: 'abc'")));
+  EXPECT_THAT([] { ParseModelSpec("fopdt:K=1.6"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("missing field 'tau'")));
+  EXPECT_THAT([] { ParseModelSpec("fopdt:K=1,tau=1,zeta=2"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("unknown field 'zeta'")));
+  EXPECT_THAT([] { ParseModelSpec("tf:num=1,den="); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("field 'den' has no coefficients")));
+  EXPECT_THAT([] { ParseModelSpec("fopdt:K=1,tau=-1"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("tau must be > 0")));
+  EXPECT_THAT([] { ParseModelSpec("arx-papr"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("unknown model spec 'arx-papr'")));
+  EXPECT_THAT([] { ParseModelSpec(""); }, ThrowsMessage<InvalidArgument>(HasSubstr("empty")));
+}
+
+}  // namespace
+}  // namespace pneumid
