@@ -31,6 +31,16 @@ std::string SourcePrefix(const std::string& source) {
   return source.empty() ? std::string("dataset") : source;
 }
 
+/// Median of the sample intervals: the nominal sample time, unaffected by a
+/// few gaps or jitter.
+double MedianInterval(const Eigen::VectorXd& t) {
+  std::vector<double> dt(static_cast<std::size_t>(t.size() - 1));
+  for (Eigen::Index i = 1; i < t.size(); ++i) dt[static_cast<std::size_t>(i - 1)] = t[i] - t[i - 1];
+  const auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
+  std::nth_element(dt.begin(), mid, dt.end());
+  return *mid;
+}
+
 }  // namespace
 
 Dataset::Dataset(Eigen::VectorXd time, Eigen::MatrixXd inputs, Eigen::MatrixXd outputs,
@@ -99,10 +109,16 @@ double Dataset::SampleTime() const {
   return (time_[size() - 1] - time_[0]) / static_cast<double>(size() - 1);
 }
 
+double Dataset::MedianSampleInterval() const {
+  PNEUMID_CHECK(size() >= 2, "Dataset::MedianSampleInterval: needs at least 2 samples, {} has {}",
+                SourcePrefix(source_), size());
+  return MedianInterval(time_);
+}
+
 bool Dataset::IsUniform(double rel_tol) const {
   PNEUMID_CHECK(rel_tol >= 0, "Dataset::IsUniform: tolerance must be >= 0, got {}", rel_tol);
   if (size() < 3) return true;
-  const double Ts = SampleTime();
+  const double Ts = MedianInterval(time_);
   for (Eigen::Index i = 1; i < size(); ++i) {
     if (std::abs((time_[i] - time_[i - 1]) - Ts) > rel_tol * Ts) return false;
   }
@@ -112,13 +128,14 @@ bool Dataset::IsUniform(double rel_tol) const {
 void Dataset::RequireUniform(double rel_tol) const {
   PNEUMID_CHECK(rel_tol >= 0, "Dataset::RequireUniform: tolerance must be >= 0, got {}", rel_tol);
   if (size() < 3) return;
-  const double Ts = SampleTime();
+  const double Ts = MedianInterval(time_);
   for (Eigen::Index i = 1; i < size(); ++i) {
     const double dt = time_[i] - time_[i - 1];
     if (std::abs(dt - Ts) > rel_tol * Ts) {
       throw DataError(fmt::format(
           "{}: column '{}': sampling is not uniform: interval {:g} s between t = {:g} and t = {:g} "
-          "differs from the mean interval {:g} s by {:.3g} % (tolerance {:g} %); resample the data "
+          "differs from the typical (median) interval {:g} s by {:.3g} % (tolerance {:g} %); "
+          "resample the data "
           "to a uniform grid first (pneumid::Resample, or `pneumid info {} --resample {:g} --save "
           "FILE`)",
           Where(i), time_channel_.name, dt, time_[i - 1], time_[i], Ts,

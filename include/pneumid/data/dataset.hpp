@@ -57,7 +57,12 @@ class Dataset {
 
   /// Mean sample interval (t_end - t_0) / (N - 1) in seconds; throws when N < 2.
   double SampleTime() const;
-  /// True when every interval is within `rel_tol` * SampleTime() of the mean.
+  /// Median sample interval in seconds: the nominal sample time of data with
+  /// gaps or jitter; throws InvalidArgument when N < 2.
+  double MedianSampleInterval() const;
+  /// True when every sample interval is within `rel_tol` times the median
+  /// interval from it. The median interval is the nominal sample time:
+  /// a few gaps do not move it, and for uniform data it equals SampleTime().
   bool IsUniform(double rel_tol = 1e-3) const;
   /// Throws DataError naming the source and the first offending sample when the
   /// sampling is not uniform within `rel_tol` (suggesting resampling).
