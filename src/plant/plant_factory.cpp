@@ -1,0 +1,105 @@
+// Plants by name (see include/pneumid/plant/plant_factory.hpp).
+#include "pneumid/plant/plant_factory.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/linear_plant.hpp"
+
+namespace pneumid {
+
+bool PlantOptions::IsValid(std::string* error) const {
+  if (noise_sigma && !(std::isfinite(*noise_sigma) && *noise_sigma >= 0.0)) {
+    if (error) *error = fmt::format("noise sigma must be >= 0, got {}", *noise_sigma);
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+std::unique_ptr<Plant> MakeIpa(const std::string& spec, const std::string& base, double Ts,
+                               const PlantOptions& options) {
+  std::string config = options.config_path;
+  std::optional<IpaMode> mode;
+  if (base == "ipa-position") mode = IpaMode::kPosition;
+  std::optional<PwmMode> pwm = options.pwm_mode;
+  const auto colon = spec.find(':');
+  if (colon != std::string::npos) {
+    std::istringstream in(spec.substr(colon + 1));
+    std::string item;
+    while (std::getline(in, item, ',')) {
+      if (item.empty()) continue;
+      const auto eq = item.find('=');
+      PNEUMID_CHECK(eq != std::string::npos, "plant '{}': expected key=value, got '{}'", spec,
+                    item);
+      const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+      if (key == "config") {
+        config = value;
+      } else if (key == "mode") {
+        mode = IpaModeFromString(value);
+      } else if (key == "pwm") {
+        pwm = PwmModeFromString(value);
+      } else {
+        PNEUMID_CHECK(false, "plant '{}': unknown key '{}' (allowed: config, mode, pwm)", spec,
+                      key);
+      }
+    }
+  }
+  IpaParameters p = config.empty() ? IpaParameters{} : LoadIpaParameters(config);
+  if (mode) p.mode = *mode;
+  if (pwm) p.pwm_mode = *pwm;
+  if (options.noise_sigma) {
+    if (p.mode == IpaMode::kForce)
+      p.pressure_noise = *options.noise_sigma / p.AreaA();
+    else
+      p.position_noise = *options.noise_sigma;
+  }
+  return std::make_unique<IpaSimulator>(p, Ts, options.seed);
+}
+
+}  // namespace
+
+std::unique_ptr<Plant> MakePlant(const std::string& spec, double Ts, const PlantOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "invalid plant options: {}", error);
+  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
+  PNEUMID_CHECK(!spec.empty(), "empty plant spec; give ipa, ipa-position or a model ({})",
+                "arx-paper, fopdt:K=..,tau=..,theta=.., MODEL.json");
+  const std::string base = spec.substr(0, spec.find(':'));
+  if (base == "ipa" || base == "ipa-position") return MakeIpa(spec, base, Ts, options);
+  TransferFunction g = ParseModelSpec(spec);
+  return std::make_unique<LinearPlant>(g, Ts, options.noise_sigma.value_or(0.0), options.seed,
+                                       spec);
+}
+
+Channel PlantInputChannel(const Plant& plant) {
+  if (dynamic_cast<const IpaSimulator*>(&plant)) return {"u", "%"};
+  return {"u", ""};
+}
+
+Channel PlantOutputChannel(const Plant& plant) {
+  if (const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant))
+    return {"y", ipa->parameters().mode == IpaMode::kForce ? "N" : "m"};
+  return {"y", ""};
+}
+
+std::string PlantSpecHelp() {
+  return R"(Plant specs:
+  ipa                      IPA physics simulator, force mode (rod fixed): input PWM duty %,
+                           output force N (docs/simulator.md)
+  ipa-position             the same with a moving piston: output position m
+  ipa:config=FILE.toml[,mode=force|position][,pwm=switching|averaged]
+                           IPA with parameters from a TOML file (see config/ipa_default.toml)
+  arx-paper                the paper's ARX(3,3,1) force model, Ts = 0.01 s (Eq. 5)
+  arx-paper-ct, fopdt-paper, fopdt:K=1.6,tau=0.245,theta=0.001, sopdt:K=..,tau1=..,tau2=..,theta=..,
+  tf:num=..,den=..[,Ts=..]  linear models (continuous ones discretized with zoh at --Ts)
+  MODEL.json[#method]      a model written by pneumid (identify --json)
+)";
+}
+
+}  // namespace pneumid
