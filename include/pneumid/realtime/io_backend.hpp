@@ -1,0 +1,65 @@
+// I/O backends of the real-time loop: one interface for the simulator, a data
+// acquisition card (comedi) and a remote plant server (UDP).
+//
+// Per period k the loop calls
+//   Read(&m)    -> m.y: the measured output (force, N) at t_k
+//   Write(u)    -> applies the input u (valve duty, %) until t_(k+1)
+// and on a fault or stop EnterSafeState(). Read, Write and EnterSafeState run on
+// the loop thread: implementations must not allocate, lock or do file I/O
+// there (system calls to the device or socket are the backend's job).
+// Open and Close run outside the loop and may allocate and throw.
+#pragma once
+
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "pneumid/realtime/safety.hpp"
+
+namespace pneumid {
+
+/// One sample read from the plant.
+struct Measurement {
+  double y = 0.0;  ///< measured output (force, N)
+  /// Auxiliary measurement (chamber pressure, Pa) when the backend has one, else NaN.
+  double aux = std::numeric_limits<double>::quiet_NaN();
+};
+
+class IoBackend {
+ public:
+  virtual ~IoBackend() = default;
+  /// Prepares the device for a run with sample period `period` (s).
+  /// @throws DataError (device missing, server not answering) or InvalidArgument.
+  virtual void Open(double period) = 0;
+  /// Reads the current sample. Never throws; failures are returned as a status.
+  virtual IoStatus Read(Measurement* m) noexcept = 0;
+  /// Applies input u (duty %) for one period. Never throws.
+  virtual IoStatus Write(double u) noexcept = 0;
+  /// Drives the outputs to the safe state. Never throws; best effort on a broken device.
+  virtual IoStatus EnterSafeState(SafeState state) noexcept = 0;
+  /// Releases the device (outputs are left in the last state written).
+  virtual void Close() = 0;
+  /// True when the backend keeps its own time (simulation) so the loop may run
+  /// as fast as possible instead of sleeping.
+  virtual bool CanRunFast() const { return false; }
+  /// Short description for logs, e.g. "udp://127.0.0.1:5000 (ipa ...)".
+  virtual std::string Describe() const = 0;
+};
+
+/// Backend kinds selectable with --io.
+enum class IoKind { kSim, kComedi, kUdp };
+const char* ToString(IoKind k);
+
+/// Parsed --io value: "sim", "comedi" or "comedi:/dev/comediN", "udp://HOST:PORT".
+struct IoSpec {
+  IoKind kind = IoKind::kSim;
+  std::string device = "/dev/comedi0";  ///< comedi device path
+  std::string host = "127.0.0.1";       ///< udp server host
+  int port = 0;                         ///< udp server port
+  std::string ToString() const;
+};
+
+/// Parses an --io spec. @throws InvalidArgument naming the spec and what is wrong.
+IoSpec ParseIoSpec(const std::string& spec);
+
+}  // namespace pneumid

@@ -1,0 +1,127 @@
+// Logging of the real-time loop: the loop thread pushes one LogRecord per
+// sample into a lock-free ring buffer; a writer thread formats and writes them.
+//
+// CSV layout (format "csv"):
+//   # pneumid real-time log                      <- header lines start with '#'
+//   # key: value                                 <- configuration, controller, ...
+//   # timing: ...                                <- filled in at Close() (reserved space)
+//   # stop: ...                                  <- filled in at Close() (reserved space)
+//   t,u,y,r,u_ctrl,aux,jitter_us,compute_us,flags,fault
+//   0.00,12.5,0.31,...
+// Columns: t (s, scheduled time), u (applied duty %, after the safety layer),
+// y (measured force, N), r (set point, N), u_ctrl (controller output before the
+// safety layer, %), aux (chamber pressure, Pa, or nan), jitter_us (wake-up
+// lateness), compute_us (time of the step), flags (bit 0 clamped, 1 rate
+// limited, 2 stale sample, 3 deadline overrun, 4 safe state), fault (name, or
+// empty). The dataset format ("dataset") writes only t,u,y so that
+// `pneumid identify` reads it directly.
+//
+// Durability: the writer flushes to the operating system at least every
+// flush_interval seconds (default 1 s), so a process killed with SIGKILL loses
+// at most the last second; Close() drains the buffer, writes the statistics,
+// flushes and fsyncs. With ".mat" output the records are kept in memory and
+// written with matio at Close() (nothing survives SIGKILL: use CSV for that).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "pneumid/realtime/safety.hpp"
+#include "pneumid/realtime/spsc_ring_buffer.hpp"
+
+namespace pneumid {
+
+/// One logged sample (trivially copyable, pushed from the loop thread).
+struct LogRecord {
+  std::int64_t k = 0;
+  double t = 0.0;
+  double u = 0.0;
+  double y = 0.0;
+  double r = 0.0;
+  double u_ctrl = 0.0;
+  double aux = 0.0;
+  double jitter_us = 0.0;
+  double compute_us = 0.0;
+  std::uint32_t flags = 0;
+  Fault fault = Fault::kNone;
+};
+
+/// Bits of LogRecord::flags.
+enum LogFlag : std::uint32_t {
+  kLogClamped = 1u << 0,
+  kLogRateLimited = 1u << 1,
+  kLogStale = 1u << 2,
+  kLogOverrun = 1u << 3,
+  kLogSafeState = 1u << 4,
+};
+
+enum class LogFormat {
+  kCsv,      ///< all columns, CSV with '#' header
+  kDataset,  ///< t,u,y only (CSV with '#' header), for `pneumid identify`
+  kMat,      ///< MATLAB .mat (v5) written at Close()
+};
+const char* ToString(LogFormat f);
+/// "csv", "dataset", "mat". @throws InvalidArgument.
+LogFormat LogFormatFromString(const std::string& name);
+
+struct LogWriterOptions {
+  LogFormat format = LogFormat::kCsv;
+  std::size_t capacity = 1 << 16;  ///< ring buffer records (65 s at 1 kHz)
+  double flush_interval = 1.0;     ///< seconds between flushes to the OS
+  bool IsValid(std::string* error) const;
+};
+
+class LogWriter {
+ public:
+  /// Opens `path` (truncating), writes the header lines (key, value) and starts the
+  /// writer thread. @throws DataError when the file cannot be created, InvalidArgument
+  /// on bad options.
+  LogWriter(std::string path, std::vector<std::pair<std::string, std::string>> header,
+            LogWriterOptions options = {});
+  /// Closes if still open (errors ignored).
+  ~LogWriter();
+  LogWriter(const LogWriter&) = delete;
+  LogWriter& operator=(const LogWriter&) = delete;
+
+  /// Loop thread: queues a record. Never blocks or allocates; when the buffer is
+  /// full the record is dropped and counted.
+  void Push(const LogRecord& r) noexcept {
+    if (!ring_.TryPush(r)) dropped_.fetch_add(1, std::memory_order_relaxed);
+  }
+  /// Stops the writer thread after draining every queued record, fills in the
+  /// reserved `timing` and `stop` header lines, flushes and fsyncs.
+  /// @throws DataError on a write error.
+  void Close(const std::string& timing_line = "", const std::string& stop_line = "");
+
+  const std::string& path() const { return path_; }
+  std::int64_t written() const { return written_.load(); }
+  std::int64_t dropped() const { return dropped_.load(); }
+
+ private:
+  void WriterMain();
+  void WriteRecord(const LogRecord& r);
+  void WriteMat();
+
+  std::string path_;
+  LogWriterOptions options_;
+  std::vector<std::pair<std::string, std::string>> header_;
+  SpscRingBuffer<LogRecord> ring_;
+  std::FILE* file_ = nullptr;
+  long timing_offset_ = -1;
+  long stop_offset_ = -1;
+  std::vector<LogRecord> mat_records_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::int64_t> written_{0};
+  std::atomic<std::int64_t> dropped_{0};
+  std::atomic<bool> io_error_{false};
+  std::thread thread_;
+  bool closed_ = false;
+};
+
+}  // namespace pneumid

@@ -1,0 +1,132 @@
+// Fixed-period real-time loop.
+//
+// The loop runs on its own thread. At start-up that thread asks for real-time
+// scheduling (SCHED_FIFO, mlockall, CPU pinning); when the system refuses, it
+// keeps normal priority and says so in one line (LoopSummary::scheduling).
+// Then, for k = 0 .. N-1, with t_k = t_0 + k Ts on CLOCK_MONOTONIC:
+//
+//   clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, t_k)   (skipped when fast)
+//   y_k = io.Read()            -> SafetyMonitor::CheckMeasurement
+//   u_k = controller(r_k, y_k) -> SafetyMonitor::LimitOutput (clamp, rate)
+//   io.Write(u_k)
+//   timing (jitter, compute, overrun) -> TimingStats; record -> LogWriter ring
+//
+// After start-up nothing on the loop thread allocates, locks or does file
+// I/O (tests/realtime/realtime_loop_test.cpp checks it with a counting
+// allocator). A fault, a stop signal (SIGINT/SIGTERM with
+// InstallStopSignalHandlers) or the end of the run drive the outputs to the
+// safe state.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pneumid/realtime/io_backend.hpp"
+#include "pneumid/realtime/log_writer.hpp"
+#include "pneumid/realtime/safety.hpp"
+#include "pneumid/realtime/timing_stats.hpp"
+
+namespace pneumid {
+
+/// What the loop calls every period. Update runs on the loop thread: it must not
+/// allocate, lock or do I/O, and must not throw (return NaN to report a failure).
+class LoopController {
+ public:
+  virtual ~LoopController() = default;
+  /// Called once before the first period (may allocate). y0 is the first measurement.
+  virtual void Reset() {}
+  /// Input u_k (duty, %) for set point r (N) and measurement y (N) at sample k.
+  virtual double Update(std::int64_t k, double r, double y) noexcept = 0;
+  /// Description for the log header, e.g. "dmc P=126 M=5 lambda=2.25".
+  virtual std::string Describe() const = 0;
+};
+
+/// Open-loop input (experiments): u_k = input[k] (the last value held beyond the end).
+class OpenLoopInput : public LoopController {
+ public:
+  /// @throws InvalidArgument when input is empty or holds non-finite values.
+  OpenLoopInput(std::vector<double> input, std::string description);
+  double Update(std::int64_t k, double r, double y) noexcept override;
+  std::string Describe() const override { return description_; }
+
+ private:
+  std::vector<double> input_;
+  std::string description_;
+};
+
+struct LoopOptions {
+  double period = 0.01;    ///< s; default 10 ms (the paper's Ts), allowed 1e-4 .. 10 s
+  double duration = 10.0;  ///< s; number of samples = round(duration / period)
+  /// Run as fast as possible (no sleeping; only for backends that keep their own
+  /// time, i.e. sim). Jitter is then not measured. Default false.
+  bool fast = false;
+  bool realtime = true;  ///< try SCHED_FIFO + mlockall + pinning (default true)
+  int priority = 80;     ///< SCHED_FIFO priority 1..99
+  int cpu = -1;          ///< CPU to pin to; -1: the last allowed CPU; -2: no pinning
+  bool IsValid(std::string* error) const;
+  /// round(duration / period).
+  std::int64_t Samples() const;
+};
+
+enum class LoopTermination {
+  kCompleted,  ///< all samples run
+  kStopped,    ///< SIGINT/SIGTERM or RequestStop()
+  kFault,      ///< a safety fault; outputs in the safe state
+};
+const char* ToString(LoopTermination t);
+
+struct LoopSummary {
+  LoopTermination termination = LoopTermination::kCompleted;
+  Fault fault = Fault::kNone;
+  int signal = 0;            ///< signal number when stopped by a signal
+  std::string message;       ///< what happened, e.g. "sensor-nan at t = 1.230 s (sample 123) ..."
+  std::string scheduling;    ///< one line: real-time scheduling obtained or why not
+  std::int64_t samples = 0;  ///< samples run (rows logged)
+  std::int64_t log_dropped = 0;  ///< records the log could not take (ring buffer full)
+  SafeState safe_state = SafeState::kValvesClosed;
+  IoStatus safe_state_status = IoStatus::kOk;  ///< result of EnterSafeState
+  TimingReport timing;
+  double wall_time = 0.0;  ///< s from the first to the last sample
+
+  /// 0 when completed, 128 + signal when stopped by a signal, 3 on a fault.
+  int ExitStatus() const;
+  std::string BriefReport() const;
+  /// timing keys of TimingReport::ToJson plus termination, fault, message, samples,
+  /// scheduling, safe_state, log_dropped, wall_time.
+  nlohmann::json ToJson() const;
+};
+
+/// Live values published by the loop (relaxed atomics) for a status line.
+struct LoopStatus {
+  std::atomic<std::int64_t> k{-1};
+  std::atomic<double> r{0.0}, y{0.0}, u{0.0}, jitter_us{0.0};
+  std::atomic<std::int64_t> overruns{0};
+  std::atomic<bool> running{false};
+};
+
+/// Runs the loop (blocking until it ends). `setpoint` holds r_k per sample (the last
+/// value is held; empty means 0). `log` and `status` may be null. The backend is
+/// opened before and closed after the run; the log is not closed (the caller adds
+/// the summary with LogWriter::Close).
+/// @throws InvalidArgument on invalid options (or fast with a backend that cannot),
+/// DataError when the backend cannot be opened. Faults during the run are reported
+/// in the summary, never thrown.
+LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& controller,
+                    const std::vector<double>& setpoint, SafetyMonitor& safety,
+                    LogWriter* log = nullptr, LoopStatus* status = nullptr);
+
+/// Installs SIGINT and SIGTERM handlers that ask every running loop to stop
+/// (outputs to the safe state, log flushed). Idempotent.
+void InstallStopSignalHandlers();
+/// Asks running loops to stop as a signal would (signal 0 = programmatic).
+void RequestStop(int signal = 0);
+/// Clears a previous stop request (before a new run).
+void ClearStopRequest();
+/// The signal that requested a stop (-1 when none).
+int StopRequestSignal();
+
+}  // namespace pneumid

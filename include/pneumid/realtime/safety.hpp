@@ -1,0 +1,102 @@
+// Safety layer of the real-time loop, independent of the controller.
+//
+// Every sample the loop
+//   1. checks the measurement (I/O status, NaN, range, frozen sensor),
+//   2. lets the controller compute u,
+//   3. clamps u to [u_min, u_max] and limits its rate to |du/dt| <= rate_max,
+//   4. counts deadline overruns.
+// Any fault ends the run: the outputs go to the configured safe state (both
+// valves closed, or exhaust open), the reason is logged, the log is flushed and
+// the program exits non-zero.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace pneumid {
+
+/// What the outputs are driven to on a fault or stop.
+enum class SafeState {
+  kValvesClosed,  ///< inlet and exhaust valves closed: chamber pressure held
+  kExhaustOpen,   ///< inlet closed, exhaust open: chamber vents, force falls to its minimum
+};
+/// "valves-closed" / "exhaust-open".
+const char* ToString(SafeState s);
+/// Inverse of ToString. @throws InvalidArgument listing the accepted names.
+SafeState SafeStateFromString(const std::string& name);
+
+/// Why a run ended abnormally (kNone: no fault).
+enum class Fault : std::uint8_t {
+  kNone = 0,
+  kSensorNaN,         ///< measurement not finite
+  kSensorOutOfRange,  ///< measurement outside [y_min, y_max] or ADC rail
+  kSensorFrozen,      ///< measurement unchanged for frozen_samples samples
+  kIoError,           ///< backend read/write failed
+  kTimeout,           ///< backend (plant server) stopped answering
+  kDeadlineOverruns,  ///< more than max_overruns deadline overruns
+  kControllerError,   ///< controller returned a non-finite output
+};
+/// "none", "sensor-nan", "sensor-out-of-range", "sensor-frozen", "io-error", "timeout",
+/// "deadline-overruns", "controller-error". Static strings, safe on the loop thread.
+const char* ToString(Fault f);
+/// Inverse of ToString. @throws InvalidArgument listing the accepted names.
+Fault FaultFromString(const std::string& name);
+
+/// Status of one backend read or write.
+enum class IoStatus : std::uint8_t {
+  kOk = 0,
+  kStale,       ///< no new sample this period (e.g. a late UDP reply); last value repeated
+  kOutOfRange,  ///< ADC at its rail / converter reported out of range
+  kError,       ///< the call failed
+  kTimeout,     ///< too many consecutive stale samples
+};
+const char* ToString(IoStatus s);
+
+struct SafetyOptions {
+  double u_min = 0.0;    ///< lower output clamp (duty %, default 0)
+  double u_max = 100.0;  ///< upper output clamp (duty %, default 100)
+  /// Maximum output rate (duty % per second; 0 or infinity disables). Default: disabled.
+  double rate_max = 0.0;
+  double y_min = -1e300;  ///< measurement range (output units, e.g. N); outside -> fault
+  double y_max = 1e300;
+  /// Fault when the measurement stays within frozen_tolerance of the same value for this
+  /// many consecutive samples (0 disables; default 0 because a noise-free simulator
+  /// legitimately settles to a constant).
+  int frozen_samples = 0;
+  double frozen_tolerance = 0.0;  ///< output units
+  /// Fault when the number of deadline overruns exceeds this (negative: never). Default 10.
+  int max_overruns = 10;
+  SafeState safe_state = SafeState::kValvesClosed;  ///< default: both valves closed
+
+  bool IsValid(std::string* error) const;
+};
+
+/// Stateful checks; all methods are allocation-free and meant for the loop thread.
+class SafetyMonitor {
+ public:
+  /// @throws InvalidArgument when options are invalid (message from IsValid).
+  explicit SafetyMonitor(const SafetyOptions& options);
+  const SafetyOptions& options() const { return options_; }
+
+  /// Back to the initial state; `u0` is the output the rate limiter starts from.
+  void Reset(double u0 = 0.0) noexcept;
+  /// Checks one measurement and its I/O status; returns the fault, or kNone.
+  Fault CheckMeasurement(IoStatus status, double y) noexcept;
+  /// Clamps and rate-limits a controller output for a period of `dt` seconds.
+  /// Sets *flags bits: 1 = clamped, 2 = rate limited. A non-finite u is returned as is.
+  double LimitOutput(double u, double dt, unsigned* flags) noexcept;
+  /// Counts one deadline overrun; returns kDeadlineOverruns once the count exceeds
+  /// max_overruns.
+  Fault OnOverrun() noexcept;
+  std::int64_t overruns() const { return overruns_; }
+
+ private:
+  SafetyOptions options_;
+  double last_u_ = 0.0;
+  double frozen_ref_ = 0.0;
+  int frozen_count_ = 0;
+  bool have_ref_ = false;
+  std::int64_t overruns_ = 0;
+};
+
+}  // namespace pneumid

@@ -1,0 +1,44 @@
+// Simulation backend: any Plant (the nonlinear IPA simulator, a linear digital
+// twin) behind the IoBackend interface. Read() is Plant::Measure(), Write(u) is
+// Plant::Advance(u). Paced in real time by the loop, or as fast as possible
+// (LoopOptions::fast) since the plant keeps its own time.
+//
+// Safe state in simulation: the Plant interface has a single input (duty, %),
+// so "exhaust-open" applies u = 0 % for one period (the inlet closed, chamber
+// venting) and "valves-closed" stops advancing the plant (pressure held).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "pneumid/plant/plant.hpp"
+#include "pneumid/realtime/io_backend.hpp"
+
+namespace pneumid {
+
+class SimBackend : public IoBackend {
+ public:
+  /// Takes ownership of the plant. @throws InvalidArgument when plant is null.
+  explicit SimBackend(std::unique_ptr<Plant> plant);
+  /// Resets the plant. @throws InvalidArgument when `period` differs from the plant's
+  /// Ts by more than 1e-9 s.
+  void Open(double period) override;
+  IoStatus Read(Measurement* m) noexcept override;
+  IoStatus Write(double u) noexcept override;
+  IoStatus EnterSafeState(SafeState state) noexcept override;
+  void Close() override {}
+  bool CanRunFast() const override { return true; }
+  std::string Describe() const override;
+
+  Plant& plant() { return *plant_; }
+  /// True once EnterSafeState was called; which state.
+  bool in_safe_state() const { return in_safe_state_; }
+  SafeState safe_state() const { return safe_state_; }
+
+ private:
+  std::unique_ptr<Plant> plant_;
+  bool in_safe_state_ = false;
+  SafeState safe_state_ = SafeState::kValvesClosed;
+};
+
+}  // namespace pneumid

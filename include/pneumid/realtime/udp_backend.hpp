@@ -1,0 +1,67 @@
+// UDP backend (client side of the plant-server protocol, udp_protocol.hpp).
+//
+// Per period: Read() collects the reply to the previous Step (y_k) without
+// blocking longer than reply_wait; Write(u_k) sends the next Step and returns
+// at once. A reply that has not arrived gives a stale sample (the last value is
+// repeated and flagged); max_missed consecutive stale samples give
+// IoStatus::kTimeout, so a server that stops answering is detected within
+// max_missed periods.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "pneumid/realtime/io_backend.hpp"
+#include "pneumid/realtime/udp_protocol.hpp"
+
+namespace pneumid {
+
+struct UdpBackendOptions {
+  std::string host = "127.0.0.1";
+  int port = 5000;
+  int max_missed = 3;          ///< consecutive missing replies before a timeout fault (>= 1)
+  double reply_wait = 0.25;    ///< fraction of the period Read() may wait for a late reply
+  double hello_timeout = 1.0;  ///< s to wait for the server's answer to Hello (per attempt)
+  int hello_attempts = 3;
+  bool IsValid(std::string* error) const;
+};
+
+class UdpBackend : public IoBackend {
+ public:
+  /// @throws InvalidArgument on invalid options.
+  explicit UdpBackend(UdpBackendOptions options);
+  ~UdpBackend() override;
+  /// Resolves the host, connects and sends Hello(period).
+  /// @throws DataError when the host cannot be resolved, the server does not answer,
+  /// or it rejects the period.
+  void Open(double period) override;
+  IoStatus Read(Measurement* m) noexcept override;
+  IoStatus Write(double u) noexcept override;
+  /// Sends Safe(state) and waits up to one period (at least 20 ms) for the answer.
+  IoStatus EnterSafeState(SafeState state) noexcept override;
+  void Close() override;
+  std::string Describe() const override;
+
+  std::int64_t stale_samples() const { return stale_total_; }
+  /// Round-trip time of the last reply (us).
+  double last_rtt_us() const { return last_rtt_us_; }
+
+ private:
+  // Receives pending replies; returns true when the one for `expect_seq_` arrived.
+  bool Collect(std::int64_t wait_ns) noexcept;
+
+  UdpBackendOptions options_;
+  int fd_ = -1;
+  double period_ = 0.01;
+  std::uint32_t seq_ = 0;
+  std::uint32_t expect_seq_ = 0;
+  bool have_reply_ = false;  // reply for expect_seq_ received
+  bool bad_status_ = false;
+  double last_y_ = 0.0;
+  double last_aux_ = 0.0;
+  int missed_ = 0;
+  std::int64_t stale_total_ = 0;
+  double last_rtt_us_ = 0.0;
+};
+
+}  // namespace pneumid

@@ -1,0 +1,91 @@
+// Datagram protocol between the real-time loop (client) and a plant server
+// (`pneumid plant-server`), version 1. Documented in docs/realtime.md.
+//
+// Every datagram is exactly 64 bytes, all fields little-endian, no padding:
+//
+//   Request (client -> server)             Reply (server -> client)
+//   off size field                          off size field
+//    0   4   magic 0x444D4E50 ("PNMD")       0   4   magic
+//    4   2   version = 1                      4   2   version
+//    6   2   type (Hello, Step, Safe, Bye)    6   2   type | 0x80
+//    8   4   sequence                         8   4   sequence (echoed)
+//   12   4   arg (safe state for Safe)       12   4   status (PacketStatus)
+//   16   8   client time, ns (int64)         16   8   client time (echoed)
+//   24   8   u, duty % (float64)             24   8   server time, ns (int64, monotonic)
+//   32   8   Ts, s (Hello) (float64)         32   8   plant time, s (float64)
+//   40  24   reserved, zero                  40   8   y, measured output (float64)
+//                                            48   8   aux (pressure, Pa, or NaN)
+//                                            56   8   reserved, zero
+//
+// Semantics (one exchange per period):
+//   Hello(Ts)  -> the server resets its plant and replies y_0 (status BadTs when the
+//                 plant's sample time differs from Ts).
+//   Step(u_k)  -> the server holds u_k for one period (Plant::Advance) and replies
+//                 y_(k+1); a repeated sequence number is answered again, not re-applied.
+//   Safe(s)    -> the server drives its plant's outputs to safe state s and replies.
+//   Bye        -> the session ends (the server keeps serving new Hellos).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+
+namespace pneumid::udp {
+
+inline constexpr std::uint32_t kMagic = 0x444D4E50u;  // bytes "PNMD" on the wire
+inline constexpr std::uint16_t kVersion = 1;
+inline constexpr std::size_t kPacketSize = 64;
+inline constexpr std::uint16_t kReplyBit = 0x80;
+
+enum class PacketType : std::uint16_t { kHello = 1, kStep = 2, kSafe = 3, kBye = 4 };
+enum class PacketStatus : std::uint32_t {
+  kOk = 0,
+  kBadVersion = 1,
+  kBadType = 2,
+  kBadTs = 3,
+  kNoSession = 4,  ///< Step before Hello
+};
+const char* ToString(PacketStatus s);
+
+using Packet = std::array<std::uint8_t, kPacketSize>;
+
+struct Request {
+  PacketType type = PacketType::kStep;
+  std::uint32_t sequence = 0;
+  std::uint32_t arg = 0;
+  std::int64_t client_time_ns = 0;
+  double u = 0.0;
+  double Ts = 0.0;
+};
+
+struct Reply {
+  PacketType type = PacketType::kStep;
+  std::uint32_t sequence = 0;
+  PacketStatus status = PacketStatus::kOk;
+  std::int64_t client_time_ns = 0;
+  std::int64_t server_time_ns = 0;
+  double plant_time = 0.0;
+  double y = 0.0;
+  double aux = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// Result of decoding a datagram.
+enum class DecodeResult {
+  kOk,
+  kWrongSize,
+  kBadMagic,
+  kBadVersion,
+  kBadType,
+  kNotReply,
+  kNotRequest
+};
+const char* ToString(DecodeResult r);
+
+/// Serialization (allocation-free, usable on the loop thread).
+Packet Encode(const Request& r) noexcept;
+Packet Encode(const Reply& r) noexcept;
+/// Decodes `size` bytes at `data`.
+DecodeResult DecodeRequest(const std::uint8_t* data, std::size_t size, Request* out) noexcept;
+DecodeResult DecodeReply(const std::uint8_t* data, std::size_t size, Reply* out) noexcept;
+
+}  // namespace pneumid::udp

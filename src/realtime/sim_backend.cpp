@@ -1,0 +1,55 @@
+#include "pneumid/realtime/sim_backend.hpp"
+
+#include <cmath>
+
+#include "pneumid/common/check.hpp"
+
+namespace pneumid {
+
+SimBackend::SimBackend(std::unique_ptr<Plant> plant) : plant_(std::move(plant)) {
+  PNEUMID_CHECK(plant_ != nullptr, "SimBackend needs a plant, got null");
+}
+
+void SimBackend::Open(double period) {
+  PNEUMID_CHECK(std::abs(period - plant_->Ts()) <= 1e-9,
+                "loop period {} s differs from the plant's sample time {} s", period, plant_->Ts());
+  plant_->Reset();
+  in_safe_state_ = false;
+}
+
+IoStatus SimBackend::Read(Measurement* m) noexcept {
+  try {
+    m->y = plant_->Measure();
+  } catch (...) {
+    return IoStatus::kError;
+  }
+  return IoStatus::kOk;
+}
+
+IoStatus SimBackend::Write(double u) noexcept {
+  if (in_safe_state_) return IoStatus::kOk;
+  try {
+    plant_->Advance(u);
+  } catch (...) {
+    return IoStatus::kError;
+  }
+  return IoStatus::kOk;
+}
+
+IoStatus SimBackend::EnterSafeState(SafeState state) noexcept {
+  IoStatus status = IoStatus::kOk;
+  if (state == SafeState::kExhaustOpen && !in_safe_state_) {
+    try {
+      plant_->Advance(0.0);
+    } catch (...) {
+      status = IoStatus::kError;
+    }
+  }
+  in_safe_state_ = true;
+  safe_state_ = state;
+  return status;
+}
+
+std::string SimBackend::Describe() const { return "sim (" + plant_->Describe() + ")"; }
+
+}  // namespace pneumid

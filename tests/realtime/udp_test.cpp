@@ -1,0 +1,290 @@
+// The plant-server protocol: byte layout, decoding of bad datagrams, and a
+// closed loop through a plant server on 127.0.0.1 compared with the offline
+// simulation; a server that stops answering is detected within max_missed periods.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/realtime/plant_server.hpp"
+#include "pneumid/realtime/realtime_loop.hpp"
+#include "pneumid/realtime/udp_backend.hpp"
+#include "pneumid/realtime/udp_protocol.hpp"
+#include "test_support.hpp"
+
+namespace pneumid {
+namespace {
+
+using testing::CountingPi;
+using testing::FirstOrderPlant;
+using ::testing::HasSubstr;
+
+TEST(UdpProtocol, RequestLayoutIsLittleEndianAtTheDocumentedOffsets) {
+  udp::Request r;
+  r.type = udp::PacketType::kStep;
+  r.sequence = 0x01020304;
+  r.arg = 7;
+  r.client_time_ns = 0x1122334455667788LL;
+  r.u = 1.5;  // 0x3FF8000000000000
+  r.Ts = 0.01;
+  const udp::Packet p = udp::Encode(r);
+  EXPECT_EQ(p[0], 'P');
+  EXPECT_EQ(p[1], 'N');
+  EXPECT_EQ(p[2], 'M');
+  EXPECT_EQ(p[3], 'D');
+  EXPECT_EQ(p[4], 1);  // version 1
+  EXPECT_EQ(p[5], 0);
+  EXPECT_EQ(p[6], 2);  // Step
+  EXPECT_EQ(p[8], 0x04);
+  EXPECT_EQ(p[11], 0x01);
+  EXPECT_EQ(p[12], 7);
+  EXPECT_EQ(p[16], 0x88);
+  EXPECT_EQ(p[23], 0x11);
+  EXPECT_EQ(p[30], 0xF8);
+  EXPECT_EQ(p[31], 0x3F);
+  for (std::size_t i = 40; i < 64; ++i) EXPECT_EQ(p[i], 0) << i;
+  udp::Request back;
+  ASSERT_EQ(udp::DecodeRequest(p.data(), p.size(), &back), udp::DecodeResult::kOk);
+  EXPECT_EQ(back.sequence, r.sequence);
+  EXPECT_EQ(back.client_time_ns, r.client_time_ns);
+  EXPECT_EQ(back.u, 1.5);
+  EXPECT_EQ(back.Ts, 0.01);
+}
+
+TEST(UdpProtocol, ReplyRoundTripAndRejections) {
+  udp::Reply r;
+  r.type = udp::PacketType::kHello;
+  r.sequence = 9;
+  r.status = udp::PacketStatus::kBadTs;
+  r.server_time_ns = 123456789;
+  r.plant_time = 2.5;
+  r.y = -12.25;
+  const udp::Packet p = udp::Encode(r);
+  EXPECT_EQ(p[6], 0x81);  // Hello | reply bit
+  udp::Reply back;
+  ASSERT_EQ(udp::DecodeReply(p.data(), p.size(), &back), udp::DecodeResult::kOk);
+  EXPECT_EQ(back.status, udp::PacketStatus::kBadTs);
+  EXPECT_EQ(back.y, -12.25);
+  EXPECT_TRUE(std::isnan(back.aux));
+  udp::Request req;
+  EXPECT_EQ(udp::DecodeRequest(p.data(), p.size(), &req), udp::DecodeResult::kNotRequest);
+  EXPECT_EQ(udp::DecodeReply(p.data(), 63, &back), udp::DecodeResult::kWrongSize);
+  udp::Packet bad = p;
+  bad[0] = 'X';
+  EXPECT_EQ(udp::DecodeReply(bad.data(), bad.size(), &back), udp::DecodeResult::kBadMagic);
+  bad = p;
+  bad[4] = 2;
+  EXPECT_EQ(udp::DecodeReply(bad.data(), bad.size(), &back), udp::DecodeResult::kBadVersion);
+  bad = p;
+  bad[6] = 0x85;
+  EXPECT_EQ(udp::DecodeReply(bad.data(), bad.size(), &back), udp::DecodeResult::kBadType);
+}
+
+TEST(PlantServer, HandlesHelloStepRetransmissionAndBadPeriod) {
+  PlantServerOptions o;
+  o.port = 0;
+  PlantServer server(std::make_unique<FirstOrderPlant>(0.01, 0.5, 1.0), o);
+  EXPECT_GT(server.port(), 0);
+  udp::Packet out;
+  udp::Reply rep;
+  udp::Request step;
+  step.type = udp::PacketType::kStep;
+  step.sequence = 1;
+  step.u = 2.0;
+  udp::Packet p = udp::Encode(step);
+  ASSERT_TRUE(server.Handle(p.data(), p.size(), &out));
+  udp::DecodeReply(out.data(), out.size(), &rep);
+  EXPECT_EQ(rep.status, udp::PacketStatus::kNoSession);
+
+  udp::Request hello;
+  hello.type = udp::PacketType::kHello;
+  hello.Ts = 0.02;
+  p = udp::Encode(hello);
+  ASSERT_TRUE(server.Handle(p.data(), p.size(), &out));
+  udp::DecodeReply(out.data(), out.size(), &rep);
+  EXPECT_EQ(rep.status, udp::PacketStatus::kBadTs);
+  hello.Ts = 0.01;
+  p = udp::Encode(hello);
+  ASSERT_TRUE(server.Handle(p.data(), p.size(), &out));
+  udp::DecodeReply(out.data(), out.size(), &rep);
+  EXPECT_EQ(rep.status, udp::PacketStatus::kOk);
+  EXPECT_EQ(rep.y, 0.0);
+
+  p = udp::Encode(step);
+  ASSERT_TRUE(server.Handle(p.data(), p.size(), &out));
+  udp::DecodeReply(out.data(), out.size(), &rep);
+  EXPECT_EQ(rep.y, 2.0);                                 // y1 = 0.5 * 0 + 1.0 * 2
+  ASSERT_TRUE(server.Handle(p.data(), p.size(), &out));  // same sequence: not applied again
+  udp::DecodeReply(out.data(), out.size(), &rep);
+  EXPECT_EQ(rep.y, 2.0);
+  step.sequence = 2;
+  p = udp::Encode(step);
+  ASSERT_TRUE(server.Handle(p.data(), p.size(), &out));
+  udp::DecodeReply(out.data(), out.size(), &rep);
+  EXPECT_EQ(rep.y, 3.0);  // 0.5 * 2 + 2
+  EXPECT_DOUBLE_EQ(rep.plant_time, 0.02);
+  EXPECT_FALSE(server.Handle(p.data(), 10, &out));
+  EXPECT_EQ(server.stats().steps, 2);
+  EXPECT_EQ(server.stats().bad_packets, 1);
+}
+
+TEST(PlantServer, PortInUseIsAClearError) {
+  PlantServerOptions o;
+  o.port = 0;
+  PlantServer a(std::make_unique<FirstOrderPlant>(0.01, 0.5, 1.0), o);
+  o.port = a.port();
+  try {
+    PlantServer b(std::make_unique<FirstOrderPlant>(0.01, 0.5, 1.0), o);
+    FAIL() << "second bind succeeded";
+  } catch (const DataError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("cannot bind"));
+  }
+}
+
+struct ServerThread {
+  explicit ServerThread(PlantServerOptions o)
+      : server(std::make_unique<FirstOrderPlant>(0.01, 0.95, 0.05), o),
+        thread([this] { server.Serve(stop); }) {}
+  ~ServerThread() {
+    stop = true;
+    thread.join();
+  }
+  std::atomic<bool> stop{false};
+  PlantServer server;
+  std::thread thread;
+};
+
+TEST(UdpBackend, ClosedLoopThroughThePlantServerMatchesTheOfflineSimulation) {
+  PlantServerOptions so;
+  so.port = 0;
+  auto srv = std::make_unique<ServerThread>(so);
+  UdpBackendOptions uo;
+  uo.port = srv->server.port();
+  UdpBackend io(uo);
+  CountingPi pi(0.8, 4.0, 0.01);
+  SafetyOptions safety_options;
+  safety_options.max_overruns = -1;  // correctness here; timing is measured in bench/
+  SafetyMonitor safety(safety_options);
+  const std::string path = std::string(PNEUMID_BINARY_DIR) + "/realtime_test_udp.csv";
+  LogWriter log(path, {{"io", io.Describe()}});
+  LoopOptions o;
+  o.period = 0.01;
+  o.duration = 3.0;
+  o.realtime = false;
+  const LoopSummary s = RunLoop(o, io, pi, {10.0}, safety, &log);
+  log.Close(s.timing.BriefReport(), s.message);
+  srv.reset();
+
+  EXPECT_EQ(s.termination, LoopTermination::kCompleted) << s.message;
+  EXPECT_EQ(s.samples, 300);
+  EXPECT_EQ(pi.allocations_during_run(), 0);
+  // Offline: the same plant and controller in a plain loop.
+  FirstOrderPlant plant(0.01, 0.95, 0.05);
+  CountingPi ref(0.8, 4.0, 0.01);
+  ref.Reset();
+  plant.Reset();
+  std::vector<double> y_ref;
+  for (int k = 0; k < 300; ++k) {
+    y_ref.push_back(plant.Measure());
+    plant.Advance(std::clamp(ref.Update(k, 10.0, y_ref.back()), 0.0, 100.0));
+  }
+  std::ifstream in(path);
+  std::string line;
+  std::vector<double> y;
+  int stale = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line[0] == 't') continue;
+    std::vector<std::string> c;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) c.push_back(cell);
+    y.push_back(std::stod(c[2]));
+    if (std::stoi(c[8]) & kLogStale) ++stale;
+  }
+  ASSERT_EQ(y.size(), 300u);
+  EXPECT_EQ(stale, io.stale_samples());
+  if (stale == 0) {  // every reply arrived in time: the trajectories are identical
+    for (int k = 0; k < 300; ++k) EXPECT_NEAR(y[k], y_ref[k], 1e-6 * (1 + std::abs(y_ref[k])));
+  } else {  // a heavily loaded machine delayed some replies: same end point
+    EXPECT_NEAR(y.back(), y_ref.back(), 0.5);
+  }
+}
+
+TEST(UdpBackend, SilentServerIsATimeoutWithinMaxMissedPeriods) {
+  PlantServerOptions so;
+  so.port = 0;
+  so.stop_answering_after = 50;
+  auto srv = std::make_unique<ServerThread>(so);
+  UdpBackendOptions uo;
+  uo.port = srv->server.port();
+  uo.max_missed = 3;
+  UdpBackend io(uo);
+  CountingPi pi(0.8, 4.0, 0.01);
+  SafetyOptions safety_options;
+  safety_options.max_overruns = -1;
+  safety_options.safe_state = SafeState::kExhaustOpen;
+  SafetyMonitor safety(safety_options);
+  const std::string path = std::string(PNEUMID_BINARY_DIR) + "/realtime_test_udp_timeout.csv";
+  LogWriter log(path, {});
+  LoopOptions o;
+  o.period = 0.01;
+  o.duration = 3.0;
+  o.realtime = false;
+  const LoopSummary s = RunLoop(o, io, pi, {10.0}, safety, &log);
+  log.Close(s.timing.BriefReport(), s.message);
+  srv.reset();
+  EXPECT_EQ(s.termination, LoopTermination::kFault);
+  EXPECT_EQ(s.fault, Fault::kTimeout);
+  // 50 steps answered (samples 0..50 fresh), then 3 missing replies: fault at sample 53.
+  EXPECT_EQ(s.samples, 54);
+  EXPECT_THAT(s.message, HasSubstr("timeout"));
+  EXPECT_THAT(s.message, HasSubstr("exhaust-open"));
+}
+
+TEST(UdpBackend, NoServerIsAClearErrorAtOpen) {
+  PlantServerOptions so;
+  so.port = 0;
+  int port = 0;
+  {
+    PlantServer probe(std::make_unique<FirstOrderPlant>(0.01, 0.5, 1.0), so);
+    port = probe.port();
+  }  // closed: nobody listens on `port` now
+  UdpBackendOptions uo;
+  uo.port = port;
+  uo.hello_timeout = 0.1;
+  uo.hello_attempts = 2;
+  UdpBackend io(uo);
+  try {
+    io.Open(0.01);
+    FAIL() << "Open succeeded without a server";
+  } catch (const DataError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("no answer from a plant server"));
+  }
+  EXPECT_THROW(UdpBackend(UdpBackendOptions{"", 1}), InvalidArgument);
+}
+
+TEST(IoSpec, ParsesTheThreeBackends) {
+  EXPECT_EQ(ParseIoSpec("sim").kind, IoKind::kSim);
+  IoSpec c = ParseIoSpec("comedi:/dev/comedi1");
+  EXPECT_EQ(c.kind, IoKind::kComedi);
+  EXPECT_EQ(c.device, "/dev/comedi1");
+  EXPECT_EQ(ParseIoSpec("comedi").device, "/dev/comedi0");
+  IoSpec u = ParseIoSpec("udp://127.0.0.1:5000");
+  EXPECT_EQ(u.kind, IoKind::kUdp);
+  EXPECT_EQ(u.host, "127.0.0.1");
+  EXPECT_EQ(u.port, 5000);
+  EXPECT_EQ(u.ToString(), "udp://127.0.0.1:5000");
+  EXPECT_EQ(ParseIoSpec("udp://[::1]:7").host, "::1");
+  EXPECT_THROW(ParseIoSpec("udp://host"), InvalidArgument);
+  EXPECT_THROW(ParseIoSpec("udp://host:99999"), InvalidArgument);
+  EXPECT_THROW(ParseIoSpec("serial"), InvalidArgument);
+  EXPECT_THROW(ParseIoSpec("comedi:dev"), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pneumid
