@@ -1,0 +1,117 @@
+// Closed-loop evaluation: a controller driving any Plant (the controller's
+// model need not be the plant) through a set-point profile, with load
+// disturbance steps, measurement noise and actuator limits, and the metrics
+// engineers compare controllers by.
+//
+// Loop at sample k = 0 .. n-1 (t_k = k Ts, n = round(duration / Ts)):
+//   d_k applied with plant.SetLoadDisturbance (sum of the load steps with at <= t_k)
+//   y_k = plant.Measure();  y_meas = y_k + v_k   (v Gaussian, std noise_std)
+//   u_k = actuator.Clip(controller.Update(r_k, y_meas))
+//   plant.Advance(u_k)
+// The controller is Reset(u0, y_0) first, with r_{-1} = setpoint(-Ts) the
+// operating point the run starts from.
+//
+// Metrics (errors e = r - y use the plant output without the added noise):
+//   rise_time, overshoot_percent, settling_time (2 %): of the response to the
+//     first set-point change, over the samples until the next change
+//     (ComputeStepInfo of lti/response.hpp with y_initial = the previous
+//     set-point, y_final = the new one; times from the change), NaN when the
+//     set-point never changes or the response never settles in the window;
+//   steady_state_error: r - y averaged over the last 5 % (at least 1, at most
+//     50 samples) of the final set-point segment;
+//   iae = sum |e| Ts, ise = sum e^2 Ts, itae = sum t |e| Ts;
+//   tv_u = sum |u_k - u_{k-1}| (u_{-1} = u0); u_min, u_max;
+//   first_move = u_k - u_{k-1} at the first set-point change;
+//   load_peak_deviation: the largest |y - r| after the first load step (signed),
+//   load_recovery_time: time from the load step until |y - r| stays within
+//     max(2 % of |load size|, 3 noise_std) (NaN if it never does before the
+//     next set-point change or the end).
+// Per set-point change the same step metrics are listed in `steps`.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pneumid/control/controller.hpp"
+#include "pneumid/plant/plant.hpp"
+#include "pneumid/plant/signal.hpp"
+
+namespace pneumid {
+
+struct LoadStep {
+  double at = 0.0;    ///< s
+  double size = 0.0;  ///< output units, added to the disturbance from `at` on
+};
+
+struct ClosedLoopOptions {
+  double duration = 1.0;  ///< s (> 0)
+  std::vector<LoadStep> load_steps;
+  double noise_std = 0.0;  ///< measurement noise standard deviation (output units)
+  std::uint64_t seed = 1;  ///< noise seed
+  /// Actuator limits applied after the controller (infinite = none).
+  InputLimits actuator;
+  double u0 = 0.0;  ///< input before t = 0
+  /// Settling band as a fraction of the step (and rise 10-90 %).
+  double settling_threshold = 0.02;
+  /// Record the wall-clock time of every Update() call.
+  bool time_updates = false;
+  bool IsValid(std::string* error) const;
+};
+
+struct StepMetrics {
+  double time = 0.0;  ///< s, when the set-point changed
+  double from = 0.0;
+  double to = 0.0;
+  double rise_time = std::numeric_limits<double>::quiet_NaN();
+  double overshoot_percent = std::numeric_limits<double>::quiet_NaN();
+  double settling_time = std::numeric_limits<double>::quiet_NaN();
+  double steady_state_error = std::numeric_limits<double>::quiet_NaN();  ///< end of the segment
+  double first_move = std::numeric_limits<double>::quiet_NaN();
+};
+
+struct ClosedLoopMetrics {
+  double rise_time = std::numeric_limits<double>::quiet_NaN();
+  double overshoot_percent = std::numeric_limits<double>::quiet_NaN();
+  double settling_time = std::numeric_limits<double>::quiet_NaN();
+  double steady_state_error = std::numeric_limits<double>::quiet_NaN();
+  double first_move = std::numeric_limits<double>::quiet_NaN();
+  double iae = 0.0, ise = 0.0, itae = 0.0;
+  double tv_u = 0.0;
+  double u_min = 0.0, u_max = 0.0;
+  double load_peak_deviation = std::numeric_limits<double>::quiet_NaN();
+  double load_recovery_time = std::numeric_limits<double>::quiet_NaN();
+  std::vector<StepMetrics> steps;
+};
+
+struct ClosedLoopResult {
+  Eigen::VectorXd t;               ///< s
+  Eigen::VectorXd r;               ///< set-point
+  Eigen::VectorXd y;               ///< plant output (Measure())
+  Eigen::VectorXd y_meas;          ///< what the controller saw (y + noise)
+  Eigen::VectorXd u;               ///< applied input
+  Eigen::VectorXd d;               ///< load disturbance
+  Eigen::VectorXd update_seconds;  ///< per Update() (empty unless time_updates)
+  ClosedLoopMetrics metrics;
+  std::string controller;  ///< controller.Describe()
+  std::string plant;       ///< plant.Describe()
+};
+
+/// Runs the loop described above; the plant is Reset() first. The plant's
+/// and the controller's sample times must agree within 1e-9 relative.
+/// @throws InvalidArgument for invalid options or mismatched sample times.
+ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const Signal& setpoint,
+                                    const ClosedLoopOptions& options);
+
+/// Metrics of a logged run (t, r, y, u of equal length, uniform step Ts) as
+/// defined above; r_before and u_before are the values before t(0).
+/// @throws InvalidArgument for inconsistent lengths or fewer than 2 samples.
+ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen::VectorXd& r,
+                                           const Eigen::VectorXd& y, const Eigen::VectorXd& u,
+                                           double r_before, double u_before,
+                                           const ClosedLoopOptions& options);
+
+}  // namespace pneumid

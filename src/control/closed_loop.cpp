@@ -1,0 +1,212 @@
+#include "pneumid/control/closed_loop.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+
+#include <fmt/format.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/lti/response.hpp"
+
+namespace pneumid {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool Changed(double a, double b) { return std::abs(a - b) > 1e-12 * (1.0 + std::abs(a)); }
+}  // namespace
+
+bool ClosedLoopOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (!(duration > 0.0) || !std::isfinite(duration))
+    return fail(fmt::format("duration must be positive, got {}", duration));
+  for (const LoadStep& l : load_steps) {
+    if (!std::isfinite(l.at) || l.at < 0.0 || !std::isfinite(l.size))
+      return fail(
+          fmt::format("load step at={} size={}: need a finite time >= 0 and size", l.at, l.size));
+  }
+  if (!(noise_std >= 0.0) || !std::isfinite(noise_std))
+    return fail(fmt::format("noise_std must be >= 0, got {}", noise_std));
+  if (!std::isfinite(u0)) return fail(fmt::format("u0 must be finite, got {}", u0));
+  if (!(settling_threshold > 0.0 && settling_threshold < 1.0))
+    return fail(fmt::format("settling_threshold must be in (0, 1), got {}", settling_threshold));
+  std::string e;
+  if (!actuator.IsValid(&e)) return fail("actuator: " + e);
+  return true;
+}
+
+ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen::VectorXd& r,
+                                           const Eigen::VectorXd& y, const Eigen::VectorXd& u,
+                                           double r_before, double u_before,
+                                           const ClosedLoopOptions& options) {
+  const Eigen::Index n = t.size();
+  PNEUMID_CHECK(n >= 2 && r.size() == n && y.size() == n && u.size() == n,
+                "need t, r, y, u of equal length >= 2, got {}, {}, {}, {}", n, r.size(), y.size(),
+                u.size());
+  const double Ts = t(1) - t(0);
+  PNEUMID_CHECK(Ts > 0.0, "time must increase, got t(0) = {}, t(1) = {}", t(0), t(1));
+  ClosedLoopMetrics m;
+  // Integral criteria and input statistics.
+  double u_prev = u_before;
+  m.u_min = u.minCoeff();
+  m.u_max = u.maxCoeff();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double e = r(k) - y(k);
+    m.iae += std::abs(e) * Ts;
+    m.ise += e * e * Ts;
+    m.itae += (t(k) - t(0)) * std::abs(e) * Ts;
+    m.tv_u += std::abs(u(k) - u_prev);
+    u_prev = u(k);
+  }
+  // Set-point segments.
+  std::vector<Eigen::Index> changes;
+  double r_prev = r_before;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (Changed(r(k), r_prev)) changes.push_back(k);
+    r_prev = r(k);
+  }
+  auto segment_error = [&](Eigen::Index begin, Eigen::Index end) {
+    const Eigen::Index len = end - begin;
+    const Eigen::Index w = std::clamp<Eigen::Index>(len / 20, 1, 50);
+    double acc = 0.0;
+    for (Eigen::Index k = end - w; k < end; ++k) acc += r(k) - y(k);
+    return acc / static_cast<double>(w);
+  };
+  for (std::size_t c = 0; c < changes.size(); ++c) {
+    const Eigen::Index k0 = changes[c];
+    const Eigen::Index k1 = c + 1 < changes.size() ? changes[c + 1] : n;
+    StepMetrics s;
+    s.time = t(k0);
+    s.from = k0 > 0 ? r(k0 - 1) : r_before;
+    s.to = r(k0);
+    s.first_move = u(k0) - (k0 > 0 ? u(k0 - 1) : u_before);
+    s.steady_state_error = segment_error(k0, k1);
+    if (k1 - k0 >= 3) {
+      StepInfoOptions o;
+      o.settling_threshold = options.settling_threshold;
+      o.y_initial = s.from;
+      o.y_final = s.to;
+      const Eigen::VectorXd ts = t.segment(k0, k1 - k0).array() - t(k0);
+      const Eigen::VectorXd ys = y.segment(k0, k1 - k0);
+      const StepInfo info = ComputeStepInfo(ts, ys, o);
+      s.rise_time = info.rise_time;
+      s.overshoot_percent = info.overshoot;
+      s.settling_time = info.settling_time;
+      // A response still outside the band at the end of the window has not settled.
+      if (std::abs(ys(ys.size() - 1) - s.to) > options.settling_threshold * std::abs(s.to - s.from))
+        s.settling_time = kNaN;
+    }
+    m.steps.push_back(s);
+  }
+  if (!m.steps.empty()) {
+    m.rise_time = m.steps[0].rise_time;
+    m.overshoot_percent = m.steps[0].overshoot_percent;
+    m.settling_time = m.steps[0].settling_time;
+    m.first_move = m.steps[0].first_move;
+  }
+  const Eigen::Index last_begin = changes.empty() ? 0 : changes.back();
+  m.steady_state_error = segment_error(last_begin, n);
+  // First load step.
+  if (!options.load_steps.empty()) {
+    const LoadStep* first = &options.load_steps[0];
+    for (const LoadStep& l : options.load_steps)
+      if (l.at < first->at) first = &l;
+    Eigen::Index k0 = 0;
+    while (k0 < n && t(k0) - t(0) < first->at - 1e-9 * Ts) ++k0;
+    if (k0 < n) {
+      Eigen::Index k1 = n;
+      for (Eigen::Index c : changes)
+        if (c > k0) {
+          k1 = c;
+          break;
+        }
+      for (const LoadStep& l : options.load_steps) {
+        if (l.at > first->at) {
+          Eigen::Index k = k0;
+          while (k < k1 && t(k) - t(0) < l.at - 1e-9 * Ts) ++k;
+          k1 = std::min(k1, k);
+        }
+      }
+      const double band =
+          std::max(options.settling_threshold * std::abs(first->size), 3.0 * options.noise_std);
+      double peak = 0.0;
+      Eigen::Index last_out = -1;
+      for (Eigen::Index k = k0; k < k1; ++k) {
+        const double dev = y(k) - r(k);
+        if (std::abs(dev) > std::abs(peak)) peak = dev;
+        if (std::abs(dev) > band) last_out = k;
+      }
+      m.load_peak_deviation = peak;
+      if (last_out < 0) {
+        m.load_recovery_time = 0.0;
+      } else if (last_out + 1 < k1) {
+        m.load_recovery_time = t(last_out + 1) - t(k0);
+      }
+    }
+  }
+  return m;
+}
+
+ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const Signal& setpoint,
+                                    const ClosedLoopOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "invalid closed-loop options: {}", error);
+  const double Ts = controller.Ts();
+  PNEUMID_CHECK(std::abs(plant.Ts() - Ts) <= 1e-9 * Ts,
+                "the plant samples at Ts = {} s but the controller at Ts = {} s", plant.Ts(), Ts);
+  const Eigen::Index n = std::max<Eigen::Index>(2, std::llround(options.duration / Ts));
+  ClosedLoopResult res;
+  res.t = Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1) * Ts);
+  res.r.resize(n);
+  res.y.resize(n);
+  res.y_meas.resize(n);
+  res.u.resize(n);
+  res.d.resize(n);
+  if (options.time_updates) res.update_seconds.resize(n);
+  for (Eigen::Index k = 0; k < n; ++k) res.r(k) = setpoint(res.t(k));
+  const double r_before = setpoint(-Ts);
+
+  plant.Reset();
+  plant.SetLoadDisturbance(0.0);
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  double u_prev = options.u0;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    double d = 0.0;
+    for (const LoadStep& l : options.load_steps)
+      if (res.t(k) >= l.at - 1e-9 * Ts) d += l.size;
+    if (k == 0 || d != res.d(k - 1)) plant.SetLoadDisturbance(d);
+    res.d(k) = d;
+    const double y = plant.Measure();
+    const double ym = options.noise_std > 0.0 ? y + options.noise_std * noise(rng) : y;
+    if (k == 0) controller.Reset(options.u0, ym);
+    double u;
+    if (options.time_updates) {
+      const auto start = std::chrono::steady_clock::now();
+      u = controller.Update(res.r(k), ym);
+      const auto stop = std::chrono::steady_clock::now();
+      res.update_seconds(k) = std::chrono::duration<double>(stop - start).count();
+    } else {
+      u = controller.Update(res.r(k), ym);
+    }
+    u = std::clamp(u, options.actuator.u_min, options.actuator.u_max);
+    if (std::isfinite(options.actuator.du_max))
+      u = std::clamp(u, u_prev - options.actuator.du_max, u_prev + options.actuator.du_max);
+    plant.Advance(u);
+    res.y(k) = y;
+    res.y_meas(k) = ym;
+    res.u(k) = u;
+    u_prev = u;
+  }
+  res.metrics = ComputeClosedLoopMetrics(res.t, res.r, res.y, res.u, r_before, options.u0, options);
+  res.controller = controller.Describe();
+  res.plant = plant.Describe();
+  return res;
+}
+
+}  // namespace pneumid

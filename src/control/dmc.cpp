@@ -1,0 +1,271 @@
+#include "pneumid/control/dmc.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/lti/conversion.hpp"
+
+namespace pneumid {
+
+TransferFunction SampledModel(const TransferFunction& model, double Ts) {
+  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
+  if (model.IsContinuous()) return C2D(model, Ts, DiscretizationMethod::kZoh);
+  PNEUMID_CHECK(std::abs(model.Ts() - Ts) <= 1e-9 * Ts,
+                "the discrete model has Ts = {} s but the controller runs at Ts = {} s", model.Ts(),
+                Ts);
+  return model;
+}
+
+Eigen::VectorXd StepResponseCoefficients(const TransferFunction& model, double Ts, int n) {
+  PNEUMID_CHECK(n >= 1, "need at least one step coefficient, got n = {}", n);
+  const TransferFunction g = SampledModel(model, Ts);
+  const Eigen::VectorXd& b = g.num();
+  const Eigen::VectorXd& a = g.den();
+  const int d = g.DelaySamples();
+  PNEUMID_CHECK(a.size() > 0 && a(0) != 0.0,
+                "the discrete model needs a nonzero leading denominator coefficient a0");
+  // a0 y[k] = sum_i b_i u[k-d-i] - sum_{i>=1} a_i y[k-i], u[k] = 1 for k >= 0.
+  Eigen::VectorXd s = Eigen::VectorXd::Zero(n + 1);
+  for (int k = 0; k <= n; ++k) {
+    double acc = 0.0;
+    for (int i = 0; i < b.size(); ++i) acc += (k - d - i >= 0) ? b(i) : 0.0;
+    for (int i = 1; i < a.size() && i <= k; ++i) acc -= a(i) * s(k - i);
+    s(k) = acc / a(0);
+  }
+  return s;
+}
+
+int SettlingModelHorizon(const TransferFunction& model, double Ts, double tol, int max_n) {
+  PNEUMID_CHECK(tol > 0.0, "tolerance must be positive, got {}", tol);
+  PNEUMID_CHECK(max_n >= 1, "max_n must be >= 1, got {}", max_n);
+  const TransferFunction g = SampledModel(model, Ts);
+  PNEUMID_CHECK(g.IsStable(),
+                "DMC needs a stable model (a finite step response); the model {} is not stable",
+                model.ToString());
+  const double s_inf = g.DcGain();
+  PNEUMID_CHECK(std::isfinite(s_inf) && s_inf != 0.0,
+                "DMC needs a finite, nonzero static gain; got {}", s_inf);
+  const Eigen::VectorXd s = StepResponseCoefficients(g, Ts, max_n);
+  int last_out = -1;
+  for (int i = 0; i <= max_n; ++i) {
+    if (std::abs(s(i) - s_inf) > tol * std::abs(s_inf)) last_out = i;
+  }
+  return std::min(max_n, last_out + 1);
+}
+
+Eigen::MatrixXd DynamicMatrix(const Eigen::VectorXd& step, int P, int M) {
+  PNEUMID_CHECK(P >= 1 && M >= 1 && M <= P, "need 1 <= M <= P, got P = {}, M = {}", P, M);
+  PNEUMID_CHECK(step.size() >= 1, "the step response is empty");
+  const Eigen::Index last = step.size() - 1;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(P, M);
+  for (int i = 0; i < P; ++i) {
+    for (int j = 0; j <= std::min(i, M - 1); ++j) {
+      A(i, j) = step(std::min<Eigen::Index>(i + 1 - j, last));
+    }
+  }
+  return A;
+}
+
+bool DmcOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (P < 1) return fail(fmt::format("prediction horizon P must be >= 1, got {}", P));
+  if (M < 1 || M > P) return fail(fmt::format("need 1 <= M <= P, got M = {}, P = {}", M, P));
+  if (!(lambda >= 0.0) || !std::isfinite(lambda))
+    return fail(fmt::format("lambda must be finite and >= 0, got {}", lambda));
+  if (output_weights.size() != 0 &&
+      (output_weights.size() != P || !(output_weights.array() > 0.0).all() ||
+       !output_weights.allFinite()))
+    return fail(fmt::format("output_weights must have P = {} positive entries (or none), got {}", P,
+                            output_weights.size()));
+  if (move_weights.size() != 0 &&
+      (move_weights.size() != M || !(move_weights.array() > 0.0).all() ||
+       !move_weights.allFinite()))
+    return fail(fmt::format("move_weights must have M = {} positive entries (or none), got {}", M,
+                            move_weights.size()));
+  if (model_horizon < 0)
+    return fail(fmt::format("model_horizon must be >= 0, got {}", model_horizon));
+  std::string e;
+  if (!limits.IsValid(&e)) return fail(e);
+  if (std::isnan(y_min) || std::isnan(y_max) || y_min > y_max)
+    return fail(fmt::format("need y_min <= y_max, got {} and {}", y_min, y_max));
+  if (!(slack_linear_weight >= 0.0) || !(slack_quadratic_weight > 0.0))
+    return fail(fmt::format("slack weights must be >= 0 (linear) and > 0 (quadratic), got {}, {}",
+                            slack_linear_weight, slack_quadratic_weight));
+  if (!qp.IsValid(&e)) return fail("qp: " + e);
+  return true;
+}
+
+DmcController::DmcController(const TransferFunction& model, double Ts, const DmcOptions& options)
+    : options_(options), Ts_(Ts) {
+  std::string error;
+  PNEUMID_CHECK(options_.IsValid(&error), "invalid DMC options: {}", error);
+  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
+  int N = options_.model_horizon;
+  if (N == 0)
+    N = SettlingModelHorizon(model, Ts);
+  else
+    PNEUMID_CHECK(SampledModel(model, Ts).IsStable(), "DMC needs a stable model; {} is not stable",
+                  model.ToString());
+  N = std::max(N, options_.P);
+  step_ = StepResponseCoefficients(model, Ts, N);
+  Build();
+}
+
+DmcController::DmcController(const Eigen::VectorXd& step_coefficients, double Ts,
+                             const DmcOptions& options)
+    : options_(options), Ts_(Ts) {
+  std::string error;
+  PNEUMID_CHECK(options_.IsValid(&error), "invalid DMC options: {}", error);
+  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
+  PNEUMID_CHECK(step_coefficients.size() >= 2 && step_coefficients.allFinite(),
+                "need finite step coefficients s_0..s_N with N >= 1, got {} values",
+                step_coefficients.size());
+  int N = static_cast<int>(step_coefficients.size()) - 1;
+  if (options_.model_horizon > 0) N = std::min(N, options_.model_horizon);
+  const int N_eff = std::max(N, options_.P);
+  step_.resize(N_eff + 1);
+  for (int i = 0; i <= N_eff; ++i) step_(i) = step_coefficients(std::min(i, N));
+  Build();
+}
+
+DmcController::~DmcController() = default;
+
+void DmcController::Build() {
+  const int P = options_.P, M = options_.M;
+  N_ = static_cast<int>(step_.size()) - 1;
+  A_ = DynamicMatrix(step_, P, M);
+  const Eigen::VectorXd q =
+      options_.output_weights.size() ? options_.output_weights : Eigen::VectorXd::Ones(P);
+  const Eigen::VectorXd r =
+      options_.move_weights.size() ? options_.move_weights : Eigen::VectorXd::Ones(M);
+  AtQ_ = A_.transpose() * q.asDiagonal();
+  Eigen::MatrixXd H = AtQ_ * A_;
+  H.diagonal() += options_.lambda * r;
+  Eigen::LLT<Eigen::MatrixXd> llt(H);
+  PNEUMID_CHECK(llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() >
+                                                    1e-10 * std::sqrt(H.diagonal().maxCoeff()),
+                "A'QA + lambda R is singular (the model's dead time may exceed the horizon); "
+                "increase lambda (now {}) or P (now {})",
+                options_.lambda, P);
+  const Eigen::MatrixXd Kmat = llt.solve(AtQ_);
+  gain_ = Kmat.row(0);
+  gain_sum_ = gain_.sum();
+  yhat_.setZero(N_ + 1);
+  free_.setZero(P);
+  err_.setZero(P);
+
+  if (options_.constrained) {
+    const InputLimits& lim = options_.limits;
+    soft_output_ = std::isfinite(options_.y_min) || std::isfinite(options_.y_max);
+    nvar_ = M + (soft_output_ ? 1 : 0);
+    const bool u_rows = std::isfinite(lim.u_min) || std::isfinite(lim.u_max);
+    const int rows = (u_rows ? M : 0) + (std::isfinite(options_.y_min) ? P : 0) +
+                     (std::isfinite(options_.y_max) ? P : 0);
+    Eigen::MatrixXd Hq = Eigen::MatrixXd::Zero(nvar_, nvar_);
+    Hq.topLeftCorner(M, M) = H;
+    if (soft_output_) Hq(M, M) = options_.slack_quadratic_weight;
+    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(rows, nvar_);
+    int row = 0;
+    if (u_rows) {
+      for (int j = 0; j < M; ++j) C.row(row + j).head(j + 1).setOnes();
+      row += M;
+    }
+    if (std::isfinite(options_.y_min)) {
+      C.block(row, 0, P, M) = A_;
+      C.block(row, M, P, 1).setOnes();  // A du + e >= y_min - f
+      row += P;
+    }
+    if (std::isfinite(options_.y_max)) {
+      C.block(row, 0, P, M) = A_;
+      C.block(row, M, P, 1).setConstant(-1.0);  // A du - e <= y_max - f
+      row += P;
+    }
+    qp_ = std::make_unique<QpSolver>(options_.qp);
+    PNEUMID_CHECK(qp_->Setup(Hq, C), "the QDMC Hessian is not positive definite: {}",
+                  qp_->summary().BriefReport());
+    g_.setZero(nvar_);
+    lb_.setZero(rows);
+    ub_.setZero(rows);
+    lbx_.setConstant(nvar_, -lim.du_max);
+    ubx_.setConstant(nvar_, lim.du_max);
+    if (soft_output_) {
+      lbx_(M) = 0.0;
+      ubx_(M) = std::numeric_limits<double>::infinity();
+    }
+  } else {
+    qp_ = std::make_unique<QpSolver>(options_.qp);  // summary reports "not set up"
+  }
+  Reset();
+}
+
+void DmcController::Reset(double u0, double y0) {
+  yhat_.setConstant(y0);
+  free_.setConstant(y0);
+  u_prev_ = u0;
+  last_du_ = 0.0;
+  qp_failures_ = 0;
+  if (qp_) qp_->ClearWarmStart();
+}
+
+double DmcController::Update(double setpoint, double measurement) {
+  const int P = options_.P, M = options_.M;
+  const double bias = measurement - yhat_(0);
+  for (int i = 0; i < P; ++i) free_(i) = yhat_(i + 1) + bias;
+  double du = gain_sum_ * setpoint - gain_.dot(free_);
+  if (options_.constrained) {
+    const InputLimits& lim = options_.limits;
+    err_.setConstant(setpoint);
+    err_ -= free_;
+    g_.head(M).noalias() = -AtQ_ * err_;
+    if (soft_output_) g_(M) = options_.slack_linear_weight;
+    int row = 0;
+    if (std::isfinite(lim.u_min) || std::isfinite(lim.u_max)) {
+      lb_.head(M).setConstant(lim.u_min - u_prev_);
+      ub_.head(M).setConstant(lim.u_max - u_prev_);
+      row += M;
+    }
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    if (std::isfinite(options_.y_min)) {
+      lb_.segment(row, P).setConstant(options_.y_min);
+      lb_.segment(row, P) -= free_;
+      ub_.segment(row, P).setConstant(kInf);
+      row += P;
+    }
+    if (std::isfinite(options_.y_max)) {
+      lb_.segment(row, P).setConstant(-kInf);
+      ub_.segment(row, P).setConstant(options_.y_max);
+      ub_.segment(row, P) -= free_;
+    }
+    const QpSummary& s = qp_->Solve(g_, lb_, ub_, lbx_, ubx_);
+    if (s.status == QpStatus::kSolved) {
+      du = qp_->x()(0);
+    } else {
+      ++qp_failures_;
+    }
+  }
+  const double u = options_.limits.Clip(u_prev_ + du, u_prev_);
+  du = u - u_prev_;
+  // Shift the prediction one sample and add the effect of the move.
+  double* y = yhat_.data();
+  const double* s = step_.data();
+  for (int i = 0; i < N_; ++i) y[i] = y[i + 1] + s[i + 1] * du;
+  y[N_] += s[N_] * du;
+  u_prev_ = u;
+  last_du_ = du;
+  return u;
+}
+
+std::string DmcController::Describe() const {
+  return fmt::format("dmc P={} M={} lambda={:g} N={}{}", options_.P, options_.M, options_.lambda,
+                     N_, options_.constrained ? " constrained" : "");
+}
+
+}  // namespace pneumid

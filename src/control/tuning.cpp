@@ -1,0 +1,163 @@
+#include "pneumid/control/tuning.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <Eigen/Eigenvalues>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/control/dmc.hpp"
+#include "pneumid/lti/response.hpp"
+
+namespace pneumid {
+
+std::string ToString(TuningRule rule) {
+  switch (rule) {
+    case TuningRule::kShridharCooper:
+      return "shridhar-cooper";
+    case TuningRule::kPaperModified:
+      return "paper-modified";
+    case TuningRule::kExplicit:
+      return "explicit";
+  }
+  return "unknown";
+}
+
+TuningRule TuningRuleFromString(const std::string& name) {
+  if (name == "conventional") return TuningRule::kShridharCooper;
+  if (name == "modified") return TuningRule::kPaperModified;
+  for (TuningRule r :
+       {TuningRule::kShridharCooper, TuningRule::kPaperModified, TuningRule::kExplicit}) {
+    if (ToString(r) == name) return r;
+  }
+  PNEUMID_CHECK(false,
+                "unknown tuning rule '{}'; valid: shridhar-cooper (conventional), paper-modified "
+                "(modified), explicit",
+                name);
+  return TuningRule::kExplicit;
+}
+
+double RoundSignificant(double x, int digits) {
+  PNEUMID_CHECK(digits >= 1, "need at least one significant digit, got {}", digits);
+  if (x == 0.0 || !std::isfinite(x)) return x;
+  const double e = std::floor(std::log10(std::abs(x)));
+  const double scale = std::pow(10.0, digits - 1 - e);
+  // The relative nudge makes decimal halves stored just below .5 round up.
+  return std::round(x * scale * (1.0 + 1e-12)) / scale;
+}
+
+FopdtParameters FopdtFromModel(const TransferFunction& model) {
+  PNEUMID_CHECK(model.IsStable(), "the model {} is not stable; no FOPDT description",
+                model.ToString());
+  const double K = model.DcGain();
+  PNEUMID_CHECK(std::isfinite(K) && K != 0.0,
+                "the model's static gain must be finite and "
+                "nonzero, got {}",
+                K);
+  FopdtParameters p;
+  p.K = K;
+  if (model.IsContinuous()) {
+    const TransferFunction g = model.Normalized();
+    const Eigen::VectorXd num = poly::TrimLeading(g.num());
+    if (g.Order() == 1 && num.size() == 1) {
+      // b / (s + a1): tau = 1 / a1.
+      p.tau = 1.0 / g.den()(g.den().size() - 1);
+      p.theta = model.delay();
+      p.method = "exact";
+      return p;
+    }
+  }
+  // Two-point method on the unit step response (Smith 1972).
+  const TimeResponse r = Step(model);
+  auto crossing = [&](double fraction) {
+    const double level = fraction * K;
+    for (Eigen::Index i = 1; i < r.y.size(); ++i) {
+      if ((r.y(i) - level) * (K > 0 ? 1 : -1) >= 0.0) {
+        const double y1 = r.y(i - 1), y2 = r.y(i);
+        return r.t(i - 1) + (level - y1) / (y2 - y1) * (r.t(i) - r.t(i - 1));
+      }
+    }
+    return r.t(r.t.size() - 1);
+  };
+  const double t28 = crossing(0.283), t63 = crossing(0.632);
+  p.tau = 1.5 * (t63 - t28);
+  p.theta = std::max(0.0, t63 - p.tau);
+  p.method = "two-point";
+  return p;
+}
+
+bool TuningOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (M < 0) return fail(fmt::format("M must be >= 0 (0 = rule default), got {}", M));
+  if (P < 0) return fail(fmt::format("P must be >= 0 (0 = rule default), got {}", P));
+  if (!std::isnan(lambda) && !(lambda >= 0.0 && std::isfinite(lambda)))
+    return fail(fmt::format("lambda must be finite and >= 0, got {}", lambda));
+  if (rule == TuningRule::kExplicit && (P == 0 || M == 0 || std::isnan(lambda)))
+    return fail("the explicit rule needs P, M and lambda");
+  if (tau_significant_digits < 0)
+    return fail(fmt::format("tau_significant_digits must be >= 0, got {}", tau_significant_digits));
+  if (!(target_condition > 1.0))
+    return fail(fmt::format("target_condition must exceed 1, got {}", target_condition));
+  if (P > 0 && M > P) return fail(fmt::format("need M <= P, got M = {}, P = {}", M, P));
+  return true;
+}
+
+TuningResult Tune(const TransferFunction& model, double Ts, const TuningOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "invalid tuning options: {}", error);
+  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
+  TuningResult r;
+  r.rule = options.rule;
+  switch (options.rule) {
+    case TuningRule::kShridharCooper: {
+      r.fopdt = FopdtFromModel(model);
+      const FopdtParameters& f = r.fopdt;
+      r.tau_used = options.tau_significant_digits > 0
+                       ? RoundSignificant(f.tau, options.tau_significant_digits)
+                       : f.tau;
+      r.P_unrounded = 5.0 * r.tau_used / Ts + f.theta / Ts + 1.0;
+      r.P = options.P > 0 ? options.P : std::max(1, static_cast<int>(std::lround(r.P_unrounded)));
+      r.M = options.M > 0 ? options.M : 5;
+      PNEUMID_CHECK(r.M <= r.P, "need M <= P, got M = {}, P = {}", r.M, r.P);
+      const Eigen::MatrixXd A = DynamicMatrix(StepResponseCoefficients(model, Ts, r.P), r.P, r.M);
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A.transpose() * A,
+                                                               Eigen::EigenvaluesOnly);
+      r.lambda_condition = eig.eigenvalues().maxCoeff() / options.target_condition;
+      r.lambda_formula = r.M / options.target_condition * f.K * f.K *
+                         (3.5 * r.tau_used / Ts + 2.0 - (r.M - 1) / 2.0);
+      r.lambda = std::isnan(options.lambda) ? r.lambda_condition : options.lambda;
+      r.formula = fmt::format(
+          "Shridhar-Cooper: P = round(5 tau/Ts + theta/Ts + 1) = round({:.4g}) = {} with tau = "
+          "{:g} s ({} FOPDT tau = {:.6g} s rounded to {} significant digits), theta = {:g} s; "
+          "lambda = lambda_max(A'A)/{:g} = {:.6g} (used; A is the {}x{} dynamic matrix), "
+          "closed form (M/{:g}) K^2 (3.5 tau/Ts + 2 - (M-1)/2) = {:.6g}",
+          r.P_unrounded, r.P, r.tau_used, f.method, f.tau, options.tau_significant_digits, f.theta,
+          options.target_condition, r.lambda_condition, r.P, r.M, options.target_condition,
+          r.lambda_formula);
+      if (options.P > 0 || !std::isnan(options.lambda))
+        r.formula += "; overridden by explicit settings";
+      break;
+    }
+    case TuningRule::kPaperModified:
+      r.P = options.P > 0 ? options.P : 126;
+      r.M = options.M > 0 ? options.M : 10;
+      r.lambda = std::isnan(options.lambda) ? 1.92 : options.lambda;
+      PNEUMID_CHECK(r.M <= r.P, "need M <= P, got M = {}, P = {}", r.M, r.P);
+      r.formula =
+          "paper's modified method: P = 126, M = 10, lambda = 1.92 taken as published settings "
+          "(the formula is not published)";
+      break;
+    case TuningRule::kExplicit:
+      r.P = options.P;
+      r.M = options.M;
+      r.lambda = options.lambda;
+      r.formula = "explicit settings";
+      break;
+  }
+  return r;
+}
+
+}  // namespace pneumid
