@@ -1,0 +1,44 @@
+// Configuration of a real-time run from a TOML file (config/realtime_example.toml),
+// shared by `pneumid run`, `pneumid experiment` and the bindings. Command-line
+// flags override the file. Every key is optional; defaults are those of the
+// option structs:
+//
+//   [loop]    period (s), duration (s), realtime (bool), priority, cpu, fast (bool)
+//   [io]      backend = "sim" | "comedi:/dev/comedi0" | "udp://HOST:PORT", plant (sim)
+//   [safety]  u_min, u_max (%), rate_max (%/s), y_min, y_max (N), frozen_samples,
+//             frozen_tolerance (N), max_overruns, safe_state = "valves-closed" | "exhaust-open"
+//   [udp]     max_missed, reply_wait (periods), hello_timeout (s), hello_attempts
+//   [comedi]  device, ai_subdevice, ai_channel, ai_range, ai_aref, v_min, v_max,
+//             pressure_gain, pressure_offset, force_gain, force_offset, ao_subdevice,
+//             inlet_channel, exhaust_channel, ao_range, v_closed, v_open,
+//             exhaust_complementary, use_calibration
+//   [log]     flush_interval (s), capacity (records)
+#pragma once
+
+#include <string>
+
+#include "pneumid/realtime/comedi_backend.hpp"
+#include "pneumid/realtime/log_writer.hpp"
+#include "pneumid/realtime/realtime_loop.hpp"
+#include "pneumid/realtime/safety.hpp"
+#include "pneumid/realtime/udp_backend.hpp"
+
+namespace pneumid {
+
+struct RealtimeConfig {
+  LoopOptions loop;
+  SafetyOptions safety;
+  std::string io = "sim";     ///< --io spec
+  std::string plant = "ipa";  ///< plant of the sim backend (MakePlant spec)
+  UdpBackendOptions udp;
+  ComediConfig comedi;
+  LogWriterOptions log;
+};
+
+/// Reads a configuration file. @throws DataError naming the file, line and column
+/// for a syntax error, an unknown section or key, or a value of the wrong type.
+RealtimeConfig LoadRealtimeConfig(const std::string& path);
+/// Same from TOML text (`source` names it in errors).
+RealtimeConfig ParseRealtimeConfig(const std::string& text, const std::string& source);
+
+}  // namespace pneumid

@@ -1,0 +1,174 @@
+#include "pneumid/realtime/realtime_config.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "pneumid/common/check.hpp"
+
+namespace pneumid {
+
+namespace {
+
+struct Reader {
+  const std::string& source;
+
+  [[noreturn]] void Fail(const toml::node& n, const std::string& what) const {
+    const auto& s = n.source().begin;
+    throw DataError(fmt::format("{}:{}:{}: {}", source, s.line, s.column, what));
+  }
+
+  template <typename T>
+  void Get(const toml::table& t, const char* section, const char* key, T* out) const {
+    const toml::node* n = t.get(key);
+    if (!n) return;
+    if constexpr (std::is_same_v<T, bool>) {
+      if (!n->is_boolean()) Fail(*n, fmt::format("[{}] {} must be true or false", section, key));
+      *out = n->as_boolean()->get();
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      if (!n->is_string()) Fail(*n, fmt::format("[{}] {} must be a string", section, key));
+      *out = n->as_string()->get();
+    } else if constexpr (std::is_integral_v<T>) {
+      if (!n->is_integer()) Fail(*n, fmt::format("[{}] {} must be an integer", section, key));
+      *out = static_cast<T>(n->as_integer()->get());
+    } else {
+      if (!n->is_number()) Fail(*n, fmt::format("[{}] {} must be a number", section, key));
+      *out = n->is_integer() ? static_cast<double>(n->as_integer()->get())
+                             : n->as_floating_point()->get();
+    }
+  }
+
+  void CheckKeys(const toml::table& t, const char* section,
+                 std::initializer_list<const char*> keys) const {
+    for (const auto& [k, v] : t) {
+      bool known = false;
+      for (const char* key : keys) known = known || k.str() == key;
+      if (!known) {
+        std::string list;
+        for (const char* key : keys) list += (list.empty() ? "" : ", ") + std::string(key);
+        Fail(v, fmt::format("unknown key '{}' in [{}] (known: {})", k.str(), section, list));
+      }
+    }
+  }
+
+  template <typename F>
+  void Convert(const toml::table& t, const char* key, F&& f) const {
+    const toml::node* n = t.get(key);
+    if (!n) return;
+    try {
+      f(n->value_or(std::string()));
+    } catch (const InvalidArgument& e) {
+      Fail(*n, e.what());
+    }
+  }
+};
+
+}  // namespace
+
+RealtimeConfig ParseRealtimeConfig(const std::string& text, const std::string& source) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    throw DataError(fmt::format("{}:{}:{}: {}", source, e.source().begin.line,
+                                e.source().begin.column, e.description()));
+  }
+  Reader r{source};
+  RealtimeConfig c;
+  for (const auto& [k, v] : root) {
+    const std::string name(k.str());
+    if (!v.is_table())
+      r.Fail(v,
+             fmt::format("'{}' must be a section ([loop], [io], [safety], [udp], [comedi], [log])",
+                         name));
+    const toml::table& t = *v.as_table();
+    if (name == "loop") {
+      r.CheckKeys(t, "loop", {"period", "duration", "realtime", "priority", "cpu", "fast"});
+      r.Get(t, "loop", "period", &c.loop.period);
+      r.Get(t, "loop", "duration", &c.loop.duration);
+      r.Get(t, "loop", "realtime", &c.loop.realtime);
+      r.Get(t, "loop", "priority", &c.loop.priority);
+      r.Get(t, "loop", "cpu", &c.loop.cpu);
+      r.Get(t, "loop", "fast", &c.loop.fast);
+    } else if (name == "io") {
+      r.CheckKeys(t, "io", {"backend", "plant"});
+      r.Get(t, "io", "backend", &c.io);
+      r.Convert(t, "backend", [](const std::string& s) { ParseIoSpec(s); });
+      r.Get(t, "io", "plant", &c.plant);
+    } else if (name == "safety") {
+      r.CheckKeys(t, "safety",
+                  {"u_min", "u_max", "rate_max", "y_min", "y_max", "frozen_samples",
+                   "frozen_tolerance", "max_overruns", "safe_state"});
+      auto& s = c.safety;
+      r.Get(t, "safety", "u_min", &s.u_min);
+      r.Get(t, "safety", "u_max", &s.u_max);
+      r.Get(t, "safety", "rate_max", &s.rate_max);
+      r.Get(t, "safety", "y_min", &s.y_min);
+      r.Get(t, "safety", "y_max", &s.y_max);
+      r.Get(t, "safety", "frozen_samples", &s.frozen_samples);
+      r.Get(t, "safety", "frozen_tolerance", &s.frozen_tolerance);
+      r.Get(t, "safety", "max_overruns", &s.max_overruns);
+      r.Convert(t, "safe_state",
+                [&](const std::string& v) { s.safe_state = SafeStateFromString(v); });
+    } else if (name == "udp") {
+      r.CheckKeys(t, "udp", {"max_missed", "reply_wait", "hello_timeout", "hello_attempts"});
+      r.Get(t, "udp", "max_missed", &c.udp.max_missed);
+      r.Get(t, "udp", "reply_wait", &c.udp.reply_wait);
+      r.Get(t, "udp", "hello_timeout", &c.udp.hello_timeout);
+      r.Get(t, "udp", "hello_attempts", &c.udp.hello_attempts);
+    } else if (name == "comedi") {
+      r.CheckKeys(t, "comedi",
+                  {"device", "ai_subdevice", "ai_channel", "ai_range", "ai_aref", "v_min", "v_max",
+                   "pressure_gain", "pressure_offset", "force_gain", "force_offset", "ao_subdevice",
+                   "inlet_channel", "exhaust_channel", "ao_range", "v_closed", "v_open",
+                   "exhaust_complementary", "use_calibration"});
+      auto& m = c.comedi;
+      r.Get(t, "comedi", "device", &m.device);
+      r.Get(t, "comedi", "ai_subdevice", &m.ai_subdevice);
+      r.Get(t, "comedi", "ai_channel", &m.ai_channel);
+      r.Get(t, "comedi", "ai_range", &m.ai_range);
+      r.Convert(t, "ai_aref",
+                [&](const std::string& v) { m.ai_aref = AnalogReferenceFromString(v); });
+      r.Get(t, "comedi", "v_min", &m.v_min);
+      r.Get(t, "comedi", "v_max", &m.v_max);
+      r.Get(t, "comedi", "pressure_gain", &m.pressure_gain);
+      r.Get(t, "comedi", "pressure_offset", &m.pressure_offset);
+      r.Get(t, "comedi", "force_gain", &m.force_gain);
+      r.Get(t, "comedi", "force_offset", &m.force_offset);
+      r.Get(t, "comedi", "ao_subdevice", &m.ao_subdevice);
+      r.Get(t, "comedi", "inlet_channel", &m.inlet_channel);
+      r.Get(t, "comedi", "exhaust_channel", &m.exhaust_channel);
+      r.Get(t, "comedi", "ao_range", &m.ao_range);
+      r.Get(t, "comedi", "v_closed", &m.v_closed);
+      r.Get(t, "comedi", "v_open", &m.v_open);
+      r.Get(t, "comedi", "exhaust_complementary", &m.exhaust_complementary);
+      r.Get(t, "comedi", "use_calibration", &m.use_calibration);
+    } else if (name == "log") {
+      r.CheckKeys(t, "log", {"flush_interval", "capacity"});
+      r.Get(t, "log", "flush_interval", &c.log.flush_interval);
+      r.Get(t, "log", "capacity", &c.log.capacity);
+    } else {
+      r.Fail(v,
+             fmt::format("unknown section [{}] (known: loop, io, safety, udp, comedi, log)", name));
+    }
+  }
+  // Value checks, reported against the file.
+  std::string error;
+  if (!c.loop.IsValid(&error)) throw DataError(fmt::format("{}: [loop] {}", source, error));
+  if (!c.safety.IsValid(&error)) throw DataError(fmt::format("{}: [safety] {}", source, error));
+  if (!c.comedi.IsValid(&error)) throw DataError(fmt::format("{}: [comedi] {}", source, error));
+  if (!c.log.IsValid(&error)) throw DataError(fmt::format("{}: [log] {}", source, error));
+  return c;
+}
+
+RealtimeConfig LoadRealtimeConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw DataError(fmt::format("{}: cannot open configuration file", path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ParseRealtimeConfig(ss.str(), path);
+}
+
+}  // namespace pneumid
