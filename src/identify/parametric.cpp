@@ -6,6 +6,8 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/arx.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/iv.hpp"
+#include "pneumid/identify/pem.hpp"
 #include "pneumid/lti/conversion.hpp"
 
 namespace pneumid {
@@ -98,6 +100,28 @@ IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& dat
     o.nk = {request.nk};
     const ArxResult r = EstimateArx(d, o);
     PNEUMID_CHECK(r.summary.IsSolutionUsable(), "ARX estimation failed: {}", r.summary.message);
+    return ToIdentifiedModel(method, r.model, r.summary, d);
+  }
+  if (method == "iv4") {
+    IvOptions o;
+    o.na = request.na;
+    o.nb = request.nb;
+    o.nk = request.nk;
+    const IvResult r = EstimateIv4(d, o);
+    PNEUMID_CHECK(r.summary.IsSolutionUsable(), "IV4 estimation failed: {}", r.summary.message);
+    return ToIdentifiedModel(method, r.model, r.summary, d);
+  }
+  if (method == "armax" || method == "oe" || method == "bj") {
+    PemOrders o;
+    o.na = request.na;
+    o.nb = request.nb;
+    o.nc = request.nc;
+    o.nd = request.nd;
+    o.nf = request.nf;
+    o.nk = request.nk;
+    const PemResult r = EstimatePolynomial(PolynomialStructureFromString(method), o, d);
+    PNEUMID_CHECK(r.summary.IsSolutionUsable(), "{} estimation failed: {}", method,
+                  r.summary.message);
     return ToIdentifiedModel(method, r.model, r.summary, d);
   }
   PNEUMID_CHECK(false, "method '{}' is not available yet", method);
