@@ -1,0 +1,93 @@
+// Closed-loop metrics on logs with closed-form answers, and the loop itself.
+#include "pneumid/control/closed_loop.hpp"
+
+#include <cmath>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/control/dmc.hpp"
+#include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/signal.hpp"
+#include "test_plants.hpp"
+
+namespace pneumid {
+namespace {
+
+TEST(ClosedLoopMetricsTest, FirstOrderResponseClosedForms) {
+  // y = 1 - exp(-t/tau) after a unit set-point step at t = 0:
+  // rise 10-90 % = tau ln 9, settling 2 % = tau ln 50, overshoot 0,
+  // IAE = sum exp(-t/tau) Ts ~ tau, ISE ~ tau/2, ITAE ~ tau^2.
+  const double tau = 0.2, Ts = 1e-3;
+  const int n = 5000;
+  Eigen::VectorXd t(n), r(n), y(n), u(n);
+  for (int k = 0; k < n; ++k) {
+    t(k) = k * Ts;
+    r(k) = 1.0;
+    y(k) = 1.0 - std::exp(-t(k) / tau);
+    u(k) = k < 10 ? 2.0 : 1.0;
+  }
+  ClosedLoopOptions o;
+  const ClosedLoopMetrics m = ComputeClosedLoopMetrics(t, r, y, u, 0.0, 0.0, o);
+  EXPECT_NEAR(m.rise_time, tau * std::log(9.0), Ts);
+  EXPECT_NEAR(m.settling_time, tau * std::log(50.0), Ts);
+  EXPECT_NEAR(m.overshoot_percent, 0.0, 1e-12);
+  EXPECT_NEAR(m.iae, tau, 1e-3);  // geometric sum tau (1 + Ts/(2 tau))
+  EXPECT_NEAR(m.ise, tau / 2.0, 1e-3);
+  EXPECT_NEAR(m.itae, tau * tau, 1e-3);
+  EXPECT_NEAR(m.first_move, 2.0, 0.0);
+  EXPECT_NEAR(m.tv_u, 3.0, 1e-12);  // 0 -> 2 -> 1
+  EXPECT_EQ(m.u_min, 1.0);
+  EXPECT_EQ(m.u_max, 2.0);
+  EXPECT_NEAR(m.steady_state_error, std::exp(-4.975 / tau), 1e-9);
+  ASSERT_EQ(m.steps.size(), 1u);
+}
+
+TEST(ClosedLoopMetricsTest, LoadStepPeakAndRecovery) {
+  // After a load of -1 at t = 1: deviation -exp(-(t-1)/0.1); band 2 % of 1:
+  // recovery when exp(-s/0.1) = 0.02, s = 0.1 ln 50.
+  const double Ts = 1e-3;
+  const int n = 3000;
+  Eigen::VectorXd t(n), r = Eigen::VectorXd::Zero(n), y(n), u = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < n; ++k) {
+    t(k) = k * Ts;
+    y(k) = t(k) < 1.0 - 1e-12 ? 0.0 : -std::exp(-(t(k) - 1.0) / 0.1);
+  }
+  ClosedLoopOptions o;
+  o.load_steps = {{1.0, -1.0}};
+  const ClosedLoopMetrics m = ComputeClosedLoopMetrics(t, r, y, u, 0.0, 0.0, o);
+  EXPECT_NEAR(m.load_peak_deviation, -1.0, 1e-12);
+  EXPECT_NEAR(m.load_recovery_time, 0.1 * std::log(50.0), Ts);
+  EXPECT_TRUE(m.steps.empty());
+  EXPECT_TRUE(std::isnan(m.rise_time));
+}
+
+TEST(ClosedLoopTest, ActuatorLimitsAndNoise) {
+  DmcOptions d;
+  d.P = 126;
+  d.M = 5;
+  d.lambda = 2.25;
+  DmcController dmc(PaperFopdtModel(), 0.01, d);
+  testing_util::DifferenceEquationPlant plant(PaperFopdtModel(), 0.01);
+  auto sp = ParseSignal("step:from=0,to=1,at=0.2");
+  ClosedLoopOptions o;
+  o.duration = 2.0;
+  o.noise_std = 0.01;
+  o.actuator.u_max = 0.8;
+  const auto r = SimulateClosedLoop(dmc, plant, *sp, o);
+  EXPECT_EQ(r.t.size(), 200);
+  EXPECT_LE(r.u.maxCoeff(), 0.8);
+  EXPECT_GT((r.y_meas - r.y).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_NEAR((r.y_meas - r.y).array().square().mean(), 1e-4, 3e-5);  // noise variance
+  EXPECT_NEAR(r.metrics.steady_state_error, 0.0, 0.01);
+  ClosedLoopOptions bad;
+  bad.duration = -1;
+  EXPECT_THROW(SimulateClosedLoop(dmc, plant, *sp, bad), InvalidArgument);
+  testing_util::DifferenceEquationPlant other(PaperFopdtModel(), 0.02);
+  EXPECT_THAT([&] { SimulateClosedLoop(dmc, other, *sp, o); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("Ts = 0.02")));
+}
+
+}  // namespace
+}  // namespace pneumid
