@@ -61,10 +61,16 @@ TEST(ModelIoTest, JsonRoundTripIsMonic) {
   const TransferFunction back = TransferFunctionFromJson(j);
   EXPECT_DOUBLE_EQ(back.DcGain(), 1.0);
   EXPECT_DOUBLE_EQ(back.delay(), 0.5);
-  EXPECT_THAT([] { TransferFunctionFromJson({{"num", {1}}}); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("missing key 'den'")));
-  EXPECT_THAT([] { TransferFunctionFromJson({{"num", {1}}, {"den", {"a"}}}); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("'den' must contain only numbers")));
+  EXPECT_THAT(
+      [] {
+        TransferFunctionFromJson({{"num", {1}}});
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("missing key 'den'")));
+  EXPECT_THAT(
+      [] {
+        TransferFunctionFromJson({{"num", {1}}, {"den", {"a"}}});
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("'den' must contain only numbers")));
 }
 
 TEST(ModelIoTest, JsonFiles) {
