@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/data/load.hpp"
 
 namespace pneumid {
 namespace {
@@ -276,6 +277,21 @@ TEST(PreprocessTest, SelectWindowKeepsFileLines) {
               ThrowsMessage<DataError>(
                   AllOf(HasSubstr("w.csv"), HasSubstr("no sample in the time window"))));
   EXPECT_THROW(SelectWindow(d, 0.5, 0.4), InvalidArgument);
+}
+
+TEST(PreprocessTest, ExampleStepTestGivesThePapersStaticGain) {
+  // data/ipa_step.csv: the paper's ARX model (Eq. 4-5) under a 0.61 -> 82 % step
+  // at t = 0.5 s with 0.3 N noise; its static gain is 1.59796 N/% (paper sec. 2).
+  const Dataset d = LoadDataset(std::string(PNEUMID_SOURCE_DIR) + "/data/ipa_step.csv");
+  ASSERT_EQ(d.size(), 301);
+  EXPECT_TRUE(d.IsUniform());
+  EXPECT_EQ(d.output_channels()[0].unit, "N");
+  const StepEvent e = DetectStep(d);
+  EXPECT_NEAR(e.time, 0.5, 0.5 * d.SampleTime());
+  EXPECT_NEAR(e.size, 81.39, 1e-9);
+  const Dataset r = RemoveInitialOffset(d, e);
+  const double y_final = r.y().tail(100).mean();
+  EXPECT_NEAR(y_final / e.size, 1.59796, 0.005 * 1.59796);
 }
 
 }  // namespace
