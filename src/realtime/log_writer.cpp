@@ -67,8 +67,11 @@ LogWriter::LogWriter(std::string path, std::vector<std::pair<std::string, std::s
       options_(options),
       header_(std::move(header)),
       ring_(CheckedCapacity(options)) {
-  PNEUMID_CHECK(!path_.empty(), "log path must not be empty");
-  if (options_.format != LogFormat::kMat) {
+  PNEUMID_CHECK(!path_.empty() || options_.keep_in_memory,
+                "log path must not be empty (unless the log is kept in memory only)");
+  if (path_.empty()) {
+    mat_records_.reserve(4096);
+  } else if (options_.format != LogFormat::kMat) {
     file_ = std::fopen(path_.c_str(), "w");
     if (!file_)
       throw DataError(fmt::format("{}: cannot create log file: {}", path_, std::strerror(errno)));
@@ -110,8 +113,9 @@ LogWriter::~LogWriter() {
 }
 
 void LogWriter::WriteRecord(const LogRecord& r) {
-  if (options_.format == LogFormat::kMat) {
-    mat_records_.push_back(r);
+  if (options_.keep_in_memory && options_.format != LogFormat::kMat) mat_records_.push_back(r);
+  if (options_.format == LogFormat::kMat || !file_) {
+    if (options_.format == LogFormat::kMat) mat_records_.push_back(r);
     written_.fetch_add(1, std::memory_order_relaxed);
     return;
   }
@@ -193,6 +197,7 @@ void LogWriter::Close(const std::string& timing_line, const std::string& stop_li
   closed_ = true;
   stop_.store(true, std::memory_order_release);
   if (thread_.joinable()) thread_.join();
+  if (path_.empty()) return;
   if (options_.format == LogFormat::kMat) {
     if (!timing_line.empty()) header_.emplace_back("timing", timing_line);
     if (!stop_line.empty()) header_.emplace_back("stop", stop_line);

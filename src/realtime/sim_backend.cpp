@@ -8,6 +8,7 @@ namespace pneumid {
 
 SimBackend::SimBackend(std::unique_ptr<Plant> plant) : plant_(std::move(plant)) {
   PNEUMID_CHECK(plant_ != nullptr, "SimBackend needs a plant, got null");
+  ipa_ = dynamic_cast<IpaSimulator*>(plant_.get());
 }
 
 void SimBackend::Open(double period) {
@@ -20,6 +21,7 @@ void SimBackend::Open(double period) {
 IoStatus SimBackend::Read(Measurement* m) noexcept {
   try {
     m->y = plant_->Measure();
+    if (ipa_) m->aux = ipa_->pressure_a();
   } catch (...) {
     return IoStatus::kError;
   }
@@ -38,9 +40,12 @@ IoStatus SimBackend::Write(double u) noexcept {
 
 IoStatus SimBackend::EnterSafeState(SafeState state) noexcept {
   IoStatus status = IoStatus::kOk;
-  if (state == SafeState::kExhaustOpen && !in_safe_state_) {
+  if (!in_safe_state_ && (ipa_ || state == SafeState::kExhaustOpen)) {
     try {
-      plant_->Advance(0.0);
+      if (ipa_)
+        ipa_->AdvanceValves(false, state == SafeState::kExhaustOpen);
+      else
+        plant_->Advance(0.0);
     } catch (...) {
       status = IoStatus::kError;
     }

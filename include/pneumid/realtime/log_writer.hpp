@@ -74,14 +74,16 @@ struct LogWriterOptions {
   LogFormat format = LogFormat::kCsv;
   std::size_t capacity = 1 << 16;  ///< ring buffer records (65 s at 1 kHz)
   double flush_interval = 1.0;     ///< seconds between flushes to the OS
+  /// Also keep every record in memory (writer thread) for records() after Close().
+  bool keep_in_memory = false;
   bool IsValid(std::string* error) const;
 };
 
 class LogWriter {
  public:
-  /// Opens `path` (truncating), writes the header lines (key, value) and starts the
-  /// writer thread. @throws DataError when the file cannot be created, InvalidArgument
-  /// on bad options.
+  /// Opens `path` (truncating; empty with keep_in_memory: no file), writes the header lines (key,
+  /// value) and starts the writer thread. @throws DataError when the file cannot be created,
+  /// InvalidArgument on bad options.
   LogWriter(std::string path, std::vector<std::pair<std::string, std::string>> header,
             LogWriterOptions options = {});
   /// Closes if still open (errors ignored).
@@ -102,6 +104,8 @@ class LogWriter {
   const std::string& path() const { return path_; }
   std::int64_t written() const { return written_.load(); }
   std::int64_t dropped() const { return dropped_.load(); }
+  /// Records written, when keep_in_memory or the .mat format (valid after Close()).
+  const std::vector<LogRecord>& records() const { return mat_records_; }
 
  private:
   void WriterMain();

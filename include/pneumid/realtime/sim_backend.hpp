@@ -3,14 +3,18 @@
 // Plant::Advance(u). Paced in real time by the loop, or as fast as possible
 // (LoopOptions::fast) since the plant keeps its own time.
 //
-// Safe state in simulation: the Plant interface has a single input (duty, %),
-// so "exhaust-open" applies u = 0 % for one period (the inlet closed, chamber
-// venting) and "valves-closed" stops advancing the plant (pressure held).
+// Safe state in simulation: with the IPA simulator the valves are commanded
+// directly for one period (IpaSimulator::AdvanceValves: both closed, or inlet
+// closed and exhaust open) and the plant is not advanced any further; with
+// another plant (single input) "exhaust-open" applies u = 0 % for one period
+// and "valves-closed" stops advancing it. With the IPA simulator, Read() also
+// returns the chamber-A pressure (Pa, absolute) as the auxiliary measurement.
 #pragma once
 
 #include <memory>
 #include <string>
 
+#include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/plant.hpp"
 #include "pneumid/realtime/io_backend.hpp"
 
@@ -37,6 +41,7 @@ class SimBackend : public IoBackend {
 
  private:
   std::unique_ptr<Plant> plant_;
+  IpaSimulator* ipa_ = nullptr;  // plant_ when it is the IPA simulator
   bool in_safe_state_ = false;
   SafeState safe_state_ = SafeState::kValvesClosed;
 };

@@ -1,0 +1,44 @@
+// A complete logged run, as `pneumid run` and `pneumid experiment` do it:
+// log file with header, SIGINT/SIGTERM handling, optional live status line on
+// stderr, the loop, then the statistics written into the log.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pneumid/realtime/log_writer.hpp"
+#include "pneumid/realtime/realtime_loop.hpp"
+
+namespace pneumid {
+
+struct SessionOptions {
+  LoopOptions loop;
+  SafetyOptions safety;
+  std::string log_path;  ///< empty: no log file
+  LogWriterOptions log;
+  /// Header lines (key, value) recorded in the log besides the automatic ones
+  /// (io, controller, period, duration, safety).
+  std::vector<std::pair<std::string, std::string>> header;
+  /// Redraw a one-line status (t, set point, force, duty, jitter) on stderr every 0.2 s.
+  bool live_status = false;
+  /// Keep the records in memory (SessionResult::records), e.g. for metrics.
+  bool keep_records = false;
+};
+
+struct SessionResult {
+  LoopSummary summary;
+  std::int64_t log_rows = 0;
+  std::vector<LogRecord> records;  ///< when keep_records
+};
+
+/// Runs the session. Installs the stop-signal handlers.
+/// @throws InvalidArgument / DataError as RunLoop and LogWriter do (before the run);
+/// DataError when the log cannot be completed.
+SessionResult RunSession(const SessionOptions& options, IoBackend& io, LoopController& controller,
+                         const std::vector<double>& setpoint);
+
+/// Human-readable safety settings, e.g. "u in [0, 100] %, rate off, y in [..], ...".
+std::string DescribeSafety(const SafetyOptions& s);
+
+}  // namespace pneumid
