@@ -417,23 +417,34 @@ ProcessParams InitialProcessGuess(const Dataset& data, int input, int output,
     p.theta = 0.3 * lag;
     from = "the final ramp";
   } else {
+    // The first step of the record (up to the next input change), when it is
+    // a clean settled step, gives the graphical initial guess.
+    Eigen::Index k1 = k0;
+    const double utol = 0.05 * std::abs(k0 < n ? u[k0] - u0 : 0.0);
+    while (k1 < n && std::abs(u[k1] - u[k0]) <= utol) ++k1;
+    Dataset first = data;
+    if (k1 < n && k1 >= 10) {
+      first = Dataset(t.head(k1), data.inputs().topRows(k1), data.outputs().topRows(k1),
+                      data.input_channels(), data.output_channels());
+      first.set_source(data.source());
+    }
     bool have_step = false;
     try {
-      const StepAnalysis s = AnalyzeStep(data, input, output);
+      const StepAnalysis s = AnalyzeStep(first, input, output);
       p.y0 = s.y0;
       if (structure == ProcessStructure::kP1D) {
         const FopdtParams f = ReactionCurve(s);
         p.K = f.K;
         p.T1 = f.tau;
         p.theta = f.theta;
-        from = "the reaction curve";
+        from = k1 < n ? "the reaction curve of the first step" : "the reaction curve";
       } else {
         const ThreePointSopdtResult so = ThreePointSopdt(s);
         p.K = so.params.K;
         p.T1 = so.params.tau1;
         p.T2 = std::max(so.params.tau2, 0.05 * so.params.tau1);
         p.theta = so.params.theta;
-        from = "the three-point SOPDT";
+        from = k1 < n ? "the three-point SOPDT of the first step" : "the three-point SOPDT";
         if (structure == ProcessStructure::kP3D) {
           p.T3 = 0.5 * p.T2;
           p.theta = std::max(0.0, p.theta - p.T3);
@@ -454,21 +465,48 @@ ProcessParams InitialProcessGuess(const Dataset& data, int input, int output,
         }
       }
       have_step = true;
-    } catch (const DataError&) {
+    } catch (const std::exception&) {  // not a clean step: fall back to the grid
       have_step = false;
     }
     if (!have_step) {
-      // Static least-squares gain on the deviations, a tenth of the record as lag.
-      const Eigen::ArrayXd du = u.array() - u0, dy = y.array() - p.y0;
-      const double suu = du.square().sum();
-      p.K = suu > 0.0 ? (du * dy).sum() / suu : 1.0;
-      p.T1 = 0.1 * duration;
-      p.T2 = 0.5 * p.T1;
-      p.T3 = 0.25 * p.T1;
-      p.Tw = 0.1 * duration;
-      p.zeta = 0.7;
-      p.theta = 0.0;
-      from = "a static gain and a tenth of the record";
+      // Grid search: lags T (geometric, 2 Ts .. half the record) and delays
+      // theta in {0, 0.1, 0.3, 1} T; K and y0 by linear least squares each.
+      const Eigen::VectorXd du = (u.array() - u0).matrix();
+      const double Ts = data.SampleTime();
+      double best = std::numeric_limits<double>::infinity();
+      const int nT = 16;
+      for (int i = 0; i < nT; ++i) {
+        const double T =
+            2.0 * Ts * std::pow(0.25 * duration / Ts, static_cast<double>(i) / (nT - 1));
+        for (double f : {0.0, 0.1, 0.3, 1.0}) {
+          ProcessParams q;
+          q.K = 1.0;
+          q.T1 = T;
+          q.T2 = 0.5 * T;
+          q.T3 = 0.25 * T;
+          q.Tw = 0.5 * T;
+          q.zeta = 0.7;
+          q.theta = std::min(f * T, 0.5 * duration);
+          Eigen::VectorXd h;
+          try {
+            h = Lsim(ProcessTransferFunction(structure, false, q), du, Ts);
+          } catch (const std::exception&) {
+            continue;
+          }
+          Eigen::MatrixXd A(n, 2);
+          A.col(0) = h;
+          A.col(1).setOnes();
+          const Eigen::Vector2d c = A.colPivHouseholderQr().solve(y);
+          const double cost = (A * c - y).squaredNorm();
+          if (std::isfinite(cost) && cost < best && c[0] != 0.0) {
+            best = cost;
+            q.K = c[0];
+            q.y0 = c[1];
+            p = q;
+          }
+        }
+      }
+      from = "a grid search over lag and delay";
     }
   }
   if (p.K == 0.0) p.K = 1.0;
@@ -503,10 +541,49 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
   ProcessFitResult res;
   res.structure = options.structure;
   res.zero = options.zero;
-  ProcessParams p0 = initial ? *initial
-                             : InitialProcessGuess(data, input, output, options.structure,
-                                                   options.zero, &res.summary.initial_guess);
-  if (initial) res.summary.initial_guess = "the caller";
+  ProcessParams p0;
+  if (initial) {
+    p0 = *initial;
+    res.summary.initial_guess = "the caller";
+  } else if (options.zero) {
+    // A zero is fitted from the converged model without it, started with
+    // Tz = 0 and with Tz = +-Tm (Tm = the second lag, at least T1 / 5, the
+    // faster lags raised to Tm); the lowest cost wins.
+    ProcessFitOptions no_zero = options;
+    no_zero.zero = false;
+    const ProcessFitResult first = FitProcessModel(data, input, output, no_zero);
+    const double T1 =
+        options.structure == ProcessStructure::kP2DU ? first.params.Tw : first.params.T1;
+    const double Tm = std::max(first.params.T2, 0.2 * T1);
+    ProcessFitResult best;
+    bool have = false;
+    for (double sign : {0.0, 1.0, -1.0}) {
+      ProcessParams start = first.params;
+      start.Tz = sign * Tm;
+      if (sign != 0.0) {
+        start.T2 = std::max(start.T2, Tm);
+        start.T3 = std::max(start.T3, 0.5 * Tm);
+      }
+      ProcessFitResult r = FitProcessModel(data, input, output, options, &start);
+      if (r.summary.termination != FitTermination::kFailure &&
+          (!have || r.summary.final_cost < best.summary.final_cost)) {
+        best = std::move(r);
+        have = true;
+      }
+    }
+    if (have) {
+      best.summary.initial_guess = "the fitted " + ToString(options.structure) +
+                                   " without zero, Tz started at 0 and +-" +
+                                   fmt::format("{:.4g}", Tm) + " s";
+      return best;
+    }
+    p0 = first.params;
+    p0.Tz = 0.0;
+    res.summary.initial_guess = "the fitted " + ToString(options.structure) + " without zero";
+  } else {
+    p0 = InitialProcessGuess(data, input, output, options.structure, false,
+                             &res.summary.initial_guess);
+  }
   if (!options.estimate_offset) p0.y0 = k0 > 0 ? y.head(k0).mean() : y[0];
 
   const std::vector<Slot> slots = Slots(options.structure, options.zero, options.estimate_offset);

@@ -20,10 +20,13 @@
 // identity (least squares), Huber or Cauchy loss, under the bounds
 //   T1, T2, T3, Tw > 1e-3 Ts,  0.001 <= zeta <= 1 (P2DU),  0 <= theta <= max_delay.
 // Jacobians by finite differences that stay inside the bounds. The initial
-// guess comes from the graphical methods when the data are a clean step
-// (reaction curve for P1D, three-point SOPDT for P2D/P2DU/P3D, the end ramp
-// for P1DI), otherwise from a static least-squares gain and a tenth of the
-// record as time constant.
+// guess comes from the graphical methods when the data, or their first step
+// (up to the next input change), are a clean settled step (reaction curve for
+// P1D, three-point SOPDT for P2D/P2DU/P3D); for P1DI from the final ramp;
+// otherwise from a grid search over 16 lags (2 Ts to a quarter of the record)
+// and 4 delays (0, 0.1, 0.3, 1 lag) with K and y0 by linear least squares.
+// With a zero, the fit starts from the converged model without it, with Tz = 0
+// and Tz = +-(second lag, at least T1/5); the lowest cost is kept.
 // Parameter standard deviations: sigma^2 = 2 cost / (N - p) and
 // cov = sigma^2 (J^T J)^-1 at the solution (Ceres Covariance [2]).
 //
