@@ -1,0 +1,118 @@
+#!/usr/bin/env bash
+# CLI tests of the real-time commands: run, experiment, plant-server.
+# Usage: bash realtime_test.sh /path/to/pneumid   (cwd: a scratch/build directory)
+set -u
+PNEUMID=${1:?usage: realtime_test.sh /path/to/pneumid}
+TMP=$(mktemp -d)
+SERVER_PID=""
+cleanup() {
+  if [ -n "$SERVER_PID" ]; then kill "$SERVER_PID" 2>/dev/null; wait "$SERVER_PID" 2>/dev/null; fi
+  rm -rf "$TMP"
+}
+trap cleanup EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+data_rows() { grep -v '^#' "$1" | tail -n +2 | wc -l; }
+
+start_server() {  # start_server [extra flags]; sets SERVER_PID and PORT
+  "$PNEUMID" plant-server --plant ipa --port 0 "$@" > "$TMP/server.txt" 2>&1 &
+  SERVER_PID=$!
+  for _ in $(seq 50); do
+    PORT=$(sed -n 's/.*udp:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$TMP/server.txt")
+    [ -n "$PORT" ] && return 0
+    sleep 0.1
+  done
+  fail "plant-server did not start: $(cat "$TMP/server.txt")"
+}
+stop_server() {
+  kill -INT "$SERVER_PID"; wait "$SERVER_PID"; SERVER_PID=""
+}
+
+# --help everywhere
+for c in run experiment plant-server; do
+  "$PNEUMID" $c --help > "$TMP/help.txt" || fail "$c --help"
+  grep -q -- "--io\|--port" "$TMP/help.txt" || fail "$c --help lacks its options"
+done
+
+# experiment: a data set with t,u,y that the identification reads
+"$PNEUMID" experiment step --fast --duration 2 -o "$TMP/step.csv" > "$TMP/out.txt" || fail "experiment step"
+[ "$(data_rows "$TMP/step.csv")" -eq 200 ] || fail "experiment rows: $(data_rows "$TMP/step.csv")"
+grep -v '^#' "$TMP/step.csv" | head -1 | grep -qx 't,u,y' || fail "experiment header"
+"$PNEUMID" experiment prbs --fast --duration 1 -o "$TMP/prbs.csv" --json > "$TMP/prbs.json" || fail "experiment prbs"
+grep -q '"samples": 100' "$TMP/prbs.json" || fail "experiment prbs json"
+"$PNEUMID" experiment staircase --fast --duration 1 -o "$TMP/stairs.mat" > /dev/null || fail "experiment .mat"
+[ -s "$TMP/stairs.mat" ] || fail "no .mat written"
+if "$PNEUMID" --help 2>&1 | grep -qE '^ +identify '; then
+  "$PNEUMID" identify "$TMP/step.csv" > "$TMP/id.txt" 2>&1 ||
+    "$PNEUMID" identify --data "$TMP/step.csv" > "$TMP/id.txt" 2>&1 ||
+    fail "identify cannot read the experiment data: $(cat "$TMP/id.txt")"
+fi
+
+# closed loop through a plant server (hardware in the loop on 127.0.0.1)
+start_server
+"$PNEUMID" run --controller dmc --model fopdt-paper --io "udp://127.0.0.1:$PORT" \
+  --setpoint step:from=0,to=100,at=0.2 --duration 1 --max-overruns -1 \
+  --log "$TMP/udp.csv" --json > "$TMP/udp.json" || fail "run over udp: $(cat "$TMP/udp.json")"
+for key in '"samples": 100' '"termination": "completed"' '"jitter_p99_us"' '"jitter_max_us"' '"overruns"'; do
+  grep -q "$key" "$TMP/udp.json" || fail "run --json lacks $key"
+done
+[ "$(data_rows "$TMP/udp.csv")" -eq 100 ] || fail "udp log rows: $(data_rows "$TMP/udp.csv")"
+grep -q '^# timing: 100 samples' "$TMP/udp.csv" || fail "timing statistics missing from the log"
+stop_server
+grep -q "safe-state requests" "$TMP/server.txt" || fail "server summary"
+
+# a server that stops answering: timeout fault, safe state, complete log, exit 3
+start_server --stop-answering-after 30
+"$PNEUMID" run --controller pid --model fopdt-paper --io "udp://127.0.0.1:$PORT" \
+  --setpoint step:from=0,to=50,at=0 --duration 2 --max-overruns -1 --safe-state exhaust-open \
+  --log "$TMP/timeout.csv" > "$TMP/timeout.out" 2> "$TMP/timeout.err"
+rc=$?
+[ $rc -eq 3 ] || fail "timeout exit status $rc"
+grep -q "timeout" "$TMP/timeout.err" || fail "timeout not reported: $(cat "$TMP/timeout.err")"
+grep -q "exhaust-open" "$TMP/timeout.err" || fail "safe state not reported"
+[ "$(data_rows "$TMP/timeout.csv")" -eq 34 ] || fail "timeout log rows: $(data_rows "$TMP/timeout.csv")"
+tail -1 "$TMP/timeout.csv" | grep -q ',timeout$' || fail "fault reason not in the last row"
+grep -q '^# stop: fault: timeout' "$TMP/timeout.csv" || fail "fault not in the log header"
+stop_server
+
+# sensor range fault on the simulator
+"$PNEUMID" run --controller pid --model fopdt-paper --io sim --fast --duration 3 \
+  --setpoint step:from=0,to=100,at=0 --y-max 50 --log "$TMP/range.csv" > /dev/null 2> "$TMP/range.err"
+[ $? -eq 3 ] || fail "range fault exit status"
+grep -q "sensor-out-of-range" "$TMP/range.err" || fail "range fault message"
+tail -1 "$TMP/range.csv" | grep -q ',sensor-out-of-range$' || fail "range fault not logged"
+
+# SIGINT: safe state, complete log, exit 130
+"$PNEUMID" run --controller pid --model fopdt-paper --io sim --duration 60 --no-realtime \
+  --max-overruns -1 --log "$TMP/int.csv" > "$TMP/int.out" 2>&1 &
+RUN_PID=$!
+sleep 1.5
+kill -INT $RUN_PID
+wait $RUN_PID
+rc=$?
+[ $rc -eq 130 ] || fail "SIGINT exit status $rc"
+rows=$(data_rows "$TMP/int.csv")
+grep -q "^# stop: stopped: stopped by signal 2 (Interrupt) after $rows samples" "$TMP/int.csv" ||
+  fail "SIGINT: log rows ($rows) differ from the samples run: $(grep '^# stop' "$TMP/int.csv")"
+
+# kill -9: at most the last second (flush interval) is missing
+"$PNEUMID" run --controller pid --model fopdt-paper --io sim --duration 60 --no-realtime \
+  --max-overruns -1 --log "$TMP/kill.csv" > /dev/null 2>&1 &
+RUN_PID=$!
+sleep 3
+kill -9 $RUN_PID
+wait $RUN_PID 2>/dev/null
+rows=$(data_rows "$TMP/kill.csv")
+[ "$rows" -ge 100 ] || fail "after kill -9 only $rows rows survived"
+
+# bad input: clear errors, non-zero exit, no crash
+"$PNEUMID" run --io serial --duration 1 2> "$TMP/e1" && fail "bad --io accepted"
+grep -q "unknown backend" "$TMP/e1" || fail "bad --io message: $(cat "$TMP/e1")"
+"$PNEUMID" run --io comedi:/dev/comedi_pneumid_missing --duration 1 2> "$TMP/e2" && fail "missing device accepted"
+grep -q "/dev/comedi_pneumid_missing" "$TMP/e2" || fail "missing device message: $(cat "$TMP/e2")"
+"$PNEUMID" run --io udp://127.0.0.1:1 --duration 1 2> "$TMP/e3" && fail "no server accepted"
+grep -q "no answer from a plant server" "$TMP/e3" || fail "no-server message: $(cat "$TMP/e3")"
+"$PNEUMID" run --period 0 --duration 1 2> "$TMP/e4" && fail "--period 0 accepted"
+grep -q "period" "$TMP/e4" || fail "--period message"
+"$PNEUMID" experiment step --io udp://127.0.0.1:9 --fast -o "$TMP/x.csv" 2> "$TMP/e5" && fail "--fast with udp accepted"
+grep -q "fast" "$TMP/e5" || fail "--fast message"
+echo "realtime CLI tests passed"
