@@ -72,7 +72,14 @@ std::unique_ptr<Plant> MakePlant(const std::string& spec, double Ts, const Plant
                 "arx-paper, fopdt:K=..,tau=..,theta=.., MODEL.json");
   const std::string base = spec.substr(0, spec.find(':'));
   if (base == "ipa" || base == "ipa-position") return MakeIpa(spec, base, Ts, options);
-  TransferFunction g = ParseModelSpec(spec);
+  TransferFunction g;
+  try {
+    g = ParseModelSpec(spec);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(fmt::format(
+        "unknown plant '{}': expected ipa, ipa-position, ipa:config=FILE.toml or a model ({})",
+        spec, e.what()));
+  }
   return std::make_unique<LinearPlant>(g, Ts, options.noise_sigma.value_or(0.0), options.seed,
                                        spec);
 }
