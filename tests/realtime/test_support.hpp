@@ -136,3 +136,29 @@ class FaultyBackend : public IoBackend {
 };
 
 }  // namespace pneumid::testing
+
+namespace pneumid::testing {
+
+/// Delegates to another LoopController and records the loop thread's allocations.
+class CountingWrapper : public LoopController {
+ public:
+  explicit CountingWrapper(LoopController& inner) : inner_(inner) {}
+  void Reset() override {
+    inner_.Reset();
+    first_ = -1;
+  }
+  double Update(std::int64_t k, double r, double y) noexcept override {
+    const std::int64_t a = ThreadAllocations();
+    if (first_ < 0) first_ = a;
+    last_ = a;
+    return inner_.Update(k, r, y);
+  }
+  std::string Describe() const override { return inner_.Describe(); }
+  std::int64_t allocations_during_run() const { return last_ - first_; }
+
+ private:
+  LoopController& inner_;
+  std::int64_t first_ = -1, last_ = 0;
+};
+
+}  // namespace pneumid::testing
