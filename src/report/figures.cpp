@@ -8,7 +8,6 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
-#include "pneumid/lti/frequency.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {
@@ -232,7 +231,9 @@ Figure BodeFigure(const std::vector<NamedModel>& models, const Eigen::VectorXd& 
     double hi = wmax > 0.0 ? std::ceil(std::log10(wmax)) + 1.0 : 3.0;
     if (std::isfinite(nyquist)) hi = std::min(hi, std::log10(nyquist));
     if (hi <= lo) lo = hi - 2.0;
-    w = LogSpace(lo, hi, 400);
+    w = Eigen::VectorXd::LinSpaced(400, lo, hi).unaryExpr([](double e) {
+      return std::pow(10.0, e);
+    });
   }
   PNEUMID_CHECK(w.size() >= 2 && (w.array() > 0.0).all(),
                 "BodeFigure: omega needs at least 2 positive frequencies");
@@ -256,11 +257,20 @@ Figure BodeFigure(const std::vector<NamedModel>& models, const Eigen::VectorXd& 
       wm = Eigen::Map<Eigen::VectorXd>(keep.data(), static_cast<Eigen::Index>(keep.size()));
     }
     if (wm.size() < 2) continue;
-    const BodeData b = Bode(m.model, wm);
+    // Magnitude in dB and phase unwrapped along the grid (delay included).
+    Eigen::VectorXd mag_db(wm.size()), phase(wm.size());
+    double prev = 0.0;
+    for (Eigen::Index i = 0; i < wm.size(); ++i) {
+      const std::complex<double> h = m.model.FrequencyResponse(wm[i]);
+      mag_db[i] = 20.0 * std::log10(std::abs(h));
+      double p = std::arg(h) * 180.0 / M_PI;
+      if (i > 0) p += 360.0 * std::round((prev - p) / 360.0);
+      phase[i] = prev = p;
+    }
     const Color c = PaletteColor(k);
     const LineStyle style = k % 2 == 0 ? LineStyle::kSolid : LineStyle::kDashed;
-    mag.AddLine(b.omega, b.magnitude_db, m.label, style).color = c;
-    ph.AddLine(b.omega, b.phase_deg, m.label, style).color = c;
+    mag.AddLine(wm, mag_db, m.label, style).color = c;
+    ph.AddLine(wm, phase, m.label, style).color = c;
     ++k;
   }
   PNEUMID_CHECK(k > 0, "BodeFigure: no model has frequencies below its Nyquist frequency");
@@ -294,9 +304,14 @@ Figure ClosedLoopFigure(const Eigen::VectorXd& t, const Eigen::VectorXd& setpoin
   int k = 0;
   for (const auto& tr : traces) {
     const Color c = PaletteColor(k++);
-    out.AddLine(t, tr.y, tr.label).color = c;
+    // Alternate solid and dashed lines so that runs that nearly coincide stay
+    // distinguishable.
+    const LineStyle style = k % 2 == 1 ? LineStyle::kSolid : LineStyle::kDashed;
+    Series& so = out.AddLine(t, tr.y, tr.label, style);
+    so.color = c;
     Series& s = in.AddStairs(t, tr.u, tr.label);
     s.color = c;
+    s.style = style;
   }
   if (std::isfinite(options.disturbance_time)) {
     for (Axes* ax : {&out, &in}) {

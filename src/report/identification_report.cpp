@@ -129,7 +129,9 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
   }
 
   const std::string source = data.source().empty() ? "(in-memory data)" : data.source();
-  HtmlDocument doc(options.title.empty() ? "Identification report: " + source : options.title);
+  HtmlDocument doc(options.title.empty() ? "Identification report: " +
+                                               std::filesystem::path(source).filename().string()
+                                         : options.title);
   const Channel uc = in < static_cast<int>(data.input_channels().size()) ? data.input_channels()[in]
                                                                          : Channel{"u", ""};
   const Channel yc = out < static_cast<int>(data.output_channels().size())

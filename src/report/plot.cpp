@@ -379,6 +379,26 @@ std::string PlainText(const std::string& s) {
 
 }  // namespace
 
+std::string DescribeFigure(const Figure& figure);
+
+namespace {
+
+// Accessible text: <title> and <desc> after the opening <svg ...> tag (cairo
+// draws text as glyph outlines, so the labels are not otherwise searchable).
+void AddSvgMetadata(const Figure& fig, std::string* svg) {
+  const auto open = svg->find("<svg");
+  if (open == std::string::npos) return;
+  const auto close_tag = svg->find('>', open);
+  if (close_tag == std::string::npos) return;
+  const std::string title = PlainText(!fig.title.empty() ? fig.title : fig.axes(0).title);
+  const std::string meta = "\n<title>" + XmlEscape(title) + "</title>\n<desc>" +
+                           XmlEscape(DescribeFigure(fig)) + "</desc>";
+  svg->insert(close_tag + 1, meta);
+  svg->insert(open + 4, " role=\"img\"");
+}
+
+}  // namespace
+
 std::string ToString(LineStyle style) {
   switch (style) {
     case LineStyle::kSolid:
@@ -533,6 +553,19 @@ void Figure::Save(const std::string& path, ImageFormat format) const {
   std::error_code ec;
   if (std::filesystem::file_size(path, ec) == 0 || ec)
     throw DataError(path + ": PLplot wrote no image");
+  if (format == ImageFormat::kSvg) {
+    std::string svg;
+    {
+      std::ifstream in(path, std::ios::binary);
+      std::ostringstream ss;
+      ss << in.rdbuf();
+      svg = ss.str();
+    }
+    AddSvgMetadata(*this, &svg);
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << svg;
+    if (!out) throw DataError(path + ": write failed");
+  }
 }
 
 std::string Figure::ToSvg(const std::string& id_prefix) const {
@@ -566,19 +599,6 @@ std::string Figure::ToSvg(const std::string& id_prefix) const {
   ReplaceAll(&svg, "id=\"", "id=\"" + p);
   ReplaceAll(&svg, "href=\"#", "href=\"#" + p);
   ReplaceAll(&svg, "url(#", "url(#" + p);
-  // Accessible text: title and description after the opening <svg ...> tag.
-  const auto open = svg.find("<svg");
-  if (open != std::string::npos) {
-    const auto close_tag = svg.find('>', open);
-    if (close_tag != std::string::npos) {
-      std::string title = !this->title.empty() ? this->title : axes_.front().title;
-      title = PlainText(title);
-      std::string meta = "\n<title>" + XmlEscape(title) + "</title>\n<desc>" +
-                         XmlEscape(DescribeFigure(*this)) + "</desc>";
-      svg.insert(close_tag + 1, meta);
-      svg.insert(open + 4, " role=\"img\"");
-    }
-  }
   return svg;
 }
 

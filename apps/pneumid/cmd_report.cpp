@@ -1,0 +1,135 @@
+// pneumid report DATA [--methods M,...] -o DIR [--json]
+//
+// Identifies models of DATA by several methods and writes DIR/report.html (a
+// self-contained page with inline SVG plots, parameter and metric tables and
+// the commands that reproduce it) and DIR/models.json.
+#include <iostream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "data_options.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/report/identification_report.hpp"
+
+namespace {
+
+std::string ShellQuote(const std::string& s) {
+  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                        "0123456789_-./=,:+") == std::string::npos)
+    return s;
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::vector<std::string> SplitComma(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const auto b = item.find_first_not_of(' ');
+    const auto e = item.find_last_not_of(' ');
+    if (b != std::string::npos) out.push_back(item.substr(b, e - b + 1));
+  }
+  return out;
+}
+
+struct ReportArgs {
+  pneumid::cli::DataOptions data;
+  std::string methods = "reaction-curve,ptn,arx";
+  std::string out_dir;
+  std::string title;
+  int order = 2, na = 3, nb = 3, nk = 1;
+  int max_lag = 25;
+  bool json = false;
+};
+
+void Run(const ReportArgs& a) {
+  using namespace pneumid;
+  ReportOptions o;
+  o.methods = SplitComma(a.methods);
+  o.request.order = a.order;
+  o.request.na = a.na;
+  o.request.nb = a.nb;
+  o.request.nk = a.nk;
+  o.residual_max_lag = a.max_lag;
+  o.title = a.title;
+  std::string error;
+  PNEUMID_CHECK(o.IsValid(&error), "{}", error);
+
+  std::string cmd = "pneumid report " + ShellQuote(a.data.path);
+  const cli::DataOptions defaults;
+  if (a.data.time_col != defaults.time_col) cmd += " --time-col " + ShellQuote(a.data.time_col);
+  if (a.data.input_col != defaults.input_col) cmd += " --input-col " + ShellQuote(a.data.input_col);
+  if (a.data.output_col != defaults.output_col)
+    cmd += " --output-col " + ShellQuote(a.data.output_col);
+  if (a.data.sample_time > 0) cmd += fmt::format(" --sample-time {}", a.data.sample_time);
+  if (!a.data.delimiter.empty()) cmd += " --delimiter " + ShellQuote(a.data.delimiter);
+  if (a.data.format != defaults.format) cmd += " --format " + a.data.format;
+  cmd += " --methods " + ShellQuote(a.methods);
+  if (a.order != 2) cmd += fmt::format(" --order {}", a.order);
+  if (a.na != 3 || a.nb != 3 || a.nk != 1)
+    cmd += fmt::format(" --na {} --nb {} --nk {}", a.na, a.nb, a.nk);
+  if (a.max_lag != 25) cmd += fmt::format(" --max-lag {}", a.max_lag);
+  if (!a.title.empty()) cmd += " --title " + ShellQuote(a.title);
+  cmd += " -o " + ShellQuote(a.out_dir);
+  o.commands = {cmd};
+
+  const Dataset data = cli::LoadFromOptions(a.data);
+  const ReportSummary s = WriteIdentificationReport(data, o, a.out_dir);
+
+  if (a.json) {
+    nlohmann::json j;
+    j["termination"] = ToString(s.termination);
+    j["message"] = s.message;
+    j["html"] = s.html_path;
+    j["models_json"] = s.models_path;
+    j["figures"] = s.num_figures;
+    j["tables"] = s.num_tables;
+    j["models"] = nlohmann::json::array();
+    for (const auto& m : s.models) j["models"].push_back(m.ToJson());
+    j["failures"] = nlohmann::json::array();
+    for (const auto& [m, e] : s.failures) j["failures"].push_back({{"method", m}, {"error", e}});
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << fmt::format("{:<16} {:<10} {:>10}  {}\n", "method", "structure", "fit [%]",
+                             "model");
+    for (const auto& m : s.models)
+      std::cout << fmt::format("{:<16} {:<10} {:>10.2f}  {}\n", m.method, m.structure,
+                               m.fit_percent, m.tf.ToString(5));
+    for (const auto& [m, e] : s.failures) std::cout << fmt::format("{:<16} failed: {}\n", m, e);
+    std::cout << s.BriefReport() << "\n";
+  }
+  if (s.termination == ReportTermination::kFailure) {
+    std::cerr << "pneumid report: error: " << s.message << " (see " << s.html_path << ")\n";
+    throw cli::ExitCode{1};
+  }
+}
+
+const pneumid::cli::Registrar reg(
+    "report", "Identify models of a data file and write a self-contained HTML report",
+    [](CLI::App& app) {
+      auto a = std::make_shared<ReportArgs>();
+      pneumid::cli::AddDataOptions(app, a->data);
+      app.add_option("--methods,-m", a->methods,
+                     "Comma-separated identification methods (names of `pneumid identify "
+                     "--method`)")
+          ->capture_default_str();
+      app.add_option("-o,--output-dir", a->out_dir,
+                     "Directory for report.html and models.json (created when missing)")
+          ->required();
+      app.add_option("--order", a->order, "PTn order")->capture_default_str();
+      app.add_option("--na", a->na, "ARX order of A")->capture_default_str();
+      app.add_option("--nb", a->nb, "ARX order of B")->capture_default_str();
+      app.add_option("--nk", a->nk, "ARX input delay in samples")->capture_default_str();
+      app.add_option("--max-lag", a->max_lag, "Largest lag of the residual correlations")
+          ->capture_default_str();
+      app.add_option("--title", a->title, "Report title (default: from the data file)");
+      app.add_flag("--json", a->json, "Print the summary as JSON");
+      app.callback([a]() { Run(*a); });
+    });
+
+}  // namespace

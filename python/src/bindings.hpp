@@ -1,0 +1,21 @@
+// Internal declarations of the pneumid Python module (one Bind* per area).
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+#include <nlohmann/json.hpp>
+
+namespace pneumid::python {
+
+void BindData(pybind11::module_& m);
+void BindLti(pybind11::module_& m);
+void BindIdentify(pybind11::module_& m);
+void BindReport(pybind11::module_& m);
+/// Plant, control and closed-loop bindings.
+void BindExtras(pybind11::module_& m);
+
+/// JSON value <-> Python object (through the json module).
+pybind11::object JsonToPython(const nlohmann::json& j);
+nlohmann::json PythonToJson(const pybind11::handle& obj);
+
+}  // namespace pneumid::python

@@ -1,0 +1,195 @@
+// Bindings of the identify and report areas.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/identified_model.hpp"
+#include "pneumid/identify/step_analysis.hpp"
+#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/report/figures.hpp"
+#include "pneumid/report/identification_report.hpp"
+#include "pneumid/report/plot.hpp"
+
+namespace py = pybind11;
+using namespace py::literals;
+
+namespace pneumid::python {
+
+namespace {
+
+std::vector<NamedModel> ToNamed(const std::vector<std::pair<std::string, TransferFunction>>& v) {
+  std::vector<NamedModel> out;
+  for (const auto& [label, g] : v) out.push_back({label, g});
+  return out;
+}
+
+void SaveFigure(const Figure& fig, const std::string& path) {
+  py::gil_scoped_release release;
+  fig.Save(path);
+}
+
+}  // namespace
+
+void BindIdentify(py::module_& m) {
+  py::class_<IdentifiedModel>(m, "IdentifiedModel",
+                              "Result of an identification method: named parameters, the "
+                              "model, its fit to the data.")
+      .def_readonly("method", &IdentifiedModel::method)
+      .def_readonly("structure", &IdentifiedModel::structure)
+      .def_property_readonly(
+          "params", [](const IdentifiedModel& r) { return JsonToPython(r.params); },
+          "Named parameters (dict), e.g. {'K': 1.6, 'tau': 0.245, 'theta': 0.001}.")
+      .def_property_readonly("param_std",
+                             [](const IdentifiedModel& r) { return JsonToPython(r.param_std); })
+      .def_readonly("tf", &IdentifiedModel::tf, "Model (continuous when it exists).")
+      .def_readonly("discrete", &IdentifiedModel::discrete,
+                    "Discrete form of polynomial models, else None.")
+      .def_readonly("fit_percent", &IdentifiedModel::fit_percent, "NRMSE fit [%].")
+      .def_readonly("iae", &IdentifiedModel::iae, "Integrated absolute error [units s].")
+      .def_readonly("notes", &IdentifiedModel::notes)
+      .def(
+          "to_dict", [](const IdentifiedModel& r) { return JsonToPython(r.ToJson()); },
+          "The JSON form of `pneumid identify --json`.")
+      .def("__repr__", [](const IdentifiedModel& r) {
+        return "<IdentifiedModel " + r.method + " " + r.structure + ": " + r.tf.ToString(5) + ">";
+      });
+
+  m.def("identify_methods", &ReportMethodNames,
+        "Names of the identification methods (as `pneumid identify --method`).");
+  m.def(
+      "identify",
+      [](const std::string& method, const Dataset& data, int input, int output, int order, int na,
+         int nb, int nk, int nc, int nd, int nf) {
+        IdentifyRequest r;
+        r.input = input;
+        r.output = output;
+        r.order = order;
+        r.na = na;
+        r.nb = nb;
+        r.nk = nk;
+        r.nc = nc;
+        r.nd = nd;
+        r.nf = nf;
+        py::gil_scoped_release release;
+        return IdentifyByName(method, data, r);
+      },
+      "method"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3, "nb"_a = 3,
+      "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3,
+      "Identifies a model of data with a method of identify_methods(): e.g. "
+      "'reaction-curve' (FOPDT, paper Eq. 2), 'ptn' (PTn of order `order`, Eq. 3), 'arx' "
+      "(ARX(na, nb, nk), Eq. 4). Raises DataError when the data do not suit the method.");
+  m.def(
+      "simulate_on_data",
+      [](const TransferFunction& g, const Dataset& data, int input, int output, double y0) {
+        py::gil_scoped_release release;
+        return SimulateOnData(g, data, input, output, y0);
+      },
+      "g"_a, "data"_a, "input"_a = 0, "output"_a = 0,
+      "y0"_a = std::numeric_limits<double>::quiet_NaN(),
+      "Model output on the data's input in deviation variables: y0 + lsim(g, u - u0).");
+  m.def("nrmse_fit", &NrmseFit, "y"_a, "yhat"_a, "NRMSE fit [%] (MATLAB compare).");
+  m.def("rmse", &Rmse, "y"_a, "yhat"_a);
+  m.def(
+      "analyze_step",
+      [](const Dataset& data, int input, int output) {
+        const StepAnalysis s = AnalyzeStep(data, input, output);
+        return py::dict("step_time"_a = s.step_time, "Ts"_a = s.Ts, "u0"_a = s.u0, "u1"_a = s.u1,
+                        "du"_a = s.du, "y0"_a = s.y0, "y_final"_a = s.y_final, "dy"_a = s.dy,
+                        "gain"_a = s.gain, "noise_std"_a = s.noise_std,
+                        "departure_time"_a = s.departure_time, "t"_a = s.t, "r"_a = s.r);
+      },
+      "data"_a, "input"_a = 0, "output"_a = 0,
+      "Step analysis (baseline, final value, gain, noise) as a dict.");
+}
+
+void BindReport(py::module_& m) {
+  m.def(
+      "residual_correlation",
+      [](const Eigen::VectorXd& e, const Eigen::VectorXd& u, int max_lag, double confidence) {
+        const ResidualCorrelation c = ComputeResidualCorrelation(e, u, max_lag, confidence);
+        return py::dict("auto_lags"_a = c.auto_lags, "autocorr"_a = c.autocorr,
+                        "cross_lags"_a = c.cross_lags, "crosscorr"_a = c.crosscorr,
+                        "bound"_a = c.bound, "confidence"_a = c.confidence);
+      },
+      "residuals"_a, "input"_a, "max_lag"_a = 25, "confidence"_a = 0.99,
+      "Normalized residual auto- and cross-correlations with the confidence bound.");
+  m.def(
+      "plot_step_responses",
+      [](const std::vector<std::pair<std::string, TransferFunction>>& models,
+         const std::string& path, double amplitude, double t_final, const std::string& title) {
+        StepFigureOptions o;
+        o.amplitude = amplitude;
+        o.t_final = t_final;
+        o.title = title;
+        SaveFigure(StepResponseFigure(ToNamed(models), o), path);
+      },
+      "models"_a, "path"_a, "amplitude"_a = 1.0, "t_final"_a = 0.0, "title"_a = "Step response",
+      "Step responses of [(label, model), ...] (paper Fig. 4) to a PNG or SVG file.");
+  m.def(
+      "plot_model_comparison",
+      [](const Dataset& data, const std::vector<std::pair<std::string, TransferFunction>>& models,
+         const std::string& path, const std::string& title) {
+        ComparisonFigureOptions o;
+        o.title = title;
+        SaveFigure(ModelComparisonFigure(data, ToNamed(models), o), path);
+      },
+      "data"_a, "models"_a, "path"_a, "title"_a = "Model comparison",
+      "Measured data and models simulated on its input (paper Fig. 5).");
+  m.def(
+      "plot_bode",
+      [](const std::vector<std::pair<std::string, TransferFunction>>& models,
+         const std::string& path) { SaveFigure(BodeFigure(ToNamed(models)), path); },
+      "models"_a, "path"_a, "Bode diagram of [(label, model), ...].");
+  m.def(
+      "plot_residuals",
+      [](const Eigen::VectorXd& e, const Eigen::VectorXd& u, const std::string& path, int max_lag) {
+        SaveFigure(ResidualFigure(ComputeResidualCorrelation(e, u, max_lag)), path);
+      },
+      "residuals"_a, "input"_a, "path"_a, "max_lag"_a = 25,
+      "Residual correlations with the 99 % confidence band.");
+  m.def(
+      "plot_closed_loop",
+      [](const Eigen::VectorXd& t, const Eigen::VectorXd& r,
+         const std::vector<std::tuple<std::string, Eigen::VectorXd, Eigen::VectorXd>>& runs,
+         const std::string& path, const std::string& title) {
+        std::vector<ClosedLoopTrace> traces;
+        for (const auto& [label, y, u] : runs) traces.push_back({label, y, u});
+        ClosedLoopFigureOptions o;
+        o.title = title;
+        SaveFigure(ClosedLoopFigure(t, r, traces, o), path);
+      },
+      "t"_a, "setpoint"_a, "runs"_a, "path"_a, "title"_a = "Closed-loop response",
+      "Set-point, outputs and inputs of [(label, y, u), ...] (paper Fig. 6).");
+  m.def(
+      "write_identification_report",
+      [](const Dataset& data, const std::string& dir, std::vector<std::string> methods, int order,
+         int na, int nb, int nk) {
+        ReportOptions o;
+        o.methods = std::move(methods);
+        o.request.order = order;
+        o.request.na = na;
+        o.request.nb = nb;
+        o.request.nk = nk;
+        ReportSummary s;
+        {
+          py::gil_scoped_release release;
+          s = WriteIdentificationReport(data, o, dir);
+        }
+        py::list models;
+        for (const auto& mm : s.models) models.append(py::cast(mm));
+        py::list failures;
+        for (const auto& [mm, e] : s.failures) failures.append(py::make_tuple(mm, e));
+        return py::dict("termination"_a = ToString(s.termination), "message"_a = s.message,
+                        "html"_a = s.html_path, "models_json"_a = s.models_path,
+                        "models"_a = models, "failures"_a = failures, "figures"_a = s.num_figures,
+                        "tables"_a = s.num_tables);
+      },
+      "data"_a, "dir"_a, "methods"_a = std::vector<std::string>{"reaction-curve", "ptn", "arx"},
+      "order"_a = 2, "na"_a = 3, "nb"_a = 3, "nk"_a = 1,
+      "Writes DIR/report.html and DIR/models.json (as `pneumid report`); returns a summary "
+      "dict.");
+}
+
+}  // namespace pneumid::python
