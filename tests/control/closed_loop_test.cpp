@@ -9,8 +9,8 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
-#include "test_plants.hpp"
 
 namespace pneumid {
 namespace {
@@ -69,7 +69,7 @@ TEST(ClosedLoopTest, ActuatorLimitsAndNoise) {
   d.M = 5;
   d.lambda = 2.25;
   DmcController dmc(PaperFopdtModel(), 0.01, d);
-  testing_util::DifferenceEquationPlant plant(PaperFopdtModel(), 0.01);
+  LinearPlant plant(PaperFopdtModel(), 0.01);
   auto sp = ParseSignal("step:from=0,to=1,at=0.2");
   ClosedLoopOptions o;
   o.duration = 2.0;
@@ -84,7 +84,7 @@ TEST(ClosedLoopTest, ActuatorLimitsAndNoise) {
   ClosedLoopOptions bad;
   bad.duration = -1;
   EXPECT_THROW(SimulateClosedLoop(dmc, plant, *sp, bad), InvalidArgument);
-  testing_util::DifferenceEquationPlant other(PaperFopdtModel(), 0.02);
+  LinearPlant other(PaperFopdtModel(), 0.02);
   EXPECT_THAT([&] { SimulateClosedLoop(dmc, other, *sp, o); },
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("Ts = 0.02")));
 }

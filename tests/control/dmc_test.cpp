@@ -13,13 +13,11 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
-#include "test_plants.hpp"
 
 namespace pneumid {
 namespace {
-
-using testing_util::DifferenceEquationPlant;
 
 constexpr double kTs = 0.01;
 
@@ -76,7 +74,7 @@ TEST_P(DmcPaperTest, NominalFopdtReproducesReferenceFigures) {
   o.M = c.M;
   o.lambda = c.lambda;
   DmcController dmc(PaperFopdt(), kTs, o);
-  DifferenceEquationPlant plant(PaperFopdt(), kTs);
+  LinearPlant plant(PaperFopdt(), kTs);
   auto setpoint = ParseSignal("step:from=0,to=1,at=0");
   ClosedLoopOptions cl;
   cl.duration = 3.0;
@@ -109,7 +107,7 @@ TEST(DmcTest, OffsetFreeUnderModelMismatchAndLoad) {
   o.M = 5;
   o.lambda = 2.25;
   DmcController dmc(PaperFopdt(), kTs, o);
-  DifferenceEquationPlant plant(PaperArxModel(), kTs);
+  LinearPlant plant(PaperArxModel(), kTs);
   auto setpoint = ParseSignal("staircase:levels=0 20 40 20,dwell=1.5");
   ClosedLoopOptions cl;
   cl.duration = 7.0;
@@ -154,7 +152,7 @@ TEST(QdmcTest, LooseBoundsGiveTheUnconstrainedMoves) {
   oc.limits.u_max = 100;
   oc.limits.du_max = 50;
   DmcController a(PaperFopdt(), kTs, o), b(PaperFopdt(), kTs, oc);
-  DifferenceEquationPlant pa(PaperFopdt(), kTs), pb(PaperFopdt(), kTs);
+  LinearPlant pa(PaperFopdt(), kTs), pb(PaperFopdt(), kTs);
   auto sp = ParseSignal("staircase:levels=0 1 -1 0.5,dwell=0.5");
   ClosedLoopOptions cl;
   cl.duration = 2.0;
@@ -175,7 +173,7 @@ TEST(QdmcTest, RespectsInputAndRateBoundsAndBeatsClipping) {
   DmcOptions oc = o;
   oc.constrained = true;
   DmcController clip(PaperFopdt(), kTs, o), qdmc(PaperFopdt(), kTs, oc);
-  DifferenceEquationPlant p1(PaperFopdt(), kTs), p2(PaperFopdt(), kTs);
+  LinearPlant p1(PaperFopdt(), kTs), p2(PaperFopdt(), kTs);
   auto sp = ParseSignal("step:from=0,to=1.3,at=0.05");
   ClosedLoopOptions cl;
   cl.duration = 2.0;
@@ -201,7 +199,7 @@ TEST(QdmcTest, SoftOutputBoundLimitsOvershoot) {
   o.M = 10;
   o.lambda = 1.92;
   o.constrained = true;
-  DifferenceEquationPlant p(PaperFopdt(), kTs);
+  LinearPlant p(PaperFopdt(), kTs);
   auto sp = ParseSignal("step:from=0,to=1,at=0");
   ClosedLoopOptions cl;
   cl.duration = 2.0;

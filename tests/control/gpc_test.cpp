@@ -13,13 +13,12 @@
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
-#include "test_plants.hpp"
 
 namespace pneumid {
 namespace {
 
-using testing_util::DifferenceEquationPlant;
 constexpr double kTs = 0.01;
 
 TEST(CarimaTest, ArxModelPolynomials) {
@@ -67,7 +66,7 @@ TEST(GpcTest, PredictorMatchesSimulationWithTFilter) {
       o.t_polynomial << 1.0, -0.8;
     }
     GpcController gpc(PaperArxModel(), kTs, o);
-    DifferenceEquationPlant plant(PaperArxModel(), kTs);
+    LinearPlant plant(PaperArxModel(), kTs);
     gpc.Reset(0.0, 0.0);
     double u = 0.0;
     for (int k = 0; k < 40; ++k) {
@@ -81,7 +80,7 @@ TEST(GpcTest, PredictorMatchesSimulationWithTFilter) {
     gpc.Update(0.0, y);  // computes the free response at t
     const Eigen::VectorXd f = gpc.free_response();
     // Simulate forward holding u at its value before this last Update.
-    DifferenceEquationPlant copy = plant;
+    LinearPlant copy = plant;
     for (int j = 1; j <= o.N2; ++j) {
       copy.Advance(u);
       if (j >= o.N1)
@@ -105,7 +104,7 @@ double MaxMoveDifference(const TransferFunction& model, const TransferFunction& 
   g.t_equals_a = t_equals_a;
   DmcController dmc(model, kTs, d);
   GpcController gpc(model, kTs, g);
-  DifferenceEquationPlant p1(plant_model, kTs), p2(plant_model, kTs);
+  LinearPlant p1(plant_model, kTs), p2(plant_model, kTs);
   auto sp = ParseSignal("staircase:levels=0 1 3 2,dwell=0.4");
   ClosedLoopOptions cl;
   cl.duration = 1.6;
@@ -149,7 +148,7 @@ TEST(GpcTest, OffsetFreeWithTEqualsOne) {
   g.Nu = 5;
   g.lambda = 2.25;
   GpcController gpc(TransferFunction::Fopdt(1.6, 0.245, 0.001), kTs, g);
-  DifferenceEquationPlant plant(PaperArxModel(), kTs);
+  LinearPlant plant(PaperArxModel(), kTs);
   auto sp = ParseSignal("step:from=0,to=50,at=0.1");
   ClosedLoopOptions cl;
   cl.duration = 4.0;

@@ -10,13 +10,12 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
-#include "test_plants.hpp"
 
 namespace pneumid {
 namespace {
 
-using testing_util::DifferenceEquationPlant;
 constexpr double kTs = 0.01;
 
 TEST(PidTuningTest, SimcClosedForm) {
@@ -47,7 +46,7 @@ TEST(PidControllerTest, TracksArxPlantWithoutOffset) {
   PidOptions o;
   o.gains = TunePid(1.6, 0.245, 0.001, kTs, PidTuningRule::kImc, 0.05);
   PidController pid(kTs, o);
-  DifferenceEquationPlant plant(PaperArxModel(), kTs);
+  LinearPlant plant(PaperArxModel(), kTs);
   auto sp = ParseSignal("step:from=0,to=40,at=0.1");
   ClosedLoopOptions cl;
   cl.duration = 3.0;
@@ -68,7 +67,7 @@ TEST(PidControllerTest, AntiWindupShortensSaturatedOvershoot) {
   PidOptions no_aw = o;
   no_aw.tracking_time = 1e9;  // Ts/Tt ~ 0: practically no back-calculation
   PidController with(kTs, o), without(kTs, no_aw);
-  DifferenceEquationPlant p1(PaperFopdtModel(), kTs), p2(PaperFopdtModel(), kTs);
+  LinearPlant p1(PaperFopdtModel(), kTs), p2(PaperFopdtModel(), kTs);
   auto sp = ParseSignal("staircase:levels=0 2 1,dwell=1");
   ClosedLoopOptions cl;
   cl.duration = 4.0;

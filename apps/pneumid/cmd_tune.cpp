@@ -1,0 +1,105 @@
+// pneumid tune: prediction horizon P, control horizon M and move suppression
+// lambda of a predictive controller from a model.
+//
+//   pneumid tune --model fopdt:K=1.6,tau=0.245,theta=0.001 --Ts 0.01 \
+//                --rule shridhar-cooper [--M 5] [--json]
+//   -> {"rule": "shridhar-cooper", "P": 126, "M": 5, "lambda": 2.2508, ...,
+//       "formula": "..."}
+#include <cmath>
+#include <iostream>
+#include <limits>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/control/tuning.hpp"
+#include "pneumid/lti/model_io.hpp"
+
+namespace pneumid::cli {
+namespace {
+
+struct TuneCli {
+  std::string model;
+  double Ts = 0.0;
+  std::string rule = "shridhar-cooper";
+  int M = 0;
+  int P = 0;
+  double lambda = std::numeric_limits<double>::quiet_NaN();
+  int tau_digits = 2;
+  bool json = false;
+};
+
+nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+void Run(const TuneCli& c) {
+  PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
+  const TransferFunction model = ParseModelSpec(c.model);
+  TuningOptions o;
+  o.rule = TuningRuleFromString(c.rule);
+  o.M = c.M;
+  o.P = c.P;
+  o.lambda = c.lambda;
+  o.tau_significant_digits = c.tau_digits;
+  const TuningResult r = Tune(model, c.Ts, o);
+  if (c.json) {
+    nlohmann::ordered_json j;
+    j["rule"] = ToString(r.rule);
+    j["P"] = r.P;
+    j["M"] = r.M;
+    j["lambda"] = r.lambda;
+    if (r.rule == TuningRule::kShridharCooper) {
+      j["lambda_source"] = std::isnan(c.lambda) ? "lambda_condition" : "explicit";
+      j["lambda_condition"] = Number(r.lambda_condition);
+      j["lambda_formula"] = Number(r.lambda_formula);
+      j["P_unrounded"] = r.P_unrounded;
+      j["tau_used"] = r.tau_used;
+      j["fopdt"] = {{"K", r.fopdt.K},
+                    {"tau", r.fopdt.tau},
+                    {"theta", r.fopdt.theta},
+                    {"method", r.fopdt.method}};
+    }
+    j["Ts"] = c.Ts;
+    j["formula"] = r.formula;
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  std::cout << fmt::format("rule    {}\nP       {}\nM       {}\nlambda  {:.6g}\n", ToString(r.rule),
+                           r.P, r.M, r.lambda);
+  if (r.rule == TuningRule::kShridharCooper) {
+    std::cout << fmt::format(
+        "FOPDT   K = {:.6g}, tau = {:.6g} s, theta = {:.6g} s ({})\n"
+        "lambda_condition  {:.6g}  (lambda_max(A'A)/500, used{})\n"
+        "lambda_formula    {:.6g}  ((M/500) K^2 (3.5 tau/Ts + 2 - (M-1)/2), tau = {:g} s)\n",
+        r.fopdt.K, r.fopdt.tau, r.fopdt.theta, r.fopdt.method, r.lambda_condition,
+        std::isnan(c.lambda) ? "" : " unless --lambda", r.lambda_formula, r.tau_used);
+  }
+  std::cout << "formula: " << r.formula << "\n";
+}
+
+const Registrar reg(
+    "tune", "Horizons and move suppression (P, M, lambda) of DMC/GPC from a model",
+    [](CLI::App& app) {
+      auto c = std::make_shared<TuneCli>();
+      app.add_option("--model", c->model,
+                     "Model spec: fopdt:K=..,tau=..,theta=.., arx-paper, tf:..., FILE.json")
+          ->required();
+      app.add_option("--Ts", c->Ts, "Controller sample time in s")->required();
+      app.add_option("--rule", c->rule,
+                     "shridhar-cooper (conventional), paper-modified (P=126, M=10, lambda=1.92), "
+                     "explicit (needs --P --M --lambda)")
+          ->capture_default_str();
+      app.add_option("--M", c->M,
+                     "Control horizon (default: 5 shridhar-cooper, 10 paper-modified)");
+      app.add_option("--P", c->P, "Prediction horizon (overrides the rule)");
+      app.add_option("--lambda", c->lambda, "Move suppression (overrides the rule)");
+      app.add_option("--tau-digits", c->tau_digits,
+                     "Significant digits tau is rounded to in the P formula (0 = none)")
+          ->capture_default_str();
+      app.add_flag("--json", c->json, "Print a JSON object");
+      app.callback([c] { Run(*c); });
+    });
+
+}  // namespace
+}  // namespace pneumid::cli
