@@ -59,6 +59,22 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void ReduceKernel(do
 
 }  // namespace
 
+TallSkinnyQr::TallSkinnyQr(int cols) {
+  PNEUMID_CHECK(cols >= 1, "a QR factorization needs >= 1 column, got {}", cols);
+  R_ = Eigen::MatrixXd::Zero(cols, cols);
+  block_.resize(kBlockRows, cols);
+}
+
+void TallSkinnyQr::AddRows(const Eigen::Ref<const Eigen::MatrixXd>& rows) {
+  PNEUMID_CHECK(rows.cols() == R_.cols(), "rows need {} columns, got {}", R_.cols(), rows.cols());
+  for (Eigen::Index r0 = 0; r0 < rows.rows(); r0 += kBlockRows) {
+    const Eigen::Index m = std::min(kBlockRows, rows.rows() - r0);
+    block_.topRows(m) = rows.middleRows(r0, m);
+    ReduceKernel(R_.data(), static_cast<int>(R_.cols()), block_.data(), kBlockRows, m);
+    num_rows_ += m;
+  }
+}
+
 bool ArxOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& msg) {
     if (error) *error = msg;

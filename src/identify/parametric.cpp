@@ -5,10 +5,14 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/arx.hpp"
+#include "pneumid/identify/cra.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/iv.hpp"
+#include "pneumid/identify/nonparametric_freq.hpp"
 #include "pneumid/identify/pem.hpp"
+#include "pneumid/identify/subspace.hpp"
 #include "pneumid/lti/conversion.hpp"
+#include "pneumid/lti/response.hpp"
 
 namespace pneumid {
 
@@ -86,6 +90,34 @@ Dataset SisoData(const Dataset& data, const IdentifyRequest& request) {
   return d;
 }
 
+// Fills discrete/tf (d2c when possible), fit and IAE of a transfer-function model.
+IdentifiedModel FinishTransferFunctionModel(IdentifiedModel m, const TransferFunction& g,
+                                            const EstimationSummary& summary, const Dataset& d,
+                                            bool try_d2c = true) {
+  m.discrete = g;
+  m.tf = g;
+  if (try_d2c) {
+    try {
+      m.tf = D2C(g, DiscretizationMethod::kZoh);
+    } catch (const InvalidArgument& e) {
+      m.notes.push_back(std::string("no continuous (zoh d2c) equivalent: ") + e.what());
+    }
+  }
+  const Eigen::VectorXd y = d.y(0);
+  const Eigen::VectorXd yhat = Lsim(g, d.u(0), g.Ts());
+  if (yhat.allFinite()) {
+    m.fit_percent = NrmseFit(y, yhat);
+    m.iae = Iae(d.time(), y, yhat);
+  } else {
+    m.fit_percent = -std::numeric_limits<double>::infinity();
+    m.iae = std::numeric_limits<double>::infinity();
+    m.notes.push_back("the simulated model output diverges (unstable model)");
+  }
+  m.notes.push_back(summary.BriefReport());
+  for (const auto& w : summary.warnings) m.notes.push_back(w);
+  return m;
+}
+
 }  // namespace
 
 IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& data,
@@ -124,8 +156,72 @@ IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& dat
                   r.summary.message);
     return ToIdentifiedModel(method, r.model, r.summary, d);
   }
-  PNEUMID_CHECK(false, "method '{}' is not available yet", method);
-  return {};
+  if (method == "n4sid") {
+    SubspaceOptions o;
+    o.order = request.na;
+    const SubspaceResult r = EstimateSubspace(d, o);
+    PNEUMID_CHECK(r.summary.IsSolutionUsable(), "subspace estimation failed: {}",
+                  r.summary.message);
+    IdentifiedModel m;
+    m.method = method;
+    m.structure = "SS";
+    auto mat = [](const Eigen::MatrixXd& x) {
+      nlohmann::json rows = nlohmann::json::array();
+      for (Eigen::Index i = 0; i < x.rows(); ++i) {
+        std::vector<double> row(x.cols());
+        for (Eigen::Index k = 0; k < x.cols(); ++k) row[k] = x(i, k);
+        rows.push_back(row);
+      }
+      return rows;
+    };
+    m.params = {{"A", mat(r.model.A())}, {"B", mat(r.model.B())}, {"C", mat(r.model.C())},
+                {"D", mat(r.model.D())}, {"order", r.order},      {"Ts", r.model.Ts()}};
+    std::vector<double> sv(r.singular_values.data(),
+                           r.singular_values.data() + r.singular_values.size());
+    m.params["singular_values"] = sv;
+    return FinishTransferFunctionModel(std::move(m), ToTransferFunction(r.model), r.summary, d);
+  }
+  if (method == "cra") {
+    // Long enough for slow processes (MATLAB's default of 20 lags truncates them).
+    CraOptions co;
+    co.num_lags = static_cast<int>(std::min<Eigen::Index>(200, d.size() / 8));
+    const CraResult r = Cra(d, co);
+    IdentifiedModel m;
+    m.method = method;
+    m.structure = "FIR";
+    m.params = r.ToJson();
+    std::vector<double> g(r.impulse.data(), r.impulse.data() + r.impulse.size());
+    EstimationSummary s;
+    s.termination = EstimationTermination::kConvergence;
+    s.message = fmt::format("correlation analysis, {} lags, 99 % bound {:.4g}",
+                            r.impulse.size() - 1, r.bound);
+    return FinishTransferFunctionModel(std::move(m), TransferFunction::Discrete(g, {1.0}, r.Ts), s,
+                                       d, false);
+  }
+  // spa: frequency response; the FIR model is the inverse DFT of the estimate.
+  SpaOptions so;
+  so.lag_window = static_cast<int>(std::min<Eigen::Index>(300, d.size() / 10));
+  const FrequencyResponseEstimate r = Spa(d, so);
+  IdentifiedModel m;
+  m.method = method;
+  m.structure = "FRD";
+  m.params = r.ToJson();
+  const int K = static_cast<int>(r.response.size());
+  const int taps = 2 * K;
+  std::vector<double> g(taps, 0.0);
+  // G(e^{i w}) on w_k = k pi / K, k = 1..K; k = 0 taken equal to k = 1 (real part).
+  for (int n = 0; n < taps; ++n) {
+    double acc = r.response[0].real();
+    for (int k = 1; k < K; ++k)
+      acc += 2.0 * std::real(r.response[k - 1] * std::polar(1.0, M_PI * k * n / K));
+    acc += std::real(r.response[K - 1] * std::polar(1.0, M_PI * n));
+    g[n] = acc / taps;
+  }
+  EstimationSummary s;
+  s.termination = EstimationTermination::kConvergence;
+  s.message = fmt::format("Blackman-Tukey spectral analysis, Hann window, {} frequencies", K);
+  return FinishTransferFunctionModel(
+      std::move(m), TransferFunction::Discrete(g, {1.0}, d.SampleTime()), s, d, false);
 }
 
 }  // namespace pneumid

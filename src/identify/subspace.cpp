@@ -1,0 +1,133 @@
+#include "pneumid/identify/subspace.hpp"
+
+#include <cmath>
+
+#include <Eigen/Dense>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/identify/arx.hpp"
+
+namespace pneumid {
+
+bool SubspaceOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error) *error = m;
+    return false;
+  };
+  if (order < 0) return fail(fmt::format("order must be >= 0 (0 = automatic), got {}", order));
+  if (max_order < 1) return fail(fmt::format("max_order must be >= 1, got {}", max_order));
+  if (horizon < 0)
+    return fail(fmt::format("horizon must be >= 0 (0 = automatic), got {}", horizon));
+  const int nmax = order > 0 ? order : max_order;
+  if (horizon > 0 && horizon <= nmax)
+    return fail(fmt::format("horizon {} must exceed the (maximum) order {}", horizon, nmax));
+  return true;
+}
+
+SubspaceResult EstimateSubspace(const Eigen::VectorXd& y, const Eigen::VectorXd& u, double Ts,
+                                const SubspaceOptions& o) {
+  std::string error;
+  PNEUMID_CHECK(o.IsValid(&error), "invalid subspace options: {}", error);
+  PNEUMID_CHECK(Ts > 0, "sample time must be positive, got Ts = {}", Ts);
+  PNEUMID_CHECK(y.size() == u.size(), "output and input lengths differ: {} vs {}", y.size(),
+                u.size());
+  PNEUMID_CHECK(y.allFinite() && u.allFinite(), "the data contain a non-finite value");
+  const int nmax = o.order > 0 ? o.order : o.max_order;
+  const int s = o.horizon > 0 ? o.horizon : std::max(2 * nmax, 10);
+  const Eigen::Index N = y.size();
+  const Eigen::Index j = N - 2 * s + 1;
+  PNEUMID_CHECK(j >= 8 * s, "{} samples are too few for horizon {} (need at least {})", N, s,
+                10 * s);
+  // QR of the j x 4s matrix H' whose row t is [U_f U_p Y_p Y_f] at column t.
+  TallSkinnyQr qr(4 * s);
+  const Eigen::Index kChunk = 1024;
+  Eigen::MatrixXd rows(kChunk, 4 * s);
+  for (Eigen::Index t0 = 0; t0 < j; t0 += kChunk) {
+    const Eigen::Index m = std::min(kChunk, j - t0);
+    for (int i = 0; i < s; ++i) {
+      rows.col(i).head(m) = u.segment(t0 + s + i, m);
+      rows.col(s + i).head(m) = u.segment(t0 + i, m);
+      rows.col(2 * s + i).head(m) = y.segment(t0 + i, m);
+      rows.col(3 * s + i).head(m) = y.segment(t0 + s + i, m);
+    }
+    qr.AddRows(rows.topRows(m));
+  }
+  const Eigen::MatrixXd L = qr.R().transpose();  // H = L Q'
+  const Eigen::MatrixXd L42 = L.block(3 * s, s, s, 2 * s);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(L42, Eigen::ComputeThinU);
+  SubspaceResult r;
+  r.singular_values = svd.singularValues();
+  const Eigen::VectorXd& sv = r.singular_values;
+  int n = o.order;
+  if (n == 0) {
+    double best_gap = -1;
+    n = 1;
+    for (int k = 1; k <= std::min<int>(o.max_order, static_cast<int>(sv.size()) - 1); ++k) {
+      if (sv[k] <= 0) {
+        n = k;
+        break;
+      }
+      const double gap = std::log10(sv[k - 1]) - std::log10(sv[k]);
+      if (gap > best_gap) {
+        best_gap = gap;
+        n = k;
+      }
+    }
+  }
+  r.order = n;
+  const Eigen::MatrixXd gamma = svd.matrixU().leftCols(n) * sv.head(n).cwiseSqrt().asDiagonal();
+  const Eigen::MatrixXd C = gamma.topRows(1);
+  const Eigen::MatrixXd A =
+      gamma.topRows(s - 1).colPivHouseholderQr().solve(gamma.bottomRows(s - 1));
+  // B, D, x0 by least squares: regressors [C A^t (n) | C X_t (n) | u(t)] with
+  // X_{t+1} = A X_t + I u(t), X_0 = 0.
+  const int nd = o.feedthrough ? 1 : 0;
+  const int p = 2 * n + nd;
+  TallSkinnyQr qr2(p + 1);
+  Eigen::MatrixXd block(kChunk, p + 1);
+  Eigen::RowVectorXd cat = C;  // C A^t
+  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n, n);
+  Eigen::Index filled = 0;
+  for (Eigen::Index t = 0; t < N; ++t) {
+    block.row(filled).head(n) = cat;
+    block.row(filled).segment(n, n) = C * X;
+    if (nd) block(filled, 2 * n) = u[t];
+    block(filled, p) = y[t];
+    if (++filled == kChunk || t == N - 1) {
+      qr2.AddRows(block.topRows(filled));
+      filled = 0;
+    }
+    cat = cat * A;
+    X = A * X;
+    X.diagonal().array() += u[t];
+  }
+  const Eigen::MatrixXd R2 = qr2.R();
+  const Eigen::MatrixXd R11 = R2.topLeftCorner(p, p);
+  const Eigen::VectorXd theta = R11.triangularView<Eigen::Upper>().solve(R2.col(p).head(p));
+  r.x0 = theta.head(n);
+  const Eigen::MatrixXd B = theta.segment(n, n);
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(1, 1);
+  if (nd) D(0, 0) = theta[2 * n];
+  r.model = StateSpace(A, B, C, D, Ts);
+  EstimationSummary& sum = r.summary;
+  sum.num_rows = N;
+  sum.num_parameters = n * n + 2 * n + nd;
+  sum.loss = R2(p, p) * R2(p, p) / static_cast<double>(N);
+  sum.termination =
+      theta.allFinite() ? EstimationTermination::kConvergence : EstimationTermination::kFailure;
+  sum.message = fmt::format("PO-MOESP, order {}, horizon {}", n, s);
+  if (!r.model.IsStable()) sum.warnings.push_back("the identified model is unstable");
+  return r;
+}
+
+SubspaceResult EstimateSubspace(const Dataset& data, const SubspaceOptions& options, int input,
+                                int output) {
+  data.RequireUniform();
+  PNEUMID_CHECK(input >= 0 && input < data.num_inputs(), "input column {} out of range [0, {})",
+                input, data.num_inputs());
+  PNEUMID_CHECK(output >= 0 && output < data.num_outputs(), "output column {} out of range [0, {})",
+                output, data.num_outputs());
+  return EstimateSubspace(data.y(output), data.u(input), data.SampleTime(), options);
+}
+
+}  // namespace pneumid

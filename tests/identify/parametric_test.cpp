@@ -1,0 +1,137 @@
+#include "pneumid/identify/parametric.hpp"
+
+#include <cmath>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "parametric_test_util.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/lti/model_io.hpp"
+
+namespace pneumid {
+namespace {
+
+using ::testing::HasSubstr;
+
+Dataset PaperArxData(Eigen::Index n, double noise, unsigned seed = 1) {
+  const PolynomialModel truth = testing::PaperArx();
+  const Eigen::VectorXd u = testing::Prbs(n, 10.0, 90.0, 3, seed);
+  const Eigen::VectorXd y = testing::SimulateArx(truth, u, testing::WhiteNoise(n, noise, seed + 5));
+  return Dataset::FromUniform(0.01, u, y, 0.0, {"u", "%"}, {"F", "N"});
+}
+
+TEST(Parametric, MethodNames) {
+  for (const char* m : {"arx", "armax", "oe", "bj", "iv4", "n4sid", "cra", "spa"})
+    EXPECT_TRUE(IsParametricMethod(m)) << m;
+  EXPECT_FALSE(IsParametricMethod("reaction-curve"));
+  EXPECT_THROW(IdentifyParametric("arma", PaperArxData(500, 0.1), IdentifyRequest{}),
+               InvalidArgument);
+}
+
+TEST(Parametric, ArxReproducesThePaperModelAndItsContinuousForm) {
+  // Noise-free data of the paper's Eq. 5: ARX(3,3,1) returns its coefficients,
+  // and the zoh d2c form is the paper's Eq. 6,
+  // (6.102 s^2 - 91.95 s + 520000) / (s^3 + 281 s^2 + 74990 s + 325400)
+  // (paper-values.md sec. 3: [6.10237, -91.9458, 520011.9] / [1, 280.9917, 74994.63, 325421.7]).
+  const IdentifiedModel m = IdentifyParametric("arx", PaperArxData(2000, 0.0), IdentifyRequest{});
+  EXPECT_EQ(m.method, "arx");
+  EXPECT_EQ(m.structure, "ARX");
+  const std::vector<double> a = m.params["a"];
+  const std::vector<double> b = m.params["b"];
+  ASSERT_EQ(a.size(), 4u);
+  ASSERT_EQ(b.size(), 4u);
+  EXPECT_NEAR(a[1], -0.60870, 1e-9);
+  EXPECT_NEAR(a[2], -0.27020, 1e-9);
+  EXPECT_NEAR(a[3], -0.06021, 1e-9);
+  EXPECT_EQ(b[0], 0.0);
+  EXPECT_NEAR(b[1], 0.03938, 1e-9);
+  EXPECT_NEAR(b[2], 0.04506, 1e-9);
+  EXPECT_NEAR(b[3], 0.01286, 1e-9);
+  EXPECT_EQ(m.params["nk"], 1);
+  EXPECT_DOUBLE_EQ(m.params["Ts"].get<double>(), 0.01);
+  ASSERT_TRUE(m.discrete.has_value());
+  EXPECT_NEAR(m.discrete->DcGain(), 1.59796, 1e-5);
+  ASSERT_TRUE(m.tf.IsContinuous());
+  const TransferFunction g = m.tf.Normalized();
+  const Eigen::VectorXd num = poly::TrimLeading(g.num(), 1e-12);
+  ASSERT_EQ(num.size(), 3);
+  ASSERT_EQ(g.den().size(), 4);
+  EXPECT_NEAR(num[0], 6.10237, 1e-4);
+  EXPECT_NEAR(num[1], -91.9458, 1e-3);
+  EXPECT_NEAR(num[2], 520011.9, 0.5);
+  EXPECT_NEAR(g.den()[1], 280.9917, 1e-3);
+  EXPECT_NEAR(g.den()[2], 74994.63, 0.05);
+  EXPECT_NEAR(g.den()[3], 325421.7, 0.5);
+  EXPECT_GT(m.fit_percent, 99.999);
+  EXPECT_LT(m.iae, 1e-6);
+  // Standard deviations are reported for every free parameter.
+  EXPECT_EQ(m.param_std.size(), 6u);
+}
+
+TEST(Parametric, EveryMethodFitsNoisyPaperData) {
+  const Dataset d = PaperArxData(3000, 0.2, 3);
+  IdentifyRequest req;
+  req.nc = 3;  // ARMAX noise model C = A for the ARX data
+  req.nd = 3;
+  req.nf = 3;
+  for (const char* method : {"arx", "iv4", "armax", "oe", "bj", "n4sid", "cra", "spa"}) {
+    SCOPED_TRACE(method);
+    const IdentifiedModel m = IdentifyParametric(method, d, req);
+    EXPECT_EQ(m.method, method);
+    ASSERT_TRUE(m.discrete.has_value());
+    // The simulated output tracks the data (noise std 0.2 N on a 130 N swing).
+    // Non-parametric estimates are truncated / smoothed and fitted with the
+    // means removed, so their simulation from raw data carries an offset:
+    // they are only required to beat the mean and to get the gain roughly.
+    const bool np = std::string(method) == "cra" || std::string(method) == "spa";
+    EXPECT_GT(m.fit_percent, np ? 10.0 : 95.0);
+    EXPECT_NEAR(m.discrete->DcGain(), 1.59796, (np ? 0.2 : 0.01) * 1.59796);
+    EXPECT_FALSE(m.notes.empty());
+  }
+}
+
+TEST(Parametric, PolynomialParamsJsonRoundTrip) {
+  PolynomialModel m = testing::PaperArx();
+  m.structure = "BJ";
+  m.c = Eigen::Vector2d(1, 0.3);
+  m.d = Eigen::Vector2d(1, -0.5);
+  m.f = {Eigen::Vector2d(1, -0.2)};
+  const PolynomialModel back = PolynomialModel::FromParamsJson(m.ParamsJson(), "BJ");
+  EXPECT_EQ(back.Parameters(), m.Parameters());
+  EXPECT_EQ(back.ParameterNames(), m.ParameterNames());
+  nlohmann::json bad = m.ParamsJson();
+  bad.erase("nk");
+  try {
+    PolynomialModel::FromParamsJson(bad);
+    FAIL();
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("nk"));
+  }
+}
+
+TEST(Parametric, KStepPredictionBetweenOneStepAndSimulation) {
+  const Dataset d = PaperArxData(3000, 1.0, 7);
+  const PolynomialModel truth = testing::PaperArx();
+  Eigen::MatrixXd u = d.u(0);
+  const Eigen::VectorXd y = d.y(0);
+  // One-step prediction errors of the true ARX model are the white noise e.
+  const Eigen::VectorXd e1 = y - Predict(truth, y, u, 1);
+  EXPECT_NEAR(e1.tail(2990).squaredNorm() / 2990, 1.0, 0.08);
+  const double v1 = (y - Predict(truth, y, u, 1)).squaredNorm();
+  const double v5 = (y - Predict(truth, y, u, 5)).squaredNorm();
+  const double vinf = (y - Predict(truth, y, u, 0)).squaredNorm();
+  EXPECT_LT(v1, v5);
+  EXPECT_LT(v5, vinf * 1.001);
+  // For an ARX model the k-step predictor variance is sum_{i<k} h_i^2 (Ljung eq. 3.29).
+  Eigen::VectorXd impulse = Eigen::VectorXd::Zero(5);
+  impulse[0] = 1;
+  PolynomialModel h = truth;
+  h.b = {Eigen::VectorXd::Ones(1)};
+  h.nk = {0};
+  const Eigen::VectorXd hk = Simulate(h, Eigen::MatrixXd(impulse));
+  EXPECT_NEAR(v5 / 3000, hk.squaredNorm(), 0.15 * hk.squaredNorm());
+}
+
+}  // namespace
+}  // namespace pneumid
