@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# pneumid control: the paper's conventional and modified DMC on the nominal
+# FOPDT (paper-values.md section 6), --compare, CSV output, the IPA plant
+# with duty bounds, and error handling. Usage: bash control_test.sh PNEUMID
+set -u
+PNEUMID=${1:?usage: control_test.sh /path/to/pneumid}
+PY=/usr/bin/python3
+fail() { echo "FAIL: $*" >&2; exit 1; }
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+out=$("$PNEUMID" control --controller dmc --model fopdt-paper --plant fopdt-paper --Ts 0.01 \
+      --P 126 --M 5 --lambda 2.25 --setpoint step:from=0,to=1,at=0 --duration 2 --json) \
+  || fail "control dmc exited non-zero"
+echo "$out" | $PY -c '
+import json, sys
+j = json.load(sys.stdin)
+for k in ("rise_time", "overshoot_percent", "settling_time", "steady_state_error", "iae", "u_min", "u_max", "first_move", "ise", "itae", "tv_u"):
+    assert k in j, k
+assert abs(j["first_move"] - 0.672) < 1e-3, j["first_move"]
+assert abs(j["rise_time"] - 0.110) <= 0.01, j["rise_time"]
+assert abs(j["overshoot_percent"] - 2.0) < 0.1, j["overshoot_percent"]
+assert abs(j["settling_time"] - 0.23) <= 0.01, j["settling_time"]
+assert abs(j["steady_state_error"]) < 1e-9, j["steady_state_error"]
+assert j["settings"]["rule"] == "explicit"
+' || fail "explicit M=5 metrics: $out"
+
+out=$("$PNEUMID" control --controller dmc --model fopdt-paper --Ts 0.01 --setpoint step:from=0,to=1,at=0 \
+      --duration 2 --compare --json -o "$tmp/fig6.csv") || fail "--compare exited non-zero"
+echo "$out" | $PY -c '
+import json, sys
+runs = json.load(sys.stdin)["compare"]
+assert [r["label"] for r in runs] == ["shridhar-cooper", "paper-modified"], runs
+assert abs(runs[1]["first_move"] - 0.761) < 1e-3, runs[1]["first_move"]
+assert abs(runs[1]["overshoot_percent"] - 3.6) < 0.1, runs[1]["overshoot_percent"]
+assert runs[1]["settings"]["M"] == 10 and runs[1]["settings"]["lambda"] == 1.92
+' || fail "--compare JSON: $out"
+head -1 "$tmp/fig6.csv" | grep -q "^t,r,y_shridhar-cooper" || fail "CSV header: $(head -1 "$tmp/fig6.csv")"
+[ "$(wc -l < "$tmp/fig6.csv")" -eq 201 ] || fail "CSV rows: $(wc -l < "$tmp/fig6.csv")"
+
+# Text table; GPC and PID run too.
+"$PNEUMID" control --controller gpc --model arx-paper --Ts 0.01 --setpoint step:from=0,to=1,at=0.1 \
+  --duration 2 | grep -q "rise time" || fail "gpc text output"
+"$PNEUMID" control --controller pid --model fopdt-paper --plant arx-paper --Ts 0.01 \
+  --setpoint step:from=0,to=1,at=0.1 --duration 3 --json | $PY -c '
+import json, sys
+j = json.load(sys.stdin)
+assert abs(j["steady_state_error"]) < 1e-3, j
+' || fail "pid"
+
+# Nonlinear IPA simulator, QDMC with the duty cycle bounded to 0..100 %, load step.
+out=$("$PNEUMID" control --controller dmc --model fopdt-paper --plant ipa --Ts 0.01 --u-min 0 --u-max 100 \
+      --constrained --setpoint "staircase:levels=0 40 80,dwell=2" --duration 6 --load-step at=5,size=-10 --json) \
+  || fail "ipa exited non-zero"
+echo "$out" | $PY -c '
+import json, sys
+j = json.load(sys.stdin)
+assert j["u_min"] >= 0 and j["u_max"] <= 100, (j["u_min"], j["u_max"])
+assert abs(j["steady_state_error"]) < 2.0, j["steady_state_error"]
+assert j["load_peak_deviation"] < -5, j["load_peak_deviation"]
+' || fail "ipa metrics: $out"
+
+# Errors.
+err=$("$PNEUMID" control --controller mpc --model fopdt-paper --Ts 0.01 --setpoint step:from=0,to=1,at=0 \
+      --duration 1 2>&1 >/dev/null) && fail "unknown controller accepted"
+echo "$err" | grep -q "dmc, gpc, pid" || fail "unknown controller message: $err"
+"$PNEUMID" control --model fopdt-paper --Ts 0.01 --setpoint step:from=0,to=1,at=0 --duration 1 \
+  --load-step at=x >/dev/null 2>&1 && fail "bad load step accepted"
+"$PNEUMID" control --model fopdt-paper --Ts 0.01 --setpoint bogus --duration 1 >/dev/null 2>&1 \
+  && fail "bad set-point accepted"
+"$PNEUMID" control --help | grep -q -- "--compare" || fail "--help"
+echo "control_test: OK"
