@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/data/load.hpp"
 #include "pneumid/plant/prbs.hpp"
 
 namespace pneumid {
@@ -258,13 +259,24 @@ class RampSignal final : public Signal {
   Shaping s_;
 };
 
-/// Input read from a delimited text file: a header line with column names
-/// (the first column is time unless a column named t/time exists), then rows.
+/// Input read from a data file (CSV/MAT through LoadDataset): column `column`
+/// against the time column `time_column`, held between samples.
 class FileSignal final : public Signal {
  public:
-  FileSignal(std::string path, std::string column, Shaping s)
-      : path_(std::move(path)), column_(std::move(column)), s_(s) {
-    Load();
+  FileSignal(std::string path, std::string column, std::string time_column, Shaping s)
+      : path_(std::move(path)),
+        column_(std::move(column)),
+        time_column_(std::move(time_column)),
+        s_(s) {
+    LoadOptions options;
+    options.time_column = time_column_;
+    options.input_columns = {};
+    options.output_columns = {column_};
+    const Dataset data = LoadDataset(path_, options);
+    if (data.size() < 1) throw DataError(fmt::format("{}: no samples", path_));
+    time_.assign(data.time().data(), data.time().data() + data.size());
+    const Eigen::VectorXd v = data.y(0);
+    value_.assign(v.data(), v.data() + v.size());
   }
   double operator()(double t) const override {
     // Zero-order hold: the last sample at or before t (first value before the start).
@@ -274,93 +286,14 @@ class FileSignal final : public Signal {
     return s_.Apply(value_[static_cast<std::size_t>(it - time_.begin() - 1)]);
   }
   std::string ToString() const override {
-    return "file:" + path_ + ",col=" + column_ + s_.Suffix();
+    return "file:" + path_ + ",col=" + column_ +
+           (time_column_ == "t" ? "" : ",time=" + time_column_) + s_.Suffix();
   }
 
  private:
-  static std::vector<std::string> SplitRow(const std::string& line) {
-    std::vector<std::string> out;
-    std::string cur;
-    for (char c : line) {
-      if (c == ',' || c == ';' || c == '\t' || c == ' ') {
-        if (!cur.empty()) out.push_back(cur);
-        cur.clear();
-      } else if (c != '\r' && c != '"') {
-        cur += c;
-      }
-    }
-    if (!cur.empty()) out.push_back(cur);
-    return out;
-  }
-
-  void Load() {
-    std::ifstream in(path_);
-    if (!in) throw DataError(fmt::format("{}: cannot open file for reading", path_));
-    std::string line;
-    std::size_t line_no = 0;
-    std::vector<std::string> header;
-    while (std::getline(in, line)) {
-      ++line_no;
-      std::string t = Trim(line);
-      if (t.empty() || t[0] == '#' || t[0] == '%') continue;
-      header = SplitRow(t);
-      break;
-    }
-    if (header.empty()) throw DataError(fmt::format("{}: no header line with column names", path_));
-    // Strip units in brackets, e.g. "F [N]" -> "F" (the split on spaces leaves "[N]" apart).
-    std::vector<std::string> names;
-    for (const auto& h : header)
-      if (!(h.front() == '[' || h.front() == '(')) names.push_back(h);
-    auto find = [&](const std::string& name) -> int {
-      for (std::size_t i = 0; i < names.size(); ++i) {
-        std::string n = names[i];
-        auto bracket = n.find_first_of("[(");
-        if (bracket != std::string::npos) n = n.substr(0, bracket);
-        if (n == name) return static_cast<int>(i);
-      }
-      return -1;
-    };
-    int tcol = find("t");
-    if (tcol < 0) tcol = find("time");
-    if (tcol < 0) tcol = 0;
-    int ucol = find(column_);
-    if (ucol < 0) {
-      std::string list;
-      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-      throw DataError(
-          fmt::format("{}:{}: no column '{}' (columns: {})", path_, line_no, column_, list));
-    }
-    while (std::getline(in, line)) {
-      ++line_no;
-      std::string t = Trim(line);
-      if (t.empty() || t[0] == '#' || t[0] == '%') continue;
-      auto cells = SplitRow(t);
-      auto cell = [&](int col) {
-        if (col >= static_cast<int>(cells.size()))
-          throw DataError(fmt::format("{}:{}: column {} ('{}') missing, row has {} values", path_,
-                                      line_no, col + 1, names[static_cast<std::size_t>(col)],
-                                      cells.size()));
-        const std::string& c = cells[static_cast<std::size_t>(col)];
-        double v = 0.0;
-        auto [ptr, ec] = std::from_chars(c.data(), c.data() + c.size(), v);
-        if (ec != std::errc() || ptr != c.data() + c.size() || !std::isfinite(v))
-          throw DataError(fmt::format("{}:{}: column {} ('{}'): not a finite number: '{}'", path_,
-                                      line_no, col + 1, names[static_cast<std::size_t>(col)], c));
-        return v;
-      };
-      double tv = cell(tcol);
-      double uv = cell(ucol);
-      if (!time_.empty() && !(tv > time_.back()))
-        throw DataError(fmt::format("{}:{}: time {} is not greater than the previous {}", path_,
-                                    line_no, tv, time_.back()));
-      time_.push_back(tv);
-      value_.push_back(uv);
-    }
-    if (time_.empty()) throw DataError(fmt::format("{}: no data rows", path_));
-  }
-
   std::string path_;
   std::string column_;
+  std::string time_column_;
   Shaping s_;
   std::vector<double> time_;
   std::vector<double> value_;
@@ -466,9 +399,10 @@ std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
     out = std::make_unique<RampSignal>(from, to, at, duration, s);
   } else {  // file
     std::string col = p.Text("col", "u");
+    std::string time_col = p.Text("time", "t");
     Shaping s = p.TakeShaping();
-    p.Finish("col, offset, min, max");
-    out = std::make_unique<FileSignal>(file_path, col, s);
+    p.Finish("col, time, offset, min, max");
+    out = std::make_unique<FileSignal>(file_path, col, time_col, s);
   }
   return out;
 }
@@ -488,9 +422,9 @@ std::string SignalSyntaxHelp() {
                                         sine between A and B, frequency swept linearly from
                                         F0 to F1 over D seconds (default 10), (A+B)/2 outside
   ramp:from=A,to=B,at=T,duration=D      A until T, linear to B over D seconds, then B
-  file:PATH[,col=NAME]                  column NAME (default u) of a CSV/whitespace file with
-                                        a header line, against its time column (t, time or
-                                        the first column), held between samples
+  file:PATH[,col=NAME][,time=NAME]     column (MAT: variable) NAME (default u) of a CSV or
+                                        .mat data file against its time column (default t),
+                                        held between samples
 Every kind also takes offset=O, min=LO, max=HI: value = clamp(signal + O, LO, HI).
 Example: --input step:from=0.61,to=82,at=1.0
 )";
