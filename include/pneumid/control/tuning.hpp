@@ -21,7 +21,7 @@
 // gives about 110 and is not the paper's.
 // "paper-modified": the paper's modified method, P = 126, M = 10,
 //   lambda = 1.92, taken as explicit settings: its formula (the authors'
-//   ASCC 2015 paper) is not published, and the rules above give about 4.4 for
+//   ASCC 2015 paper) is not published, and the rules above give 4.35-4.37 for
 //   M = 10.
 // "explicit": P, M and lambda given by the user.
 //
