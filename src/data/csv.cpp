@@ -283,7 +283,10 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
             throw cell_error(c, fmt::format("number out of range: '{}'", cell));
           }
           if (ec != std::errc() || ptr != last) {
-            throw cell_error(c, fmt::format("not a number: '{}'", cell));
+            const bool decimal_comma = delimiter != ',' && cell.find(',') != cell.npos;
+            throw cell_error(
+                c, fmt::format("not a number: '{}'{}", cell,
+                               decimal_comma ? " (numbers need '.' as decimal point)" : ""));
           }
           if (std::isnan(v)) throw cell_error(c, fmt::format("NaN value '{}'", cell));
           if (std::isinf(v)) throw cell_error(c, fmt::format("infinite value '{}'", cell));

@@ -66,6 +66,23 @@ bool IsNumericClass(matio_classes c) {
   }
 }
 
+std::size_t ElementSize(matio_classes c) {
+  switch (c) {
+    case MAT_C_INT8:
+    case MAT_C_UINT8:
+      return 1;
+    case MAT_C_INT16:
+    case MAT_C_UINT16:
+      return 2;
+    case MAT_C_INT32:
+    case MAT_C_UINT32:
+    case MAT_C_SINGLE:
+      return 4;
+    default:
+      return 8;
+  }
+}
+
 std::string ClassName(matio_classes c) {
   switch (c) {
     case MAT_C_CELL:
@@ -130,6 +147,7 @@ class MatReader {
     }
     if (S_ISDIR(st.st_mode)) throw DataError(fmt::format("{}: is a directory", path));
     if (st.st_size == 0) throw DataError(fmt::format("{}: empty file (not a MAT file)", path));
+    file_size_ = static_cast<std::size_t>(st.st_size);
     g_matio_message.clear();
     mat_.reset(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
     if (!mat_) {
@@ -235,6 +253,16 @@ class MatReader {
                       "an N x k matrix",
                       path_, v.name, v.dims.size(), v.shape()));
     }
+    // A corrupt header can claim any size; zlib expands at most ~1032:1, so a
+    // variable cannot hold more than about 1100 bytes per byte of file.
+    const double claimed = static_cast<double>(v.dims[0]) * static_cast<double>(v.dims[1]) *
+                           static_cast<double>(ElementSize(v.class_type));
+    if (claimed > 1100.0 * static_cast<double>(file_size_) + 1e6) {
+      throw DataError(
+          fmt::format("{}: variable '{}' claims {} elements ({}), more than the file "
+                      "can hold: the file is corrupt",
+                      path_, v.name, v.shape(), ClassName(v.class_type)));
+    }
     Mat_Rewind(mat_.get());
     g_matio_message.clear();
     VarPtr var(Mat_VarRead(mat_.get(), v.name.c_str()));
@@ -294,6 +322,7 @@ class MatReader {
   }
 
   std::string path_;
+  std::size_t file_size_ = 0;
   MatPtr mat_;
   std::vector<VarInfo> vars_;
   std::map<std::string, Eigen::MatrixXd> cache_;

@@ -75,7 +75,7 @@ TEST_F(CsvTest, ExplicitDelimiter) {
   CsvReadOptions o;
   o.delimiter = ';';
   // With ';' forced, the comma is part of the cell and is not a number.
-  ExpectError("t;u;y\n0;1,5;2\n", 2, "'u'", "not a number: '1,5'", o);
+  ExpectError("t;u;y\n0;1,5;2\n", 2, "'u'", "not a number: '1,5' (numbers need '.'", o);
   const Dataset d = ReadCsv(Write("t;u;y\n0;1;2\n"), o);
   EXPECT_DOUBLE_EQ(d.y()[0], 2.0);
 }

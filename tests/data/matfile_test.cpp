@@ -211,5 +211,25 @@ TEST_F(MatFileTest, OptionsAndVersions) {
   EXPECT_THROW(ReadMat(dir_.Path("x.mat"), r), InvalidArgument);
 }
 
+TEST_F(MatFileTest, ReadsFileWrittenByScipy) {
+  // tests/data/scipy_v5.mat from gen_matfile.py (scipy.io.savemat, compressed v5).
+  const std::string path = std::string(PNEUMID_SOURCE_DIR) + "/tests/data/scipy_v5.mat";
+  const Dataset d = ReadMat(path);
+  ASSERT_EQ(d.size(), 5);
+  EXPECT_NEAR(d.time()[4], 0.04, 1e-15);
+  EXPECT_DOUBLE_EQ(d.u()[0], 0.61);
+  EXPECT_DOUBLE_EQ(d.y()[2], 35.0);
+  MatReadOptions o;
+  o.time_variable = "data:0";
+  o.input_variables = {"data:1"};
+  o.output_variables = {"data:2"};
+  const Dataset m = ReadMat(path, o);
+  EXPECT_NEAR(m.time()[1], 0.01, 1e-8);  // single precision
+  EXPECT_NEAR(m.u()[0], 0.61, 1e-6);
+  EXPECT_DOUBLE_EQ(m.y()[4], 80.0);
+  o.output_variables = {"name"};
+  ExpectError(path, o, {"variable 'name'", "char"});
+}
+
 }  // namespace
 }  // namespace pneumid
