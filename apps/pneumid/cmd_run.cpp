@@ -14,10 +14,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller.hpp"
-#include "pneumid/control/dmc.hpp"
-#include "pneumid/control/gpc.hpp"
-#include "pneumid/control/pid.hpp"
-#include "pneumid/control/tuning.hpp"
+#include "pneumid/control/controller_factory.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
@@ -62,50 +59,33 @@ struct Built {
   std::string tuning;  // what was used, for the log header
 };
 
+// The control area's factory (controller_factory.hpp) from the command-line settings.
 Built BuildController(const RunOptions& o, const TransferFunction& model, double Ts,
                       const InputLimits& limits) {
-  const ControllerType type = ControllerTypeFromString(o.controller);
+  ControllerSpec spec;
+  spec.type = ControllerTypeFromString(o.controller);
+  if (!o.rule.empty()) {
+    spec.tuning.rule = TuningRuleFromString(o.rule);
+  } else if (o.P > 0 && o.M > 0 && std::isfinite(o.lambda)) {
+    spec.tuning.rule = TuningRule::kExplicit;
+  }
+  spec.tuning.P = o.P;
+  spec.tuning.M = o.M;
+  spec.tuning.lambda = o.lambda;
+  spec.limits = limits;
+  spec.constrained = o.constrained;
+  spec.pid_rule = PidTuningRuleFromString(o.pid_rule);
+  BuiltController bc = MakeController(model, Ts, spec);
   Built b;
-  if (type == ControllerType::kPid) {
-    const FopdtParameters f = FopdtFromModel(model);
-    PidOptions p;
-    p.gains = TunePid(f.K, f.tau, f.theta, Ts, PidTuningRuleFromString(o.pid_rule));
-    p.limits = limits;
+  b.controller = std::move(bc.controller);
+  if (spec.type == ControllerType::kPid) {
     b.tuning =
         fmt::format("pid {} from FOPDT K={:g} tau={:g} theta={:g} ({}): Kc={:g} Ti={:g} Td={:g}",
-                    o.pid_rule, f.K, f.tau, f.theta, f.method, p.gains.Kc, p.gains.Ti, p.gains.Td);
-    b.controller = std::make_unique<PidController>(Ts, p);
-    return b;
-  }
-  TuningOptions t;
-  if (!o.rule.empty()) {
-    t.rule = TuningRuleFromString(o.rule);
-  } else if (o.P > 0 && o.M > 0 && std::isfinite(o.lambda)) {
-    t.rule = TuningRule::kExplicit;
-  }
-  t.P = o.P;
-  t.M = o.M;
-  t.lambda = o.lambda;
-  const TuningResult tr = Tune(model, Ts, t);
-  b.tuning = fmt::format("{}: P={} M={} lambda={:g}; {}", ToString(tr.rule), tr.P, tr.M, tr.lambda,
-                         tr.formula);
-  if (type == ControllerType::kDmc) {
-    DmcOptions d;
-    d.P = tr.P;
-    d.M = tr.M;
-    d.lambda = tr.lambda;
-    d.limits = limits;
-    d.constrained = o.constrained;
-    b.controller = std::make_unique<DmcController>(model, Ts, d);
+                    o.pid_rule, bc.fopdt.K, bc.fopdt.tau, bc.fopdt.theta, bc.fopdt.method,
+                    bc.pid_gains.Kc, bc.pid_gains.Ti, bc.pid_gains.Td);
   } else {
-    PNEUMID_CHECK(!o.constrained, "--constrained applies to dmc only");
-    GpcOptions g;
-    g.N1 = 1;
-    g.N2 = tr.P;
-    g.Nu = tr.M;
-    g.lambda = tr.lambda;
-    g.limits = limits;
-    b.controller = std::make_unique<GpcController>(model, Ts, g);
+    b.tuning = fmt::format("{}: P={} M={} lambda={:g}; {}", ToString(bc.tuning.rule), bc.tuning.P,
+                           bc.tuning.M, bc.tuning.lambda, bc.tuning.formula);
   }
   return b;
 }
