@@ -141,7 +141,7 @@ TEST(ConversionTest, TustinPrewarpRoundTripAndMatchAtPrewarpFrequency) {
 
 TEST(ConversionTest, FopdtFractionalDelayIsTheModifiedZTransform) {
   // K exp(-theta s)/(tau s + 1), theta = d Ts + f with 0 < f < Ts (Franklin,
-  // Powell, Workman, Digital Control of Dynamic Systems, 3rd ed., 4.3.4):
+  // Powell, Workman, Digital Control of Dynamic Systems, 3rd ed., 1998, ch. 4 and 6):
   //   G(z) = K z^-d ((1 - e^{-(Ts-f)/tau}) z^-1 + (e^{-(Ts-f)/tau} - e^{-Ts/tau}) z^-2)
   //          / (1 - e^{-Ts/tau} z^-1)
   const double K = 1.6, tau = 0.245, Ts = 0.01;

@@ -4,7 +4,8 @@
 //                       fopdt-paper   1.6 exp(-0.001 s) / (0.245 s + 1) (Eq. 2)
 //   * inline specs:     fopdt:K=1.6,tau=0.245,theta=0.001
 //                       sopdt:K=..,tau1=..,tau2=..,theta=..
-//                       tf:num=1 2,den=1 3 2[,Ts=0.01][,delay=0]   (space- or ;-separated)
+//                       tf:num=1 2,den=1 3 2[,Ts=0.01][,delay=0]   (space- or ;-separated;
+//                       coefficients as in TransferFunction, delay in seconds)
 //   * a model JSON file written by pneumid (`pneumid identify --json`, a single
 //     model object, or an object {"num","den","Ts","delay"}); for a list of
 //     models the first (best) one is taken, or `FILE.json#method` selects one.

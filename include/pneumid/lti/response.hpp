@@ -31,7 +31,10 @@ TimeResponse Impulse(const TransferFunction& g, double t_final = 0.0, double dt 
 
 /// Response to samples u[k] at t = k dt held constant over each interval,
 /// starting from rest (zero state, and u = 0 for t < 0 in the delay line).
-/// For a discrete model dt must equal Ts (throws InvalidArgument otherwise).
+/// A continuous model is discretized once by zoh with its delay (exact at the
+/// samples), then run in O(N nx^2) without allocation per sample.
+/// @throws InvalidArgument for dt <= 0, a non-finite input, or a discrete
+///   model whose Ts differs from dt.
 Eigen::VectorXd Lsim(const TransferFunction& g, const Eigen::VectorXd& u, double dt);
 /// State-space version: u is N x nu, returns N x ny; x0 has nx entries (or is
 /// empty for zero). Input delay in the delay line starts at zero input.
@@ -68,10 +71,17 @@ struct StepInfoOptions {
 };
 
 /// Metrics of a sampled response; crossing times are linearly interpolated
-/// between samples.
+/// between samples, times are measured from t[0]. Rise and settling times are
+/// NaN when the response never reaches the level / has not settled by the last
+/// sample; with y_final == y_initial they are NaN and the percentages 0.
+/// Note: y_initial defaults to y[0] here, where MATLAB's stepinfo(y, t)
+/// assumes 0; ComputeStepInfo(g) uses 0 like stepinfo(sys).
+/// @throws InvalidArgument for invalid options, sizes that differ, fewer than
+///   2 samples, NaN/Inf, or t not strictly increasing.
 StepInfo ComputeStepInfo(const Eigen::VectorXd& t, const Eigen::VectorXd& y,
                          const StepInfoOptions& options = {});
-/// Metrics of the model's unit step response (final value = DcGain()).
+/// Metrics of the model's unit step response on the default grid of Step()
+/// (y_initial = 0, final value = DcGain()). An unstable model gives NaN metrics.
 StepInfo ComputeStepInfo(const TransferFunction& g, const StepInfoOptions& options = {});
 
 }  // namespace pneumid

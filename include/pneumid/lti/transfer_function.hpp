@@ -11,6 +11,9 @@
 // that they are at the same time the descending powers of z.
 // The input delay `delay` is always in seconds; for a discrete model it must
 // be an integer multiple of Ts (see DelaySamples()).
+// A discrete model needs a0 != 0 (causality); common trailing zeros of the
+// two vectors (a cancelling factor z^k) are removed. A continuous denominator
+// is stored without leading zeros.
 #pragma once
 
 #include <complex>
@@ -31,8 +34,8 @@ class TransferFunction {
   TransferFunction(Eigen::VectorXd num, Eigen::VectorXd den, double Ts = 0.0, double delay = 0.0);
 
   /// Continuous model, coefficients in descending powers of s, delay in seconds.
-  static TransferFunction Continuous(const std::vector<double>& num,
-                                     const std::vector<double>& den, double delay = 0.0);
+  static TransferFunction Continuous(const std::vector<double>& num, const std::vector<double>& den,
+                                     double delay = 0.0);
   /// Discrete model, coefficients in ascending powers of z^-1, delay in samples.
   static TransferFunction Discrete(const std::vector<double>& num_zinv,
                                    const std::vector<double>& den_zinv, double Ts,
