@@ -1,0 +1,187 @@
+// pneumid validate MODEL.json DATA: simulation / k-step prediction fit and the
+// residual tests of MATLAB compare and resid, with an optional plot.
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "data_options.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/identify/parametric_model.hpp"
+#include "pneumid/identify/residual_analysis.hpp"
+#include "pneumid/identify/validation.hpp"
+#include "pneumid/lti/model_io.hpp"
+#include "pneumid/report/plot.hpp"
+
+namespace pneumid::cli {
+namespace {
+
+struct ValidateArgs {
+  std::string model;
+  DataOptions data;
+  int horizon = 0;
+  int max_lag = 25;
+  int skip = 0;
+  std::string plot;
+  bool json = false;
+};
+
+// The polynomial model inside a JSON file written by `pneumid identify --json`
+// (first model, or FILE.json#method), or nothing when the file holds another kind of model.
+std::optional<PolynomialModel> ReadPolynomial(const std::string& spec, std::string* label) {
+  std::string path = spec, method;
+  const auto hash = spec.rfind('#');
+  if (hash != std::string::npos) {
+    path = spec.substr(0, hash);
+    method = spec.substr(hash + 1);
+  }
+  if (path.size() < 5 || path.substr(path.size() - 5) != ".json") return std::nullopt;
+  std::ifstream f(path);
+  if (!f) throw DataError(fmt::format("{}: cannot open model file", path));
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(f);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw DataError(fmt::format("{}: not valid JSON: {}", path, e.what()));
+  }
+  nlohmann::json m = j;
+  if (j.is_object() && j.contains("models")) {
+    PNEUMID_CHECK(j["models"].is_array() && !j["models"].empty(), "{}: 'models' is empty", path);
+    m = j["models"][0];
+    if (!method.empty()) {
+      bool found = false;
+      for (const auto& x : j["models"])
+        if (x.value("method", "") == method) {
+          m = x;
+          found = true;
+          break;
+        }
+      PNEUMID_CHECK(found, "{}: no model with method '{}'", path, method);
+    }
+  }
+  if (!m.is_object() || !m.contains("params") || !m["params"].is_object() ||
+      !m["params"].contains("b") || !m["params"].contains("Ts"))
+    return std::nullopt;
+  *label = fmt::format("{} {}", m.value("method", "model"), m.value("structure", ""));
+  return PolynomialModel::FromParamsJson(m["params"], m.value("structure", "ARX"));
+}
+
+Eigen::VectorXd ToVec(const Eigen::VectorXd& v) { return v; }
+
+void Run(const ValidateArgs& a) {
+  PNEUMID_CHECK(a.horizon >= 0, "--horizon must be >= 0 (0 = simulation), got {}", a.horizon);
+  const Dataset data = LoadFromOptions(a.data);
+  std::string label = a.model;
+  const std::optional<PolynomialModel> poly = ReadPolynomial(a.model, &label);
+  CompareOptions co;
+  co.skip = a.skip;
+  ResidualAnalysisOptions ro;
+  ro.max_lag = a.max_lag;
+  CompareResult sim, pred;
+  ResidualAnalysis res;
+  bool have_pred = false;
+  if (poly) {
+    sim = Compare(*poly, data, co);
+    if (a.horizon > 0) {
+      co.horizon = a.horizon;
+      pred = Compare(*poly, data, co);
+      have_pred = true;
+    }
+    res = AnalyzeResiduals(*poly, data, ro);
+  } else {
+    PNEUMID_CHECK(a.horizon == 0,
+                  "--horizon needs a polynomial model with a noise model; '{}' is a transfer "
+                  "function (simulation only)",
+                  a.model);
+    const TransferFunction g = ParseModelSpec(a.model);
+    sim = Compare(g, data, co);
+    res = AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro);
+  }
+  if (!a.plot.empty()) {
+    Figure fig(3);
+    fig.title = fmt::format("Validation of {}", label);
+    auto& ax = fig.axes(0);
+    ax.title = fmt::format("simulation fit {:.2f} %", sim.fit_percent);
+    ax.xlabel = "time [s]";
+    ax.ylabel = "output";
+    ax.AddLine(sim.t, sim.y, "data");
+    ax.AddLine(sim.t, sim.yhat, "simulated");
+    if (have_pred)
+      ax.AddLine(pred.t, pred.yhat, fmt::format("{}-step prediction", a.horizon),
+                 LineStyle::kDashed);
+    auto& ac = fig.axes(1);
+    ac.title = fmt::format("residual autocorrelation: {}", res.whiteness_passed ? "pass" : "fail");
+    ac.xlabel = "lag [samples]";
+    ac.AddLine(res.lags_auto, res.autocorr, "r_e");
+    ac.AddHorizontalLine(res.bound, "99 % bound");
+    ac.AddHorizontalLine(-res.bound);
+    auto& xc = fig.axes(2);
+    xc.title = fmt::format("residual-input cross-correlation: {}",
+                           res.independence_passed ? "pass" : "fail");
+    xc.xlabel = "lag [samples]";
+    xc.AddLine(res.lags_cross, res.crosscorr, "r_eu");
+    xc.AddHorizontalLine(res.bound, "99 % bound");
+    xc.AddHorizontalLine(-res.bound);
+    fig.Save(a.plot);
+  }
+  if (a.json) {
+    nlohmann::json j;
+    j["model"] = label;
+    j["samples"] = data.size();
+    j["fit_percent"] = sim.fit_percent;
+    j["rmse"] = sim.rmse;
+    if (have_pred) {
+      j["prediction"] = {
+          {"horizon", a.horizon}, {"fit_percent", pred.fit_percent}, {"rmse", pred.rmse}};
+    }
+    j["residuals"] = res.ToJson();
+    if (!a.plot.empty()) j["plot"] = a.plot;
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  std::cout << fmt::format("model: {}\ndata: {} samples, Ts = {:g} s\n", label, data.size(),
+                           data.SampleTime());
+  std::cout << fmt::format("simulation fit: {:.2f} % (NRMSE), RMSE {:.6g}\n", sim.fit_percent,
+                           sim.rmse);
+  if (have_pred)
+    std::cout << fmt::format("{}-step prediction fit: {:.2f} %, RMSE {:.6g}\n", a.horizon,
+                             pred.fit_percent, pred.rmse);
+  std::cout << fmt::format("residual analysis (max lag {}, 99 % bound +-{:.4g}):\n", a.max_lag,
+                           res.bound);
+  std::cout << fmt::format(
+      "  whiteness:    {} (Q = {:.4g}, chi2 limit {:.4g}; {} of {} lags outside)\n",
+      res.whiteness_passed ? "pass" : "FAIL", res.whiteness_statistic, res.whiteness_threshold,
+      res.auto_outside, res.autocorr.size() - 1);
+  std::cout << fmt::format(
+      "  independence: {} (Q = {:.4g}, chi2 limit {:.4g}; {} of {} lags outside)\n",
+      res.independence_passed ? "pass" : "FAIL", res.independence_statistic,
+      res.independence_threshold, res.cross_outside, res.crosscorr.size());
+  std::cout << fmt::format("verdict: {}\n", res.passed() ? "pass" : "FAIL");
+  if (!a.plot.empty()) std::cout << "plot written to " << a.plot << "\n";
+}
+
+static Registrar reg(
+    "validate", "Fit (simulation, k-step prediction) and residual tests of a model on data",
+    [](CLI::App& app) {
+      auto args = std::make_shared<ValidateArgs>();
+      app.add_option("MODEL", args->model,
+                     "Model: JSON written by `pneumid identify --json` (FILE.json[#method]) or "
+                     "any model spec (arx-paper, tf:..., fopdt:...)")
+          ->required();
+      AddDataOptions(app, args->data);
+      app.add_option("--horizon", args->horizon,
+                     "Also report the k-step-ahead prediction fit (polynomial models)");
+      app.add_option("--max-lag", args->max_lag, "Largest correlation lag of the residual tests")
+          ->capture_default_str();
+      app.add_option("--skip", args->skip, "Initial samples left out of the fit")
+          ->capture_default_str();
+      app.add_option("--plot", args->plot, "Write data/model and residual correlations (PNG/SVG)");
+      app.add_flag("--json", args->json, "Print the results as JSON");
+      app.callback([args] { Run(*args); });
+    });
+
+}  // namespace
+}  // namespace pneumid::cli

@@ -1,0 +1,45 @@
+// ARX estimation from a delimited text file too large for memory: the file is
+// read in chunks and each chunk's regression rows are folded into the
+// triangular factor of arx.hpp (ArxAccumulator), so memory is constant in the
+// number of samples and the estimate equals the in-memory fit on the same data.
+//
+// File format: an optional header line of column names, then one sample per
+// line, fields separated by `delimiter` (',' ';' '\t' or ' '; '\0' detects it
+// from the first line); lines starting with '#' and empty lines are skipped.
+// Columns are chosen by header name or 0-based index.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "pneumid/identify/arx.hpp"
+
+namespace pneumid {
+
+struct StreamingArxOptions {
+  ArxOptions arx;  ///< orders (SISO: one nb, one nk)
+  std::string input_column = "u";
+  std::string output_column = "y";
+  /// Time column used to find the sample time when sample_time is 0.
+  std::string time_column = "t";
+  double sample_time = 0.0;           ///< seconds; 0 = from the first two time values
+  char delimiter = '\0';              ///< '\0' = detect
+  std::size_t chunk_bytes = 1 << 22;  ///< read size (>= 4096)
+  /// Called after each chunk with the fraction of the file read (0..1).
+  std::function<void(double)> progress;
+  bool IsValid(std::string* error) const;
+};
+
+struct StreamingArxResult {
+  ArxResult arx;
+  long long num_samples = 0;  ///< data lines read
+  double bytes = 0.0;         ///< file size
+};
+
+/// Streams `path` through the ARX estimator.
+/// @throws InvalidArgument for invalid options.
+/// @throws DataError naming file, line and column for unreadable files, missing
+///         columns and fields that are not numbers.
+StreamingArxResult EstimateArxFromFile(const std::string& path, const StreamingArxOptions& options);
+
+}  // namespace pneumid
