@@ -134,7 +134,10 @@ TEST(LogWriter, PeriodicFlushSurvivesSigkill) {
     std::this_thread::sleep_for(std::chrono::seconds(30));  // killed long before
     _exit(0);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  // Wait (at most 10 s, for a loaded machine) until the flushed rows are all there; without
+  // the periodic flush the last rows would stay in the child's stdio buffer.
+  for (int i = 0; i < 200 && Lines(path).size() < 504u; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   kill(pid, SIGKILL);
   int status = 0;
   waitpid(pid, &status, 0);
