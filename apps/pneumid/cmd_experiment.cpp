@@ -176,7 +176,8 @@ static Registrar reg(
       app.add_option("--noise", o->noise,
                      "measurement noise of the simulated plant (output units)");
       app.add_option("--duration", o->duration, "s")->capture_default_str();
-      app.add_option("--period", o->period, "loop period (s), 0.001 .. 10")->capture_default_str();
+      app.add_option("--period", o->period, "loop period (s), 0.0001 .. 10 (default 10 ms)")
+          ->capture_default_str();
       app.add_flag("--fast", o->fast, "sim only: as fast as possible instead of real time");
       app.add_flag("--no-realtime", o->no_realtime,
                    "do not ask for SCHED_FIFO/mlockall/pinning (normal priority)");
