@@ -162,19 +162,14 @@ void CheckSignals(const Eigen::VectorXd& y, const Eigen::VectorXd& u) {
 // Hannan-Rissanen: least squares of v(t) = -sum a_i v(t-i) + sum b_j u(t-nk-j)
 // + sum c_i e1(t-i) + e1(t), with e1 the residuals of a high-order ARX fit.
 // Returns [a; b; c] (na + nb + nc).
-Eigen::VectorXd HannanRissanen(const Eigen::VectorXd& v, const Eigen::VectorXd* u, int na, int nb,
+Eigen::VectorXd HannanRissanen(const Eigen::VectorXd& v, const Eigen::VectorXd& u, int na, int nb,
                                int nk, int nc, int high_order) {
   const Eigen::Index n = v.size();
   ArxOptions ho;
   ho.na = high_order;
-  if (u != nullptr) {
-    ho.nb = {high_order};
-    ho.nk = {nk};
-  } else {
-    ho.nb = {0};
-    ho.nk = {0};
-  }
-  Eigen::MatrixXd um = u != nullptr ? Eigen::MatrixXd(*u) : Eigen::MatrixXd::Zero(n, 1);
+  ho.nb = {high_order};
+  ho.nk = {nk};
+  const Eigen::MatrixXd um = u;
   const ArxResult hr = EstimateArx(v, um, 1.0, ho);
   Eigen::VectorXd e1 = PredictionErrors(hr.model, v, um);
   const Eigen::Index skip = ho.FirstRow();
@@ -184,7 +179,7 @@ Eigen::VectorXd HannanRissanen(const Eigen::VectorXd& v, const Eigen::VectorXd* 
   const Eigen::Index rows = n - n0;
   Eigen::MatrixXd phi(rows, d);
   for (int l = 1; l <= na; ++l) phi.col(l - 1) = -v.segment(n0 - l, rows);
-  for (int j = 0; j < nb; ++j) phi.col(na + j) = u->segment(n0 - nk - j, rows);
+  for (int j = 0; j < nb; ++j) phi.col(na + j) = u.segment(n0 - nk - j, rows);
   for (int l = 1; l <= nc; ++l) phi.col(na + nb + l - 1) = e1.segment(n0 - l, rows);
   const Eigen::VectorXd target = v.tail(rows) - e1.tail(rows);
   return phi.colPivHouseholderQr().solve(target);
@@ -308,7 +303,7 @@ PemResult EstimatePolynomial(PolynomialStructure structure, const PemOrders& o,
   std::vector<std::string> init_notes;
   if (structure == PolynomialStructure::kArmax) {
     const int high = HighOrder(options, o.na + o.nb + o.nc, y.size());
-    const Eigen::VectorXd th = HannanRissanen(y, &u, o.na, o.nb, o.nk, o.nc, high);
+    const Eigen::VectorXd th = HannanRissanen(y, u, o.na, o.nb, o.nk, o.nc, high);
     init.structure = "ARMAX";
     init.a = Eigen::VectorXd::Ones(o.na + 1);
     init.a.tail(o.na) = th.head(o.na);
