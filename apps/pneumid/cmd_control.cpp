@@ -216,12 +216,18 @@ void WritePlot(const std::string& path, const std::vector<Run>& runs) {
   fig.title = "Closed loop";
   Axes& ay = fig.axes(0);
   ay.ylabel = "Output y";
-  ay.AddStairs(runs[0].result.t, runs[0].result.r, "set-point");
-  for (const Run& r : runs) ay.AddLine(r.result.t, r.result.y, r.label);
+  Series& sp = ay.AddStairs(runs[0].result.t, runs[0].result.r, "set-point");
+  sp.color = Color{90, 90, 90};
+  sp.style = LineStyle::kDashed;
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    ay.AddLine(runs[i].result.t, runs[i].result.y, runs[i].label).color =
+        PaletteColor(static_cast<int>(i));
   Axes& au = fig.axes(1);
   au.xlabel = "Time t [s]";
   au.ylabel = "Input u";
-  for (const Run& r : runs) au.AddStairs(r.result.t, r.result.u, r.label);
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    au.AddStairs(runs[i].result.t, runs[i].result.u, runs[i].label).color =
+        PaletteColor(static_cast<int>(i));
   fig.Save(path);
 }
 
