@@ -104,7 +104,16 @@ IdentifiedModel FinishTransferFunctionModel(IdentifiedModel m, const TransferFun
     }
   }
   const Eigen::VectorXd y = d.y(0);
-  const Eigen::VectorXd yhat = Lsim(g, d.u(0), g.Ts());
+  Eigen::VectorXd yhat;
+  if (try_d2c) {
+    yhat = Lsim(g, d.u(0), g.Ts());
+  } else {
+    // Non-parametric estimates describe deviations from the mean operating
+    // point (they are computed from mean-removed signals): simulate those.
+    const Eigen::VectorXd du = d.u(0).array() - d.u(0).mean();
+    yhat = (Lsim(g, du, g.Ts()).array() + y.mean()).matrix();
+    m.notes.push_back("fit of the deviations from the mean input and output");
+  }
   if (yhat.allFinite()) {
     m.fit_percent = NrmseFit(y, yhat);
     m.iae = Iae(d.time(), y, yhat);

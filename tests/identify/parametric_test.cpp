@@ -81,11 +81,10 @@ TEST(Parametric, EveryMethodFitsNoisyPaperData) {
     EXPECT_EQ(m.method, method);
     ASSERT_TRUE(m.discrete.has_value());
     // The simulated output tracks the data (noise std 0.2 N on a 130 N swing).
-    // Non-parametric estimates are truncated / smoothed and fitted with the
-    // means removed, so their simulation from raw data carries an offset:
-    // they are only required to beat the mean and to get the gain roughly.
+    // Non-parametric estimates are truncated / smoothed (their fit is that of
+    // the deviations from the means): looser bounds on fit and gain.
     const bool np = std::string(method) == "cra" || std::string(method) == "spa";
-    EXPECT_GT(m.fit_percent, np ? 10.0 : 95.0);
+    EXPECT_GT(m.fit_percent, np ? 50.0 : 95.0);
     EXPECT_NEAR(m.discrete->DcGain(), 1.59796, (np ? 0.2 : 0.01) * 1.59796);
     EXPECT_FALSE(m.notes.empty());
   }
