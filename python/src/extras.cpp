@@ -1,14 +1,186 @@
-// Bindings of the plant, control and closed-loop APIs.
+// Bindings of the plant and control areas, frequency responses and block
+// diagrams. (The report headers are kept out of this file: plot.hpp's struct
+// Series and interconnect.hpp's function Series share a name.)
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "pneumid/control/closed_loop.hpp"
+#include "pneumid/control/controller_factory.hpp"
+#include "pneumid/control/tuning.hpp"
+#include "pneumid/lti/frequency.hpp"
+#include "pneumid/lti/interconnect.hpp"
+#include "pneumid/plant/experiment.hpp"
+#include "pneumid/plant/plant.hpp"
+#include "pneumid/plant/plant_factory.hpp"
+#include "pneumid/plant/signal.hpp"
 
 namespace py = pybind11;
+using namespace py::literals;
 
 namespace pneumid::python {
 
-void BindExtras(py::module_& /*m*/) {}
+namespace {
+
+py::dict TuningToDict(const TuningResult& t) {
+  return py::dict("rule"_a = ToString(t.rule), "P"_a = t.P, "M"_a = t.M, "lambda"_a = t.lambda,
+                  "lambda_condition"_a = t.lambda_condition, "lambda_formula"_a = t.lambda_formula,
+                  "P_unrounded"_a = t.P_unrounded, "tau_used"_a = t.tau_used, "K"_a = t.fopdt.K,
+                  "tau"_a = t.fopdt.tau, "theta"_a = t.fopdt.theta, "formula"_a = t.formula);
+}
+
+py::dict MetricsToDict(const ClosedLoopMetrics& m) {
+  return py::dict("rise_time"_a = m.rise_time, "overshoot_percent"_a = m.overshoot_percent,
+                  "settling_time"_a = m.settling_time,
+                  "steady_state_error"_a = m.steady_state_error, "first_move"_a = m.first_move,
+                  "iae"_a = m.iae, "ise"_a = m.ise, "itae"_a = m.itae, "tv_u"_a = m.tv_u,
+                  "u_min"_a = m.u_min, "u_max"_a = m.u_max,
+                  "load_peak_deviation"_a = m.load_peak_deviation,
+                  "load_recovery_time"_a = m.load_recovery_time);
+}
+
+}  // namespace
+
+void BindExtras(py::module_& m) {
+  // --- frequency responses and block diagrams (lti) -------------------------
+  m.def("log_space", &LogSpace, "lo"_a, "hi"_a, "n"_a, "n points from 10^lo to 10^hi.");
+  m.def(
+      "bode",
+      [](const TransferFunction& g, const Eigen::VectorXd& omega) {
+        const BodeData b = Bode(g, omega);
+        return py::dict("omega"_a = b.omega, "magnitude"_a = b.magnitude,
+                        "magnitude_db"_a = b.magnitude_db, "phase_deg"_a = b.phase_deg);
+      },
+      "g"_a, "omega"_a = Eigen::VectorXd(),
+      "Frequency response: dict of omega [rad/s], magnitude, magnitude_db, phase_deg.");
+  m.def(
+      "compute_margins",
+      [](const TransferFunction& g) {
+        const Margins mg = ComputeMargins(g);
+        return py::dict("gain_margin"_a = mg.gain_margin, "gain_margin_db"_a = mg.gain_margin_db,
+                        "phase_crossover"_a = mg.phase_crossover,
+                        "phase_margin"_a = mg.phase_margin, "gain_crossover"_a = mg.gain_crossover);
+      },
+      "g"_a, "Gain and phase margins of the open loop g (dict).");
+  m.def("series", &Series, "g1"_a, "g2"_a, "g2 * g1 (delays add).");
+  m.def("parallel", &Parallel, "g1"_a, "g2"_a, "g1 + g2.");
+  m.def("feedback", &Feedback, "g"_a, "h"_a = TransferFunction(), "sign"_a = -1,
+        "g / (1 - sign g h); negative feedback by default.");
+  m.def("minimal_realization", &MinimalRealization, "g"_a, "tol"_a = 1e-6);
+
+  // --- plants and experiments ----------------------------------------------
+  py::class_<Plant>(m, "Plant",
+                    "A sampled plant: the IPA simulator or a linear model. Per sample: "
+                    "y = measure(); advance(u).")
+      .def("reset", &Plant::Reset)
+      .def("measure", &Plant::Measure, "Measured output now (sensor model included).")
+      .def("advance", &Plant::Advance, "u"_a, "Holds u for one sample period (zero-order hold).",
+           py::call_guard<py::gil_scoped_release>())
+      .def("set_load_disturbance", &Plant::SetLoadDisturbance, "d"_a)
+      .def_property_readonly("Ts", &Plant::Ts)
+      .def_property_readonly("time", &Plant::time)
+      .def("extras", &Plant::Extras, "Extra signals, e.g. chamber pressures.")
+      .def("describe", &Plant::Describe)
+      .def("__repr__", [](const Plant& p) { return "<Plant " + p.Describe() + ">"; });
+  m.def(
+      "make_plant",
+      [](const std::string& spec, double Ts, std::uint64_t seed, std::optional<double> noise,
+         const std::string& config_path) {
+        PlantOptions o;
+        o.seed = seed;
+        o.noise_sigma = noise;
+        o.config_path = config_path;
+        return MakePlant(spec, Ts, o);
+      },
+      "spec"_a = "ipa", "Ts"_a = 0.01, "seed"_a = 1, "noise_sigma"_a = py::none(),
+      "config_path"_a = "",
+      "Plant by name: 'ipa' (IPA simulator, force mode, input duty %), 'ipa-position', "
+      "'ipa:config=FILE.toml', or any model spec (linear plant).");
+  m.def(
+      "run_experiment",
+      [](Plant& plant, const std::string& signal, double duration) {
+        const auto s = ParseSignal(signal);
+        py::gil_scoped_release release;
+        return RunExperiment(plant, *s, duration).data;
+      },
+      "plant"_a, "signal"_a, "duration"_a,
+      "Drives the plant with a signal spec ('step:from=0.61,to=82,at=0.5', "
+      "'prbs:low=20,high=80,order=7,clock=0.05', ...) and returns the Dataset.");
+
+  // --- tuning, controllers and closed loops -------------------------------
+  m.def(
+      "tune",
+      [](const TransferFunction& model, double Ts, const std::string& rule, int M, int P,
+         double lambda) {
+        TuningOptions o;
+        o.rule = TuningRuleFromString(rule);
+        o.M = M;
+        o.P = P;
+        o.lambda = lambda;
+        return TuningToDict(Tune(model, Ts, o));
+      },
+      "model"_a, "Ts"_a, "rule"_a = "shridhar-cooper", "M"_a = 0, "P"_a = 0,
+      "lambda_"_a = std::numeric_limits<double>::quiet_NaN(),
+      "Horizons and move suppression: rule 'shridhar-cooper' (conventional), "
+      "'paper-modified' or 'explicit' (dict with P, M, lambda, formula).");
+  py::class_<Controller>(m, "Controller", "A sampled controller (DMC, GPC, PID).")
+      .def("reset", &Controller::Reset, "u0"_a = 0.0, "y0"_a = 0.0)
+      .def("update", &Controller::Update, "setpoint"_a, "measurement"_a,
+           "One control step; returns the input to hold over the next period.")
+      .def_property_readonly("Ts", &Controller::Ts)
+      .def("describe", &Controller::Describe)
+      .def("__repr__", [](const Controller& c) { return "<Controller " + c.Describe() + ">"; });
+  m.def(
+      "make_controller",
+      [](const TransferFunction& model, double Ts, const std::string& type, const std::string& rule,
+         int M, int P, double lambda, double u_min, double u_max, bool constrained) {
+        ControllerSpec s;
+        s.type = ControllerTypeFromString(type);
+        s.tuning.rule = TuningRuleFromString(rule);
+        s.tuning.M = M;
+        s.tuning.P = P;
+        s.tuning.lambda = lambda;
+        s.limits.u_min = u_min;
+        s.limits.u_max = u_max;
+        s.constrained = constrained;
+        BuiltController b = MakeController(model, Ts, s);
+        return std::move(b.controller);
+      },
+      "model"_a, "Ts"_a, "type"_a = "dmc", "rule"_a = "shridhar-cooper", "M"_a = 0, "P"_a = 0,
+      "lambda_"_a = std::numeric_limits<double>::quiet_NaN(),
+      "u_min"_a = -std::numeric_limits<double>::infinity(),
+      "u_max"_a = std::numeric_limits<double>::infinity(), "constrained"_a = false,
+      "Controller of type 'dmc', 'gpc' or 'pid' designed from `model` at Ts.");
+  m.def(
+      "simulate_closed_loop",
+      [](Controller& controller, Plant& plant, const std::string& setpoint, double duration,
+         const std::vector<std::pair<double, double>>& load_steps, double noise_std, double u_min,
+         double u_max, double u0, std::uint64_t seed) {
+        const auto sp = ParseSignal(setpoint);
+        ClosedLoopOptions o;
+        o.duration = duration;
+        for (const auto& [at, size] : load_steps) o.load_steps.push_back({at, size});
+        o.noise_std = noise_std;
+        o.actuator.u_min = u_min;
+        o.actuator.u_max = u_max;
+        o.u0 = u0;
+        o.seed = seed;
+        ClosedLoopResult r;
+        {
+          py::gil_scoped_release release;
+          r = SimulateClosedLoop(controller, plant, *sp, o);
+        }
+        return py::dict("t"_a = r.t, "r"_a = r.r, "y"_a = r.y, "y_meas"_a = r.y_meas, "u"_a = r.u,
+                        "d"_a = r.d, "metrics"_a = MetricsToDict(r.metrics),
+                        "controller"_a = r.controller, "plant"_a = r.plant);
+      },
+      "controller"_a, "plant"_a, "setpoint"_a, "duration"_a,
+      "load_steps"_a = std::vector<std::pair<double, double>>{}, "noise_std"_a = 0.0,
+      "u_min"_a = -std::numeric_limits<double>::infinity(),
+      "u_max"_a = std::numeric_limits<double>::infinity(), "u0"_a = 0.0, "seed"_a = 1,
+      "Closed loop of controller and plant through a set-point signal spec; load_steps = "
+      "[(at_s, size), ...]. Returns t, r, y, u, ... and metrics (dict).");
+}
 
 }  // namespace pneumid::python

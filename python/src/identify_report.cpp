@@ -10,6 +10,7 @@
 #include "pneumid/identify/step_methods.hpp"
 #include "pneumid/report/figures.hpp"
 #include "pneumid/report/identification_report.hpp"
+#include "pneumid/report/paper.hpp"
 #include "pneumid/report/plot.hpp"
 
 namespace py = pybind11;
@@ -190,6 +191,28 @@ void BindReport(py::module_& m) {
       "order"_a = 2, "na"_a = 3, "nb"_a = 3, "nk"_a = 1,
       "Writes DIR/report.html and DIR/models.json (as `pneumid report`); returns a summary "
       "dict.");
+
+  // --- the paper -------------------------------------------------------------
+  m.def(
+      "run_paper",
+      [](const std::string& figures_dir, std::uint64_t seed) {
+        PaperOptions o;
+        o.seed = seed;
+        PaperResult r;
+        std::vector<std::string> files;
+        {
+          py::gil_scoped_release release;
+          r = RunPaper(o);
+          if (!figures_dir.empty()) files = WritePaperFigures(r, figures_dir);
+        }
+        py::object j = JsonToPython(r.ToJson());
+        j["figures"] = files;
+        return j;
+      },
+      "figures_dir"_a = "", "seed"_a = 1,
+      "The paper's workflow on the IPA simulator (as `pneumid paper --json`): dict with "
+      "'rows' [{'quantity', 'paper', 'pneumid', 'note'}]; figures written when "
+      "figures_dir is given.");
 }
 
 }  // namespace pneumid::python

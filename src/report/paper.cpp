@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <deque>
 #include <filesystem>
 #include <sstream>
 
@@ -19,60 +18,13 @@
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
+#include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/report/figures.hpp"
 
 namespace pneumid {
 
 namespace {
-
-// A discrete transfer function run as a Plant (difference equation, zero
-// initial state); the nominal plant of the reference closed loops.
-class TransferFunctionPlant final : public Plant {
- public:
-  explicit TransferFunctionPlant(const TransferFunction& g) : g_(g.Normalized()) {
-    PNEUMID_CHECK(g_.IsDiscrete(), "TransferFunctionPlant needs a discrete model");
-    d_ = g_.DelaySamples();
-    Reset();
-  }
-  void Reset() override {
-    const auto n = static_cast<std::size_t>(g_.den().size());
-    u_.assign(n + static_cast<std::size_t>(d_), 0.0);
-    y_.assign(n, 0.0);
-    t_ = 0.0;
-    load_disturbance_ = 0.0;
-  }
-  double Measure() override { return Output() + load_disturbance_; }
-  void Advance(double u) override {
-    // Shift: u_[0] is u[k], y_[0] is y[k]; compute y[k+1].
-    u_.push_front(u);
-    u_.pop_back();
-    const Eigen::VectorXd& b = g_.num();
-    const Eigen::VectorXd& a = g_.den();
-    double y = 0.0;
-    // y[k+1] = sum_i b_i u[k+1-i-d] - sum_{i>=1} a_i y[k+1-i]
-    for (Eigen::Index i = 0; i < b.size(); ++i) {
-      const std::size_t idx = static_cast<std::size_t>(i + d_) - 1;  // u[k+1-i-d] at u_[i+d-1]
-      if (i + d_ >= 1 && idx < u_.size()) y += b[i] * u_[idx];
-    }
-    for (Eigen::Index i = 1; i < a.size(); ++i) y -= a[i] * y_[static_cast<std::size_t>(i - 1)];
-    // b_0 u[k+1] with d = 0 would need the future input: a proper sampled
-    // model has b_0 = 0 (zoh), asserted by the index check above.
-    y_.push_front(y);
-    y_.pop_back();
-    t_ += g_.Ts();
-  }
-  double Ts() const override { return g_.Ts(); }
-  double time() const override { return t_; }
-  std::string Describe() const override { return "linear " + g_.ToString(5); }
-
- private:
-  double Output() const { return y_.front(); }
-  TransferFunction g_;
-  int d_ = 0;
-  std::deque<double> u_, y_;
-  double t_ = 0.0;
-};
 
 std::string G(double v, int digits = 5) {
   if (!std::isfinite(v)) return std::isnan(v) ? "n/a" : (v > 0 ? "inf" : "-inf");
@@ -479,7 +431,7 @@ PaperResult RunPaper(const PaperOptions& o) {
       d.M = c.M;
       d.lambda = c.lambda;
       DmcController dmc(PaperFopdtModel(), o.Ts, d);
-      TransferFunctionPlant plant(SampledModel(PaperFopdtModel(), o.Ts));
+      LinearPlant plant(PaperFopdtModel(), o.Ts);
       const auto sp = ParseSignal("step:from=0,to=1,at=0");
       ClosedLoopOptions lo;
       lo.duration = 1.5;

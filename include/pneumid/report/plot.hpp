@@ -53,7 +53,10 @@ struct Color {
 /// The i-th colour of the default palette (Tableau 10; wraps around).
 Color PaletteColor(int i);
 
-/// One curve y(x). `label` empty = not listed in the legend.
+/// One curve y(x) of a subplot. `label` empty = not listed in the legend.
+/// (A translation unit that also includes pneumid/lti/interconnect.hpp sees
+/// the function pneumid::Series too; refer to this type as `struct Series`
+/// or use `auto&` there.)
 struct Series {
   Eigen::VectorXd x;
   Eigen::VectorXd y;

@@ -1,0 +1,124 @@
+// The paper workflow (include/pneumid/report/paper.hpp). Golden values:
+// ../shared/reference/paper-values.md (sections 2, 3, 6), which come from the
+// paper, from the matrix-logarithm d2c and from an independent closed-loop
+// computation, as noted there.
+#include "pneumid/report/paper.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+
+namespace pneumid {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const PaperResult& Result() {
+  static const PaperResult r = RunPaper();
+  return r;
+}
+
+const PaperRow& Row(const std::string& quantity) {
+  for (const auto& r : Result().rows)
+    if (r.quantity == quantity) return r;
+  ADD_FAILURE() << "no row '" << quantity << "'";
+  static const PaperRow none;
+  return none;
+}
+
+TEST(PaperTest, RunsCompletelyWithThreeFigures) {
+  const PaperResult& r = Result();
+  EXPECT_EQ(r.termination, PaperTermination::kSuccess) << ::testing::PrintToString(r.problems);
+  ASSERT_EQ(r.figure_names, (std::vector<std::string>{"fig4", "fig5", "fig6"}));
+  ASSERT_EQ(r.models.size(), 3u);
+  EXPECT_GT(r.rows.size(), 40u);
+  EXPECT_EQ(r.step_test.size(), 301);
+}
+
+TEST(PaperTest, RecomputedArxQuantitiesMatchThePaper) {
+  // paper-values.md section 2: static gain 1.59796, poles 0.95685, -0.17407 +/- 0.18062j
+  EXPECT_EQ(Row("static gain of Eq. 5 (recomputed)").pneumid, "1.59796");
+  EXPECT_EQ(Row("discrete poles of Eq. 5").pneumid, "0.956848, -0.174074 ± 0.18062j");
+  // section 3: matrix-logarithm zoh d2c
+  EXPECT_EQ(Row("numerator of d2c(Eq. 5, zoh)").pneumid, "6.10237 s^2 - 91.9458 s + 520012");
+  EXPECT_EQ(Row("denominator of d2c(Eq. 5, zoh)").pneumid,
+            "s^3 + 280.992 s^2 + 74994.6 s + 325422");
+  EXPECT_EQ(Row("continuous poles of Eq. 6").pneumid, "-4.41102, -138.29 ± 233.774j");
+  // section 4: t63 of the ARX unit step
+  EXPECT_EQ(Row("t63 of the Eq. 5 model's unit step").pneumid, "0.2306 s");
+}
+
+TEST(PaperTest, TuningOfThePaperFopdtReproducesSection6) {
+  // P = 126 (tau rounded to 0.25 s), lambda = lambda_max(A'A)/500 = 2.2508
+  EXPECT_EQ(Row("P, lambda from the paper's FOPDT (Eq. 2)").pneumid, "126, 2.251");
+  EXPECT_EQ(Row("modified P, M, lambda").pneumid, "126, 10, 1.92");
+}
+
+TEST(PaperTest, ReferenceClosedLoopsMatchTheIndependentComputation) {
+  // paper-values.md section 6: M = 5: first move 0.672, rise 0.110 s,
+  // overshoot 2.0 %, settling 0.23 s; M = 10: 0.761, 0.090 s, 3.6 %, 0.25 s.
+  // Times agree within one sample (note empty), amplitudes to the printed digits.
+  for (const char* q :
+       {"M = 5, lambda = 2.25: first move", "M = 5, lambda = 2.25: rise time 10-90 %",
+        "M = 5, lambda = 2.25: overshoot", "M = 5, lambda = 2.25: settling time 2 %",
+        "M = 10, lambda = 1.92: first move", "M = 10, lambda = 1.92: rise time 10-90 %",
+        "M = 10, lambda = 1.92: overshoot", "M = 10, lambda = 1.92: settling time 2 %"}) {
+    EXPECT_EQ(Row(q).note, "") << q << ": " << Row(q).pneumid;
+  }
+  EXPECT_EQ(Row("M = 5, lambda = 2.25: first move").pneumid, "0.672");
+  EXPECT_EQ(Row("M = 10, lambda = 1.92: first move").pneumid, "0.761");
+}
+
+TEST(PaperTest, SimulatorStepTestIsThePapersExperiment) {
+  // Duty 0.61 -> 82 %; the simulator is calibrated to the paper's 0 -> 129 N
+  // and t63 = 0.245 s (within one sample).
+  EXPECT_EQ(Row("force before -> after the step").note, "");
+  EXPECT_EQ(Row("Kp = dy/du").note, "");
+  EXPECT_EQ(Row("t63 (time to 63.2 % after the step)").note, "within one sample");
+  EXPECT_EQ(Row("conventional P").pneumid, "126");
+}
+
+TEST(PaperTest, JsonAndTableForms) {
+  const nlohmann::json j = Result().ToJson();
+  ASSERT_TRUE(j.contains("rows"));
+  ASSERT_EQ(j["rows"].size(), Result().rows.size());
+  for (const auto& r : j["rows"]) {
+    for (const char* k : {"quantity", "paper", "pneumid", "note"}) {
+      ASSERT_TRUE(r.contains(k)) << k;
+      EXPECT_TRUE(r[k].is_string()) << k;
+    }
+  }
+  const std::string table = Result().TableText();
+  EXPECT_THAT(table, HasSubstr("[3 continuous equivalent (Eq. 6)]"));
+  EXPECT_THAT(table, HasSubstr("6.102 s^2 - 91.95 s + 520000"));
+}
+
+TEST(PaperTest, WritesFigureFiles) {
+  const fs::path dir = fs::path(PNEUMID_BINARY_DIR) / "test-output" / "paper";
+  const auto files = WritePaperFigures(Result(), dir.string());
+  ASSERT_EQ(files.size(), 6u);
+  for (const auto& f : files) EXPECT_GT(fs::file_size(f), 10000u) << f;
+}
+
+TEST(PaperTest, InvalidOptionsThrow) {
+  PaperOptions o;
+  o.u_final = o.u_initial;
+  EXPECT_THAT([&] { RunPaper(o); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("duties")));
+  o = PaperOptions{};
+  o.Ts = -1.0;
+  EXPECT_THROW(RunPaper(o), InvalidArgument);
+  o = PaperOptions{};
+  o.ipa_config = "/nonexistent/ipa.toml";
+  EXPECT_THROW(RunPaper(o), DataError);
+}
+
+}  // namespace
+}  // namespace pneumid
