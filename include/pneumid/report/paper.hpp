@@ -12,12 +12,13 @@
 //      its unit step;
 //   4. Figure 4 (step responses of the FOPDT and PTn models) and Figure 5
 //      (data, FOPDT, PTn, ARX on one time axis);
-//   5. tuning from the identified FOPDT: conventional (Shridhar-Cooper: P, M = 5,
+//   5. tuning from the FOPDT as the paper reads it off the step test (K = dy/du,
+//      tau = t63, theta = 0.001 s): conventional (Shridhar-Cooper: P, M = 5,
 //      lambda) and modified (P, M = 10, lambda = 1.92) [1, sec. 5], control/tuning.hpp;
 //   6. the reference closed loops of paper-values.md section 6 (DMC with the
 //      paper's P, M, lambda on the paper's FOPDT, unit set-point step): first
 //      move, rise time, overshoot, settling time;
-//   7. Figure 6: DMC with both tunings (model: the identified FOPDT) driving
+//   7. Figure 6: DMC with both tunings (model: the FOPDT of step 5) driving
 //      the IPA simulator through set-point steps and a load disturbance,
 //      with the actuator limited to 0..100 % duty.
 // Each row says where pneumid's value differs from the paper's and why (the
