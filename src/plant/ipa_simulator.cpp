@@ -144,7 +144,46 @@ IpaSimulator::IpaSimulator(IpaParameters parameters, double Ts, std::uint64_t se
   std::string error;
   PNEUMID_CHECK(p_.IsValid(&error), "invalid IPA parameters: {}", error);
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
+  // Fixed storage for the sample loop (see EventQueue and readings_).
+  inlet_.pending.Reserve(EventCapacity());
+  exhaust_.pending.Reserve(EventCapacity());
+  readings_.resize(static_cast<std::size_t>(p_.transport_delay_samples) + 1);
   Reset();
+}
+
+std::size_t IpaSimulator::EventCapacity() const {
+  // An event pending at time t was queued by a command issued after t - D,
+  // D = the longest valve delay. Commands come at PWM period starts and falling
+  // edges (each at most once per PWM period T, period starts at least T apart)
+  // and at sample instants (manual valve commands, every Ts); two may coincide.
+  // Doubled for margin, capped: beyond the cap the queue grows (allocates).
+  const double D = std::max(p_.open_delay, p_.close_delay);
+  const double T = 1.0 / p_.pwm_frequency;
+  const double pwm_events = 2.0 * (std::ceil(D / T) + 1.0);
+  const double sample_events = std::ceil(D / Ts_) + 1.0;
+  const double bound = 2.0 * (pwm_events + sample_events) + 4.0;
+  return static_cast<std::size_t>(std::min(bound, 65536.0));
+}
+
+void IpaSimulator::EventQueue::Reserve(std::size_t capacity) {
+  ring_.assign(std::max<std::size_t>(capacity, 1), ValveEvent{});
+  head_ = size_ = 0;
+}
+
+void IpaSimulator::EventQueue::push_back(ValveEvent e) {
+  if (size_ == ring_.size()) {  // beyond EventCapacity(): grow, keeping the order
+    std::vector<ValveEvent> grown(2 * ring_.size());
+    for (std::size_t i = 0; i < size_; ++i) grown[i] = ring_[(head_ + i) % ring_.size()];
+    ring_ = std::move(grown);
+    head_ = 0;
+  }
+  ring_[(head_ + size_) % ring_.size()] = e;
+  ++size_;
+}
+
+void IpaSimulator::EventQueue::pop_front() {
+  head_ = (head_ + 1) % ring_.size();
+  --size_;
 }
 
 void IpaSimulator::Reset() {
@@ -160,18 +199,21 @@ void IpaSimulator::Reset() {
   dt_ = 1e-4;
   steps_ = 0;
   sample_ = 0;
-  inlet_ = Valve{};
-  exhaust_ = Valve{};
+  for (Valve* v : {&inlet_, &exhaust_}) {
+    v->open = false;
+    v->command = false;
+    v->pending.clear();  // keeps its storage
+  }
   duty_ = 0.0;
   period_start_ = 0.0;
   falling_edge_ = -1.0;
   exhaust_pulse_ = false;
   load_disturbance_ = 0.0;
-  readings_.clear();
-  for (int i = 0; i <= p_.transport_delay_samples; ++i) readings_.push_back(SenseOutput());
+  for (double& r : readings_) r = SenseOutput();
+  reading_head_ = 0;
 }
 
-double IpaSimulator::Measure() { return readings_.front(); }
+double IpaSimulator::Measure() { return readings_[reading_head_]; }
 
 double IpaSimulator::pressure_a() const { return x_[0] * kBar; }
 double IpaSimulator::pressure_b() const { return x_[1] * kBar; }
@@ -326,8 +368,8 @@ void IpaSimulator::Command(Valve& valve, bool on, double t) {
   if (valve.command == on) return;
   valve.command = on;
   const double t_phys = t + (on ? p_.open_delay : p_.close_delay);
-  while (!valve.pending.empty() && valve.pending.back().first >= t_phys) valve.pending.pop_back();
-  valve.pending.emplace_back(t_phys, on);
+  while (!valve.pending.empty() && valve.pending.back().time >= t_phys) valve.pending.pop_back();
+  valve.pending.push_back(ValveEvent{t_phys, on});
 }
 
 void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaust_cmd) {
@@ -358,8 +400,8 @@ void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaus
       falling_edge_ = -1.0;
     }
     for (Valve* v : {&inlet_, &exhaust_}) {
-      while (!v->pending.empty() && v->pending.front().first <= t_ + kEventTol) {
-        v->open = v->pending.front().second;
+      while (!v->pending.empty() && v->pending.front().time <= t_ + kEventTol) {
+        v->open = v->pending.front().open;
         v->pending.pop_front();
       }
     }
@@ -370,7 +412,7 @@ void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaus
       if (falling_edge_ > t_) t_next = std::min(t_next, falling_edge_);
     }
     for (const Valve* v : {&inlet_, &exhaust_})
-      if (!v->pending.empty()) t_next = std::min(t_next, v->pending.front().first);
+      if (!v->pending.empty()) t_next = std::min(t_next, v->pending.front().time);
     Integrate(t_, t_next, inlet_.open ? 1.0 : 0.0, exhaust_.open ? 1.0 : 0.0);
     t_ = t_next;
   }
@@ -395,15 +437,20 @@ void IpaSimulator::Advance(double u) {
     Integrate(t_, t_end, fraction(duty_ * T), fraction((1.0 - duty_) * T));
     t_ = t_end;
   }
-  readings_.push_back(SenseOutput());
-  readings_.pop_front();
+  PushReading();
+}
+
+void IpaSimulator::PushReading() {
+  // Delay line: the oldest reading (just returned by Measure) is replaced by the
+  // newest, and the next oldest becomes the head.
+  readings_[reading_head_] = SenseOutput();
+  reading_head_ = (reading_head_ + 1) % readings_.size();
 }
 
 void IpaSimulator::AdvanceValves(bool inlet_open, bool exhaust_open) {
   ++sample_;
   AdvanceTo(static_cast<double>(sample_) * Ts_, false, inlet_open, exhaust_open);
-  readings_.push_back(SenseOutput());
-  readings_.pop_front();
+  PushReading();
 }
 
 }  // namespace pneumid

@@ -48,12 +48,9 @@ TEST(Integration, DmcOnTheIpaSimulatorTracks) {
 namespace pneumid {
 namespace {
 
-// Which part allocates: each of the toolkit's pieces alone on the loop thread.
-// Disabled: IpaSimulator::Advance allocates (about 15 times in 200 samples, from its
-// std::deque sensor delay line and valve event queue); enable once the plant keeps
-// them in fixed storage. The loop itself and DMC are checked below and in
-// realtime_loop_test.cpp.
-TEST(Integration, DISABLED_IpaSimulatorAloneOnTheLoopThread) {
+// Which part allocates: each of the toolkit's pieces alone on the loop thread
+// (the loop itself is checked in realtime_loop_test.cpp).
+TEST(Integration, IpaSimulatorAloneOnTheLoopThread) {
   testing::CountingPi pi(0.5, 5.0, 0.01);
   SimBackend io(MakePlant("ipa", 0.01));
   SafetyMonitor safety(SafetyOptions{});

@@ -53,11 +53,12 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <map>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "pneumid/plant/plant.hpp"
 
@@ -170,7 +171,9 @@ double Iso6358MassFlow(double C, double b, double p_up, double p_down, double T_
 
 /// The IPA as a Plant. Input: PWM duty in percent (clamped to 0..100).
 /// Output: force in N (force mode) or position in m (position mode), through
-/// the sensor model.
+/// the sensor model. Measure, Advance and AdvanceValves do not allocate
+/// (storage is sized at construction), so the simulator can run on the
+/// real-time loop thread.
 class IpaSimulator final : public Plant {
  public:
   /// Throws InvalidArgument when the parameters are not valid or Ts <= 0.
@@ -213,15 +216,46 @@ class IpaSimulator final : public Plant {
   using State = std::array<double, 6>;
 
  private:
-  struct Valve {
-    bool open = false;                            // physical state
-    bool command = false;                         // command state
-    std::deque<std::pair<double, bool>> pending;  // (time, new physical state)
+  // Advance, AdvanceValves and Measure do not allocate: the valve event queues and
+  // the sensor delay line are ring buffers sized at construction.
+
+  /// A valve state change taking effect at `time` (s).
+  struct ValveEvent {
+    double time = 0.0;
+    bool open = false;
   };
+  /// FIFO of pending valve events in increasing time, in a ring buffer whose
+  /// capacity is set once (Reserve); it only grows (allocates) if a push exceeds
+  /// that capacity, which EventCapacity() rules out below its cap.
+  class EventQueue {
+   public:
+    void Reserve(std::size_t capacity);
+    bool empty() const { return size_ == 0; }
+    const ValveEvent& front() const { return ring_[head_]; }
+    const ValveEvent& back() const { return ring_[(head_ + size_ - 1) % ring_.size()]; }
+    void push_back(ValveEvent e);
+    void pop_front();
+    void pop_back() { --size_; }
+    void clear() { head_ = size_ = 0; }
+
+   private:
+    std::vector<ValveEvent> ring_;
+    std::size_t head_ = 0, size_ = 0;
+  };
+  struct Valve {
+    bool open = false;     // physical state
+    bool command = false;  // command state
+    EventQueue pending;    // (time, new physical state)
+  };
+  /// Upper bound on the events pending in one valve's queue: commands issued
+  /// within the longest valve delay (PWM edges and sample instants).
+  std::size_t EventCapacity() const;
   void Command(Valve& valve, bool on, double t);
   void Integrate(double t0, double t1, double open_in, double open_out);
   void Rhs(const State& x, State& dxdt, double open_in, double open_out) const;
   double SenseOutput();
+  /// Appends SenseOutput() to the sensor delay line, dropping the oldest reading.
+  void PushReading();
   double Quantize(double volts) const;
   void AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaust_cmd);
 
@@ -237,11 +271,12 @@ class IpaSimulator final : public Plant {
   long long steps_ = 0;
   long long sample_ = 0;
   Valve inlet_, exhaust_;
-  double duty_ = 0.0;           // input held now (fraction 0..1)
-  double period_start_ = 0.0;   // start of the next PWM period
-  double falling_edge_ = -1.0;  // pending inlet->exhaust command switch in this period
-  bool exhaust_pulse_ = false;  // the exhaust valve is pulsed in this period
-  std::deque<double> readings_;
+  double duty_ = 0.0;             // input held now (fraction 0..1)
+  double period_start_ = 0.0;     // start of the next PWM period
+  double falling_edge_ = -1.0;    // pending inlet->exhaust command switch in this period
+  bool exhaust_pulse_ = false;    // the exhaust valve is pulsed in this period
+  std::vector<double> readings_;  // sensor delay line (ring), transport_delay_samples + 1
+  std::size_t reading_head_ = 0;  // index of the oldest reading (the one Measure returns)
 };
 
 }  // namespace pneumid
