@@ -27,6 +27,30 @@ bool IsParametricMethod(const std::string& name) {
   return std::find(n.begin(), n.end(), name) != n.end();
 }
 
+// Continuous form of an identified discrete model. Zero-order-hold d2c (matrix
+// logarithm) is exact for sampled data with a held input and is tried first.
+// A discrete pole on the negative real axis (often the alias of a ripple at
+// the Nyquist frequency) has no real logarithm; the continuous form then comes
+// from the bilinear (tustin) map s = (2/Ts)(z - 1)/(z + 1), which exists for
+// every pole but z = -1, and a note says so. When neither exists the discrete
+// model is kept, also with a note.
+static TransferFunction ContinuousForm(const TransferFunction& g, std::vector<std::string>* notes) {
+  try {
+    return D2C(g, DiscretizationMethod::kZoh);
+  } catch (const InvalidArgument& zoh_error) {
+    try {
+      TransferFunction ct = D2C(g, DiscretizationMethod::kTustin);
+      notes->push_back(std::string("continuous form by tustin d2c: no zoh equivalent (") +
+                       zoh_error.what() + ")");
+      return ct;
+    } catch (const InvalidArgument& e) {
+      notes->push_back(std::string("no continuous (zoh d2c) equivalent: ") + zoh_error.what() +
+                       "; tustin: " + e.what());
+      return g;
+    }
+  }
+}
+
 IdentifiedModel ToIdentifiedModel(const std::string& method, const PolynomialModel& model,
                                   const EstimationSummary& summary, const Dataset& data, int input,
                                   int output) {
@@ -41,12 +65,7 @@ IdentifiedModel ToIdentifiedModel(const std::string& method, const PolynomialMod
       r.param_std[names[i]] = sd[static_cast<Eigen::Index>(i)];
   }
   r.discrete = model.ToTransferFunction(0);
-  try {
-    r.tf = D2C(*r.discrete, DiscretizationMethod::kZoh);
-  } catch (const InvalidArgument& e) {
-    r.tf = *r.discrete;
-    r.notes.push_back(std::string("no continuous (zoh d2c) equivalent: ") + e.what());
-  }
+  r.tf = ContinuousForm(*r.discrete, &r.notes);
   Eigen::MatrixXd u(data.size(), model.num_inputs());
   if (model.num_inputs() == 1) {
     u.col(0) = data.u(input);
@@ -96,13 +115,7 @@ IdentifiedModel FinishTransferFunctionModel(IdentifiedModel m, const TransferFun
                                             bool try_d2c = true) {
   m.discrete = g;
   m.tf = g;
-  if (try_d2c) {
-    try {
-      m.tf = D2C(g, DiscretizationMethod::kZoh);
-    } catch (const InvalidArgument& e) {
-      m.notes.push_back(std::string("no continuous (zoh d2c) equivalent: ") + e.what());
-    }
-  }
+  if (try_d2c) m.tf = ContinuousForm(g, &m.notes);
   const Eigen::VectorXd y = d.y(0);
   Eigen::VectorXd yhat;
   if (try_d2c) {

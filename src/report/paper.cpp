@@ -278,12 +278,19 @@ PaperResult RunPaper(const PaperOptions& o) {
     problem("d2c of the paper's ARX model", e);
   }
   if (arx) {
-    row(S3, "d2c of the identified ARX", "(Eq. 6)",
+    bool by_tustin = false;
+    for (const auto& n : arx->notes) by_tustin |= n.find("tustin d2c") != std::string::npos;
+    row(S3, by_tustin ? "d2c of the identified ARX (tustin)" : "d2c of the identified ARX",
+        "(Eq. 6)",
         arx->tf.IsContinuous() ? arx->tf.Normalized().ToString(5)
                                : "none: a pole on the negative real axis",
-        arx->tf.IsContinuous() ? kSimulatorNote
-                               : "a discrete pole on the negative real axis has no real "
-                                 "logarithm, so there is no zoh continuous equivalent");
+        by_tustin ? "a discrete pole on the negative real axis (PWM ripple aliased to the "
+                    "Nyquist frequency) has no real logarithm, so no zoh equivalent exists; the "
+                    "bilinear (tustin) map gives the continuous form"
+        : arx->tf.IsContinuous()
+            ? kSimulatorNote
+            : "a discrete pole on the negative real axis has no real "
+              "logarithm, so there is no zoh continuous equivalent");
   }
 
   // Section 4: FOPDT.

@@ -25,16 +25,18 @@ TEST(ParametricPlant, ArxAndD2cFromSimulatedIpaPrbsData) {
   EXPECT_TRUE(m.discrete->IsStable());
   EXPECT_GT(m.discrete->DcGain(), 0.0);  // more duty, more force
   // The continuous form of Eq. 6: a third-order model with a proper numerator,
-  // whose DC gain equals the discrete one (zoh preserves the DC gain).
-  if (m.tf.IsContinuous()) {
-    EXPECT_EQ(m.tf.Order(), 3);
-    EXPECT_NEAR(m.tf.DcGain(), m.discrete->DcGain(), 1e-6 * std::abs(m.discrete->DcGain()));
-  } else {
-    // A discrete pole on the negative real axis (PWM ripple) has no zoh
-    // continuous equivalent: the discrete model is kept and the reason noted.
+  // whose DC gain equals the discrete one (zoh and tustin both preserve it).
+  // A discrete pole on the negative real axis (PWM ripple aliased to the
+  // Nyquist frequency) has no zoh equivalent: tustin is used and noted.
+  ASSERT_TRUE(m.tf.IsContinuous());
+  EXPECT_EQ(m.tf.Order(), 3);
+  EXPECT_NEAR(m.tf.DcGain(), m.discrete->DcGain(), 1e-6 * std::abs(m.discrete->DcGain()));
+  bool negative_real_pole = false;
+  for (const auto& p : m.discrete->Poles())
+    negative_real_pole |= std::abs(p.imag()) < 1e-12 && p.real() < 0.0;
+  if (negative_real_pole) {
     ASSERT_FALSE(m.notes.empty());
-    EXPECT_NE(m.notes[0].find("no continuous (zoh d2c) equivalent"), std::string::npos);
-    EXPECT_TRUE(m.tf.IsDiscrete());
+    EXPECT_NE(m.notes[0].find("tustin"), std::string::npos);
   }
   // A linear ARX model of the nonlinear, PWM-driven actuator explains about half
   // of the PRBS response variation (simulation fit ~50 %).
