@@ -3,6 +3,8 @@
 BUILD ?= build
 JOBS ?= 2
 CMAKE_FLAGS ?=
+# Lets ccache reuse objects across checkouts in different folders.
+export CCACHE_BASEDIR := $(CURDIR)
 
 .PHONY: all build demo test setup bench format clean sanitize-test
 
@@ -31,7 +33,7 @@ bench: build
 sanitize-test: setup
 	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DPNEUMID_SANITIZE=ON \
 	  -DPNEUMID_BUILD_BENCHMARKS=OFF -DPNEUMID_BUILD_PYTHON=OFF
-	cmake --build build-asan -j$(JOBS)
+	cmake --build build-asan -j$(JOBS) --target pneumid_unit_tests
 	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --output-on-failure -j$(JOBS) -L unit
 
