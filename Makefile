@@ -35,6 +35,7 @@ sanitize-test: setup
 	  -DPNEUMID_BUILD_BENCHMARKS=OFF -DPNEUMID_BUILD_PYTHON=OFF
 	cmake --build build-asan -j$(JOBS) --target pneumid_unit_tests
 	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
 	  ctest --output-on-failure -j$(JOBS) -L unit
 
 format:

@@ -1,10 +1,10 @@
 // pneumid control: closed-loop simulation of a predictive (DMC, GPC) or PID
 // controller designed from MODEL against PLANT, with its metrics.
 //
-//   pneumid control --controller dmc --model fopdt-paper --plant arx-paper --Ts 0.01 \
+//   pneumid control --controller dmc --model fopdt-paper --plant arx-paper --Ts 0.01
 //       --rule shridhar-cooper --setpoint step:from=0,to=1,at=0 --duration 2 [--json]
-//   pneumid control --controller dmc --model fopdt-paper --plant ipa --Ts 0.01 \
-//       --u-min 0 --u-max 100 --constrained --setpoint "staircase:levels=0 40 80 40,dwell=2" \
+//   pneumid control --controller dmc --model fopdt-paper --plant ipa --Ts 0.01
+//       --u-min 0 --u-max 100 --constrained --setpoint "staircase:levels=0 40 80 40,dwell=2"
 //       --duration 8 --load-step at=7,size=-10 -o loop.csv --plot loop.png
 //   pneumid control ... --compare [shridhar-cooper,paper-modified]    (the paper's Figure 6)
 #include <cmath>

@@ -1,6 +1,6 @@
 // pneumid convert: a linear model between time domains and discretization methods.
 //
-//   pneumid convert --num 0,0.03938,0.04506,0.01286 --den 1,-0.60870,-0.27020,-0.06021 \
+//   pneumid convert --num 0,0.03938,0.04506,0.01286 --den 1,-0.60870,-0.27020,-0.06021
 //                   --Ts 0.01 --to continuous --method zoh [--json]
 //   pneumid convert --model fopdt-paper --to discrete --Ts 0.01 [--method tustin --prewarp W]
 //

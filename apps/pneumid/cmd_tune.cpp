@@ -1,7 +1,7 @@
 // pneumid tune: prediction horizon P, control horizon M and move suppression
 // lambda of a predictive controller from a model.
 //
-//   pneumid tune --model fopdt:K=1.6,tau=0.245,theta=0.001 --Ts 0.01 \
+//   pneumid tune --model fopdt:K=1.6,tau=0.245,theta=0.001 --Ts 0.01
 //                --rule shridhar-cooper [--M 5] [--json]
 //   -> {"rule": "shridhar-cooper", "P": 126, "M": 5, "lambda": 2.2508, ...,
 //       "formula": "..."}

@@ -69,8 +69,6 @@ std::optional<PolynomialModel> ReadPolynomial(const std::string& spec, std::stri
   return PolynomialModel::FromParamsJson(m["params"], m.value("structure", "ARX"));
 }
 
-Eigen::VectorXd ToVec(const Eigen::VectorXd& v) { return v; }
-
 void Run(const ValidateArgs& a) {
   PNEUMID_CHECK(a.horizon >= 0, "--horizon must be >= 0 (0 = simulation), got {}", a.horizon);
   const Dataset data = LoadFromOptions(a.data);
