@@ -17,6 +17,7 @@
 #include <plplot/plstream.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/report/html.hpp"
 
 namespace pneumid {
 
@@ -332,29 +333,6 @@ std::mutex& PlplotMutex() {
   return m;
 }
 
-std::string XmlEscape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 void ReplaceAll(std::string* s, const std::string& from, const std::string& to) {
   std::size_t pos = 0;
   while ((pos = s->find(from, pos)) != std::string::npos) {
@@ -391,8 +369,8 @@ void AddSvgMetadata(const Figure& fig, std::string* svg) {
   const auto close_tag = svg->find('>', open);
   if (close_tag == std::string::npos) return;
   const std::string title = PlainText(!fig.title.empty() ? fig.title : fig.axes(0).title);
-  const std::string meta = "\n<title>" + XmlEscape(title) + "</title>\n<desc>" +
-                           XmlEscape(DescribeFigure(fig)) + "</desc>";
+  const std::string meta = "\n<title>" + HtmlEscape(title) + "</title>\n<desc>" +
+                           HtmlEscape(DescribeFigure(fig)) + "</desc>";
   svg->insert(close_tag + 1, meta);
   svg->insert(open + 4, " role=\"img\"");
 }
