@@ -1,5 +1,5 @@
 """Plants, tuning, closed loops and the paper workflow from Python.
-Golden values: /work/shared/reference/paper-values.md section 6."""
+Golden values: docs/paper.md, reference value 6."""
 import numpy as np
 import pytest
 import scipy.signal as sig

@@ -1,5 +1,5 @@
 """Models, conversions and responses, cross-checked against scipy.signal and
-the paper's values (/work/shared/reference/paper-values.md sections 2-3)."""
+the paper's values (docs/paper.md, reference values 2-3)."""
 import numpy as np
 import pytest
 import scipy.signal as sig
@@ -21,7 +21,7 @@ def test_paper_arx_model_coefficients_and_gain():
     assert g.Ts == pytest.approx(0.01)
     np.testing.assert_allclose(g.den, A, atol=1e-12)
     np.testing.assert_allclose(g.num, B, atol=1e-12)
-    # static gain sum(b) / (1 + sum(a)) = 1.59796 (paper-values.md section 2)
+    # static gain sum(b) / (1 + sum(a)) = 1.59796 (docs/paper.md, reference value 2)
     assert g.dc_gain() == pytest.approx(1.59796, rel=1e-5)
 
 
@@ -53,7 +53,7 @@ def test_c2d_other_methods_match_scipy(method, scipy_method):
 
 def test_d2c_of_paper_arx_gives_paper_eq6():
     gc = pneumid.d2c(pneumid.paper_arx_model(), "zoh").normalized()
-    # matrix-logarithm ZOH (paper-values.md section 3)
+    # matrix-logarithm ZOH (docs/paper.md, reference value 3)
     np.testing.assert_allclose(gc.den, [1.0, 280.9917, 74994.63, 325421.7], rtol=1e-5)
     np.testing.assert_allclose(gc.num[-3:], [6.10237, -91.9458, 520011.9], rtol=1e-5)
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # pneumid control: the paper's conventional and modified DMC on the nominal
-# FOPDT (paper-values.md section 6), --compare, CSV output, the IPA plant
+# FOPDT (docs/paper.md, reference value 6), --compare, CSV output, the IPA plant
 # with duty bounds, and error handling. Usage: bash control_test.sh PNEUMID
 set -u
 PNEUMID=${1:?usage: control_test.sh /path/to/pneumid}

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # CLI test of `pneumid convert`: d2c of the paper's ARX force model gives
-# Eq. 6 (paper-values.md section 3) through --json; c2d/d2c round trip;
+# Eq. 6 (docs/paper.md, reference value 3) through --json; c2d/d2c round trip;
 # bad input gives a non-zero exit and a message on stderr.
 # Usage: bash convert_test.sh /path/to/pneumid
 set -u

@@ -19,7 +19,7 @@ grep -q "written: $TMP/ipa.csv" "$TMP/out.txt" || fail "summary does not name th
 head -3 "$TMP/ipa.csv" | grep -q "^t \[s\],u \[%\],y \[N\],p_a \[Pa\],p_b \[Pa\]$" || fail "CSV header"
 rows=$(grep -vc "^#\|^t " "$TMP/ipa.csv")
 [ "$rows" -eq 401 ] || fail "expected 401 rows, got $rows"
-# Force before the step about 0 N, at the end about 129 N (paper-values.md section 4).
+# Force before the step about 0 N, at the end about 129 N (docs/paper.md, reference value 4).
 awk -F, '!/^#/ && !/^t/ { if ($1 > 0.5 && $1 < 1.0 && ($3 < -1 || $3 > 1)) bad = 1;
   if ($1 > 3.5 && ($3 < 124 || $3 > 134)) bad = 1 } END { exit bad }' "$TMP/ipa.csv" \
   || fail "IPA step does not go from ~0 to ~129 N"

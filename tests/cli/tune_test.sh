@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# pneumid tune: the paper's conventional settings (paper-values.md section 6),
+# pneumid tune: the paper's conventional settings (docs/paper.md, reference value 6),
 # the modified settings, and error handling. Usage: bash tune_test.sh PNEUMID
 set -u
 PNEUMID=${1:?usage: tune_test.sh /path/to/pneumid}

@@ -42,7 +42,7 @@ TEST(StepResponseCoefficientsTest, DiscreteArxUsesItsDifferenceEquation) {
   EXPECT_NEAR(s(0), 0.0, 1e-15);
   EXPECT_NEAR(s(1), 0.03938, 1e-12);                                // b1
   EXPECT_NEAR(s(2), 0.03938 + 0.04506 + 0.60870 * 0.03938, 1e-12);  // b1 + b2 - a1 s1
-  EXPECT_NEAR(s(400), 1.59796, 1e-4);  // static gain, paper-values.md section 2
+  EXPECT_NEAR(s(400), 1.59796, 1e-4);  // static gain, docs/paper.md, reference value 2
   EXPECT_THROW(StepResponseCoefficients(arx, 0.02, 10), InvalidArgument);
 }
 
@@ -61,7 +61,7 @@ struct PaperCase {
   double lambda;
   // gen_dmc_reference.py
   double first_move, rise, overshoot, settling;
-  // paper-values.md section 6
+  // docs/paper.md, reference value 6
   double paper_first_move, paper_rise, paper_overshoot, paper_settling;
 };
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Independent reference for tests/control/dmc_test.cpp (paper-values.md section 6).
+"""Independent reference for tests/control/dmc_test.cpp (docs/paper.md, reference value 6).
 
 DMC (Cutler & Ramaker 1980) on the paper's FOPDT 1.6 exp(-0.001 s)/(0.245 s + 1)
 sampled with a zero-order hold at Ts = 0.01 s. The plant is simulated exactly

@@ -1,5 +1,5 @@
 // Tuning rules: the paper's P = 126 and lambda = 2.25 (M = 5) from the
-// Shridhar-Cooper rule (paper-values.md section 6; lambda_max(A'A)/500 =
+// Shridhar-Cooper rule (docs/paper.md, reference value 6; lambda_max(A'A)/500 =
 // 2.250797 from gen_dmc_reference.py), the modified settings, and errors.
 #include "pneumid/control/tuning.hpp"
 
@@ -79,7 +79,7 @@ TEST(TuningTest, FopdtFromHigherOrderModelByTwoPointMethod) {
   const FopdtParameters arx = FopdtFromModel(PaperArxModel());
   EXPECT_EQ(arx.method, "two-point");
   EXPECT_NEAR(arx.K, 1.59796, 1e-4);
-  EXPECT_NEAR(arx.tau + arx.theta, 0.2306, 0.01);  // t63 of the ARX step (paper-values 4)
+  EXPECT_NEAR(arx.tau + arx.theta, 0.2306, 0.01);  // t63 of the ARX step (docs/paper.md, reference 4)
   const TuningResult r = Tune(PaperArxModel(), kTs, TuningOptions{});
   EXPECT_GT(r.P, 110);
   EXPECT_LT(r.P, 130);

@@ -3,10 +3,10 @@
 tests/identify/graphical_methods_test.cpp.
 
 1. Continuous equivalent (paper Eq. 6, zoh d2c, coefficients of
-   paper-values.md section 3), unit step on a 5 us grid: the tangent at the
+   docs/paper.md, reference value 3), unit step on a 5 us grid: the tangent at the
    point of largest slope.
 2. The ARX model's own sampled unit step (Ts = 0.01 s): the steepest
-   sample-to-sample segment, which reproduces paper-values.md section 4
+   sample-to-sample segment, which reproduces docs/paper.md, reference value 4
    (L = 0.0043 s, T = 0.2315 s).
 """
 import numpy as np

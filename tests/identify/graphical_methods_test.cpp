@@ -86,7 +86,7 @@ TEST(TangentTest, PaperArxModel) {
       InflectionTangent(AnalyzeStep(testing::MakeStepData(ct, 0.0005, 100, 8000, 0.0, 1.0)), o);
   EXPECT_NEAR(c.L, 0.00512, 0.0002);
   EXPECT_NEAR(c.T, 0.21877, 0.002);
-  // The ARX model's own step at Ts = 0.01 s: paper-values.md section 4 gives
+  // The ARX model's own step at Ts = 0.01 s: docs/paper.md, reference value 4 gives
   // L = 0.0043 s, T = 0.2315 s (steepest sample-to-sample segment); the
   // smoothed slope lands within one sample of both.
   const TangentResult d = InflectionTangent(

@@ -60,7 +60,7 @@ TEST(HalfRuleTest, ZerosAndDelay) {
 }
 
 TEST(HalfRuleTest, PaperArxModel) {
-  // paper-values.md section 3: continuous poles -4.41102, -138.290 +- 233.774j,
+  // docs/paper.md, reference value 3: continuous poles -4.41102, -138.290 +- 233.774j,
   // numerator 6.10237 s^2 - 91.9458 s + 520011.9. The complex pole pair becomes
   // a lag 2 zeta / w = 2 * 138.290 / |p|^2, the complex zero pair (negative s
   // coefficient) a delay 91.9458 / 520011.9.

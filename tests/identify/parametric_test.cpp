@@ -33,7 +33,7 @@ TEST(Parametric, ArxReproducesThePaperModelAndItsContinuousForm) {
   // Noise-free data of the paper's Eq. 5: ARX(3,3,1) returns its coefficients,
   // and the zoh d2c form is the paper's Eq. 6,
   // (6.102 s^2 - 91.95 s + 520000) / (s^3 + 281 s^2 + 74990 s + 325400)
-  // (paper-values.md sec. 3: [6.10237, -91.9458, 520011.9] / [1, 280.9917, 74994.63, 325421.7]).
+  // (docs/paper.md, reference value 3: [6.10237, -91.9458, 520011.9] / [1, 280.9917, 74994.63, 325421.7]).
   const IdentifiedModel m = IdentifyParametric("arx", PaperArxData(2000, 0.0), IdentifyRequest{});
   EXPECT_EQ(m.method, "arx");
   EXPECT_EQ(m.structure, "ARX");

@@ -1,5 +1,5 @@
 // Equivalent PTn by the tangent-line method, paper Eq. 3 and
-// ../shared/reference/paper-values.md section 5.
+// docs/paper.md, reference value 5.
 #include "pneumid/identify/ptn.hpp"
 
 #include <cmath>

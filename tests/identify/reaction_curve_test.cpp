@@ -1,5 +1,5 @@
 // The paper's reaction-curve FOPDT (Eq. 2) on its own ARX model (Eq. 5).
-// Golden values: ../shared/reference/paper-values.md sections 2 and 4: static
+// Golden values: docs/paper.md, reference values 2 and 4: static
 // gain 1.59796, 63.2 % time of the ARX unit step t63 = 0.2306 s; K = 1.6 within
 // 1 % and tau within one sample (Ts = 0.01 s) of t63.
 #include "pneumid/identify/reaction_curve.hpp"
@@ -13,7 +13,7 @@ namespace pneumid {
 namespace {
 
 constexpr double kTs = 0.01;
-constexpr double kT63 = 0.2306;  // paper-values.md section 4
+constexpr double kT63 = 0.2306;  // docs/paper.md, reference value 4
 
 Dataset PaperStep(double noise, unsigned seed = 7) {
   // Duty cycle stepped 0.61 -> 82 % after 0.5 s, 4 s of data (paper section 4).

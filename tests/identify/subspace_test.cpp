@@ -27,7 +27,7 @@ TEST_P(SubspaceNoise, RecoversThePaperModelPolesAndGain) {
   ASSERT_EQ(r.summary.termination, EstimationTermination::kConvergence);
   EXPECT_EQ(r.order, 3);
   EXPECT_EQ(r.model.Ts(), 0.01);
-  // Poles 0.95685, -0.17407 +- 0.18062j (paper-values.md sec. 2; more digits
+  // Poles 0.95685, -0.17407 +- 0.18062j (docs/paper.md, reference value 2; more digits
   // from numpy.roots([1, -0.6087, -0.2702, -0.06021])).
   Eigen::VectorXcd p = r.model.Poles();
   std::sort(p.data(), p.data() + p.size(), [](auto a, auto b) {

@@ -51,7 +51,7 @@ double RelativeError(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 }
 
 TEST(ConversionTest, PaperArxD2cZohGivesEq6) {
-  // paper-values.md section 3: matrix-logarithm ZOH gives numerator
+  // docs/paper.md, reference value 3: matrix-logarithm ZOH gives numerator
   // [6.10237, -91.9458, 520011.9], denominator [1, 280.9917, 74994.63, 325421.7],
   // poles -4.41102, -138.290 +/- 233.774j.
   const TransferFunction g = D2C(PaperArxModel(), DiscretizationMethod::kZoh).Normalized();

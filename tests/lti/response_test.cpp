@@ -45,7 +45,7 @@ TEST(ResponseTest, DefaultGridCoversTheTransient) {
 }
 
 TEST(ResponseTest, PaperArxStepT63) {
-  // paper-values.md section 4: the ARX model's own unit step gives t63 = 0.2306 s.
+  // docs/paper.md, reference value 4: the ARX model's own unit step gives t63 = 0.2306 s.
   const TimeResponse r = Step(PaperArxModel(), 2.0);
   const double target = 0.632 * PaperArxModel().DcGain();
   double t63 = NAN;

@@ -27,7 +27,7 @@ std::vector<std::complex<double>> Sorted(const Eigen::VectorXcd& r) {
 }
 
 TEST(TransferFunctionTest, PaperArxStaticGainAndPoles) {
-  // paper-values.md section 2: static gain 1.59796, poles 0.95685, -0.17407 +/- 0.18062j.
+  // docs/paper.md, reference value 2: static gain 1.59796, poles 0.95685, -0.17407 +/- 0.18062j.
   const TransferFunction g = PaperArxModel();
   EXPECT_TRUE(g.IsDiscrete());
   EXPECT_EQ(g.Order(), 3);

@@ -147,7 +147,7 @@ TEST(IpaSimulatorTest, MassBalanceHoldsWithMovingPiston) {
 }
 
 TEST(IpaSimulatorTest, DefaultStepReproducesThePaperForceStep) {
-  // paper-values.md section 4: duty 0.61 -> 82 % at t = 1 s, force 0 -> 129 N,
+  // docs/paper.md, reference value 4: duty 0.61 -> 82 % at t = 1 s, force 0 -> 129 N,
   // Kp = 1.585 N/%, tau (time to 63.2 %) = 0.245 s.
   IpaSimulator sim(IpaParameters{}, 0.01, 7);
   std::vector<double> y;

@@ -40,7 +40,7 @@ TEST(LinearPlantTest, PaperArxModelEqualsLsim) {
   const Eigen::VectorXd ref = Lsim(g, u, 0.01);
   ASSERT_EQ(ref.size(), y.size());
   EXPECT_LT((y - ref).cwiseAbs().maxCoeff(), 1e-9 * ref.cwiseAbs().maxCoeff());
-  // paper-values.md section 2: static gain 1.59796.
+  // docs/paper.md, reference value 2: static gain 1.59796.
   Eigen::VectorXd step = Eigen::VectorXd::Ones(3000);
   plant.Reset();
   EXPECT_NEAR(Drive(plant, step)[2999], 1.59796, 1e-4);

@@ -1,5 +1,5 @@
 // The paper workflow (include/pneumid/report/paper.hpp). Golden values:
-// ../shared/reference/paper-values.md (sections 2, 3, 6), which come from the
+// docs/paper.md (reference values 2, 3, 6), which come from the
 // paper, from the matrix-logarithm d2c and from an independent closed-loop
 // computation, as noted there.
 #include "pneumid/report/paper.hpp"
@@ -43,7 +43,7 @@ TEST(PaperTest, RunsCompletelyWithThreeFigures) {
 }
 
 TEST(PaperTest, RecomputedArxQuantitiesMatchThePaper) {
-  // paper-values.md section 2: static gain 1.59796, poles 0.95685, -0.17407 +/- 0.18062j
+  // docs/paper.md, reference value 2: static gain 1.59796, poles 0.95685, -0.17407 +/- 0.18062j
   EXPECT_EQ(Row("static gain of Eq. 5 (recomputed)").pneumid, "1.59796");
   EXPECT_EQ(Row("discrete poles of Eq. 5").pneumid, "0.956848, -0.174074 ± 0.18062j");
   // section 3: matrix-logarithm zoh d2c
@@ -62,7 +62,7 @@ TEST(PaperTest, TuningOfThePaperFopdtReproducesSection6) {
 }
 
 TEST(PaperTest, ReferenceClosedLoopsMatchTheIndependentComputation) {
-  // paper-values.md section 6: M = 5: first move 0.672, rise 0.110 s,
+  // docs/paper.md, reference value 6: M = 5: first move 0.672, rise 0.110 s,
   // overshoot 2.0 %, settling 0.23 s; M = 10: 0.761, 0.090 s, 3.6 %, 0.25 s.
   // Times agree within one sample (note empty), amplitudes to the printed digits.
   for (const char* q :

@@ -1,7 +1,7 @@
 // Tuning rules for the predictive controllers (DMC, GPC) from an FOPDT
 // description K exp(-theta s) / (tau s + 1) of the plant.
 //
-// "shridhar-cooper" [1, 2] (the paper's "conventional" method, paper-values.md
+// "shridhar-cooper" [1, 2] (the paper's "conventional" method, docs/paper.md
 // section 6):
 //   P = round(5 tau/Ts + k),  k = theta/Ts + 1                       [1, eq. 8]
 //   lambda_condition = lambda_max(A'A) / 500                         (used)

@@ -14,7 +14,7 @@
 // FOPDT (Ziegler-Nichols): K = dy/du, theta = max(L, 0), tau = T.
 // On the paper's ARX model: the continuous equivalent's tangent is
 // L = 0.00512 s, T = 0.21877 s; the steepest segment of its step sampled at
-// Ts = 0.01 s gives L = 0.0043 s, T = 0.2315 s (paper-values.md section 4).
+// Ts = 0.01 s gives L = 0.0043 s, T = 0.2315 s (docs/paper.md, reference value 4).
 //
 // [1] J. G. Ziegler, N. B. Nichols, Optimum settings for automatic
 //     controllers, Trans. ASME 64 (1942) 759-768.

@@ -29,7 +29,7 @@ nlohmann::json ToJson(const TransferFunction& g);
 /// Inverse of ToJson; throws InvalidArgument naming the missing/invalid key.
 TransferFunction TransferFunctionFromJson(const nlohmann::json& j);
 
-/// The paper's models (../shared/reference/paper-values.md sections 2-4).
+/// The paper's models (docs/paper.md, reference values 2-4).
 TransferFunction PaperArxModel();
 TransferFunction PaperFopdtModel();
 

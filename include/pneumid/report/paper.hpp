@@ -1,5 +1,5 @@
 // The paper reproduced end to end (`pneumid paper`): every number of
-// ../shared/reference/paper-values.md next to the value pneumid obtains, and
+// docs/paper.md next to the value pneumid obtains, and
 // Figures 4-6 of [1], from the built-in IPA simulator.
 //
 // Workflow (RunPaper):
@@ -15,7 +15,7 @@
 //   5. tuning from the FOPDT as the paper reads it off the step test (K = dy/du,
 //      tau = t63, theta = 0.001 s): conventional (Shridhar-Cooper: P, M = 5,
 //      lambda) and modified (P, M = 10, lambda = 1.92) [1, sec. 5], control/tuning.hpp;
-//   6. the reference closed loops of paper-values.md section 6 (DMC with the
+//   6. the reference closed loops of docs/paper.md, reference value 6 (DMC with the
 //      paper's P, M, lambda on the paper's FOPDT, unit set-point step): first
 //      move, rise time, overshoot, settling time;
 //   7. Figure 6: DMC with both tunings (model: the FOPDT of step 5) driving
@@ -60,7 +60,7 @@ struct PaperOptions {
 
 /// One line of the side-by-side table.
 struct PaperRow {
-  std::string section;   ///< paper-values.md section, e.g. "2 ARX model"
+  std::string section;   ///< reference value of docs/paper.md, e.g. "2 ARX model"
   std::string quantity;  ///< e.g. "a1"
   std::string paper;     ///< the paper's value as printed
   std::string pneumid;   ///< pneumid's value
