@@ -1,18 +1,15 @@
 #include "column_spec.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/strings.hpp"
 
 namespace pneumid::internal {
 namespace {
 
-std::string TrimCopy(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t");
-  return s.substr(b, e - b + 1);
-}
 
 }  // namespace
 
@@ -24,10 +21,10 @@ ColumnName ParseColumnName(const std::string& label) {
     if (open != '\0') {
       const auto pos = label.rfind(open);
       if (pos != std::string::npos && pos > 0) {
-        std::string name = TrimCopy(label.substr(0, pos));
+        std::string name = std::string(Trim(std::string_view(label).substr(0, pos)));
         if (!name.empty()) {
           c.name = std::move(name);
-          c.unit = TrimCopy(label.substr(pos + 1, label.size() - pos - 2));
+          c.unit = std::string(Trim(std::string_view(label).substr(pos + 1, label.size() - pos - 2)));
         }
       }
     }
@@ -48,14 +45,16 @@ bool IsIndex(const std::string& s, std::size_t* value) {
 
 std::string ListColumns(const std::vector<ColumnName>& columns) {
   std::string out;
-  for (std::size_t i = 0; i < columns.size(); ++i) {
+  const std::size_t shown = std::min(columns.size(), kMaxListedColumns);
+  for (std::size_t i = 0; i < shown; ++i) {
     if (i > 0) out += ", ";
     if (columns[i].label.empty()) {
       out += fmt::format("(unnamed column {})", i);
     } else {
-      out += fmt::format("'{}'", columns[i].label);
+      out += fmt::format("'{}'", Excerpt(columns[i].label));
     }
   }
+  if (shown < columns.size()) out += fmt::format(", ... ({} columns in all)", columns.size());
   return out;
 }
 
@@ -76,7 +75,7 @@ std::size_t ResolveColumn(const std::string& spec, const std::vector<ColumnName>
   }
   throw DataError(fmt::format(
       "{}: unknown {} column '{}'; available columns: {} (or a 0-based index 0..{})", where, role,
-      spec, ListColumns(columns), columns.empty() ? 0 : columns.size() - 1));
+      Excerpt(spec), ListColumns(columns), columns.empty() ? 0 : columns.size() - 1));
 }
 
 }  // namespace pneumid::internal

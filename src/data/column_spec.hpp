@@ -26,7 +26,11 @@ bool IsIndex(const std::string& s, std::size_t* value);
 std::size_t ResolveColumn(const std::string& spec, const std::vector<ColumnName>& columns,
                           const std::string& where, const std::string& role);
 
-/// "t, u, y" (quoted names, unnamed columns as their index).
+/// At most this many columns are named in an error message.
+inline constexpr std::size_t kMaxListedColumns = 20;
+
+/// "'t', 'u', 'y'" (quoted names, each cut to a short excerpt, unnamed columns
+/// as their index); after kMaxListedColumns names, "... (N columns in all)".
 std::string ListColumns(const std::vector<ColumnName>& columns);
 
 }  // namespace pneumid::internal

@@ -1,10 +1,6 @@
 #include "pneumid/data/csv.hpp"
 
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -16,63 +12,14 @@
 #include <fmt/format.h>
 
 #include "column_spec.hpp"
+#include "mapped_file.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/strings.hpp"
 
 namespace pneumid {
 namespace {
 
-/// Read-only view of a whole file, memory-mapped (or empty for an empty file).
-class MappedFile {
- public:
-  explicit MappedFile(const std::string& path) {
-    fd_ = ::open(path.c_str(), O_RDONLY);
-    if (fd_ < 0) {
-      throw DataError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
-    }
-    struct stat st {};
-    if (::fstat(fd_, &st) != 0) {
-      const int e = errno;
-      ::close(fd_);
-      throw DataError(fmt::format("{}: cannot read: {}", path, std::strerror(e)));
-    }
-    if (S_ISDIR(st.st_mode)) {
-      ::close(fd_);
-      throw DataError(fmt::format("{}: is a directory, not a data file", path));
-    }
-    size_ = static_cast<std::size_t>(st.st_size);
-    if (size_ > 0) {
-      void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd_, 0);
-      if (p == MAP_FAILED) {
-        const int e = errno;
-        ::close(fd_);
-        throw DataError(fmt::format("{}: cannot map: {}", path, std::strerror(e)));
-      }
-      ::madvise(p, size_, MADV_SEQUENTIAL);
-      data_ = static_cast<const char*>(p);
-    }
-  }
-  ~MappedFile() {
-    if (data_ != nullptr) ::munmap(const_cast<char*>(data_), size_);
-    if (fd_ >= 0) ::close(fd_);
-  }
-  MappedFile(const MappedFile&) = delete;
-  MappedFile& operator=(const MappedFile&) = delete;
-
-  std::string_view view() const { return {data_ == nullptr ? "" : data_, size_}; }
-
- private:
-  int fd_ = -1;
-  const char* data_ = nullptr;
-  std::size_t size_ = 0;
-};
-
 inline bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
-
-inline std::string_view Trim(std::string_view s) {
-  while (!s.empty() && IsBlank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && IsBlank(s.back())) s.remove_suffix(1);
-  return s;
-}
 
 inline std::string_view StripQuotes(std::string_view s) {
   if (s.size() >= 2 && s.front() == '"' && s.back() == '"') {
@@ -146,6 +93,34 @@ std::string DelimiterName(char d) {
   }
 }
 
+/// Throws DataError when `text` (the start of a file) is not 8-bit text: a
+/// UTF-16/UTF-32 byte order mark, or NUL bytes (binary data or UTF-16 without
+/// a byte order mark) within the first 64 KiB.
+void CheckTextEncoding(const std::string& path, std::string_view text) {
+  auto starts = [&](std::string_view bom) { return text.substr(0, bom.size()) == bom; };
+  const char* encoding = starts(std::string_view("\xFF\xFE\0\0", 4))   ? "UTF-32LE"
+                         : starts(std::string_view("\0\0\xFE\xFF", 4)) ? "UTF-32BE"
+                         : starts("\xFF\xFE")                         ? "UTF-16LE"
+                         : starts("\xFE\xFF")                         ? "UTF-16BE"
+                                                                      : nullptr;
+  if (encoding != nullptr) {
+    throw DataError(fmt::format(
+        "{}:1: the file is {} text (byte order mark); pneumid reads UTF-8 or ASCII: save it "
+        "as UTF-8 (e.g. iconv -f {} -t UTF-8)",
+        path, encoding, encoding));
+  }
+  const std::string_view head = text.substr(0, 64 * 1024);
+  const void* nul = std::memchr(head.data(), '\0', head.size());
+  if (nul != nullptr) {
+    const auto offset = static_cast<std::size_t>(static_cast<const char*>(nul) - head.data());
+    const long line = 1 + static_cast<long>(std::count(head.begin(), head.begin() + offset, '\n'));
+    throw DataError(fmt::format(
+        "{}:{}: NUL byte at offset {}: this is a binary file (or UTF-16 text without byte "
+        "order mark), not delimited text; save the data as CSV in UTF-8",
+        path, line, offset));
+  }
+}
+
 }  // namespace
 
 bool CsvReadOptions::IsValid(std::string* error) const {
@@ -186,11 +161,12 @@ bool CsvReadOptions::IsValid(std::string* error) const {
 Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
   std::string error;
   PNEUMID_CHECK(options.IsValid(&error), "ReadCsv: {}", error);
-  MappedFile file(path);
+  internal::MappedFile file(path);
   std::string_view text = file.view();
   if (text.size() >= 3 && std::memcmp(text.data(), "\xEF\xBB\xBF", 3) == 0) {
     text.remove_prefix(3);  // UTF-8 byte order mark
   }
+  CheckTextEncoding(path, text);
   if (text.empty()) throw DataError(fmt::format("{}:1: empty file (expected a header row)", path));
 
   const char* p = text.data();
@@ -217,27 +193,55 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
         fmt::format("{}:{}: empty file: no header row (only blank or comment lines)", path, line));
   }
   const long header_line = line;
+  if (header.size() > kCsvMaxHeaderBytes) {
+    throw DataError(fmt::format(
+        "{}:{}: header row is {} bytes long (at most {}): not a header row; the file needs a "
+        "first row of column names such as 't,u,y'",
+        path, line, header.size(), kCsvMaxHeaderBytes));
+  }
   const char delimiter = options.delimiter != '\0' ? options.delimiter : DetectDelimiter(header);
   std::vector<internal::ColumnName> columns;
-  ForEachCell(header, delimiter, [&](std::size_t, std::string_view cell) {
-    columns.push_back(internal::ParseColumnName(std::string(StripQuotes(Trim(cell)))));
+  bool numeric_header = true;
+  ForEachCell(header, delimiter, [&](std::size_t index, std::string_view cell) {
+    if (index >= kCsvMaxColumns) return;
+    cell = StripQuotes(Trim(cell));
+    double v = 0.0;
+    const auto [ptr, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
+    numeric_header = numeric_header && ec == std::errc() && ptr == cell.data() + cell.size();
+    columns.push_back(internal::ParseColumnName(std::string(cell)));
   });
+  const std::size_t header_cells = ForEachCell(header, delimiter, [](std::size_t, auto) {});
+  if (header_cells > kCsvMaxColumns) {
+    throw DataError(fmt::format(
+        "{}:{}: header row has {} columns (delimiter {}), more than the {} supported{}", path,
+        line, header_cells, DelimiterName(delimiter), kCsvMaxColumns,
+        numeric_header ? "; it holds numbers: is the header row missing?" : ""));
+  }
   const std::size_t num_columns = columns.size();
 
   // Resolve the selected columns into slots: time (optional), inputs, outputs.
-  auto where = [&](long l) { return fmt::format("{}:{}", path, l); };
   const bool has_time = options.sample_time <= 0;
   std::vector<std::size_t> slot_column;
-  if (has_time) {
-    slot_column.push_back(
-        internal::ResolveColumn(options.time_column, columns, where(header_line), "time"));
-  }
-  for (const auto& s : options.input_columns) {
-    slot_column.push_back(internal::ResolveColumn(s, columns, where(header_line), "input"));
-  }
-  for (const auto& s : options.output_columns) {
-    slot_column.push_back(internal::ResolveColumn(s, columns, where(header_line), "output"));
-  }
+  // A header that is not text or holds only numbers explains an unknown column.
+  std::size_t bad_byte = 0;
+  const std::string header_note =
+      !IsValidUtf8(header, &bad_byte)
+          ? fmt::format(" (the header row is not valid UTF-8 text: byte 0x{:02X} at offset {}; "
+                        "save the file as UTF-8 text)",
+                        static_cast<unsigned char>(header[bad_byte]), bad_byte)
+      : numeric_header ? " (the first row holds numbers: is the header row missing?)"
+                       : "";
+  auto resolve = [&](const std::string& spec, const char* role) {
+    try {
+      slot_column.push_back(
+          internal::ResolveColumn(spec, columns, fmt::format("{}:{}", path, header_line), role));
+    } catch (const DataError& e) {
+      throw DataError(e.what() + header_note);
+    }
+  };
+  if (has_time) resolve(options.time_column, "time");
+  for (const auto& s : options.input_columns) resolve(s, "input");
+  for (const auto& s : options.output_columns) resolve(s, "output");
   const std::size_t num_slots = slot_column.size();
   // column -> first slot reading it (a column may feed several slots).
   std::vector<int> column_slot(num_columns, -1);
@@ -261,7 +265,7 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
 
   auto cell_error = [&](std::size_t column, const std::string& what) {
     return DataError(
-        fmt::format("{}:{}: column '{}': {}", path, line, columns[column].label, what));
+        fmt::format("{}:{}: column '{}': {}", path, line, Excerpt(columns[column].label), what));
   };
 
   while (p < end) {
@@ -280,16 +284,16 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
           double v = 0.0;
           const auto [ptr, ec] = std::from_chars(first, last, v);
           if (ec == std::errc::result_out_of_range) {
-            throw cell_error(c, fmt::format("number out of range: '{}'", cell));
+            throw cell_error(c, fmt::format("number out of range: '{}'", Excerpt(cell)));
           }
           if (ec != std::errc() || ptr != last) {
             const bool decimal_comma = delimiter != ',' && cell.find(',') != cell.npos;
             throw cell_error(
-                c, fmt::format("not a number: '{}'{}", cell,
+                c, fmt::format("not a number: '{}'{}", Excerpt(cell),
                                decimal_comma ? " (numbers need '.' as decimal point)" : ""));
           }
-          if (std::isnan(v)) throw cell_error(c, fmt::format("NaN value '{}'", cell));
-          if (std::isinf(v)) throw cell_error(c, fmt::format("infinite value '{}'", cell));
+          if (std::isnan(v)) throw cell_error(c, fmt::format("NaN value '{}'", Excerpt(cell)));
+          if (std::isinf(v)) throw cell_error(c, fmt::format("infinite value '{}'", Excerpt(cell)));
           row[static_cast<std::size_t>(slot)] = v;
         });
     if (cells != num_columns) {
@@ -307,7 +311,7 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
       if (n > 0 && !(t > previous_time)) {
         throw DataError(fmt::format(
             "{}:{}: column '{}': time is not strictly increasing: t = {} after t = {} on line {}",
-            path, line, columns[slot_column[0]].label, t, previous_time, previous_line));
+            path, line, Excerpt(columns[slot_column[0]].label), t, previous_time, previous_line));
       }
       previous_time = t;
     }

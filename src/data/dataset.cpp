@@ -152,6 +152,39 @@ void Dataset::RequireSamples(Eigen::Index n, const std::string& what) const {
   }
 }
 
+void Dataset::RequireNumericScale() const {
+  auto check = [&](const Eigen::VectorXd& v, const std::string& kind, const Channel& channel) {
+    if (v.size() == 0) return;
+    const double lo = v.minCoeff();
+    const double hi = v.maxCoeff();
+    const double magnitude = std::max(std::abs(lo), std::abs(hi));
+    const std::string column = fmt::format("{}: {} column '{}'", SourcePrefix(source_), kind,
+                                           Excerpt(channel.name));
+    if (magnitude > kMaxMagnitude) {
+      throw DataError(fmt::format(
+          "{}: values range from {:g} to {:g}; magnitudes above {:g} overflow in the "
+          "computations (differences and squares exceed the double range): rescale the "
+          "column (e.g. change its unit)",
+          column, lo, hi, kMaxMagnitude));
+    }
+    const double spread = hi - lo;
+    if (spread > 0 && spread < kMinSpread) {
+      throw DataError(fmt::format(
+          "{}: values range from {:g} to {:g}, a spread of {:g}; variations below {:g} "
+          "underflow to zero in the computations (extreme scale): rescale the column (e.g. "
+          "change its unit)",
+          column, lo, hi, spread, kMinSpread));
+    }
+  };
+  check(time_, "time", time_channel_);
+  for (int i = 0; i < num_inputs(); ++i) {
+    check(inputs_.col(i), "input", input_channels_[static_cast<std::size_t>(i)]);
+  }
+  for (int i = 0; i < num_outputs(); ++i) {
+    check(outputs_.col(i), "output", output_channels_[static_cast<std::size_t>(i)]);
+  }
+}
+
 long Dataset::SourceLine(Eigen::Index i) const {
   PNEUMID_CHECK(i >= 0 && i < size(), "Dataset::SourceLine: sample {} out of range [0, {})", i,
                 size());

@@ -1,26 +1,26 @@
 #include "pneumid/data/load.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
+#include "pneumid/common/strings.hpp"
 
 namespace pneumid {
 namespace {
-
-std::string Lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 std::string Extension(const std::string& path) {
   const auto slash = path.find_last_of('/');
   const auto dot = path.find_last_of('.');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  return Lower(path.substr(dot + 1));
+  return ToLower(path.substr(dot + 1));
 }
 
 DataFormat Resolve(DataFormat format, const std::string& path) {
@@ -29,25 +29,21 @@ DataFormat Resolve(DataFormat format, const std::string& path) {
 
 }  // namespace
 
-std::string ToString(DataFormat f) {
-  switch (f) {
-    case DataFormat::kAuto:
-      return "auto";
-    case DataFormat::kCsv:
-      return "csv";
-    case DataFormat::kMat:
-      return "mat";
-  }
-  return "auto";
-}
+namespace {
+constexpr EnumName<DataFormat> kDataFormatNames[] = {
+    {DataFormat::kAuto, "auto"},
+    {DataFormat::kCsv, "csv"},
+    {DataFormat::kMat, "mat"},
+    {DataFormat::kCsv, "txt"},
+    {DataFormat::kCsv, "tsv"},
+    {DataFormat::kCsv, "dat"},
+};
+}  // namespace
 
-DataFormat DataFormatFromString(const std::string& s) {
-  const std::string l = Lower(s);
-  if (l == "auto") return DataFormat::kAuto;
-  if (l == "csv" || l == "txt" || l == "tsv" || l == "dat") return DataFormat::kCsv;
-  if (l == "mat") return DataFormat::kMat;
-  PNEUMID_CHECK(false, "unknown data format '{}' (expected auto, csv or mat)", s);
-  return DataFormat::kAuto;
+std::string ToString(DataFormat v) { return std::string(EnumToString(kDataFormatNames, v)); }
+
+DataFormat DataFormatFromString(const std::string& name) {
+  return EnumFromString(kDataFormatNames, name, "data format", /*ignore_case=*/true);
 }
 
 DataFormat DataFormatFromPath(const std::string& path) {
@@ -90,6 +86,14 @@ MatReadOptions LoadOptions::ToMat() const {
 Dataset LoadDataset(const std::string& path, const LoadOptions& options) {
   std::string error;
   PNEUMID_CHECK(options.IsValid(&error), "LoadDataset: {}", error);
+  // A missing file is reported as such, before its extension is looked at.
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    throw DataError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+  }
+  if (S_ISDIR(st.st_mode)) {
+    throw DataError(fmt::format("{}: is a directory, not a data file", path));
+  }
   switch (Resolve(options.format, path)) {
     case DataFormat::kMat:
       return ReadMat(path, options.ToMat());

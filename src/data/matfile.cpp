@@ -14,7 +14,10 @@
 #include <matio.h>
 
 #include "column_spec.hpp"
+#include "mapped_file.hpp"
+#include "mat_scan.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 namespace pneumid {
 namespace {
@@ -148,6 +151,11 @@ class MatReader {
     if (S_ISDIR(st.st_mode)) throw DataError(fmt::format("{}: is a directory", path));
     if (st.st_size == 0) throw DataError(fmt::format("{}: empty file (not a MAT file)", path));
     file_size_ = static_cast<std::size_t>(st.st_size);
+    {
+      // Sizes claimed by the file are checked before matio trusts them.
+      const internal::MappedFile file(path);
+      internal::ScanMatV5(path, file.view());
+    }
     g_matio_message.clear();
     mat_.reset(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
     if (!mat_) {
@@ -330,13 +338,20 @@ class MatReader {
 
 }  // namespace
 
-std::string ToString(MatVersion v) { return v == MatVersion::kV5 ? "v5" : "v7.3"; }
+namespace {
+constexpr EnumName<MatVersion> kMatVersionNames[] = {
+    {MatVersion::kV5, "v5"},
+    {MatVersion::kV73, "v7.3"},
+    {MatVersion::kV5, "5"},
+    {MatVersion::kV73, "7.3"},
+    {MatVersion::kV73, "v73"},
+};
+}  // namespace
 
-MatVersion MatVersionFromString(const std::string& s) {
-  if (s == "v5" || s == "5") return MatVersion::kV5;
-  if (s == "v7.3" || s == "7.3" || s == "v73") return MatVersion::kV73;
-  PNEUMID_CHECK(false, "unknown MAT file version '{}' (expected v5 or v7.3)", s);
-  return MatVersion::kV5;
+std::string ToString(MatVersion v) { return std::string(EnumToString(kMatVersionNames, v)); }
+
+MatVersion MatVersionFromString(const std::string& name) {
+  return EnumFromString(kMatVersionNames, name, "MAT file version");
 }
 
 bool MatHasV73() {

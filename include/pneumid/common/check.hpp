@@ -7,8 +7,10 @@
 // the file, line and column.
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -26,6 +28,23 @@ class DataError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// User data quoted in an error message, bounded in length: `text` itself when
+/// it has at most `max_chars` bytes, otherwise its first `max_chars` bytes (cut
+/// at a character boundary) followed by "... (N bytes)". Control characters and
+/// bytes that are not valid UTF-8 are written as \xHH so that a binary file
+/// cannot garble the terminal. Use it wherever a cell, a line, a name or a value
+/// from a file or the command line is echoed into an exception.
+std::string Excerpt(std::string_view text, std::size_t max_chars = 40);
+
+/// Length in bytes of the valid UTF-8 sequence starting at text[i] (1 to 4), or
+/// 0 when the bytes there are not valid UTF-8 (overlong forms, surrogates and
+/// code points above U+10FFFF are invalid).
+std::size_t Utf8SequenceLength(std::string_view text, std::size_t i);
+
+/// True when `text` is valid UTF-8; otherwise *first_bad (if not null) is the
+/// offset of the first invalid byte.
+bool IsValidUtf8(std::string_view text, std::size_t* first_bad = nullptr);
 
 namespace internal {
 [[noreturn]] void ThrowInvalidArgument(const char* condition, const char* file, int line,

@@ -11,13 +11,17 @@
 // double quotes are stripped.
 //
 // Validation (each a pneumid::DataError whose message starts with "file:line:"
-// and names the column): empty file, header row without data rows, unknown
+// and names the column; quoted cells and names are cut to a short excerpt):
+// UTF-16/UTF-32 or binary file (byte order mark, NUL bytes), header row too long
+// or with too many columns (see the limits below), empty file, header row
+// without data rows, unknown
 // column name (the message lists the available ones), ragged row (cell count
 // differs from the header), missing (empty) cell, non-numeric cell, NaN or Inf,
 // time not strictly increasing. Non-uniform sampling is not an error here;
 // check it with Dataset::RequireUniform where a method needs it.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -26,6 +30,12 @@
 #include "pneumid/data/dataset.hpp"
 
 namespace pneumid {
+
+/// Limits that keep a malformed file from taking unbounded time or memory:
+/// a header row longer than kCsvMaxHeaderBytes or with more than kCsvMaxColumns
+/// columns is rejected with a DataError.
+inline constexpr std::size_t kCsvMaxHeaderBytes = 1 << 20;
+inline constexpr std::size_t kCsvMaxColumns = 10000;
 
 struct CsvReadOptions {
   /// Cell delimiter; '\0' detects it from the header row among ',' ';' '\t'

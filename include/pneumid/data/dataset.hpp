@@ -71,6 +71,20 @@ class Dataset {
   /// `what` names the method that needs them.
   void RequireSamples(Eigen::Index n, const std::string& what) const;
 
+  /// Largest magnitude and smallest nonzero spread (max - min) of a column that
+  /// RequireNumericScale accepts. Beyond 1e150 the squares and products formed
+  /// by least squares overflow the double range (about 1.8e308) and differences
+  /// of values near 1e308 are infinite; below 1e-150 they underflow to zero, so
+  /// a step of that size is indistinguishable from no step.
+  static constexpr double kMaxMagnitude = 1e150;
+  static constexpr double kMinSpread = 1e-150;
+  /// Throws DataError naming the source, the column and its value range when a
+  /// column (time, inputs, outputs) holds a value of magnitude above
+  /// kMaxMagnitude (overflow risk) or varies by less than kMinSpread without
+  /// being constant (extreme scale): rescale the column, e.g. change its
+  /// unit. Identification calls it before it uses the data.
+  void RequireNumericScale() const;
+
   /// Line (1-based) of `source()` that holds sample `i`, or 0 when unknown (the
   /// dataset was not read from a text file, or was derived from one by
   /// resampling, filtering, ...). Throws InvalidArgument when i is out of range.

@@ -1,0 +1,245 @@
+#include "mat_scan.hpp"
+
+#include <zlib.h>
+
+#include <cstdint>
+#include <cstring>
+
+#include <fmt/format.h>
+
+#include "pneumid/common/check.hpp"
+
+namespace pneumid::internal {
+namespace {
+
+// MAT v5 data types and array classes used below (MAT-File Format, tables 1-1, 1-3).
+constexpr std::uint32_t kMiInt8 = 1;
+constexpr std::uint32_t kMiInt32 = 5;
+constexpr std::uint32_t kMiUint32 = 6;
+constexpr std::uint32_t kMiMatrix = 14;
+constexpr std::uint32_t kMiCompressed = 15;
+constexpr std::uint32_t kClassCell = 1;
+constexpr std::uint32_t kClassStruct = 2;
+constexpr std::uint32_t kClassObject = 3;
+constexpr std::uint32_t kClassSparse = 5;
+constexpr std::uint32_t kClassFunction = 16;
+constexpr std::uint32_t kClassOpaque = 17;
+constexpr int kMaxDepth = 32;
+// zlib cannot expand data by more than about 1032:1.
+constexpr double kMaxInflateRatio = 1100.0;
+// Bytes of a compressed variable inflated to check its header.
+constexpr std::size_t kInflatePrefix = 64 * 1024;
+
+/// One data element: its type, the size its tag claims, and its data.
+struct Element {
+  std::uint32_t type = 0;
+  std::uint64_t nbytes = 0;       ///< as claimed by the tag
+  std::string_view data;          ///< the claimed bytes that are present
+  std::size_t size_on_disk = 0;   ///< tag + data + padding to 8 bytes
+};
+
+class Scanner {
+ public:
+  Scanner(const std::string& path, bool swap) : path_(path), swap_(swap) {}
+
+  void ScanFile(std::string_view bytes) {
+    std::size_t offset = 128;
+    for (int index = 1; offset < bytes.size(); ++index) {
+      index_ = index;
+      name_.clear();
+      const std::string_view rest = bytes.substr(offset);
+      if (rest.size() < 8) {
+        Fail(fmt::format("the file ends inside the tag of variable {} ({} bytes left at offset "
+                         "{}): the file is truncated",
+                         index, rest.size(), offset));
+      }
+      const Element e = ReadTag(rest);
+      if (e.type == kMiCompressed) {
+        CheckCompressed(e, offset, bytes.size());
+      } else if (e.type == kMiMatrix) {
+        if (e.nbytes > rest.size() - 8) {
+          PeekName(e.data);
+          Truncated(e, offset, bytes.size());
+        }
+        CheckMatrix(e.data, e.nbytes, /*partial=*/false, 0);
+      } else if (e.nbytes > rest.size() - 8) {
+        Truncated(e, offset, bytes.size());
+      }
+      offset += e.type == kMiCompressed ? 8 + static_cast<std::size_t>(e.nbytes)
+                                         : std::min<std::size_t>(e.size_on_disk, rest.size());
+    }
+  }
+
+ private:
+  std::uint32_t U32(std::string_view s, std::size_t at) const {
+    std::uint32_t v = 0;
+    std::memcpy(&v, s.data() + at, 4);
+    return swap_ ? __builtin_bswap32(v) : v;
+  }
+
+  /// The element at the start of `s` (at least 8 bytes); data is cut to what
+  /// `s` holds.
+  Element ReadTag(std::string_view s) const {
+    Element e;
+    const std::uint32_t w0 = U32(s, 0);
+    if ((w0 >> 16) != 0) {  // small data element: 2-byte size, data in the tag
+      e.type = w0 & 0xFFFF;
+      e.nbytes = w0 >> 16;
+      e.data = s.substr(4, std::min<std::uint64_t>(e.nbytes, 4));
+      e.size_on_disk = 8;
+      return e;
+    }
+    e.type = w0;
+    e.nbytes = U32(s, 4);
+    e.data = s.substr(8, std::min<std::uint64_t>(e.nbytes, s.size() - 8));
+    e.size_on_disk = 8 + static_cast<std::size_t>((e.nbytes + 7) / 8 * 8);
+    return e;
+  }
+
+  [[noreturn]] void Fail(const std::string& what) const {
+    throw DataError(fmt::format("{}: {}", path_, what));
+  }
+
+  std::string Variable() const {
+    return name_.empty() ? fmt::format("variable {}", index_)
+                         : fmt::format("variable {} ('{}')", index_, name_);
+  }
+
+  [[noreturn]] void Truncated(const Element& e, std::size_t offset, std::size_t file_size) const {
+    Fail(fmt::format("{} needs {} bytes from offset {} but the file ends at byte {}: the file "
+                     "is truncated (or not a MAT file)",
+                     Variable(), 8 + e.nbytes, offset, file_size));
+  }
+
+  /// Sets name_ from the name subelement of matrix data, when it is there.
+  void PeekName(std::string_view matrix) {
+    std::size_t at = 0;
+    for (int k = 0; k < 3 && matrix.size() - at >= 8; ++k) {
+      const Element e = ReadTag(matrix.substr(at));
+      if (k == 2 && e.type == kMiInt8) name_ = Excerpt(e.data);
+      at += e.size_on_disk;
+      if (at > matrix.size()) return;
+    }
+  }
+
+  void CheckCompressed(const Element& e, std::size_t offset, std::size_t file_size) {
+    const bool truncated = e.nbytes > file_size - offset - 8;
+    std::string head(kInflatePrefix, '\0');
+    z_stream z{};
+    if (inflateInit(&z) != Z_OK) Fail("cannot initialise zlib");
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(e.data.data()));
+    z.avail_in = static_cast<uInt>(e.data.size());
+    z.next_out = reinterpret_cast<Bytef*>(head.data());
+    z.avail_out = static_cast<uInt>(head.size());
+    const int rc = inflate(&z, Z_SYNC_FLUSH);
+    const std::string zlib_message = z.msg == nullptr ? "" : z.msg;
+    head.resize(head.size() - z.avail_out);
+    inflateEnd(&z);
+    if (head.size() >= 8) PeekName(ReadTag(head).data);
+    if (truncated) Truncated(e, offset, file_size);
+    if (rc != Z_OK && rc != Z_STREAM_END && rc != Z_BUF_ERROR) {
+      Fail(fmt::format("{}: the compressed data is corrupt (zlib: {})", Variable(),
+                       zlib_message.empty() ? fmt::format("error {}", rc) : zlib_message));
+    }
+    if (head.size() < 8) return;  // matio reports what is missing
+    const Element inner = ReadTag(head);
+    if (inner.type != kMiMatrix) return;
+    const double limit = kMaxInflateRatio * static_cast<double>(e.nbytes) + 1024.0;
+    if (static_cast<double>(inner.nbytes) > limit) {
+      Fail(fmt::format("{} claims {} bytes after decompression, more than its {} compressed "
+                       "bytes can hold: the file is corrupt",
+                       Variable(), inner.nbytes, e.nbytes));
+    }
+    CheckMatrix(inner.data, inner.nbytes, /*partial=*/true, 0);
+  }
+
+  /// Checks an miMATRIX element whose data claims `nbytes`; `data` holds the
+  /// claimed bytes, or (partial) only their start.
+  void CheckMatrix(std::string_view data, std::uint64_t nbytes, bool partial, int depth) {
+    if (nbytes == 0) return;  // an empty array
+    if (depth > kMaxDepth) {
+      Fail(fmt::format("{}: arrays nested more than {} deep: the file is corrupt", Variable(),
+                       kMaxDepth));
+    }
+    std::size_t at = 0;
+    std::uint32_t cls = 0;
+    double elements = 1.0;
+    std::string dims;
+    std::uint64_t field_name_length = 0;
+    double fields = 1.0;
+    for (int k = 0; at < data.size(); ++k) {
+      if (data.size() - at < 8) {
+        if (partial) return;
+        Fail(fmt::format("{}: an element tag is cut off by the end of the array: the file is "
+                         "corrupt",
+                         Variable()));
+      }
+      const Element e = ReadTag(data.substr(at));
+      if (e.data.size() < e.nbytes) {
+        if (partial && data.size() < nbytes) return;
+        Fail(fmt::format("{}: an element claims {} bytes, more than the {} bytes left in its "
+                         "array: the file is corrupt",
+                         Variable(), e.nbytes, data.size() - at - 8));
+      }
+      if (k == 0 && e.type == kMiUint32 && e.nbytes >= 4) {
+        cls = U32(e.data, 0) & 0xFF;
+      } else if (k == 1 && e.type == kMiInt32) {
+        for (std::size_t d = 0; d + 4 <= e.data.size(); d += 4) {
+          const auto n = static_cast<std::int32_t>(U32(e.data, d));
+          if (n < 0) Fail(fmt::format("{}: negative dimension {}: the file is corrupt", Variable(), n));
+          elements *= static_cast<double>(n);
+          dims += (d == 0 ? "" : "x") + std::to_string(n);
+        }
+      } else if (k == 2 && e.type == kMiInt8 && depth == 0) {
+        name_ = Excerpt(e.data);
+      } else if (k == 3 && cls == kClassStruct && e.type == kMiInt32 && e.nbytes >= 4) {
+        field_name_length = U32(e.data, 0);
+      } else if (k == 4 && cls == kClassStruct && e.type == kMiInt8) {
+        fields = field_name_length == 0 ? 0.0
+                                        : static_cast<double>(e.nbytes / field_name_length);
+      }
+      if ((k == 2 && cls != kClassStruct) || (k == 4 && cls == kClassStruct)) {
+        CheckElementCount(cls, elements * fields, dims, nbytes);
+      }
+      if (k >= 3 && e.type == kMiMatrix) CheckMatrix(e.data, e.nbytes, partial, depth + 1);
+      at += e.size_on_disk;
+    }
+  }
+
+  /// Every element of an array takes at least one byte (numeric, char,
+  /// logical) or one 8-byte tag (cell, struct field).
+  void CheckElementCount(std::uint32_t cls, double elements, const std::string& dims,
+                         std::uint64_t nbytes) const {
+    if (cls == kClassSparse || cls == kClassObject || cls == kClassFunction ||
+        cls == kClassOpaque) {
+      return;  // sizes not tied to the dimensions
+    }
+    const double min_bytes = (cls == kClassCell || cls == kClassStruct ? 8.0 : 1.0) * elements;
+    if (min_bytes > static_cast<double>(nbytes)) {
+      Fail(fmt::format("{} claims dimensions {} ({} elements) but holds only {} bytes: the file "
+                       "is corrupt",
+                       Variable(), dims, elements, nbytes));
+    }
+  }
+
+  const std::string& path_;
+  bool swap_;
+  int index_ = 0;
+  std::string name_;
+};
+
+}  // namespace
+
+void ScanMatV5(const std::string& path, std::string_view bytes) {
+  if (bytes.size() < 128) return;
+  const std::string_view endian = bytes.substr(126, 2);
+  if (endian != "IM" && endian != "MI") return;  // not v5 (v4)
+  const bool swap = endian == "MI";
+  std::uint16_t version = 0;
+  std::memcpy(&version, bytes.data() + 124, 2);
+  if (swap) version = __builtin_bswap16(version);
+  if (version != 0x0100) return;  // v7.3 (HDF5) or unknown: matio decides
+  Scanner(path, swap).ScanFile(bytes);
+}
+
+}  // namespace pneumid::internal

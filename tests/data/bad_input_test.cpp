@@ -1,0 +1,292 @@
+// Malformed and hostile input files: each is rejected quickly, with a message
+// that says what is wrong and quotes user data only as a short excerpt.
+#include <zlib.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/data/csv.hpp"
+#include "pneumid/data/load.hpp"
+#include "pneumid/data/matfile.hpp"
+#include "test_files.hpp"
+
+namespace pneumid {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::ThrowsMessage;
+
+std::string Message(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no exception";
+  return "";
+}
+
+// --- MAT v5 files assembled byte by byte (MAT-File Format, level 5) ---------
+
+void PutU32(std::string* s, std::uint32_t v) { s->append(reinterpret_cast<const char*>(&v), 4); }
+
+std::string Pad8(std::string s) {
+  s.resize((s.size() + 7) / 8 * 8, '\0');
+  return s;
+}
+
+std::string Element(std::uint32_t type, const std::string& data) {
+  std::string e;
+  PutU32(&e, type);
+  PutU32(&e, static_cast<std::uint32_t>(data.size()));
+  return e + Pad8(data);
+}
+
+/// An miMATRIX element of class double with the given dimensions (as claimed)
+/// and data.
+std::string DoubleMatrix(const std::string& name, std::uint32_t rows, std::uint32_t cols,
+                         const std::vector<double>& values) {
+  std::string flags, dims, data;
+  PutU32(&flags, 6);  // mxDOUBLE_CLASS
+  PutU32(&flags, 0);
+  PutU32(&dims, rows);
+  PutU32(&dims, cols);
+  data.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+  return Element(14, Element(6, flags) + Element(5, dims) + Element(1, name) + Element(9, data));
+}
+
+std::string MatHeader() {
+  std::string h(116, ' ');
+  std::memcpy(h.data(), "MATLAB 5.0 MAT-file, written by pneumid tests", 45);
+  h.append(8, '\0');
+  h.push_back('\x00');
+  h.push_back('\x01');  // version 0x0100, little endian
+  h += "IM";
+  return h;
+}
+
+std::string Compress(const std::string& element) {
+  uLongf size = compressBound(element.size());
+  std::string out(size, '\0');
+  compress(reinterpret_cast<Bytef*>(out.data()), &size,
+           reinterpret_cast<const Bytef*>(element.data()), element.size());
+  out.resize(size);
+  std::string e;
+  PutU32(&e, 15);
+  PutU32(&e, static_cast<std::uint32_t>(out.size()));
+  return e + out;
+}
+
+class BadInputTest : public ::testing::Test {
+ protected:
+  std::string Write(const std::string& name, const std::string& content) {
+    return dir_.Write(name, content);
+  }
+  testing::TempDir dir_;
+};
+
+TEST(ExcerptTest, CapsLongTextAndEscapesControlBytes) {
+  EXPECT_EQ(Excerpt("abc"), "abc");
+  EXPECT_EQ(Excerpt(std::string(100, 'x'), 10), "xxxxxxxxxx... (100 bytes)");
+  EXPECT_EQ(Excerpt(std::string("a\0b\x1b", 4)), "a\\x00b\\x1B");
+  EXPECT_EQ(Excerpt("\xFF\xFEz"), "\\xFF\\xFEz");
+  // Valid UTF-8 is kept, and never cut inside a character.
+  EXPECT_EQ(Excerpt("T [\xC2\xB0" "C]"), "T [\xC2\xB0" "C]");
+  EXPECT_EQ(Excerpt("ab\xC2\xB0", 3), "ab... (4 bytes)");
+  std::size_t bad = 0;
+  EXPECT_TRUE(IsValidUtf8("F [N] \xE2\x82\xAC"));
+  EXPECT_FALSE(IsValidUtf8("ok\xC0\xAF", &bad));
+  EXPECT_EQ(bad, 2u);
+  EXPECT_FALSE(IsValidUtf8("\xED\xA0\x80"));  // surrogate
+}
+
+TEST_F(BadInputTest, HugeCellIsQuotedAsAnExcerpt) {
+  const std::string cell(10 << 20, 'z');
+  const std::string path = Write("big.csv", "t,u,y\n0,1," + cell + "\n");
+  const std::string m = Message([&] { ReadCsv(path); });
+  EXPECT_THAT(m, AllOf(HasSubstr(path + ":2: column 'y': not a number: 'zzzz"),
+                       HasSubstr(fmt::format("... ({} bytes)", cell.size()))));
+  EXPECT_LT(m.size(), 300u);
+}
+
+TEST_F(BadInputTest, HugeColumnNameIsQuotedAsAnExcerpt) {
+  const std::string name(1 << 16, 'n');
+  const std::string path = Write("name.csv", "t,u," + name + "\n0,1,x\n");
+  CsvReadOptions o;
+  o.output_columns = {"2"};
+  const std::string m = Message([&] { ReadCsv(path, o); });
+  EXPECT_THAT(m, HasSubstr("... (65536 bytes)': not a number: 'x'"));
+  EXPECT_LT(m.size(), 300u);
+}
+
+TEST_F(BadInputTest, Utf16FileIsReportedAsSuch) {
+  std::string text = "\xFF\xFE";
+  for (char c : std::string("t,u,y\n0,1,2\n")) {
+    text.push_back(c);
+    text.push_back('\0');
+  }
+  const std::string path = Write("utf16.csv", text);
+  EXPECT_THAT([&] { ReadCsv(path); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr(path + ":1: the file is UTF-16LE text"),
+                                             HasSubstr("save it as UTF-8"))));
+  // Without a byte order mark, the NUL bytes give it away.
+  const std::string no_bom = Write("utf16-nobom.csv", text.substr(2));
+  EXPECT_THAT([&] { ReadCsv(no_bom); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr(no_bom + ":1: NUL byte at offset 1"),
+                                             HasSubstr("binary file"))));
+}
+
+TEST_F(BadInputTest, BinaryFileIsReportedAsBinary) {
+  const std::string path = Write("data.csv", std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10));
+  EXPECT_THAT([&] { ReadCsv(path); },
+              ThrowsMessage<DataError>(HasSubstr("NUL byte at offset 7: this is a binary file")));
+}
+
+TEST_F(BadInputTest, HeaderThatIsNotUtf8IsNamedWhenAColumnIsMissing) {
+  // Latin-1 "Temperatur [\xB0C]": readable as long as the columns resolve.
+  const std::string ok = Write("latin1.csv", "t,u,y [\xB0" "C]\n0,1,2\n1,1,3\n");
+  EXPECT_EQ(ReadCsv(ok).size(), 2);
+  const std::string path = Write("mojibake.csv", "\x8F\x90,\x91\n0,1\n");
+  EXPECT_THAT([&] { ReadCsv(path); },
+              ThrowsMessage<DataError>(AllOf(
+                  HasSubstr("unknown time column 't'; available columns: '\\x8F\\x90'"),
+                  HasSubstr("the header row is not valid UTF-8 text: byte 0x8F at offset 0"))));
+}
+
+TEST_F(BadInputTest, HeaderlessLongLineIsBoundedInTimeAndMessage) {
+  std::string line;
+  for (int i = 0; i < 300000; ++i) line += "1.5,";
+  line += "2\n";
+  const std::string path = Write("numbers.csv", line);
+  const auto start = std::chrono::steady_clock::now();
+  const std::string m = Message([&] { ReadCsv(path); });
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+  EXPECT_THAT(m, AllOf(HasSubstr(path + ":1: header row is 1200001 bytes long (at most 1048576)"),
+                       HasSubstr("needs a first row of column names")));
+  // Below the byte limit but above the column limit.
+  line.resize(4 * 20000);
+  line.back() = '\n';
+  const std::string wide = Write("wide.csv", line);
+  EXPECT_THAT([&] { ReadCsv(wide); },
+              ThrowsMessage<DataError>(AllOf(
+                  HasSubstr("header row has 20000 columns (delimiter ','), more than the 10000"),
+                  HasSubstr("it holds numbers: is the header row missing?"))));
+}
+
+TEST_F(BadInputTest, ListOfAvailableColumnsIsCapped) {
+  std::string header = "t";
+  std::string row = "0";
+  for (int i = 0; i < 500; ++i) {
+    header += fmt::format(",c{}", i);
+    row += ",1";
+  }
+  const std::string path = Write("many.csv", header + "\n" + row + "\n");
+  const std::string m = Message([&] { ReadCsv(path); });
+  EXPECT_THAT(m, AllOf(HasSubstr("unknown input column 'u'; available columns: 't', 'c0'"),
+                       HasSubstr("'c18', ... (501 columns in all)"), Not(HasSubstr("c19"))));
+}
+
+TEST_F(BadInputTest, NumericFirstRowHintsAtAMissingHeader) {
+  const std::string path = Write("noheader.csv", "0,1,2\n1,1,3\n");
+  EXPECT_THAT([&] { ReadCsv(path); },
+              ThrowsMessage<DataError>(
+                  HasSubstr("(the first row holds numbers: is the header row missing?)")));
+}
+
+TEST_F(BadInputTest, MissingFileIsReportedBeforeTheExtension) {
+  EXPECT_THAT([&] { LoadDataset("/nonexistent"); },
+              ThrowsMessage<DataError>(HasSubstr("/nonexistent: cannot open: No such file")));
+  EXPECT_THAT([&] { LoadDataset(dir_.Path("")); },
+              ThrowsMessage<DataError>(HasSubstr("is a directory, not a data file")));
+}
+
+TEST_F(BadInputTest, HandBuiltMatFileReads) {
+  // The builder itself is right: a well-formed file reads back.
+  const std::string path =
+      Write("ok.mat", MatHeader() + DoubleMatrix("t", 3, 1, {0, 1, 2}) +
+                          Compress(DoubleMatrix("u", 3, 1, {1, 1, 1})) +
+                          DoubleMatrix("y", 1, 3, {0, 2, 3}));
+  const Dataset d = ReadMat(path);
+  EXPECT_EQ(d.size(), 3);
+  EXPECT_DOUBLE_EQ(d.y()[2], 3.0);
+}
+
+TEST_F(BadInputTest, TruncatedMatFileIsReportedAsTruncated) {
+  const std::string full = MatHeader() + DoubleMatrix("t", 4, 1, {0, 1, 2, 3}) +
+                           DoubleMatrix("u", 4, 1, {0, 1, 1, 1}) +
+                           DoubleMatrix("y", 4, 1, {0, 1, 2, 3});
+  const std::string path = Write("cut.mat", full.substr(0, full.size() - 20));
+  EXPECT_THAT([&] { ReadMat(path); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("variable 3 ('y') needs"),
+                                             HasSubstr("the file is truncated"))));
+  // Cut inside a compressed variable.
+  const std::string zfull = MatHeader() + DoubleMatrix("t", 4, 1, {0, 1, 2, 3}) +
+                            Compress(DoubleMatrix("u", 4, 1, {0, 1, 1, 1}));
+  const std::string zpath = Write("zcut.mat", zfull.substr(0, zfull.size() - 5));
+  EXPECT_THAT([&] { ReadMat(zpath); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("variable 2 ('u') needs"),
+                                             HasSubstr("the file is truncated"))));
+  // Cut inside the tag of the next variable.
+  const std::string tpath = Write("tagcut.mat", full.substr(0, 128 + 96 + 4));
+  EXPECT_THAT([&] { ReadMat(tpath); },
+              ThrowsMessage<DataError>(HasSubstr("ends inside the tag of variable 2")));
+}
+
+TEST_F(BadInputTest, MatVariableClaimingHugeDimensionsIsRejectedQuickly) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string path =
+      Write("huge.mat", MatHeader() + DoubleMatrix("t", 0x7FFFFFFF, 0x7FFFFFFF, {0, 1}));
+  EXPECT_THAT([&] { ReadMat(path); },
+              ThrowsMessage<DataError>(AllOf(
+                  HasSubstr("variable 1 ('t') claims dimensions 2147483647x2147483647"),
+                  HasSubstr("the file is corrupt"))));
+  // The same inside a compressed variable, and a cell of 2^31 elements.
+  std::string flags, dims;
+  PutU32(&flags, 1);  // mxCELL_CLASS
+  PutU32(&flags, 0);
+  PutU32(&dims, 0x7FFFFFFF);
+  PutU32(&dims, 1);
+  const std::string cell = Element(14, Element(6, flags) + Element(5, dims) + Element(1, "c"));
+  const std::string zpath = Write("zhuge.mat", MatHeader() + Compress(cell));
+  EXPECT_THAT([&] { ReadMat(zpath); },
+              ThrowsMessage<DataError>(HasSubstr("variable 1 ('c') claims dimensions")));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+}
+
+TEST_F(BadInputTest, ExtremeValuesAreNamedWithTheColumnAndRange) {
+  Eigen::VectorXd t(4), u(4), y(4);
+  t << 0, 1, 2, 3;
+  u << 0, 1, 1, 1;
+  y << 0, 1e308, -1e308, 1e308;
+  Dataset big(t, u, y, {{"p", "bar"}}, {{"F", "N"}});
+  big.set_source("big.csv");
+  EXPECT_THAT([&] { big.RequireNumericScale(); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("big.csv: output column 'F'"),
+                                             HasSubstr("values range from -1e+308 to 1e+308"),
+                                             HasSubstr("overflow"))));
+  y << 0, 1e-300, 2e-300, 2e-300;
+  const Dataset tiny(t, u, y);
+  EXPECT_THAT([&] { tiny.RequireNumericScale(); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("dataset: output column 'y'"),
+                                             HasSubstr("a spread of 2e-300"),
+                                             HasSubstr("extreme scale"))));
+  y << 0, 1, 2, 2;
+  EXPECT_NO_THROW(Dataset(t, u, y).RequireNumericScale());
+  // Constant columns (no step) are left to the methods to diagnose.
+  y.setConstant(1e-300);
+  EXPECT_NO_THROW(Dataset(t, u, y).RequireNumericScale());
+}
+
+}  // namespace
+}  // namespace pneumid
