@@ -6,6 +6,7 @@
 #include <random>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/response.hpp"
@@ -16,7 +17,43 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool Changed(double a, double b) { return std::abs(a - b) > 1e-12 * (1.0 + std::abs(a)); }
+
+// A metric that does not exist in the run (NaN) is null.
+nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 }  // namespace
+
+nlohmann::ordered_json StepMetrics::ToJson() const {
+  nlohmann::ordered_json j;
+  j["time"] = time;
+  j["from"] = from;
+  j["to"] = to;
+  j["rise_time"] = Number(rise_time);
+  j["overshoot_percent"] = Number(overshoot_percent);
+  j["settling_time"] = Number(settling_time);
+  j["steady_state_error"] = Number(steady_state_error);
+  j["first_move"] = Number(first_move);
+  return j;
+}
+
+nlohmann::ordered_json ClosedLoopMetrics::ToJson() const {
+  nlohmann::ordered_json j;
+  j["rise_time"] = Number(rise_time);
+  j["overshoot_percent"] = Number(overshoot_percent);
+  j["settling_time"] = Number(settling_time);
+  j["steady_state_error"] = Number(steady_state_error);
+  j["first_move"] = Number(first_move);
+  j["iae"] = Number(iae);
+  j["ise"] = Number(ise);
+  j["itae"] = Number(itae);
+  j["tv_u"] = Number(tv_u);
+  j["u_min"] = Number(u_min);
+  j["u_max"] = Number(u_max);
+  j["load_peak_deviation"] = Number(load_peak_deviation);
+  j["load_recovery_time"] = Number(load_recovery_time);
+  j["steps"] = nlohmann::ordered_json::array();
+  for (const StepMetrics& s : steps) j["steps"].push_back(s.ToJson());
+  return j;
+}
 
 bool ClosedLoopOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& message) {
@@ -159,6 +196,7 @@ ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const 
   const double Ts = controller.Ts();
   PNEUMID_CHECK(std::abs(plant.Ts() - Ts) <= 1e-9 * Ts,
                 "the plant samples at Ts = {} s but the controller at Ts = {} s", plant.Ts(), Ts);
+  setpoint.CheckSampleTime(Ts);
   const Eigen::Index n = std::max<Eigen::Index>(2, std::llround(options.duration / Ts));
   ClosedLoopResult res;
   res.t = Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1) * Ts);

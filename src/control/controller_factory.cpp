@@ -1,20 +1,97 @@
 #include "pneumid/control/controller_factory.hpp"
 
+#include <cmath>
 #include <sstream>
 #include <vector>
 
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/spec.hpp"
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/gpc.hpp"
 
 namespace pneumid {
 
+TuningRule InferTuningRule(const std::string& rule, int P, int M, double lambda) {
+  if (!rule.empty()) return TuningRuleFromString(rule);
+  return P > 0 && M > 0 && std::isfinite(lambda) ? TuningRule::kExplicit
+                                                 : TuningRule::kShridharCooper;
+}
+
+ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
+  ControllerSpec spec;
+  spec.type = ControllerTypeFromString(settings.controller);
+  spec.tuning.rule = InferTuningRule(settings.rule, settings.P, settings.M, settings.lambda);
+  spec.tuning.P = settings.P;
+  spec.tuning.M = settings.M;
+  spec.tuning.lambda = settings.lambda;
+  spec.limits = settings.limits;
+  spec.constrained = settings.constrained;
+  spec.y_min = settings.y_min;
+  spec.y_max = settings.y_max;
+  spec.t_filter = settings.t_filter;
+  spec.pid_rule = PidTuningRuleFromString(settings.pid_rule);
+  spec.tau_c = settings.tau_c;
+  return spec;
+}
+
+std::string BuiltController::Label() const {
+  return type == ControllerType::kPid ? "pid" : ToString(tuning.rule);
+}
+
+std::string BuiltController::Summary() const {
+  if (type == ControllerType::kPid)
+    return fmt::format("pid {} from FOPDT K={:g} tau={:g} theta={:g} ({}): Kc={:g} Ti={:g} Td={:g}",
+                       ToString(pid_rule), fopdt.K, fopdt.tau, fopdt.theta, fopdt.method,
+                       pid_gains.Kc, pid_gains.Ti, pid_gains.Td);
+  return fmt::format("{}: P={} M={} lambda={:g}; {}", ToString(tuning.rule), tuning.P, tuning.M,
+                     tuning.lambda, tuning.formula);
+}
+
+nlohmann::ordered_json BuiltController::SettingsToJson() const {
+  nlohmann::ordered_json j;
+  if (type == ControllerType::kPid) {
+    j["Kc"] = pid_gains.Kc;
+    j["Ti"] = std::isfinite(pid_gains.Ti) ? nlohmann::json(pid_gains.Ti) : nlohmann::json();
+    j["Td"] = pid_gains.Td;
+    j["rule"] = ToString(pid_rule);
+  } else {
+    j["rule"] = ToString(tuning.rule);
+    j["P"] = tuning.P;
+    j["M"] = tuning.M;
+    j["lambda"] = tuning.lambda;
+    j["formula"] = tuning.formula;
+  }
+  return j;
+}
+
 BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec) {
+  // A PID is tuned from the continuous FOPDT description; it needs no sampled model.
+  if (spec.type == ControllerType::kPid) {
+    BuiltController b;
+    b.type = spec.type;
+    b.pid_rule = spec.pid_rule;
+    b.fopdt = FopdtFromModel(model);
+    b.pid_gains = TunePid(b.fopdt.K, b.fopdt.tau, b.fopdt.theta, Ts, spec.pid_rule, spec.tau_c);
+    PidOptions o;
+    o.gains = b.pid_gains;
+    o.limits = spec.limits;
+    b.controller = std::make_unique<PidController>(Ts, o);
+    return b;
+  }
+  return MakeController(PredictionModel(model, Ts), spec);
+}
+
+BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec) {
   BuiltController b;
+  b.type = spec.type;
+  b.pid_rule = spec.pid_rule;
   switch (spec.type) {
     case ControllerType::kDmc: {
-      b.tuning = Tune(model, Ts, spec.tuning);
+      b.tuning = Tune(model, spec.tuning);
       DmcOptions o;
       o.P = b.tuning.P;
       o.M = b.tuning.M;
@@ -23,13 +100,13 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
       o.constrained = spec.constrained;
       o.y_min = spec.y_min;
       o.y_max = spec.y_max;
-      b.controller = std::make_unique<DmcController>(model, Ts, o);
+      b.controller = std::make_unique<DmcController>(model, o);
       break;
     }
     case ControllerType::kGpc: {
       PNEUMID_CHECK(!spec.constrained,
                     "the constrained form is implemented for dmc (QDMC); gpc clips its input");
-      b.tuning = Tune(model, Ts, spec.tuning);
+      b.tuning = Tune(model, spec.tuning);
       GpcOptions o;
       o.N1 = 1;
       o.N2 = b.tuning.P;
@@ -39,30 +116,15 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
       if (spec.t_filter == "A" || spec.t_filter == "a") {
         o.t_equals_a = true;
       } else if (spec.t_filter != "1" && !spec.t_filter.empty()) {
-        std::string text = spec.t_filter;
-        for (char& c : text)
-          if (c == ',' || c == ';') c = ' ';
-        std::istringstream in(text);
-        std::vector<double> coef;
-        double v;
-        while (in >> v) coef.push_back(v);
-        PNEUMID_CHECK(in.eof() && !coef.empty(),
-                      "T filter '{}': expected '1', 'A' or coefficients like '1 -0.8'",
-                      spec.t_filter);
-        o.t_polynomial = Eigen::Map<Eigen::VectorXd>(coef.data(), coef.size());
+        // '1', 'A' or coefficients such as '1 -0.8'.
+        const std::vector<double> coef = ParseNumberList("T filter", spec.t_filter);
+        o.t_polynomial = Eigen::Map<const Eigen::VectorXd>(coef.data(), coef.size());
       }
-      b.controller = std::make_unique<GpcController>(model, Ts, o);
+      b.controller = std::make_unique<GpcController>(model, o);
       break;
     }
-    case ControllerType::kPid: {
-      b.fopdt = FopdtFromModel(model);
-      b.pid_gains = TunePid(b.fopdt.K, b.fopdt.tau, b.fopdt.theta, Ts, spec.pid_rule, spec.tau_c);
-      PidOptions o;
-      o.gains = b.pid_gains;
-      o.limits = spec.limits;
-      b.controller = std::make_unique<PidController>(Ts, o);
-      break;
-    }
+    case ControllerType::kPid:
+      return MakeController(model.model(), model.Ts(), spec);
   }
   return b;
 }

@@ -8,68 +8,8 @@
 #include <Eigen/Dense>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/lti/conversion.hpp"
 
 namespace pneumid {
-
-TransferFunction SampledModel(const TransferFunction& model, double Ts) {
-  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
-  if (model.IsContinuous()) return C2D(model, Ts, DiscretizationMethod::kZoh);
-  PNEUMID_CHECK(std::abs(model.Ts() - Ts) <= 1e-9 * Ts,
-                "the discrete model has Ts = {} s but the controller runs at Ts = {} s", model.Ts(),
-                Ts);
-  return model;
-}
-
-Eigen::VectorXd StepResponseCoefficients(const TransferFunction& model, double Ts, int n) {
-  PNEUMID_CHECK(n >= 1, "need at least one step coefficient, got n = {}", n);
-  const TransferFunction g = SampledModel(model, Ts);
-  const Eigen::VectorXd& b = g.num();
-  const Eigen::VectorXd& a = g.den();
-  const int d = g.DelaySamples();
-  PNEUMID_CHECK(a.size() > 0 && a(0) != 0.0,
-                "the discrete model needs a nonzero leading denominator coefficient a0");
-  // a0 y[k] = sum_i b_i u[k-d-i] - sum_{i>=1} a_i y[k-i], u[k] = 1 for k >= 0.
-  Eigen::VectorXd s = Eigen::VectorXd::Zero(n + 1);
-  for (int k = 0; k <= n; ++k) {
-    double acc = 0.0;
-    for (int i = 0; i < b.size(); ++i) acc += (k - d - i >= 0) ? b(i) : 0.0;
-    for (int i = 1; i < a.size() && i <= k; ++i) acc -= a(i) * s(k - i);
-    s(k) = acc / a(0);
-  }
-  return s;
-}
-
-int SettlingModelHorizon(const TransferFunction& model, double Ts, double tol, int max_n) {
-  PNEUMID_CHECK(tol > 0.0, "tolerance must be positive, got {}", tol);
-  PNEUMID_CHECK(max_n >= 1, "max_n must be >= 1, got {}", max_n);
-  const TransferFunction g = SampledModel(model, Ts);
-  PNEUMID_CHECK(g.IsStable(),
-                "DMC needs a stable model (a finite step response); the model {} is not stable",
-                model.ToString());
-  const double s_inf = g.DcGain();
-  PNEUMID_CHECK(std::isfinite(s_inf) && s_inf != 0.0,
-                "DMC needs a finite, nonzero static gain; got {}", s_inf);
-  const Eigen::VectorXd s = StepResponseCoefficients(g, Ts, max_n);
-  int last_out = -1;
-  for (int i = 0; i <= max_n; ++i) {
-    if (std::abs(s(i) - s_inf) > tol * std::abs(s_inf)) last_out = i;
-  }
-  return std::min(max_n, last_out + 1);
-}
-
-Eigen::MatrixXd DynamicMatrix(const Eigen::VectorXd& step, int P, int M) {
-  PNEUMID_CHECK(P >= 1 && M >= 1 && M <= P, "need 1 <= M <= P, got P = {}, M = {}", P, M);
-  PNEUMID_CHECK(step.size() >= 1, "the step response is empty");
-  const Eigen::Index last = step.size() - 1;
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(P, M);
-  for (int i = 0; i < P; ++i) {
-    for (int j = 0; j <= std::min(i, M - 1); ++j) {
-      A(i, j) = step(std::min<Eigen::Index>(i + 1 - j, last));
-    }
-  }
-  return A;
-}
 
 bool DmcOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& message) {
@@ -103,21 +43,23 @@ bool DmcOptions::IsValid(std::string* error) const {
   return true;
 }
 
-DmcController::DmcController(const TransferFunction& model, double Ts, const DmcOptions& options)
-    : options_(options), Ts_(Ts) {
+DmcController::DmcController(const PredictionModel& model, const DmcOptions& options)
+    : options_(options), Ts_(model.Ts()) {
   std::string error;
   PNEUMID_CHECK(options_.IsValid(&error), "invalid DMC options: {}", error);
-  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
   int N = options_.model_horizon;
   if (N == 0)
-    N = SettlingModelHorizon(model, Ts);
+    N = model.SettlingHorizon();
   else
-    PNEUMID_CHECK(SampledModel(model, Ts).IsStable(), "DMC needs a stable model; {} is not stable",
-                  model.ToString());
+    PNEUMID_CHECK(model.IsStable(), "DMC needs a stable model; {} is not stable",
+                  model.model().ToString());
   N = std::max(N, options_.P);
-  step_ = StepResponseCoefficients(model, Ts, N);
+  step_ = model.StepResponse(N);
   Build();
 }
+
+DmcController::DmcController(const TransferFunction& model, double Ts, const DmcOptions& options)
+    : DmcController(PredictionModel(model, Ts), options) {}
 
 DmcController::DmcController(const Eigen::VectorXd& step_coefficients, double Ts,
                              const DmcOptions& options)

@@ -8,7 +8,6 @@
 #include <Eigen/Cholesky>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/control/dmc.hpp"
 
 namespace pneumid {
 
@@ -37,7 +36,11 @@ Eigen::VectorXd TrimTrailingZeros(const Eigen::VectorXd& a) {
 }  // namespace
 
 CarimaModel ToCarima(const TransferFunction& model, double Ts) {
-  const TransferFunction g = SampledModel(model, Ts);
+  return ToCarima(PredictionModel(model, Ts));
+}
+
+CarimaModel ToCarima(const PredictionModel& model) {
+  const TransferFunction& g = model.sampled();
   const double a0 = g.den()(0);
   PNEUMID_CHECK(a0 != 0.0, "the model's leading denominator coefficient is zero");
   const int d = g.DelaySamples();
@@ -48,7 +51,7 @@ CarimaModel ToCarima(const TransferFunction& model, double Ts) {
   PNEUMID_CHECK(std::abs(bbar(0)) <= 1e-12 * bmax,
                 "GPC needs a strictly proper model (no direct feedthrough); b0 = {}", bbar(0));
   CarimaModel c;
-  c.Ts = Ts;
+  c.Ts = model.Ts();
   c.A = TrimTrailingZeros(g.den() / a0);
   c.B = TrimTrailingZeros(bbar.tail(bbar.size() - 1));
   return c;
@@ -73,10 +76,13 @@ bool GpcOptions::IsValid(std::string* error) const {
 }
 
 GpcController::GpcController(const TransferFunction& model, double Ts, const GpcOptions& options)
-    : options_(options), Ts_(Ts) {
+    : GpcController(PredictionModel(model, Ts), options) {}
+
+GpcController::GpcController(const PredictionModel& model, const GpcOptions& options)
+    : options_(options), Ts_(model.Ts()) {
   std::string error;
   PNEUMID_CHECK(options_.IsValid(&error), "invalid GPC options: {}", error);
-  model_ = ToCarima(model, Ts);
+  model_ = ToCarima(model);
   const Eigen::VectorXd& A = model_.A;
   const Eigen::VectorXd& B = model_.B;
   if (options_.t_equals_a) {

@@ -4,37 +4,28 @@
 
 #include <fmt/format.h>
 #include <Eigen/Eigenvalues>
+#include <nlohmann/json.hpp>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/control/dmc.hpp"
+#include "pneumid/common/enum_names.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {
 
-std::string ToString(TuningRule rule) {
-  switch (rule) {
-    case TuningRule::kShridharCooper:
-      return "shridhar-cooper";
-    case TuningRule::kPaperModified:
-      return "paper-modified";
-    case TuningRule::kExplicit:
-      return "explicit";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<TuningRule> kTuningRuleNames[] = {
+    {TuningRule::kShridharCooper, "shridhar-cooper"},
+    {TuningRule::kPaperModified, "paper-modified"},
+    {TuningRule::kExplicit, "explicit"},
+    {TuningRule::kShridharCooper, "conventional"},
+    {TuningRule::kPaperModified, "modified"},
+};
+}  // namespace
+
+std::string ToString(TuningRule v) { return std::string(EnumToString(kTuningRuleNames, v)); }
 
 TuningRule TuningRuleFromString(const std::string& name) {
-  if (name == "conventional") return TuningRule::kShridharCooper;
-  if (name == "modified") return TuningRule::kPaperModified;
-  for (TuningRule r :
-       {TuningRule::kShridharCooper, TuningRule::kPaperModified, TuningRule::kExplicit}) {
-    if (ToString(r) == name) return r;
-  }
-  PNEUMID_CHECK(false,
-                "unknown tuning rule '{}'; valid: shridhar-cooper (conventional), paper-modified "
-                "(modified), explicit",
-                name);
-  return TuningRule::kExplicit;
+  return EnumFromString(kTuningRuleNames, name, "tuning rule");
 }
 
 double RoundSignificant(double x, int digits) {
@@ -46,7 +37,7 @@ double RoundSignificant(double x, int digits) {
   return std::round(x * scale * (1.0 + 1e-12)) / scale;
 }
 
-FopdtParameters FopdtFromModel(const TransferFunction& model) {
+FopdtEstimate FopdtFromModel(const TransferFunction& model) {
   PNEUMID_CHECK(model.IsStable(), "the model {} is not stable; no FOPDT description",
                 model.ToString());
   const double K = model.DcGain();
@@ -54,7 +45,7 @@ FopdtParameters FopdtFromModel(const TransferFunction& model) {
                 "the model's static gain must be finite and "
                 "nonzero, got {}",
                 K);
-  FopdtParameters p;
+  FopdtEstimate p;
   p.K = K;
   if (model.IsContinuous()) {
     const TransferFunction g = model.Normalized();
@@ -67,21 +58,15 @@ FopdtParameters FopdtFromModel(const TransferFunction& model) {
       return p;
     }
   }
-  // Two-point method on the unit step response (Smith 1972).
+  // Smith's two-point method on the unit step response (lti/fopdt.hpp); a
+  // level never reached counts as reached at the end of the response.
   const TimeResponse r = Step(model);
+  const Eigen::VectorXd normalized = r.y / K;
   auto crossing = [&](double fraction) {
-    const double level = fraction * K;
-    for (Eigen::Index i = 1; i < r.y.size(); ++i) {
-      if ((r.y(i) - level) * (K > 0 ? 1 : -1) >= 0.0) {
-        const double y1 = r.y(i - 1), y2 = r.y(i);
-        return r.t(i - 1) + (level - y1) / (y2 - y1) * (r.t(i) - r.t(i - 1));
-      }
-    }
-    return r.t(r.t.size() - 1);
+    const double t = FirstCrossing(r.t, normalized, fraction);
+    return std::isnan(t) ? r.t(r.t.size() - 1) : t;
   };
-  const double t28 = crossing(0.283), t63 = crossing(0.632);
-  p.tau = 1.5 * (t63 - t28);
-  p.theta = std::max(0.0, t63 - p.tau);
+  static_cast<FopdtParams&>(p) = SmithTwoPoint(K, crossing(kSmithLevel1), crossing(kSmithLevel2));
   p.method = "two-point";
   return p;
 }
@@ -108,13 +93,21 @@ bool TuningOptions::IsValid(std::string* error) const {
 TuningResult Tune(const TransferFunction& model, double Ts, const TuningOptions& options) {
   std::string error;
   PNEUMID_CHECK(options.IsValid(&error), "invalid tuning options: {}", error);
-  PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
+  return Tune(PredictionModel(model, Ts), options);
+}
+
+TuningResult Tune(const PredictionModel& model, const TuningOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "invalid tuning options: {}", error);
+  const double Ts = model.Ts();
   TuningResult r;
   r.rule = options.rule;
+  r.Ts = Ts;
+  r.lambda_explicit = !std::isnan(options.lambda);
   switch (options.rule) {
     case TuningRule::kShridharCooper: {
-      r.fopdt = FopdtFromModel(model);
-      const FopdtParameters& f = r.fopdt;
+      r.fopdt = FopdtFromModel(model.model());
+      const FopdtEstimate& f = r.fopdt;
       r.tau_used = options.tau_significant_digits > 0
                        ? RoundSignificant(f.tau, options.tau_significant_digits)
                        : f.tau;
@@ -122,7 +115,7 @@ TuningResult Tune(const TransferFunction& model, double Ts, const TuningOptions&
       r.P = options.P > 0 ? options.P : std::max(1, static_cast<int>(std::lround(r.P_unrounded)));
       r.M = options.M > 0 ? options.M : 5;
       PNEUMID_CHECK(r.M <= r.P, "need M <= P, got M = {}, P = {}", r.M, r.P);
-      const Eigen::MatrixXd A = DynamicMatrix(StepResponseCoefficients(model, Ts, r.P), r.P, r.M);
+      const Eigen::MatrixXd A = model.DynamicMatrix(r.P, r.M);
       const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A.transpose() * A,
                                                                Eigen::EigenvaluesOnly);
       r.lambda_condition = eig.eigenvalues().maxCoeff() / options.target_condition;
@@ -158,6 +151,26 @@ TuningResult Tune(const TransferFunction& model, double Ts, const TuningOptions&
       break;
   }
   return r;
+}
+
+nlohmann::ordered_json TuningResult::ToJson() const {
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  nlohmann::ordered_json j;
+  j["rule"] = ToString(rule);
+  j["P"] = P;
+  j["M"] = M;
+  j["lambda"] = lambda;
+  if (rule == TuningRule::kShridharCooper) {
+    j["lambda_source"] = lambda_explicit ? "explicit" : "lambda_condition";
+    j["lambda_condition"] = number(lambda_condition);
+    j["lambda_formula"] = number(lambda_formula);
+    j["P_unrounded"] = P_unrounded;
+    j["tau_used"] = tau_used;
+    j["fopdt"] = {{"K", fopdt.K}, {"tau", fopdt.tau}, {"theta", fopdt.theta}, {"method", fopdt.method}};
+  }
+  j["Ts"] = Ts;
+  j["formula"] = formula;
+  return j;
 }
 
 }  // namespace pneumid

@@ -5,6 +5,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/dmc.hpp"
@@ -87,6 +88,37 @@ TEST(ClosedLoopTest, ActuatorLimitsAndNoise) {
   LinearPlant other(PaperFopdtModel(), 0.02);
   EXPECT_THAT([&] { SimulateClosedLoop(dmc, other, *sp, o); },
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("Ts = 0.02")));
+}
+
+// The metric keys of `pneumid control --json` and `pneumid run --json` (a
+// contract), in order; a metric that does not exist in the run is null.
+TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
+  ClosedLoopMetrics m;
+  m.rise_time = 0.1;
+  m.iae = 2.0;
+  StepMetrics s;
+  s.time = 1.0;
+  s.to = 5.0;
+  s.settling_time = 0.3;
+  m.steps.push_back(s);
+  const nlohmann::ordered_json j = m.ToJson();
+  std::vector<std::string> keys;
+  for (const auto& [key, value] : j.items()) keys.push_back(key);
+  EXPECT_THAT(keys, ::testing::ElementsAre("rise_time", "overshoot_percent", "settling_time",
+                                           "steady_state_error", "first_move", "iae", "ise",
+                                           "itae", "tv_u", "u_min", "u_max", "load_peak_deviation",
+                                           "load_recovery_time", "steps"));
+  EXPECT_EQ(j["rise_time"], 0.1);
+  EXPECT_TRUE(j["overshoot_percent"].is_null());
+  EXPECT_TRUE(j["load_recovery_time"].is_null());
+  EXPECT_EQ(j["iae"], 2.0);
+  ASSERT_EQ(j["steps"].size(), 1u);
+  keys.clear();
+  for (const auto& [key, value] : j["steps"][0].items()) keys.push_back(key);
+  EXPECT_THAT(keys, ::testing::ElementsAre("time", "from", "to", "rise_time", "overshoot_percent",
+                                           "settling_time", "steady_state_error", "first_move"));
+  EXPECT_EQ(j["steps"][0]["settling_time"], 0.3);
+  EXPECT_TRUE(j["steps"][0]["first_move"].is_null());
 }
 
 }  // namespace

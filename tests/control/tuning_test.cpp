@@ -7,6 +7,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/model_io.hpp"
@@ -72,11 +73,11 @@ TEST(TuningTest, PaperModifiedAndExplicit) {
 
 TEST(TuningTest, FopdtFromHigherOrderModelByTwoPointMethod) {
   // A pure first-order lag sampled finely: the two-point method returns it.
-  const FopdtParameters exact = FopdtFromModel(TransferFunction::Fopdt(2.0, 0.5, 0.1));
+  const FopdtEstimate exact = FopdtFromModel(TransferFunction::Fopdt(2.0, 0.5, 0.1));
   EXPECT_EQ(exact.method, "exact");
   EXPECT_NEAR(exact.theta, 0.1, 1e-12);
   // ARX model: the paper's FOPDT has K ~ 1.6 and tau ~ 0.23-0.25 s.
-  const FopdtParameters arx = FopdtFromModel(PaperArxModel());
+  const FopdtEstimate arx = FopdtFromModel(PaperArxModel());
   EXPECT_EQ(arx.method, "two-point");
   EXPECT_NEAR(arx.K, 1.59796, 1e-4);
   EXPECT_NEAR(arx.tau + arx.theta, 0.2306, 0.01);  // t63 of the ARX step (docs/paper.md, reference 4)
@@ -106,6 +107,33 @@ TEST(TuningTest, RejectsBadInput) {
   EXPECT_THROW(Tune(PaperFopdtModel(), 0.0, TuningOptions{}), InvalidArgument);
   const TransferFunction unstable = TransferFunction::Continuous({1.0}, {1.0, -2.0});
   EXPECT_THROW(Tune(unstable, kTs, TuningOptions{}), InvalidArgument);
+}
+
+// The keys of `pneumid tune --json` (a contract), in order; NaN as null.
+TEST(TuningTest, ToJsonKeepsTheCommandLineKeys) {
+  TuningOptions o;
+  o.M = 5;
+  const nlohmann::ordered_json j = Tune(PaperFopdtModel(), kTs, o).ToJson();
+  std::vector<std::string> keys;
+  for (const auto& [key, value] : j.items()) keys.push_back(key);
+  EXPECT_THAT(keys, ::testing::ElementsAre("rule", "P", "M", "lambda", "lambda_source",
+                                           "lambda_condition", "lambda_formula", "P_unrounded",
+                                           "tau_used", "fopdt", "Ts", "formula"));
+  EXPECT_EQ(j["rule"], "shridhar-cooper");
+  EXPECT_EQ(j["P"], 126);
+  EXPECT_NEAR(j["lambda"].get<double>(), 2.250797, 1e-5);
+  EXPECT_EQ(j["lambda_source"], "lambda_condition");
+  EXPECT_EQ(j["fopdt"]["method"], "exact");
+  EXPECT_EQ(j["Ts"], kTs);
+  o.lambda = 3.0;
+  EXPECT_EQ(Tune(PaperFopdtModel(), kTs, o).ToJson()["lambda_source"], "explicit");
+
+  TuningOptions m;
+  m.rule = TuningRule::kPaperModified;
+  const nlohmann::ordered_json jm = Tune(PaperFopdtModel(), kTs, m).ToJson();
+  keys.clear();
+  for (const auto& [key, value] : jm.items()) keys.push_back(key);
+  EXPECT_THAT(keys, ::testing::ElementsAre("rule", "P", "M", "lambda", "Ts", "formula"));
 }
 
 }  // namespace

@@ -35,6 +35,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
 
 #include "pneumid/control/controller.hpp"
 #include "pneumid/plant/plant.hpp"
@@ -71,6 +72,10 @@ struct StepMetrics {
   double settling_time = std::numeric_limits<double>::quiet_NaN();
   double steady_state_error = std::numeric_limits<double>::quiet_NaN();  ///< end of the segment
   double first_move = std::numeric_limits<double>::quiet_NaN();
+
+  /// {time, from, to, rise_time, overshoot_percent, settling_time,
+  /// steady_state_error, first_move}; NaN is written as null.
+  nlohmann::ordered_json ToJson() const;
 };
 
 struct ClosedLoopMetrics {
@@ -85,6 +90,13 @@ struct ClosedLoopMetrics {
   double load_peak_deviation = std::numeric_limits<double>::quiet_NaN();
   double load_recovery_time = std::numeric_limits<double>::quiet_NaN();
   std::vector<StepMetrics> steps;
+
+  /// The metrics of `pneumid control --json` and `pneumid run --json`:
+  /// rise_time, overshoot_percent, settling_time, steady_state_error,
+  /// first_move, iae, ise, itae, tv_u, u_min, u_max, load_peak_deviation,
+  /// load_recovery_time and steps (StepMetrics::ToJson); NaN (a quantity that
+  /// does not exist in the run) is written as null.
+  nlohmann::ordered_json ToJson() const;
 };
 
 struct ClosedLoopResult {

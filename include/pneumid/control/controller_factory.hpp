@@ -14,8 +14,11 @@
 #include <memory>
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "pneumid/control/controller.hpp"
 #include "pneumid/control/pid.hpp"
+#include "pneumid/control/prediction_model.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
@@ -33,13 +36,59 @@ struct ControllerSpec {
   double tau_c = 0.0;  ///< pid closed-loop time constant (s); <= 0 = rule default
 };
 
-struct BuiltController {
-  std::unique_ptr<Controller> controller;
-  TuningResult tuning;    ///< horizons and lambda (dmc, gpc)
-  PidGains pid_gains;     ///< (pid)
-  FopdtParameters fopdt;  ///< the FOPDT the PID was tuned from (pid)
+/// Controller settings as a user states them (command line, configuration,
+/// bindings): names as strings, unset numbers as 0 / NaN.
+struct ControllerSettings {
+  std::string controller = "dmc";  ///< dmc, gpc or pid
+  /// Tuning rule name (TuningRuleFromString); empty: inferred (InferTuningRule).
+  std::string rule;
+  int P = 0;  ///< prediction horizon override (0 = the rule's)
+  int M = 0;  ///< control horizon override (0 = the rule's)
+  double lambda = std::numeric_limits<double>::quiet_NaN();  ///< override (NaN = the rule's)
+  InputLimits limits;
+  bool constrained = false;
+  double y_min = -std::numeric_limits<double>::infinity();
+  double y_max = std::numeric_limits<double>::infinity();
+  std::string t_filter = "1";
+  std::string pid_rule = "simc";
+  double tau_c = 0.0;
 };
 
+/// The tuning rule settings ask for: the named rule when `rule` is not empty;
+/// otherwise explicit when P > 0, M > 0 and a finite lambda are all given,
+/// else shridhar-cooper.
+/// @throws InvalidArgument for an unknown rule name.
+TuningRule InferTuningRule(const std::string& rule, int P, int M, double lambda);
+
+/// The spec of `settings`: names parsed, the rule inferred, P, M and lambda
+/// as overrides of the rule.
+/// @throws InvalidArgument for an unknown controller, rule or PID rule name.
+ControllerSpec ToControllerSpec(const ControllerSettings& settings);
+
+struct BuiltController {
+  std::unique_ptr<Controller> controller;
+  ControllerType type = ControllerType::kDmc;
+  TuningResult tuning;    ///< horizons and lambda (dmc, gpc)
+  PidTuningRule pid_rule = PidTuningRule::kSimc;  ///< (pid)
+  PidGains pid_gains;     ///< (pid)
+  FopdtEstimate fopdt;  ///< the FOPDT the PID was tuned from (pid)
+
+  /// "pid" for a PID, else the tuning rule's name (as in a comparison table).
+  std::string Label() const;
+  /// One line stating the design: the rule with P, M, lambda and its formula,
+  /// or the PID rule, the FOPDT it used and the gains.
+  std::string Summary() const;
+  /// `settings` of `pneumid control --json`: {rule, P, M, lambda, formula}
+  /// (dmc, gpc) or {Kc, Ti, Td, rule} (pid; Ti null when infinite).
+  nlohmann::ordered_json SettingsToJson() const;
+};
+
+/// Designs the controller from a sampled model (dmc and gpc use it as is; pid
+/// tunes from the FOPDT description of model.model()).
+/// @throws InvalidArgument for invalid settings (messages name the setting).
+BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec);
+/// dmc, gpc: MakeController(PredictionModel(model, Ts), spec), the design's
+/// one discretization; pid: from the FOPDT description of `model`.
 /// @throws InvalidArgument for invalid settings (messages name the setting).
 BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec);

@@ -2,9 +2,10 @@
 // QDMC [2].
 //
 // Model: the unit step response s_i = y(i Ts), i = 0..N, of any stable
-// single-input single-output model (a continuous transfer function is
-// sampled with an exact zero-order hold, a discrete one, e.g. ARX, is used at
-// its own Ts). N is the model horizon, after which s_i is taken as settled.
+// single-input single-output model, from its PredictionModel
+// (prediction_model.hpp: a continuous transfer function sampled with an exact
+// zero-order hold, a discrete one, e.g. ARX, used at its own Ts). N is the
+// model horizon, after which s_i is taken as settled.
 //
 // Prediction over i = 1..P (P prediction horizon, M control horizon):
 //   y^(k+i) = f_i + sum_{j=0}^{M-1} s_{i-j} du(k+j),   i.e.  y^ = f + A du,
@@ -41,36 +42,11 @@
 #include <Eigen/Core>
 
 #include "pneumid/control/controller.hpp"
+#include "pneumid/control/prediction_model.hpp"
 #include "pneumid/control/qp_solver.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
-
-/// The model as used by the controllers at sample time Ts: a continuous
-/// model sampled with an exact zero-order hold (delay included), a discrete
-/// one unchanged.
-/// @throws InvalidArgument for Ts <= 0 or a discrete model with another Ts.
-TransferFunction SampledModel(const TransferFunction& model, double Ts);
-
-/// Unit step response of `model` sampled at Ts: entries s_0..s_n (n + 1
-/// values, s_i = y(i Ts), input stepped at t = 0 and held, zero-order hold).
-/// A continuous model is discretized exactly (zoh, delay included); a discrete
-/// one must have Ts equal to its own sample time.
-/// @throws InvalidArgument for Ts <= 0, n < 1, or a discrete model sampled at
-/// another Ts.
-Eigen::VectorXd StepResponseCoefficients(const TransferFunction& model, double Ts, int n);
-
-/// Smallest model horizon N such that |s_N - s_inf| <= tol |s_inf| for a
-/// stable model (at most max_n).
-/// @throws InvalidArgument for an unstable model or a zero static gain.
-int SettlingModelHorizon(const TransferFunction& model, double Ts, double tol = 1e-9,
-                         int max_n = 5000);
-
-/// P x M dynamic matrix A_ij = s_{i+1-j} (rows i = 0..P-1 are y(k+1..k+P),
-/// columns j = 0..M-1 the moves du(k..k+M-1)) from step coefficients s_0..s_N
-/// (entries beyond N are taken as s_N).
-/// @throws InvalidArgument for P < 1, M < 1, M > P or empty coefficients.
-Eigen::MatrixXd DynamicMatrix(const Eigen::VectorXd& step, int P, int M);
 
 struct DmcOptions {
   int P = 126;           ///< prediction horizon (samples)
@@ -80,7 +56,7 @@ struct DmcOptions {
   Eigen::VectorXd output_weights;
   /// Move weights r_1..r_M (all > 0), multiplied by lambda; empty means all 1.
   Eigen::VectorXd move_weights;
-  /// Model horizon N in samples; 0 chooses SettlingModelHorizon() (1e-9),
+  /// Model horizon N in samples; 0 chooses PredictionModel::SettlingHorizon() (1e-9),
   /// and at least P.
   int model_horizon = 0;
   /// Input limits. Unconstrained: the computed input is clipped to them
@@ -101,7 +77,10 @@ struct DmcOptions {
 
 class DmcController : public Controller {
  public:
-  /// Design from a model (see StepResponseCoefficients) at sample time Ts.
+  /// Design from a sampled model (no further discretization).
+  /// @throws InvalidArgument for invalid options or an unstable model.
+  DmcController(const PredictionModel& model, const DmcOptions& options);
+  /// Design from a model at sample time Ts: DmcController(PredictionModel(model, Ts), options).
   /// @throws InvalidArgument for invalid options, Ts <= 0, an unstable model,
   /// or a discrete model with another sample time.
   DmcController(const TransferFunction& model, double Ts, const DmcOptions& options);

@@ -42,6 +42,7 @@
 #include <Eigen/Core>
 
 #include "pneumid/control/controller.hpp"
+#include "pneumid/control/prediction_model.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
@@ -70,15 +71,21 @@ struct CarimaModel {
   double Ts = 0.0;
 };
 
-/// CARIMA form of a model at sample time Ts (continuous models by zoh).
+/// CARIMA form of a sampled model.
+/// @throws InvalidArgument for direct feedthrough or a zero numerator.
+CarimaModel ToCarima(const PredictionModel& model);
+/// ToCarima(PredictionModel(model, Ts)) (continuous models by zoh).
 /// @throws InvalidArgument for Ts <= 0, a discrete model with another Ts, or
 /// direct feedthrough.
 CarimaModel ToCarima(const TransferFunction& model, double Ts);
 
 class GpcController : public Controller {
  public:
+  /// Design from a sampled model (no further discretization).
   /// @throws InvalidArgument for invalid options, a T polynomial that is not
   /// monic or not stable, or the conditions of ToCarima().
+  GpcController(const PredictionModel& model, const GpcOptions& options);
+  /// GpcController(PredictionModel(model, Ts), options).
   GpcController(const TransferFunction& model, double Ts, const GpcOptions& options);
 
   void Reset(double u0 = 0.0, double y0 = 0.0) override;

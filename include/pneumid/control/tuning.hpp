@@ -41,6 +41,10 @@
 #include <limits>
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
+
+#include "pneumid/control/prediction_model.hpp"
+#include "pneumid/lti/fopdt.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
@@ -52,17 +56,15 @@ std::string ToString(TuningRule rule);
 /// "modified" = paper-modified); throws InvalidArgument listing the valid names.
 TuningRule TuningRuleFromString(const std::string& name);
 
-struct FopdtParameters {
-  double K = 0.0;      ///< static gain (output units per input unit)
-  double tau = 0.0;    ///< time constant (s)
-  double theta = 0.0;  ///< dead time (s)
+/// FOPDT parameters (lti/fopdt.hpp) with how they were obtained.
+struct FopdtEstimate : FopdtParams {
   /// "exact" (first-order model) or "two-point" (fitted to the step response).
   std::string method;
 };
 
 /// FOPDT description of a stable model (see the file comment).
 /// @throws InvalidArgument for an unstable model or a zero static gain.
-FopdtParameters FopdtFromModel(const TransferFunction& model);
+FopdtEstimate FopdtFromModel(const TransferFunction& model);
 
 struct TuningOptions {
   TuningRule rule = TuningRule::kShridharCooper;
@@ -90,14 +92,29 @@ struct TuningResult {
   double lambda_formula = std::numeric_limits<double>::quiet_NaN();
   double P_unrounded = 0.0;  ///< 5 tau'/Ts + theta/Ts + 1 before rounding
   double tau_used = 0.0;     ///< tau after rounding, as used for P
-  FopdtParameters fopdt;
+  FopdtEstimate fopdt;
   /// Human-readable statement of the formulas used, with their values.
   std::string formula;
+  double Ts = 0.0;  ///< controller sample time the settings are for (s)
+  /// True when lambda was given explicitly (TuningOptions::lambda) rather
+  /// than taken from the rule.
+  bool lambda_explicit = false;
+
+  /// The JSON form of `pneumid tune --json`: rule, P, M, lambda; for
+  /// shridhar-cooper also lambda_source ("lambda_condition" or "explicit"),
+  /// lambda_condition, lambda_formula, P_unrounded, tau_used and fopdt {K,
+  /// tau, theta, method}; then Ts and formula. NaN is written as null.
+  nlohmann::ordered_json ToJson() const;
 };
 
-/// Horizons and move suppression for a controller sampled at Ts.
-/// @throws InvalidArgument for invalid options, Ts <= 0, or a model that
+/// Horizons and move suppression for a controller sampled at model.Ts(): the
+/// FOPDT from model.model(), the dynamic matrix from the sampled model.
+/// @throws InvalidArgument for invalid options, or a model that
 /// FopdtFromModel rejects (rule shridhar-cooper).
+TuningResult Tune(const PredictionModel& model, const TuningOptions& options);
+/// Tune(PredictionModel(model, Ts), options).
+/// @throws InvalidArgument as above, and for Ts <= 0 or a discrete model with
+/// another sample time.
 TuningResult Tune(const TransferFunction& model, double Ts, const TuningOptions& options);
 
 /// x rounded to `digits` significant decimal digits, halves away from zero

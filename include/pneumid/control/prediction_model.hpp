@@ -1,0 +1,87 @@
+// The sampled prediction model shared by the predictive controllers (DMC,
+// GPC), the tuning rules and the controller factory.
+//
+// A design samples its model once, at the controller's period Ts, and passes
+// the result down: a continuous model G(s) exp(-theta s) is discretized with
+// an exact zero-order hold (delay included, lti/conversion.hpp C2D), a
+// discrete one (e.g. ARX) is used at its own Ts. From the sampled model
+//   b(q^-1) / a(q^-1) q^-d
+// follow
+//   * the unit step-response coefficients s_0..s_n, s_i = y(i Ts) for u = 1
+//     from k = 0 on, by the difference equation
+//       a_0 s_k = sum_i b_i [k - d - i >= 0] - sum_{i>=1} a_i s_{k-i};
+//   * the model horizon N: the smallest N with |s_N - s_inf| <= tol |s_inf|
+//     (s_inf the static gain), after which s_i is taken as settled;
+//   * the P x M dynamic matrix A_ij = s_{i+1-j} (0 for j > i), rows the
+//     predicted outputs y(k+1..k+P), columns the moves du(k..k+M-1) [1, 2]:
+//       y^ = f + A du.
+// The Shridhar-Cooper rule (tuning.hpp) takes its lambda from A'A, DMC
+// (dmc.hpp) its predictor from s and A, GPC (gpc.hpp) its CARIMA polynomials
+// from the sampled model.
+//
+// [1] C. R. Cutler, B. L. Ramaker, "Dynamic matrix control - a computer
+//     control algorithm", Joint Automatic Control Conf., 1980.
+// [2] E. F. Camacho, C. Bordons, Model Predictive Control, 2nd ed., 2007,
+//     sec. 2.5.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "pneumid/lti/transfer_function.hpp"
+
+namespace pneumid {
+
+class PredictionModel {
+ public:
+  /// Samples `model` at Ts (the only discretization of a design): zoh for a
+  /// continuous model, unchanged for a discrete one.
+  /// @throws InvalidArgument for Ts <= 0 or not finite, a discrete model with
+  /// another sample time (relative 1e-9), or a zero leading denominator
+  /// coefficient of the sampled model.
+  PredictionModel(const TransferFunction& model, double Ts);
+
+  /// The model as given (continuous or discrete).
+  const TransferFunction& model() const { return model_; }
+  /// The model sampled at Ts (discrete).
+  const TransferFunction& sampled() const { return sampled_; }
+  /// Controller sample time (s).
+  double Ts() const { return Ts_; }
+  /// Stability of the sampled model (poles inside the unit circle).
+  bool IsStable() const;
+
+  /// Unit step-response coefficients s_0..s_n (n + 1 values).
+  /// @throws InvalidArgument for n < 1.
+  Eigen::VectorXd StepResponse(int n) const;
+  /// Smallest model horizon N <= max_n with |s_N - s_inf| <= tol |s_inf|.
+  /// @throws InvalidArgument for an unstable model, a zero or infinite static
+  /// gain, tol <= 0 or max_n < 1.
+  int SettlingHorizon(double tol = 1e-9, int max_n = 5000) const;
+  /// The P x M dynamic matrix of s_0..s_P (see the file comment).
+  /// @throws InvalidArgument for P < 1, M < 1 or M > P.
+  Eigen::MatrixXd DynamicMatrix(int P, int M) const;
+
+ private:
+  TransferFunction model_;
+  TransferFunction sampled_;
+  double Ts_ = 0.0;
+};
+
+/// P x M dynamic matrix A_ij = s_{i+1-j} from step coefficients s_0..s_N
+/// (entries beyond N are taken as s_N).
+/// @throws InvalidArgument for P < 1, M < 1, M > P or empty coefficients.
+Eigen::MatrixXd DynamicMatrix(const Eigen::VectorXd& step, int P, int M);
+
+/// PredictionModel(model, Ts).sampled().
+/// @throws InvalidArgument as PredictionModel's constructor.
+TransferFunction SampledModel(const TransferFunction& model, double Ts);
+
+/// PredictionModel(model, Ts).StepResponse(n).
+/// @throws InvalidArgument as PredictionModel's constructor and StepResponse.
+Eigen::VectorXd StepResponseCoefficients(const TransferFunction& model, double Ts, int n);
+
+/// PredictionModel(model, Ts).SettlingHorizon(tol, max_n).
+/// @throws InvalidArgument as PredictionModel's constructor and SettlingHorizon.
+int SettlingModelHorizon(const TransferFunction& model, double Ts, double tol = 1e-9,
+                         int max_n = 5000);
+
+}  // namespace pneumid

@@ -1,0 +1,89 @@
+// Controller settings as users give them: the inferred tuning rule (shared by
+// `pneumid control`, `pneumid run` and the bindings), parsing errors naming
+// the setting, and what a design reports about itself.
+#include "pneumid/control/controller_factory.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/lti/model_io.hpp"
+
+namespace pneumid {
+namespace {
+
+constexpr double kTs = 0.01;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+TEST(InferTuningRuleTest, NamedRuleWinsElseExplicitOnlyWithAllThreeSettings) {
+  EXPECT_EQ(InferTuningRule("", 0, 0, kNaN), TuningRule::kShridharCooper);
+  EXPECT_EQ(InferTuningRule("", 100, 5, 1.0), TuningRule::kExplicit);
+  // Any one of P, M, lambda missing: the default rule, with the others as overrides.
+  EXPECT_EQ(InferTuningRule("", 100, 5, kNaN), TuningRule::kShridharCooper);
+  EXPECT_EQ(InferTuningRule("", 0, 5, 1.0), TuningRule::kShridharCooper);
+  EXPECT_EQ(InferTuningRule("", 100, 0, 1.0), TuningRule::kShridharCooper);
+  EXPECT_EQ(InferTuningRule("", 100, 5, std::numeric_limits<double>::infinity()),
+            TuningRule::kShridharCooper);
+  EXPECT_EQ(InferTuningRule("modified", 100, 5, 1.0), TuningRule::kPaperModified);
+  EXPECT_EQ(InferTuningRule("conventional", 0, 0, kNaN), TuningRule::kShridharCooper);
+  EXPECT_THAT([] { InferTuningRule("fast", 0, 0, kNaN); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("'fast'")));
+}
+
+TEST(ControllerSettingsTest, ToSpecParsesNamesAndKeepsOverrides) {
+  ControllerSettings s;
+  s.controller = "gpc";
+  s.P = 80;
+  s.lambda = 3.0;
+  s.limits.u_min = 0.0;
+  s.limits.u_max = 100.0;
+  s.t_filter = "A";
+  s.pid_rule = "imc";
+  const ControllerSpec spec = ToControllerSpec(s);
+  EXPECT_EQ(spec.type, ControllerType::kGpc);
+  EXPECT_EQ(spec.tuning.rule, TuningRule::kShridharCooper);
+  EXPECT_EQ(spec.tuning.P, 80);
+  EXPECT_EQ(spec.tuning.M, 0);
+  EXPECT_EQ(spec.tuning.lambda, 3.0);
+  EXPECT_EQ(spec.limits.u_max, 100.0);
+  EXPECT_EQ(spec.t_filter, "A");
+  EXPECT_EQ(spec.pid_rule, PidTuningRule::kImc);
+
+  s.controller = "mpc";
+  EXPECT_THAT([&] { ToControllerSpec(s); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("'mpc'")));
+  s.controller = "pid";
+  s.pid_rule = "zn";
+  EXPECT_THAT([&] { ToControllerSpec(s); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("'zn'")));
+}
+
+TEST(BuiltControllerTest, LabelSummaryAndSettingsJson) {
+  ControllerSettings s;
+  s.M = 5;
+  const BuiltController dmc = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  EXPECT_EQ(dmc.Label(), "shridhar-cooper");
+  EXPECT_THAT(dmc.Summary(), ::testing::StartsWith("shridhar-cooper: P=126 M=5 lambda=2.25"));
+  const nlohmann::ordered_json j = dmc.SettingsToJson();
+  std::vector<std::string> keys;
+  for (const auto& [key, value] : j.items()) keys.push_back(key);
+  EXPECT_THAT(keys, ::testing::ElementsAre("rule", "P", "M", "lambda", "formula"));
+  EXPECT_EQ(j["P"], 126);
+
+  s.controller = "pid";
+  const BuiltController pid = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  EXPECT_EQ(pid.Label(), "pid");
+  EXPECT_THAT(pid.Summary(), ::testing::StartsWith("pid simc from FOPDT K=1.6 tau=0.245"));
+  const nlohmann::ordered_json p = pid.SettingsToJson();
+  keys.clear();
+  for (const auto& [key, value] : p.items()) keys.push_back(key);
+  EXPECT_THAT(keys, ::testing::ElementsAre("Kc", "Ti", "Td", "rule"));
+  EXPECT_EQ(p["rule"], "simc");
+}
+
+}  // namespace
+}  // namespace pneumid

@@ -1,0 +1,139 @@
+// The sampled prediction model: step response against the closed form of the
+// zoh-sampled FOPDT, the dynamic matrix of the paper's tuning
+// (lambda_max(A'A)/500 = 2.250797, gen_dmc_reference.py), and one sampled
+// model serving tuning, DMC and GPC of a design with the results of the
+// designs that sampled the model themselves.
+#include "pneumid/control/prediction_model.hpp"
+
+#include <cmath>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/control/controller_factory.hpp"
+#include "pneumid/control/dmc.hpp"
+#include "pneumid/control/gpc.hpp"
+#include "pneumid/control/tuning.hpp"
+#include "pneumid/lti/conversion.hpp"
+#include "pneumid/lti/model_io.hpp"
+
+namespace pneumid {
+namespace {
+
+constexpr double kTs = 0.01;
+
+TransferFunction PaperFopdt() { return TransferFunction::Fopdt(1.6, 0.245, 0.001); }
+
+TEST(PredictionModelTest, FopdtStepResponseIsTheSampledClosedForm) {
+  // zoh: s_i = K (1 - exp(-(i Ts - theta)/tau)) for i Ts >= theta.
+  const PredictionModel pm(PaperFopdt(), kTs);
+  EXPECT_TRUE(pm.sampled().Ts() == kTs);
+  EXPECT_TRUE(pm.model().IsContinuous());
+  const Eigen::VectorXd s = pm.StepResponse(150);
+  ASSERT_EQ(s.size(), 151);
+  EXPECT_NEAR(s(0), 0.0, 1e-12);
+  for (int i = 1; i <= 150; ++i)
+    EXPECT_NEAR(s(i), 1.6 * (1.0 - std::exp(-(i * kTs - 0.001) / 0.245)), 1e-10) << i;
+  EXPECT_THROW(pm.StepResponse(0), InvalidArgument);
+}
+
+TEST(PredictionModelTest, DynamicMatrixOfThePaperTuning) {
+  const PredictionModel pm(PaperFopdt(), kTs);
+  const Eigen::MatrixXd A = pm.DynamicMatrix(126, 5);
+  EXPECT_EQ(A, DynamicMatrix(pm.StepResponse(126), 126, 5));
+  EXPECT_EQ(A, DynamicMatrix(StepResponseCoefficients(PaperFopdt(), kTs, 126), 126, 5));
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A.transpose() * A,
+                                                           Eigen::EigenvaluesOnly);
+  EXPECT_NEAR(eig.eigenvalues().maxCoeff() / 500.0, 2.250797, 1e-5);  // gen_dmc_reference.py
+  EXPECT_THAT([&] { pm.DynamicMatrix(4, 5); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("1 <= M <= P")));
+}
+
+TEST(PredictionModelTest, DiscreteModelIsUsedAtItsOwnSampleTime) {
+  const PredictionModel pm(PaperArxModel(), kTs);
+  EXPECT_EQ(pm.sampled().num(), PaperArxModel().num());
+  EXPECT_EQ(pm.sampled().den(), PaperArxModel().den());
+  EXPECT_NEAR(pm.StepResponse(400)(400), 1.59796, 1e-4);  // docs/paper.md, reference value 2
+  EXPECT_THAT([] { PredictionModel(PaperArxModel(), 0.02); },
+              ::testing::ThrowsMessage<InvalidArgument>(
+                  ::testing::HasSubstr("the controller runs at Ts = 0.02 s")));
+  EXPECT_THAT([] { PredictionModel(PaperFopdt(), -1.0); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("Ts = -1")));
+}
+
+TEST(PredictionModelTest, SettlingHorizonRejectsUnstableModels) {
+  const PredictionModel unstable(TransferFunction::Continuous({1.0}, {1.0, -1.0}), kTs);
+  EXPECT_FALSE(unstable.IsStable());
+  EXPECT_THAT([&] { unstable.SettlingHorizon(); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("not stable")));
+  const PredictionModel pm(PaperFopdt(), kTs);
+  const int N = pm.SettlingHorizon();
+  const Eigen::VectorXd s = pm.StepResponse(N);
+  EXPECT_LE(std::abs(s(N) - 1.6), 1e-9 * 1.6);
+  EXPECT_GT(std::abs(pm.StepResponse(N - 1)(N - 1) - 1.6), 1e-9 * 1.6);
+}
+
+// One design, one sampled model: tuning, DMC and GPC built from the same
+// PredictionModel give exactly what each gave when it sampled the model
+// itself (the paper's P = 126, lambda = 2.2508).
+TEST(PredictionModelTest, OneSampledModelServesTuningDmcAndGpc) {
+  const PredictionModel pm(PaperFopdt(), kTs);
+  TuningOptions to;
+  to.M = 5;
+  const TuningResult shared = Tune(pm, to);
+  const TuningResult own = Tune(PaperFopdt(), kTs, to);
+  EXPECT_EQ(shared.P, 126);
+  EXPECT_NEAR(shared.lambda, 2.2508, 5e-5);
+  EXPECT_EQ(shared.P, own.P);
+  EXPECT_EQ(shared.lambda, own.lambda);
+  EXPECT_EQ(shared.Ts, kTs);
+
+  DmcOptions d;
+  d.P = shared.P;
+  d.M = shared.M;
+  d.lambda = shared.lambda;
+  const DmcController dmc_shared(pm, d);
+  const DmcController dmc_own(PaperFopdt(), kTs, d);
+  const DmcController dmc_sampled(pm.sampled(), kTs, d);  // discrete: used as is
+  EXPECT_EQ(dmc_shared.step_coefficients(), dmc_own.step_coefficients());
+  EXPECT_EQ(dmc_shared.step_coefficients(), dmc_sampled.step_coefficients());
+  EXPECT_EQ(dmc_shared.gain(), dmc_own.gain());
+  EXPECT_EQ(dmc_shared.dynamic_matrix(), pm.DynamicMatrix(d.P, d.M));
+  EXPECT_EQ(dmc_shared.Ts(), kTs);
+
+  GpcOptions g;
+  g.N2 = shared.P;
+  g.Nu = shared.M;
+  g.lambda = shared.lambda;
+  const GpcController gpc(pm, g);
+  EXPECT_LT((gpc.dynamic_matrix() - pm.DynamicMatrix(g.N2, g.Nu)).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((gpc.gain() - dmc_shared.gain()).cwiseAbs().maxCoeff(), 1e-9);
+  const CarimaModel c = ToCarima(pm);
+  EXPECT_EQ(c.Ts, kTs);
+  EXPECT_EQ(c.A, ToCarima(PaperFopdt(), kTs).A);
+}
+
+TEST(PredictionModelTest, FactoryDesignsFromOneSampledModel) {
+  const PredictionModel pm(PaperFopdt(), kTs);
+  for (ControllerType type : {ControllerType::kDmc, ControllerType::kGpc}) {
+    ControllerSpec spec;
+    spec.type = type;
+    spec.tuning.M = 5;
+    const BuiltController shared = MakeController(pm, spec);
+    const BuiltController own = MakeController(PaperFopdt(), kTs, spec);
+    EXPECT_EQ(shared.tuning.P, 126);
+    EXPECT_EQ(shared.tuning.lambda, own.tuning.lambda);
+    EXPECT_EQ(shared.controller->Describe(), own.controller->Describe());
+    EXPECT_EQ(shared.controller->Ts(), kTs);
+  }
+  ControllerSpec pid;
+  pid.type = ControllerType::kPid;
+  const BuiltController p = MakeController(pm, pid);
+  EXPECT_EQ(p.fopdt.method, "exact");
+  EXPECT_NEAR(p.fopdt.tau, 0.245, 1e-12);
+}
+
+}  // namespace
+}  // namespace pneumid
