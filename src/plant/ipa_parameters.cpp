@@ -1,6 +1,9 @@
 // TOML loader of the IPA parameters (config/ipa_default.toml documents every key).
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -117,7 +120,11 @@ IpaParameters LoadIpaParameters(const std::string& path) {
         if (!node.is_integer())
           throw DataError(
               fmt::format("{}: key '{}': expected an integer", Where(path, node), full));
-        p.*(k.field) = static_cast<int>(*node.value<std::int64_t>());
+        const std::int64_t v = node.as_integer()->get();
+        if (!std::in_range<int>(v))
+          throw DataError(fmt::format("{}: key '{}': {} is out of range for an integer (at most {})",
+                                      Where(path, node), full, v, std::numeric_limits<int>::max()));
+        p.*(k.field) = static_cast<int>(v);
       }
       if (full == "simulation.mode" || full == "simulation.pwm_mode") {
         known = true;

@@ -270,12 +270,12 @@ class FileSignal final : public Signal {
         s_(s) {
     LoadOptions options;
     options.time_column = time_column_;
-    options.input_columns = {};
-    options.output_columns = {column_};
+    options.input_columns = {column_};  // errors then speak of an input column
+    options.output_columns = {};
     const Dataset data = LoadDataset(path_, options);
     if (data.size() < 1) throw DataError(fmt::format("{}: no samples", path_));
     time_.assign(data.time().data(), data.time().data() + data.size());
-    const Eigen::VectorXd v = data.y(0);
+    const Eigen::VectorXd v = data.u(0);
     value_.assign(v.data(), v.data() + v.size());
   }
   double operator()(double t) const override {

@@ -1,7 +1,10 @@
 #include "pneumid/realtime/realtime_config.hpp"
 
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -32,7 +35,13 @@ struct Reader {
       *out = n->as_string()->get();
     } else if constexpr (std::is_integral_v<T>) {
       if (!n->is_integer()) Fail(*n, fmt::format("[{}] {} must be an integer", section, key));
-      *out = static_cast<T>(n->as_integer()->get());
+      const std::int64_t v = n->as_integer()->get();
+      if (!std::in_range<T>(v)) {
+        Fail(*n, fmt::format("[{}] {} = {} is out of range (at most {}, at least {})", section,
+                             key, v, std::numeric_limits<T>::max(),
+                             std::numeric_limits<T>::min()));
+      }
+      *out = static_cast<T>(v);
     } else {
       if (!n->is_number()) Fail(*n, fmt::format("[{}] {} must be a number", section, key));
       *out = n->is_integer() ? static_cast<double>(n->as_integer()->get())

@@ -283,6 +283,10 @@ TEST(IpaParametersTest, BadFilesNameTheKey) {
   EXPECT_THAT(load_error("[simulation]\nmode = \"speed\"\n"), HasSubstr("simulation.mode"));
   EXPECT_THAT(load_error("[cylinder\nbore = 1\n"), HasSubstr("ipa_params_test.toml:1:"));
   EXPECT_THAT(load_error("[sensors]\nadc_bits = 12.5\n"), HasSubstr("expected an integer"));
+  // 4294967308 = 2^32 + 12 would wrap to 12 bits in an int.
+  EXPECT_THAT(load_error("[sensors]\nadc_bits = 4294967308\n"),
+              HasSubstr("ipa_params_test.toml:2:12: key 'sensors.adc_bits': 4294967308 is out of "
+                        "range for an integer"));
   const std::string ok =
       load_error("[pwm]\nfrequency = 100\n[simulation]\npwm_mode = \"averaged\"\n");
   EXPECT_EQ(ok, "no error");

@@ -173,6 +173,24 @@ TEST(SignalTest, FileInputIsHeldBetweenSamples) {
   std::remove(path.c_str());
 }
 
+TEST(SignalTest, FileInputErrorsNameTheFileAndTheInputColumn) {
+  // A missing file is "no such file", whatever its name ends with.
+  EXPECT_THAT([] { ParseSignal("file:/nonexistent"); },
+              ::testing::ThrowsMessage<DataError>(
+                  HasSubstr("/nonexistent: cannot open: No such file or directory")));
+  const std::string path = std::string(PNEUMID_BINARY_DIR) + "/signal_test_columns.csv";
+  {
+    std::ofstream out(path);
+    out << "t,u\n0,1\n1,2\n";
+  }
+  // The column feeds the plant input: the error must not call it an output.
+  EXPECT_THAT([&] { ParseSignal("file:" + path + ",col=p"); },
+              ::testing::ThrowsMessage<DataError>(
+                  ::testing::AllOf(HasSubstr("unknown input column 'p'"),
+                                   ::testing::Not(HasSubstr("output")))));
+  std::remove(path.c_str());
+}
+
 TEST(SignalTest, BadSpecsGiveClearErrors) {
   auto expect_error = [](const std::string& spec, const std::string& fragment) {
     try {

@@ -55,5 +55,22 @@ TEST(RealtimeConfig, ErrorsNameFileLineAndColumn) {
   EXPECT_THROW(LoadRealtimeConfig("/nonexistent/rt.toml"), DataError);
 }
 
+TEST(RealtimeConfig, IntegersOutOfRangeAreRejectedNotWrapped) {
+  auto message = [](const std::string& text) {
+    try {
+      ParseRealtimeConfig(text, "rt.toml");
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // 4294967376 = 2^32 + 80 wrapped to a valid priority of 80 before.
+  EXPECT_THAT(message("[loop]\npriority = 4294967376\n"),
+              HasSubstr("rt.toml:2:12: [loop] priority = 4294967376 is out of range"));
+  EXPECT_THAT(message("[loop]\ncpu = -9223372036854775807\n"),
+              HasSubstr("[loop] cpu = -9223372036854775807 is out of range"));
+  EXPECT_THAT(message("[loop]\npriority = 80\ncpu = 1\n"), "no error");
+}
+
 }  // namespace
 }  // namespace pneumid
