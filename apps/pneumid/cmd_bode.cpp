@@ -1,6 +1,7 @@
 // pneumid bode: frequency response and stability margins of a model.
 //
 //   pneumid bode --model fopdt-paper [--w-min 0.1 --w-max 1000 --points 50] [--json]
+//                [--plot bode.svg]
 #include <cmath>
 #include <iostream>
 
@@ -9,8 +10,11 @@
 
 #include "command.hpp"
 #include "model_options.hpp"
+#include "output_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/frequency.hpp"
+#include "pneumid/report/figures.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -19,13 +23,10 @@ struct BodeOptions {
   ModelOptions model;
   double w_min = 0.0;
   double w_max = 0.0;
-  int points = 50;
+  int points = 0;  ///< 0: 50 over --w-min..--w-max, else the automatic grid
   bool json = false;
+  std::string plot;
 };
-
-nlohmann::json Number(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
 
 void Run(const BodeOptions& o) {
   const TransferFunction g = ResolveModel(o.model);
@@ -35,11 +36,23 @@ void Run(const BodeOptions& o) {
     PNEUMID_CHECK(o.w_min > 0.0 && o.w_max > o.w_min,
                   "--w-min and --w-max must satisfy 0 < w-min < w-max (rad/s), got {} and {}",
                   o.w_min, o.w_max);
-    PNEUMID_CHECK(o.points >= 2, "--points must be >= 2, got {}", o.points);
-    omega = LogSpace(std::log10(o.w_min), std::log10(o.w_max), o.points);
+    omega = LogSpace(std::log10(o.w_min), std::log10(o.w_max), o.points > 0 ? o.points : 50);
+  } else if (o.points > 0) {
+    // --points alone: that many frequencies over the automatic range.
+    const Eigen::VectorXd automatic = Bode(g).omega;
+    omega = LogSpace(std::log10(automatic[0]), std::log10(automatic[automatic.size() - 1]),
+                     o.points);
   }
   const BodeData b = Bode(g, omega);
   const Margins m = ComputeMargins(g);
+  if (!o.plot.empty()) {
+    // The figure over the range of the table, on a grid of at least 400 frequencies.
+    const Eigen::VectorXd w =
+        LogSpace(std::log10(b.omega[0]), std::log10(b.omega[b.omega.size() - 1]),
+                 std::max<int>(400, static_cast<int>(b.omega.size())));
+    const std::string label = ModelLabel(o.model, g);
+    BodeFigure({{label, g}}, w, "Bode diagram of " + label).Save(o.plot);
+  }
   if (o.json) {
     nlohmann::ordered_json j;
     j["omega"] = std::vector<double>(b.omega.data(), b.omega.data() + b.omega.size());
@@ -48,12 +61,13 @@ void Run(const BodeOptions& o) {
     j["phase_deg"] =
         std::vector<double>(b.phase_deg.data(), b.phase_deg.data() + b.phase_deg.size());
     nlohmann::ordered_json mj;
-    mj["gain_margin"] = Number(m.gain_margin);
-    mj["gain_margin_db"] = Number(m.gain_margin_db);
-    mj["phase_crossover"] = Number(m.phase_crossover);
-    mj["phase_margin"] = Number(m.phase_margin);
-    mj["gain_crossover"] = Number(m.gain_crossover);
+    mj["gain_margin"] = JsonNumber(m.gain_margin);
+    mj["gain_margin_db"] = JsonNumber(m.gain_margin_db);
+    mj["phase_crossover"] = JsonNumber(m.phase_crossover);
+    mj["phase_margin"] = JsonNumber(m.phase_margin);
+    mj["gain_crossover"] = JsonNumber(m.gain_crossover);
     j["margins"] = mj;
+    if (!o.plot.empty()) j["plot"] = o.plot;
     std::cout << j.dump() << "\n";
     return;
   }
@@ -67,6 +81,7 @@ void Run(const BodeOptions& o) {
                            m.gain_margin_db, m.phase_crossover);
   std::cout << fmt::format("phase margin: {:.6g} deg at {:.6g} rad/s\n", m.phase_margin,
                            m.gain_crossover);
+  if (!o.plot.empty()) std::cout << "plot written to " << o.plot << "\n";
 }
 
 const Registrar reg("bode",
@@ -75,14 +90,19 @@ const Registrar reg("bode",
                       auto o = std::make_shared<BodeOptions>();
                       AddModelOptions(app, o->model);
                       app.add_option("--w-min", o->w_min,
-                                     "Lowest frequency in rad/s (default: from the poles/zeros)");
+                                     "Lowest frequency in rad/s (default: from the poles/zeros)")
+                          ->check(Positive());
                       app.add_option("--w-max", o->w_max,
-                                     "Highest frequency in rad/s (discrete: at most pi/Ts)");
-                      app.add_option("--points", o->points, "Number of log-spaced frequencies")
-                          ->capture_default_str();
+                                     "Highest frequency in rad/s (discrete: at most pi/Ts)")
+                          ->check(Positive());
+                      app.add_option("--points", o->points,
+                                     "Number of log-spaced frequencies (default: 50 from --w-min "
+                                     "to --w-max, else the automatic grid)")
+                          ->check(AtLeast(2));
                       app.add_flag("--json", o->json,
                                    "Print {\"omega\", \"magnitude_db\", \"phase_deg\", "
                                    "\"margins\"} instead");
+                      AddPlotOption(app, o->plot, "magnitude and phase");
                       app.callback([o] { Run(*o); });
                     });
 

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "validators.hpp"
 #include "model_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/conversion.hpp"
@@ -85,15 +86,17 @@ const Registrar reg(
       app.add_option("--to", o->to, "Target domain: continuous or discrete")
           ->required()
           ->check(CLI::IsMember({"continuous", "discrete"}));
-      app.add_option("--method", o->method,
+      app.add_option("-m,--method,--methods", o->method,
                      "zoh, foh, tustin (bilinear), euler (forward_diff), backward_diff, matched; "
                      "d2c: zoh or tustin")
           ->capture_default_str();
       app.add_option("--Ts", o->Ts,
                      "Sample time in s: of the --num/--den model for --to continuous, the target "
-                     "for --to discrete");
+                     "for --to discrete")
+          ->check(NonNegative());
       app.add_option("--prewarp", o->prewarp, "Tustin prewarp frequency in rad/s (0 = none)")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(NonNegative());
       app.add_flag("--json", o->json,
                    "Print {\"num\", \"den\", \"Ts\", \"delay\"} (monic denominator) instead");
       app.callback([o] { Run(*o); });

@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "validators.hpp"
+#include "realtime_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/data/load.hpp"
@@ -34,21 +36,9 @@ struct ExperimentOptions {
   // staircase
   std::string levels = "0 20 40 60 40 20";
   double dwell = 1.5;
-  // run
-  std::string io = "sim";
-  std::string config;
-  std::string plant;
-  std::uint64_t seed = 1;
-  std::optional<double> noise;
-  double duration = 4.0;
-  double period = 0.01;
-  bool fast = false;
-  bool no_realtime = false;
-  std::string safe_state;
-  int max_overruns = 10;
+  // run: --io, --config, --plant, --Ts, --duration, --log, --json, ...
+  RealtimeOptions rt;
   std::string output;
-  std::string log;
-  bool json = false;
 };
 
 std::string InputSpec(const ExperimentOptions& o) {
@@ -56,7 +46,7 @@ std::string InputSpec(const ExperimentOptions& o) {
   if (o.kind == "step") return fmt::format("step:from={:g},to={:g},at={:g}", o.from, o.to, o.at);
   if (o.kind == "prbs")
     return fmt::format("prbs:low={:g},high={:g},order={},clock={:g},seed={}", o.low, o.high,
-                       o.order, o.clock, o.seed);
+                       o.order, o.clock, o.rt.seed);
   if (o.kind == "staircase")
     return fmt::format("staircase:levels={},dwell={:g}", o.levels, o.dwell);
   throw InvalidArgument(fmt::format(
@@ -64,21 +54,9 @@ std::string InputSpec(const ExperimentOptions& o) {
 }
 
 void Run(const ExperimentOptions& o, CLI::App& app) {
-  RealtimeConfig config = o.config.empty() ? RealtimeConfig{} : LoadRealtimeConfig(o.config);
-  if (app.count("--io") || o.config.empty()) config.io = o.io;
-  if (!o.plant.empty()) config.plant = o.plant;
-  if (app.count("--duration") || o.config.empty()) config.loop.duration = o.duration;
-  if (app.count("--period") || o.config.empty()) config.loop.period = o.period;
-  if (o.fast) config.loop.fast = true;
-  if (o.no_realtime) config.loop.realtime = false;
-  if (!o.safe_state.empty()) config.safety.safe_state = SafeStateFromString(o.safe_state);
-  if (app.count("--max-overruns")) config.safety.max_overruns = o.max_overruns;
+  const RealtimeConfig config = ResolveRealtimeConfig(o.rt, app);
   PNEUMID_CHECK(!o.output.empty(), "-o/--output is required");
-
   const IoSpec spec = ParseIoSpec(config.io);
-  PNEUMID_CHECK(!config.loop.fast || spec.kind == IoKind::kSim,
-                "--fast runs the simulator as fast as possible; it needs --io sim, got '{}'",
-                config.io);
   const std::string input_spec = InputSpec(o);
   const auto signal = ParseSignal(input_spec);
   const std::int64_t n = config.loop.Samples();
@@ -86,12 +64,9 @@ void Run(const ExperimentOptions& o, CLI::App& app) {
   std::vector<double> input(u.data(), u.data() + u.size());
   OpenLoopInput controller(input, "open loop: " + signal->ToString());
 
-  PlantOptions plant_options;
-  plant_options.seed = o.seed;
-  plant_options.noise_sigma = o.noise;
-  auto io = MakeIoBackend(spec, config, plant_options);
+  auto io = MakeIoBackend(spec, config, SimulatedPlantOptions(o.rt));
 
-  const bool to_mat = o.output.size() > 4 && o.output.substr(o.output.size() - 4) == ".mat";
+  const bool to_mat = IsMatPath(o.output);
   SessionOptions so;
   so.loop = config.loop;
   so.safety = config.safety;
@@ -99,10 +74,10 @@ void Run(const ExperimentOptions& o, CLI::App& app) {
   // CSV: the data set is streamed (t,u,y); .mat: the records are kept and written at the
   // end, with --log streaming the full log meanwhile.
   so.log.format = to_mat ? LogFormat::kCsv : LogFormat::kDataset;
-  so.log_path = to_mat ? o.log : o.output;
-  so.keep_records = to_mat || !o.log.empty();
+  so.log_path = to_mat ? o.rt.log : o.output;
+  so.keep_records = to_mat || !o.rt.log.empty();
   so.header.emplace_back("experiment", input_spec);
-  so.live_status = StderrIsTerminal() && !o.json;
+  so.live_status = StderrIsTerminal() && !o.rt.json;
   const SessionResult r = RunSession(so, *io, controller, {});
   const LoopSummary& s = r.summary;
 
@@ -117,15 +92,15 @@ void Run(const ExperimentOptions& o, CLI::App& app) {
       }
       PNEUMID_CHECK(t.size() >= 2, "the run ended after {} samples: nothing to write to {}",
                     t.size(), o.output);
-      SaveDataset(Dataset(t, uu, yy, {{"u", "%"}}, {{"y", "N"}}), o.output);
+      SaveDataset(Dataset(t, uu, yy, {io->actuator().input}, {io->actuator().output}), o.output);
     } else {
-      LogWriter full(o.log, {{"experiment", input_spec}, {"io", io->Describe()}});
+      LogWriter full(o.rt.log, {{"experiment", input_spec}, {"io", io->Describe()}});
       for (const auto& rec : r.records) full.Push(rec);
       full.Close(s.timing.BriefReport(), std::string(ToString(s.termination)) + ": " + s.message);
     }
   }
 
-  if (o.json) {
+  if (o.rt.json) {
     nlohmann::json j = s.ToJson();
     j["output"] = o.output;
     j["rows"] = to_mat ? static_cast<std::int64_t>(r.records.size()) : r.log_rows;
@@ -138,10 +113,7 @@ void Run(const ExperimentOptions& o, CLI::App& app) {
                              io->Describe(), input_spec);
     std::cout << fmt::format("{}\n{}\n{}\n", s.message, s.timing.BriefReport(), s.scheduling);
   }
-  if (s.termination != LoopTermination::kCompleted) {
-    std::cerr << "pneumid experiment: " << ToString(s.termination) << ": " << s.message << "\n";
-    throw ExitCode{s.ExitStatus()};
-  }
+  FinishSession("experiment", s);
 }
 
 }  // namespace
@@ -158,38 +130,28 @@ static Registrar reg(
                      "input signal spec (overrides the kind's flags)\n" + SignalSyntaxHelp());
       app.add_option("--from", o->from, "step: initial duty (%)")->capture_default_str();
       app.add_option("--to", o->to, "step: final duty (%)")->capture_default_str();
-      app.add_option("--at", o->at, "step: time of the step (s)")->capture_default_str();
+      app.add_option("--at", o->at, "step: time of the step (s)")
+          ->capture_default_str()
+          ->check(NonNegative());
       app.add_option("--low", o->low, "prbs: low level (%)")->capture_default_str();
       app.add_option("--high", o->high, "prbs: high level (%)")->capture_default_str();
       app.add_option("--order", o->order, "prbs: shift-register order")->capture_default_str();
-      app.add_option("--clock", o->clock, "prbs: clock period (s)")->capture_default_str();
+      app.add_option("--clock", o->clock, "prbs: clock period (s)")
+          ->capture_default_str()
+          ->check(Positive());
       app.add_option("--levels", o->levels, "staircase: levels (%), space separated")
           ->capture_default_str();
-      app.add_option("--dwell", o->dwell, "staircase: time per level (s)")->capture_default_str();
-      app.add_option("--io", o->io, "backend: sim, comedi:/dev/comediN or udp://HOST:PORT")
-          ->capture_default_str();
-      app.add_option("--config", o->config, "real-time TOML configuration (flags override it)");
-      app.add_option("--plant", o->plant,
-                     "plant of the sim backend (default ipa)\n" + PlantSpecHelp());
-      app.add_option("--seed", o->seed, "noise seed of the simulated plant and PRBS")
-          ->capture_default_str();
-      app.add_option("--noise", o->noise,
-                     "measurement noise of the simulated plant (output units)");
-      app.add_option("--duration", o->duration, "s")->capture_default_str();
-      app.add_option("--period", o->period, "loop period (s), 0.0001 .. 10 (default 10 ms)")
-          ->capture_default_str();
-      app.add_flag("--fast", o->fast, "sim only: as fast as possible instead of real time");
-      app.add_flag("--no-realtime", o->no_realtime,
-                   "do not ask for SCHED_FIFO/mlockall/pinning (normal priority)");
-      app.add_option("--safe-state", o->safe_state, "valves-closed (default) or exhaust-open")
-          ->check(CLI::IsMember({"valves-closed", "exhaust-open"}));
-      app.add_option("--max-overruns", o->max_overruns,
-                     "deadline overruns tolerated before the fault stop (-1: never)")
-          ->capture_default_str();
+      app.add_option("--dwell", o->dwell, "staircase: time per level (s)")
+          ->capture_default_str()
+          ->check(Positive());
+      o->rt.duration = 4.0;
+      RealtimeHelp help;
+      help.plant = "plant of the sim backend (default ipa)\n" + PlantSpecHelp();
+      help.seed = "noise seed of the simulated plant and PRBS";
+      help.log = "also write the full real-time log (CSV) here";
+      AddRealtimeOptions(app, o->rt, help);
       app.add_option("-o,--output", o->output, "data set to write (.csv streamed, or .mat)")
           ->required();
-      app.add_option("--log", o->log, "also write the full real-time log (CSV) here");
-      app.add_flag("--json", o->json, "print the run summary as JSON");
       app.callback([o, &app] { Run(*o, app); });
     });
 

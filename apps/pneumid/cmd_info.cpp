@@ -8,6 +8,7 @@
 
 #include "command.hpp"
 #include "data_options.hpp"
+#include "validators.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/data/preprocess.hpp"
@@ -48,7 +49,7 @@ void Run(const InfoOptions& o) {
   PNEUMID_CHECK(o.window.empty() || o.window.size() == 2,
                 "--window takes two times T0,T1 in seconds, got {} values", o.window.size());
   PNEUMID_CHECK(o.save.empty() || !o.window.empty() || o.resample >= 0 || o.decimate > 1,
-                "--save writes preprocessed data: give --window, --resample or --decimate");
+                "-o/--output (--save) writes preprocessed data: give --window, --resample or --decimate");
 
   const LoadOptions load = ToLoadOptions(o.data);
   Dataset data = LoadDataset(o.data.path, load);
@@ -107,7 +108,7 @@ void Run(const InfoOptions& o) {
     max_dt = dt.maxCoeff();
   }
   const std::string resample_hint =
-      fmt::format("pneumid info {} --resample {:g} --save {}", o.data.path, Tnom,
+      fmt::format("pneumid info {} --resample {:g} -o {}", o.data.path, Tnom,
                   o.data.path.substr(0, o.data.path.find_last_of('.')) + "_uniform.csv");
 
   std::vector<ChannelStats> stats;
@@ -236,17 +237,20 @@ static Registrar reg(
       app.add_flag("--json", o->json, "Print the summary as JSON");
       app.add_option("--tolerance", o->tolerance,
                      "Relative tolerance of uniform sampling (fraction of the median interval)")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(NonNegative());
       app.add_flag("--strict", o->strict, "Exit with an error when the sampling is not uniform");
       app.add_option("--window", o->window, "Keep only samples with T0 <= t <= T1 (seconds)")
           ->delimiter(',')
           ->expected(2);
       app.add_option("--resample", o->resample,
                      "Resample to a uniform grid with this sample time in s (0: the median "
-                     "interval), by linear interpolation");
+                     "interval), by linear interpolation")
+          ->check(NonNegative());
       app.add_option("--decimate", o->decimate,
-                     "Keep every Q-th sample after a zero-phase anti-alias low-pass");
-      app.add_option("--save", o->save,
+                     "Keep every Q-th sample after a zero-phase anti-alias low-pass")
+          ->check(AtLeast(1));
+      app.add_option("-o,--output,--save", o->save,
                      "Write the preprocessed data to this file (.csv .tsv .txt .dat or .mat)");
       app.footer(
           "Errors (NaN/Inf, non-numeric cells, ragged rows, time not increasing, unknown\n"

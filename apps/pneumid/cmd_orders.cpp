@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "validators.hpp"
 #include "data_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/order_selection.hpp"
@@ -84,7 +85,8 @@ static Registrar reg(
       app.add_option("--split", args->split,
                      "Estimate on the first fraction of the data and measure the loss on the "
                      "rest, e.g. 0.7 (default: all data, loss on the estimation data)");
-      app.add_option("--top", args->top, "Print only the N best candidates by MDL (0 = all)");
+      app.add_option("--top", args->top, "Print only the N best candidates by MDL (0 = all)")
+          ->check(AtLeast(0));
       app.add_flag("--json", args->json, "Print the table and the best orders as JSON");
       app.callback([args] { Run(*args); });
     });

@@ -51,7 +51,7 @@ const pneumid::cli::Registrar reg(
     "Figures 4-6",
     [](CLI::App& app) {
       auto a = std::make_shared<PaperArgs>();
-      app.add_option("-o,--output-dir", a->out_dir,
+      app.add_option("--output-dir,-o", a->out_dir,
                      "Directory for fig4/fig5/fig6 .png and .svg (created when missing)")
           ->capture_default_str();
       app.add_flag("--json", a->json,

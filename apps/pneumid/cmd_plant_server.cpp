@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "command.hpp"
+#include "validators.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/realtime/plant_server.hpp"
@@ -69,10 +70,13 @@ static Registrar reg(
       app.add_option("--port", o->port, "UDP port (0: any free port, printed)")
           ->capture_default_str();
       app.add_option("--bind", o->bind, "numeric address to listen on")->capture_default_str();
-      app.add_option("--Ts", o->Ts, "sample period of the plant (s); clients must use the same")
-          ->capture_default_str();
+      app.add_option("--Ts,--period,--sample-time", o->Ts,
+                     "sample period of the plant (s); clients must use the same")
+          ->capture_default_str()
+          ->check(Positive());
       app.add_option("--seed", o->seed, "noise seed")->capture_default_str();
-      app.add_option("--noise", o->noise, "measurement noise (output units)");
+      app.add_option("--noise", o->noise, "measurement noise (output units)")
+          ->check(NonNegative());
       app.add_option("--stop-answering-after", o->stop_answering_after,
                      "fault drill: go silent after this many steps (-1: never)")
           ->capture_default_str();

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "validators.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/csv.hpp"
 #include "pneumid/plant/experiment.hpp"
@@ -152,13 +153,17 @@ static Registrar reg(
           ->capture_default_str();
       app.add_option("--input", o->input, "Input signal spec (see below)")->capture_default_str();
       app.add_option("--duration", o->duration, "Length of the experiment in s")
-          ->capture_default_str();
-      app.add_option("--Ts", o->Ts, "Sample period in s")->capture_default_str();
+          ->capture_default_str()
+          ->check(Positive());
+      app.add_option("--Ts,--sample-time", o->Ts, "Sample period in s")
+          ->capture_default_str()
+          ->check(Positive());
       app.add_option("--seed", o->seed, "Seed of the noise generators (runs are reproducible)")
           ->capture_default_str();
       app.add_option("--noise", o->noise,
                      "Measurement noise standard deviation in output units (N or m for the IPA, "
-                     "replacing its configured sensor noise; default: none for linear models)");
+                     "replacing its configured sensor noise; default: none for linear models)")
+          ->check(NonNegative());
       app.add_option("--plant-config", o->plant_config,
                      "IPA parameter file (TOML, see config/ipa_default.toml)");
       app.add_option("--mode", o->mode,

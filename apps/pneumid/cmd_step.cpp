@@ -1,8 +1,9 @@
 // pneumid step: step-response metrics of a model (MATLAB stepinfo definitions).
 //
-//   pneumid step --model arx-paper-ct [--json] [--t-final T]
+//   pneumid step --model arx-paper-ct [--json] [--t-final T] [--plot step.png]
 //   pneumid step --num 1 --den 0.245,1 --delay 0.001
 #include <cmath>
+#include <complex>
 #include <iostream>
 #include <limits>
 
@@ -11,8 +12,11 @@
 
 #include "command.hpp"
 #include "model_options.hpp"
+#include "output_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/response.hpp"
+#include "pneumid/report/figures.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -24,10 +28,42 @@ struct StepOptions {
   double settling_threshold = 0.02;
   std::vector<double> rise_limits = {0.1, 0.9};
   bool json = false;
+  std::string plot;
 };
 
-nlohmann::json Number(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+// "Step response of MODEL" on a generic output axis.
+void WritePlot(const StepOptions& o, const TransferFunction& g) {
+  StepFigureOptions fo;
+  fo.t_final = o.t_final;
+  fo.dt = o.dt;
+  fo.title = "Step response of " + ModelLabel(o.model, g);
+  fo.labels.output = "Output y (unit step input)";
+  StepResponseFigure({{ModelLabel(o.model, g), g}}, fo).Save(o.plot);
+}
+
+// "pole 1.2 outside the unit circle" / "pole 0.5 in the closed right half-plane".
+std::string UnstablePole(const TransferFunction& g) {
+  const Eigen::VectorXcd p = g.Poles();
+  Eigen::Index worst = 0;
+  for (Eigen::Index i = 1; i < p.size(); ++i) {
+    const bool worse = g.IsDiscrete() ? std::abs(p[i]) > std::abs(p[worst])
+                                      : p[i].real() > p[worst].real();
+    if (worse) worst = i;
+  }
+  if (p.size() == 0) return "no poles";
+  const std::string hint =
+      g.Order() > 20 ? fmt::format("; the roots of a polynomial of order {} are ill-conditioned: "
+                                   "give the model in factored or state-space form",
+                                   g.Order())
+                     : "";
+  if (!p.allFinite()) return "its poles cannot be computed" + hint;
+  const std::complex<double> z = p[worst];
+  const std::string value = std::abs(z.imag()) > 1e-12 * std::max(1.0, std::abs(z))
+                                ? fmt::format("{:.6g}{:+.6g}j", z.real(), z.imag())
+                                : fmt::format("{:.6g}", z.real());
+  return (g.IsDiscrete() ? fmt::format("pole {} with |z| = {:.6g} >= 1", value, std::abs(z))
+                         : fmt::format("pole {} with real part >= 0", value)) +
+         hint;
 }
 
 void Run(const StepOptions& o) {
@@ -40,6 +76,17 @@ void Run(const StepOptions& o) {
   so.rise_high = o.rise_limits[1];
   std::string error;
   PNEUMID_CHECK(so.IsValid(&error), "{}", error);
+  if (!g.IsStable()) {
+    // A growing response has no rise or settling time; a finite horizon can still be drawn.
+    const bool plotted = !o.plot.empty() && o.t_final > 0.0;
+    if (plotted) WritePlot(o, g);
+    throw InvalidArgument(fmt::format(
+        "the model is not stable ({}): its step response does not settle and the step "
+        "metrics are undefined{}",
+        UnstablePole(g),
+        plotted ? fmt::format(" (the response up to {} s is plotted in {})", o.t_final, o.plot)
+                : "; --t-final T --plot FILE draws the response over a finite horizon"));
+  }
   StepInfo info;
   if (o.t_final == 0.0 && o.dt == 0.0) {
     info = ComputeStepInfo(g, so);
@@ -49,17 +96,23 @@ void Run(const StepOptions& o) {
     if (g.IsStable()) so.y_final = g.DcGain();
     info = ComputeStepInfo(r.t, r.y, so);
   }
+  if (!o.plot.empty()) WritePlot(o, g);
+  PNEUMID_CHECK(!std::isnan(info.settling_time) || g.DcGain() == 0.0,
+                "the step response has not settled within the simulated horizon{}: the "
+                "metrics are undefined; give a longer --t-final",
+                o.t_final > 0.0 ? fmt::format(" of {} s", o.t_final) : "");
   if (o.json) {
     nlohmann::ordered_json j;
-    j["rise_time"] = Number(info.rise_time);
-    j["settling_time"] = Number(info.settling_time);
-    j["settling_min"] = Number(info.settling_min);
-    j["settling_max"] = Number(info.settling_max);
-    j["overshoot"] = Number(info.overshoot);
-    j["undershoot"] = Number(info.undershoot);
-    j["peak"] = Number(info.peak);
-    j["peak_time"] = Number(info.peak_time);
-    j["steady_state"] = Number(info.steady_state);
+    j["rise_time"] = JsonNumber(info.rise_time);
+    j["settling_time"] = JsonNumber(info.settling_time);
+    j["settling_min"] = JsonNumber(info.settling_min);
+    j["settling_max"] = JsonNumber(info.settling_max);
+    j["overshoot"] = JsonNumber(info.overshoot);
+    j["undershoot"] = JsonNumber(info.undershoot);
+    j["peak"] = JsonNumber(info.peak);
+    j["peak_time"] = JsonNumber(info.peak_time);
+    j["steady_state"] = JsonNumber(info.steady_state);
+    if (!o.plot.empty()) j["plot"] = o.plot;
     std::cout << j.dump() << "\n";
     return;
   }
@@ -78,6 +131,7 @@ void Run(const StepOptions& o) {
   line("peak_time", info.peak_time, " s");
   line("steady_state", info.steady_state, "");
   if (!g.IsStable()) std::cout << "  (the model is not stable: the metrics are undefined)\n";
+  if (!o.plot.empty()) std::cout << "plot written to " << o.plot << "\n";
 }
 
 const Registrar reg(
@@ -87,10 +141,12 @@ const Registrar reg(
       AddModelOptions(app, o->model);
       app.add_option("--t-final", o->t_final,
                      "Simulated horizon in s (default 0: about 7 slowest time constants)")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(NonNegative());
       app.add_option("--dt", o->dt,
                      "Time step in s (default 0: Ts, or 1/200 of the slowest time constant)")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(NonNegative());
       app.add_option("--settling-threshold", o->settling_threshold,
                      "Settling band as a fraction of the step")
           ->capture_default_str();
@@ -100,6 +156,7 @@ const Registrar reg(
       app.add_flag("--json", o->json,
                    "Print {\"rise_time\", \"settling_time\", \"overshoot\", \"undershoot\", "
                    "\"peak\", \"peak_time\", \"steady_state\", ...} instead");
+      AddPlotOption(app, o->plot, "the step response");
       app.callback([o] { Run(*o); });
     });
 

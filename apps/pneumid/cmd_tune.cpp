@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "validators.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/model_io.hpp"
@@ -31,8 +32,6 @@ struct TuneCli {
   bool json = false;
 };
 
-nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
 void Run(const TuneCli& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   const TransferFunction model = ParseModelSpec(c.model);
@@ -44,25 +43,7 @@ void Run(const TuneCli& c) {
   o.tau_significant_digits = c.tau_digits;
   const TuningResult r = Tune(model, c.Ts, o);
   if (c.json) {
-    nlohmann::ordered_json j;
-    j["rule"] = ToString(r.rule);
-    j["P"] = r.P;
-    j["M"] = r.M;
-    j["lambda"] = r.lambda;
-    if (r.rule == TuningRule::kShridharCooper) {
-      j["lambda_source"] = std::isnan(c.lambda) ? "lambda_condition" : "explicit";
-      j["lambda_condition"] = Number(r.lambda_condition);
-      j["lambda_formula"] = Number(r.lambda_formula);
-      j["P_unrounded"] = r.P_unrounded;
-      j["tau_used"] = r.tau_used;
-      j["fopdt"] = {{"K", r.fopdt.K},
-                    {"tau", r.fopdt.tau},
-                    {"theta", r.fopdt.theta},
-                    {"method", r.fopdt.method}};
-    }
-    j["Ts"] = c.Ts;
-    j["formula"] = r.formula;
-    std::cout << j.dump(2) << "\n";
+    std::cout << r.ToJson().dump(2) << "\n";
     return;
   }
   std::cout << fmt::format("rule    {}\nP       {}\nM       {}\nlambda  {:.6g}\n", ToString(r.rule),
@@ -85,14 +66,16 @@ const Registrar reg(
       app.add_option("--model", c->model,
                      "Model spec: fopdt:K=..,tau=..,theta=.., arx-paper, tf:..., FILE.json")
           ->required();
-      app.add_option("--Ts", c->Ts, "Controller sample time in s")->required();
+      app.add_option("--Ts,--sample-time", c->Ts, "Controller sample time in s")
+          ->required()
+          ->check(Positive());
       app.add_option("--rule", c->rule,
                      "shridhar-cooper (conventional), paper-modified (P=126, M=10, lambda=1.92), "
                      "explicit (needs --P --M --lambda)")
           ->capture_default_str();
       app.add_option("--M", c->M,
                      "Control horizon (default: 5 shridhar-cooper, 10 paper-modified)");
-      app.add_option("--P", c->P, "Prediction horizon (overrides the rule)");
+      app.add_option("--P", c->P, "Prediction horizon (overrides the rule)")->check(AtLeast(1));
       app.add_option("--lambda", c->lambda, "Move suppression (overrides the rule)");
       app.add_option("--tau-digits", c->tau_digits,
                      "Significant digits tau is rounded to in the P formula (0 = none)")

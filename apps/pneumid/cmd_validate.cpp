@@ -8,7 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "validators.hpp"
 #include "data_options.hpp"
+#include "output_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/parametric_model.hpp"
 #include "pneumid/identify/residual_analysis.hpp"
@@ -171,12 +173,15 @@ static Registrar reg(
           ->required();
       AddDataOptions(app, args->data);
       app.add_option("--horizon", args->horizon,
-                     "Also report the k-step-ahead prediction fit (polynomial models)");
+                     "Also report the k-step-ahead prediction fit (polynomial models)")
+          ->check(AtLeast(1));
       app.add_option("--max-lag", args->max_lag, "Largest correlation lag of the residual tests")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(AtLeast(1));
       app.add_option("--skip", args->skip, "Initial samples left out of the fit")
-          ->capture_default_str();
-      app.add_option("--plot", args->plot, "Write data/model and residual correlations (PNG/SVG)");
+          ->capture_default_str()
+          ->check(AtLeast(0));
+      AddPlotOption(app, args->plot, "data/model and residual correlations");
       app.add_flag("--json", args->json, "Print the results as JSON");
       app.callback([args] { Run(*args); });
     });

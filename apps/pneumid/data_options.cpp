@@ -3,23 +3,13 @@
 #include <sstream>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/strings.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
 
-std::vector<std::string> SplitList(const std::string& s) {
-  std::vector<std::string> out;
-  if (s.empty()) return out;
-  std::string item;
-  std::istringstream in(s);
-  while (std::getline(in, item, ',')) {
-    const auto b = item.find_first_not_of(' ');
-    const auto e = item.find_last_not_of(' ');
-    out.push_back(b == std::string::npos ? "" : item.substr(b, e - b + 1));
-  }
-  if (!s.empty() && s.back() == ',') out.push_back("");
-  return out;
-}
+std::vector<std::string> SplitList(const std::string& s) { return Split(s, ','); }
 
 }  // namespace
 
@@ -38,10 +28,10 @@ void AddDataOptions(CLI::App& app, DataOptions& options, bool positional) {
   app.add_option("--output-col", options.output_col,
                  "Output column(s), comma-separated names or 0-based indices ('' for none)")
       ->capture_default_str();
-  app.add_option("--sample-time", options.sample_time,
+  app.add_option("--Ts,--sample-time", options.sample_time,
                  "Sample time in s for data without a time column (the time column is then "
                  "not read)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   app.add_option("--delimiter", options.delimiter,
                  "CSV delimiter: ',' ';' tab or space (default: detected from the header)");
   app.add_option("--format", options.format, "Data format: auto (from extension), csv or mat")

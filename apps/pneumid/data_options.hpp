@@ -5,7 +5,8 @@
 //   --time-col C         time column: header name or 0-based index (default t)
 //   --input-col C[,C..]  input column(s) (default u)
 //   --output-col C[,C..] output column(s) (default y)
-//   --sample-time TS     sample time in s for files without a time column
+//   --Ts TS              sample time in s for files without a time column
+//                        (alias --sample-time)
 //   --delimiter D        ',' ';' 'tab' 'space' (default: detected)
 //   --format F           auto, csv or mat (default: from the extension)
 //

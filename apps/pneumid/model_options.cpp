@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/spec.hpp"
 #include "pneumid/lti/model_io.hpp"
 
 namespace pneumid::cli {
@@ -31,29 +32,7 @@ void AddModelOptions(CLI::App& app, ModelOptions& options, bool with_ts) {
 }
 
 std::vector<double> ParseCoefficientList(const std::string& option, const std::string& text) {
-  std::vector<double> out;
-  std::size_t pos = 0;
-  int index = 0;
-  while (pos <= text.size()) {
-    const std::size_t comma = text.find(',', pos);
-    const std::size_t end = comma == std::string::npos ? text.size() : comma;
-    std::string item = text.substr(pos, end - pos);
-    const auto b = item.find_first_not_of(" \t");
-    const auto e = item.find_last_not_of(" \t");
-    item = b == std::string::npos ? "" : item.substr(b, e - b + 1);
-    double v = 0.0;
-    const char* first = item.data();
-    const char* last = item.data() + item.size();
-    if (!item.empty() && *first == '+') ++first;
-    const auto [ptr, ec] = std::from_chars(first, last, v);
-    PNEUMID_CHECK(!item.empty() && ec == std::errc() && ptr == last && std::isfinite(v),
-                  "{}: coefficient {} is not a finite number: '{}' (in '{}')", option, index + 1,
-                  item, text);
-    out.push_back(v);
-    ++index;
-    pos = end + 1;
-  }
-  return out;
+  return ParseNumberList(option, text);
 }
 
 TransferFunction ResolveModel(const ModelOptions& o) {
@@ -79,6 +58,11 @@ TransferFunction ResolveModel(const ModelOptions& o) {
   }
   if (!std::isnan(o.delay)) g = g.WithDelay(o.delay);
   return g;
+}
+
+std::string ModelLabel(const ModelOptions& options, const TransferFunction& g) {
+  if (!options.model.empty()) return options.model;
+  return fmt::format("G({}) = {}", g.IsDiscrete() ? "z" : "s", g.Normalized().ToString(4));
 }
 
 std::string DescribeModel(const TransferFunction& g, const std::string& indent) {

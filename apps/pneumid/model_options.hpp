@@ -43,6 +43,10 @@ std::vector<double> ParseCoefficientList(const std::string& option, const std::s
 ///   given, or for invalid coefficients; DataError for an unreadable model file.
 TransferFunction ResolveModel(const ModelOptions& options);
 
+/// Short name of the selected model for legends and titles: the --model spec,
+/// or "G(s) = ..." / "G(z) = ..." for --num/--den.
+std::string ModelLabel(const ModelOptions& options, const TransferFunction& g);
+
 /// Human-readable description: the transfer function, its poles (conjugate
 /// pairs as a +/- bj), DC gain and stability, one item per line, each line
 /// starting with `indent`.

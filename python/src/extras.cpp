@@ -1,6 +1,5 @@
 // Bindings of the plant and control areas, frequency responses and block
-// diagrams. (The report headers are kept out of this file: plot.hpp's struct
-// Series and interconnect.hpp's function Series share a name.)
+// diagrams.
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

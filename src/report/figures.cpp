@@ -51,15 +51,21 @@ bool StepFigureOptions::IsValid(std::string* error) const {
   return true;
 }
 
-Figure StepResponseFigure(const std::vector<NamedModel>& models, const StepFigureOptions& options,
-                          const Dataset* data) {
-  CheckModels(models, "StepResponseFigure");
+namespace {
+
+using ResponseFunction = TimeResponse (*)(const TransferFunction&, double, double);
+
+// The responses `response` (Step or Impulse) of each model, scaled by the amplitude.
+Figure ResponseFigure(const char* what, ResponseFunction response,
+                      const std::vector<NamedModel>& models, const StepFigureOptions& options,
+                      const Dataset* data) {
+  CheckModels(models, what);
   std::string error;
   PNEUMID_CHECK(options.IsValid(&error), "{}", error);
   double t_final = options.t_final;
   if (t_final == 0.0) {
     for (const auto& m : models) {
-      const TimeResponse r = Step(m.model);
+      const TimeResponse r = response(m.model, 0.0, 0.0);
       if (r.t.size() > 0) t_final = std::max(t_final, r.t[r.t.size() - 1]);
     }
     if (data && data->size() > 1)
@@ -71,22 +77,34 @@ Figure StepResponseFigure(const std::vector<NamedModel>& models, const StepFigur
   ax.xlabel = options.labels.time;
   ax.ylabel = options.labels.output;
   if (data) {
-    PNEUMID_CHECK(data->num_outputs() > 0, "StepResponseFigure: the dataset has no output");
+    PNEUMID_CHECK(data->num_outputs() > 0, "{}: the dataset has no output", what);
     const Eigen::VectorXd t = data->time().array() - data->time()[0];
     const Eigen::VectorXd y = data->y(0).array() - data->y(0)[0];
-    Series& s = ax.AddLine(t, y, "measured data");
+    Curve& s = ax.AddLine(t, y, "measured data");
     s.color = Color{60, 60, 60};
     s.width = 1.2;
   }
   int k = 0;
   for (const auto& m : models) {
-    const TimeResponse r = Step(m.model, t_final, m.model.IsDiscrete() ? 0.0 : options.dt);
-    Series& s = ax.AddLine(r.t, r.y * options.amplitude, m.label);
+    const TimeResponse r = response(m.model, t_final, m.model.IsDiscrete() ? 0.0 : options.dt);
+    Curve& s = ax.AddLine(r.t, r.y * options.amplitude, m.label);
     s.color = PaletteColor(k++);
     if (m.model.IsDiscrete()) s.stairs = true;
   }
   ax.legend = LegendPosition::kBottomRight;
   return fig;
+}
+
+}  // namespace
+
+Figure StepResponseFigure(const std::vector<NamedModel>& models, const StepFigureOptions& options,
+                          const Dataset* data) {
+  return ResponseFigure("StepResponseFigure", &Step, models, options, data);
+}
+
+Figure ImpulseResponseFigure(const std::vector<NamedModel>& models,
+                             const StepFigureOptions& options) {
+  return ResponseFigure("ImpulseResponseFigure", &Impulse, models, options, nullptr);
 }
 
 Figure ModelComparisonFigure(const Dataset& data, const std::vector<NamedModel>& models,
@@ -105,7 +123,7 @@ Figure ModelComparisonFigure(const Dataset& data, const std::vector<NamedModel>&
   Axes& ax = fig.axes(0);
   ax.ylabel = options.labels.output;
   if (!options.show_input) ax.xlabel = options.labels.time;
-  Series& meas = ax.AddLine(t, y, "measured data");
+  Curve& meas = ax.AddLine(t, y, "measured data");
   meas.color = Color{60, 60, 60};
   meas.width = 1.2;
   int k = 0;
@@ -114,7 +132,7 @@ Figure ModelComparisonFigure(const Dataset& data, const std::vector<NamedModel>&
     const Eigen::VectorXd yhat = SimulateOnData(m.model, data, options.input, options.output);
     std::string label = m.label;
     if (options.show_fit && fit_defined) label += fmt::format(" (fit {:.1f} %)", NrmseFit(y, yhat));
-    Series& s = ax.AddLine(t, yhat, label, k % 2 == 0 ? LineStyle::kSolid : LineStyle::kDashed);
+    Curve& s = ax.AddLine(t, yhat, label, k % 2 == 0 ? LineStyle::kSolid : LineStyle::kDashed);
     s.color = PaletteColor(k++);
   }
   ax.legend = LegendPosition::kBottomRight;
@@ -297,7 +315,7 @@ Figure ClosedLoopFigure(const Eigen::VectorXd& t, const Eigen::VectorXd& setpoin
   out.ylabel = options.labels.output;
   in.ylabel = options.labels.input;
   in.xlabel = options.labels.time;
-  Series& sp = out.AddStairs(t, setpoint, "set-point");
+  Curve& sp = out.AddStairs(t, setpoint, "set-point");
   sp.style = LineStyle::kDashed;
   sp.color = Color{40, 40, 40};
   sp.width = 1.5;
@@ -307,9 +325,9 @@ Figure ClosedLoopFigure(const Eigen::VectorXd& t, const Eigen::VectorXd& setpoin
     // Alternate solid and dashed lines so that runs that nearly coincide stay
     // distinguishable.
     const LineStyle style = k % 2 == 1 ? LineStyle::kSolid : LineStyle::kDashed;
-    Series& so = out.AddLine(t, tr.y, tr.label, style);
+    Curve& so = out.AddLine(t, tr.y, tr.label, style);
     so.color = c;
-    Series& s = in.AddStairs(t, tr.u, tr.label);
+    Curve& s = in.AddStairs(t, tr.u, tr.label);
     s.color = c;
     s.style = style;
   }
@@ -320,7 +338,7 @@ Figure ClosedLoopFigure(const Eigen::VectorXd& t, const Eigen::VectorXd& setpoin
         lo = std::min(lo, s.y.minCoeff());
         hi = std::max(hi, s.y.maxCoeff());
       }
-      Series& d = ax->AddLine(Eigen::Vector2d(options.disturbance_time, options.disturbance_time),
+      Curve& d = ax->AddLine(Eigen::Vector2d(options.disturbance_time, options.disturbance_time),
                               Eigen::Vector2d(lo, hi), ax == &out ? "load disturbance" : "",
                               LineStyle::kDotted);
       d.color = Color{120, 120, 120};

@@ -17,16 +17,13 @@
 #include <plplot/plstream.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
+#include "pneumid/common/strings.hpp"
 #include "pneumid/report/html.hpp"
 
 namespace pneumid {
 
 namespace {
-
-std::string Lower(std::string s) {
-  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 // PLplot's predefined line styles (pllsty): 1 continuous, 2 short dashes,
 // 3 long dashes.
@@ -377,39 +374,35 @@ void AddSvgMetadata(const Figure& fig, std::string* svg) {
 
 }  // namespace
 
-std::string ToString(LineStyle style) {
-  switch (style) {
-    case LineStyle::kSolid:
-      return "solid";
-    case LineStyle::kDashed:
-      return "dashed";
-    case LineStyle::kDotted:
-      return "dotted";
-  }
-  return "solid";
-}
+namespace {
+constexpr EnumName<LineStyle> kLineStyleNames[] = {
+    {LineStyle::kSolid, "solid"},
+    {LineStyle::kDashed, "dashed"},
+    {LineStyle::kDotted, "dotted"},
+};
+}  // namespace
+
+std::string ToString(LineStyle v) { return std::string(EnumToString(kLineStyleNames, v)); }
 
 LineStyle LineStyleFromString(const std::string& name) {
-  const std::string n = Lower(name);
-  if (n == "solid") return LineStyle::kSolid;
-  if (n == "dashed") return LineStyle::kDashed;
-  if (n == "dotted") return LineStyle::kDotted;
-  PNEUMID_CHECK(false, "unknown line style '{}' (valid: solid, dashed, dotted)", name);
-  return LineStyle::kSolid;
+  return EnumFromString(kLineStyleNames, name, "line style", /*ignore_case=*/true);
 }
 
-std::string ToString(ImageFormat format) { return format == ImageFormat::kPng ? "png" : "svg"; }
+namespace {
+constexpr EnumName<ImageFormat> kImageFormatNames[] = {
+    {ImageFormat::kPng, "png"},
+    {ImageFormat::kSvg, "svg"},
+};
+}  // namespace
+
+std::string ToString(ImageFormat v) { return std::string(EnumToString(kImageFormatNames, v)); }
 
 ImageFormat ImageFormatFromString(const std::string& name) {
-  const std::string n = Lower(name);
-  if (n == "png") return ImageFormat::kPng;
-  if (n == "svg") return ImageFormat::kSvg;
-  PNEUMID_CHECK(false, "unknown image format '{}' (valid: png, svg)", name);
-  return ImageFormat::kPng;
+  return EnumFromString(kImageFormatNames, name, "image format", /*ignore_case=*/true);
 }
 
 ImageFormat ImageFormatFromPath(const std::string& path) {
-  const std::string ext = Lower(std::filesystem::path(path).extension().string());
+  const std::string ext = ToLower(std::filesystem::path(path).extension().string());
   PNEUMID_CHECK(ext == ".png" || ext == ".svg",
                 "cannot tell the image format of '{}': the file name must end in .png or .svg",
                 path);
@@ -432,10 +425,10 @@ Color PaletteColor(int i) {
   return kPalette[((i % n) + n) % n];
 }
 
-Series& Axes::AddLine(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label,
+Curve& Axes::AddLine(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label,
                       LineStyle style) {
   CheckXY(x, y, "Axes::AddLine");
-  Series s;
+  Curve s;
   s.x = x;
   s.y = y;
   s.label = std::move(label);
@@ -444,9 +437,9 @@ Series& Axes::AddLine(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::s
   return series.back();
 }
 
-Series& Axes::AddStairs(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label) {
+Curve& Axes::AddStairs(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label) {
   CheckXY(x, y, "Axes::AddStairs");
-  Series& s = AddLine(x, y, std::move(label));
+  Curve& s = AddLine(x, y, std::move(label));
   s.stairs = true;
   return s;
 }

@@ -3,13 +3,8 @@
 # (gain crossover sqrt(1.6^2 - 1)/0.245 rad/s; phase margin and crossover from
 # tests/lti/gen_frequency_cases.py), and errors for bad input.
 # Usage: bash bode_test.sh /path/to/pneumid
-set -u
-PNEUMID=${1:?usage: bode_test.sh /path/to/pneumid}
-PY=/usr/bin/python3
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-failures=0
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+dir=$TMP
 
 if ! "$PNEUMID" bode --model fopdt-paper --w-min 1 --w-max 1000 --points 31 --json >"$dir/out" 2>"$dir/err"; then
   fail "bode json: $(cat "$dir/err")"
@@ -30,15 +25,29 @@ PYEOF
 
 "$PNEUMID" bode --model fopdt-paper >"$dir/out" 2>"$dir/err" || fail "bode text: $(cat "$dir/err")"
 grep -q "phase margin: 128.39 deg" "$dir/out" || fail "bode text: $(cat "$dir/out")"
-"$PNEUMID" bode --help >"$dir/out" 2>&1 || fail "bode --help"
+check_help bode --w-min --w-max --points --plot --json
+
+# --points alone: that many frequencies over the automatic range.
+expect_ok "points alone" bode --model fopdt-paper --points 7 --json
+check_json "points alone" "len(j['omega']) == 7"
+
+# Numeric flags out of range are refused, naming flag and value.
+expect_error "points 0" "--points: must be an integer >= 2, got 0" bode --model fopdt-paper --points 0
+expect_error "w-min negative" "--w-min: must be > 0, got -1" bode --model fopdt-paper --w-min -1 --w-max 10
+expect_error "w-max zero" "--w-max: must be > 0, got 0" bode --model fopdt-paper --w-min 1 --w-max 0
+
+# --plot: magnitude and phase as PNG or SVG.
+expect_ok "plot png" bode --model fopdt-paper --plot "$dir/bode.png"
+check_png "$dir/bode.png"
+check_output "plot png" "plot written to $dir/bode.png"
+expect_ok "plot svg" bode --model arx-paper --plot "$dir/bode.svg" --json
+check_svg "$dir/bode.svg"
+check_json "plot json" "j['plot'] == '$dir/bode.svg'"
+check_output "svg title" "Bode diagram of arx-paper" "$dir/bode.svg"
+expect_error "plot extension" "must end in .png or .svg" bode --model fopdt-paper --plot "$dir/b.jpg"
 
 "$PNEUMID" bode --model arx-paper --w-min 1 --w-max 1000 >"$dir/out" 2>"$dir/err" && fail "bode above Nyquist: exit 0"
 grep -qF "Nyquist" "$dir/err" || fail "bode above Nyquist: $(cat "$dir/err")"
 "$PNEUMID" bode --model fopdt-paper --w-min 10 --w-max 1 >"$dir/out" 2>"$dir/err" && fail "bode bad range: exit 0"
 grep -qF "w-min" "$dir/err" || fail "bode bad range: $(cat "$dir/err")"
-
-if [ "$failures" -ne 0 ]; then
-  echo "$failures failure(s)" >&2
-  exit 1
-fi
-echo "bode: all checks passed"
+finish

@@ -2,12 +2,8 @@
 # pneumid control: the paper's conventional and modified DMC on the nominal
 # FOPDT (docs/paper.md, reference value 6), --compare, CSV output, the IPA plant
 # with duty bounds, and error handling. Usage: bash control_test.sh PNEUMID
-set -u
-PNEUMID=${1:?usage: control_test.sh /path/to/pneumid}
-PY=/usr/bin/python3
-fail() { echo "FAIL: $*" >&2; exit 1; }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+tmp=$TMP
 
 out=$("$PNEUMID" control --controller dmc --model fopdt-paper --plant fopdt-paper --Ts 0.01 \
       --P 126 --M 5 --lambda 2.25 --setpoint step:from=0,to=1,at=0 --duration 2 --json) \
@@ -68,5 +64,44 @@ echo "$err" | grep -q "dmc, gpc, pid" || fail "unknown controller message: $err"
   --load-step at=x >/dev/null 2>&1 && fail "bad load step accepted"
 "$PNEUMID" control --model fopdt-paper --Ts 0.01 --setpoint bogus --duration 1 >/dev/null 2>&1 \
   && fail "bad set-point accepted"
-"$PNEUMID" control --help | grep -q -- "--compare" || fail "--help"
-echo "control_test: OK"
+check_help control --compare "--Ts,--sample-time" --plot "-o,--output"
+expect_error "zero Ts" "--Ts: must be > 0, got 0" control --model fopdt-paper --Ts 0 \
+  --setpoint step:from=0,to=1,at=0 --duration 1
+expect_error "negative duration" "--duration: must be > 0, got -2" control --model fopdt-paper \
+  --setpoint step:from=0,to=1,at=0 --duration -2
+expect_error "negative lambda" "--lambda: must be >= 0, got -1" control --model fopdt-paper \
+  --setpoint step:from=0,to=1,at=0 --duration 1 --lambda -1
+
+# --plot: units on both axes (force N and duty % for the IPA), the controller and
+# its settings in the legend, a title saying what was run (the SVG's <title>/<desc>).
+expect_ok "plot ipa" control --controller dmc --model fopdt-paper --plant ipa --Ts 0.01 \
+  --u-min 0 --u-max 100 --setpoint step:from=0,to=50,at=0.1 --duration 1 --plot "$tmp/ipa.svg"
+check_svg "$tmp/ipa.svg"
+for text in "Force F [N]" "Duty cycle u [%]" "Time t [s]" "DMC on ipa (model fopdt-paper, Ts = 0.01 s)" \
+  "DMC shridhar-cooper (P="; do
+  check_output "plot ipa" "$text" "$tmp/ipa.svg"
+done
+expect_ok "plot generic" control --controller pid --model fopdt-paper --plant arx-paper --Ts 0.01 \
+  --setpoint step:from=0,to=1,at=0.1 --duration 1 --plot "$tmp/pid.png"
+check_png "$tmp/pid.png"
+expect_ok "plot generic svg" control --controller pid --model fopdt-paper --plant arx-paper --Ts 0.01 \
+  --setpoint step:from=0,to=1,at=0.1 --duration 1 --plot "$tmp/pid.svg"
+for text in "Output y" "Input u" "PID on arx-paper" "PID simc (Kc="; do
+  check_output "plot generic" "$text" "$tmp/pid.svg"
+done
+expect_ok "plot compare" control --controller dmc --model fopdt-paper --Ts 0.01 \
+  --setpoint step:from=0,to=1,at=0 --duration 1 --compare --plot "$tmp/cmp.svg"
+check_output "plot compare" "DMC paper-modified (P=126, M=10, lambda=1.92)" "$tmp/cmp.svg"
+
+# JSON keys are a contract: the run, its settings and its metrics (ClosedLoopMetrics::ToJson).
+expect_ok "json keys" control --controller dmc --model fopdt-paper --Ts 0.01 \
+  --setpoint "staircase:levels=0 1,dwell=0.5" --duration 1 --json
+check_json "json keys" "list(j) == ['label', 'controller', 'plant', 'settings', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'iae', 'ise', 'itae', 'tv_u', 'u_min', 'u_max', 'load_peak_deviation', 'load_recovery_time', 'steps']"
+check_json "settings keys" "list(j['settings']) == ['rule', 'P', 'M', 'lambda', 'formula']"
+check_json "step keys" "sorted(j['steps'][0]) == sorted(['time', 'from', 'to', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move'])"
+check_json "no load step" "j['load_peak_deviation'] is None and j['settings']['rule'] == 'shridhar-cooper'"
+# P and M without lambda override the default rule (not explicit), as in `pneumid run`.
+expect_ok "override" control --model fopdt-paper --Ts 0.01 --setpoint step:from=0,to=1,at=0 \
+  --duration 0.5 --P 50 --M 4 --json
+check_json "override" "j['settings']['rule'] == 'shridhar-cooper' and j['settings']['P'] == 50 and j['settings']['M'] == 4"
+finish

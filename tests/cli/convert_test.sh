@@ -3,40 +3,8 @@
 # Eq. 6 (docs/paper.md, reference value 3) through --json; c2d/d2c round trip;
 # bad input gives a non-zero exit and a message on stderr.
 # Usage: bash convert_test.sh /path/to/pneumid
-set -u
-PNEUMID=${1:?usage: convert_test.sh /path/to/pneumid}
-PY=/usr/bin/python3
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-failures=0
-
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
-
-expect_ok() {
-  local name=$1; shift
-  if ! "$PNEUMID" "$@" >"$dir/out" 2>"$dir/err"; then
-    fail "$name: exit non-zero (expected 0): $(cat "$dir/err")"
-  fi
-}
-
-expect_error() {
-  local name=$1 pattern=$2; shift 2
-  "$PNEUMID" "$@" >"$dir/out" 2>"$dir/err"
-  local rc=$?
-  if [ "$rc" -eq 0 ]; then
-    fail "$name: exit 0 (expected an error)"
-  elif ! grep -qF -- "$pattern" "$dir/err"; then
-    fail "$name: stderr lacks '$pattern': $(cat "$dir/err")"
-  fi
-}
-
-# check_json NAME PYTHON-EXPRESSION: evaluates with j = the JSON on stdout.
-check_json() {
-  local name=$1 expr=$2
-  if ! $PY -c "import json,sys; j=json.load(open('$dir/out')); sys.exit(0 if ($expr) else 1)"; then
-    fail "$name: '$expr' is false for $(cat "$dir/out")"
-  fi
-}
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+dir=$TMP
 
 ARX=(--num 0,0.03938,0.04506,0.01286 --den 1,-0.60870,-0.27020,-0.06021 --Ts 0.01)
 
@@ -71,7 +39,7 @@ grep -qF -- "--method" "$dir/out" || fail "help lacks --method"
 
 # Bad input.
 expect_error "pole on negative axis" "negative real axis" convert --num 0,1 --den 1,0.5 --Ts 0.1 --to continuous
-expect_error "bad number" "--den: coefficient 2 is not a finite number: 'x'" convert --num 1 --den 1,x --Ts 0.1 --to continuous
+expect_error "bad number" "--den: value 2 is not a finite number: 'x'" convert --num 1 --den 1,x --Ts 0.1 --to continuous
 expect_error "no model" "give a model" convert --to continuous --Ts 0.1
 expect_error "bad method" "unknown discretization method 'magic'" convert --num 1 --den 1,1 --to discrete --Ts 0.1 --method magic
 expect_error "missing Ts" "--Ts" convert --num 1 --den 1,1 --to continuous
@@ -79,9 +47,10 @@ expect_error "bad to" "--to" convert --num 1 --den 1,1 --to sideways
 expect_error "d2c foh" "use zoh or tustin" convert "${ARX[@]}" --to continuous --method foh
 expect_error "unknown spec" "unknown model spec" convert --model nosuch --to discrete --Ts 0.1
 expect_error "both" "not both" convert --model arx-paper --num 1 --den 1,1 --to continuous
+expect_error "negative Ts" "--Ts: must be >= 0, got -0.1" convert --num 1 --den 1,1 --to discrete --Ts=-0.1
 
-if [ "$failures" -ne 0 ]; then
-  echo "$failures failure(s)" >&2
-  exit 1
-fi
-echo "convert: all checks passed"
+# -m is the short name of --method (as in identify and report).
+expect_ok "-m" convert --num 1 --den 1,1 --to discrete --Ts 0.1 -m tustin --json
+check_json "-m tustin" "abs(j['num'][0] - 0.1 / 2.1) < 1e-12"
+check_help convert "-m,--method,--methods" --Ts
+finish

@@ -1,16 +1,10 @@
 #!/usr/bin/env bash
 # pneumid identify: table, --json contract, -o, --plot, errors on bad data.
 # Usage: bash identify_test.sh /path/to/pneumid   (cwd: a scratch/build directory)
-set -u
-PNEUMID=${1:?usage: identify_test.sh /path/to/pneumid}
-SRC=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 DATA=$SRC/tests/identify/data
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-PY=/usr/bin/python3
 
-"$PNEUMID" identify --help | grep -q -- "--method" || fail "--help does not list --method"
+check_help identify "-m,--method,--methods" "--Ts,--sample-time" "-o,--output" --plot
 
 # Human table, best fit first.
 "$PNEUMID" identify "$DATA/fopdt.csv" --method smith,reaction-curve,fit-p1d > "$TMP/table.txt" \
@@ -21,11 +15,19 @@ first=$(awk 'NR==3 {print $1}' "$TMP/table.txt")
 
 # JSON contract: {"models": [{method, structure, params{K,tau,theta}, tf{num,den,Ts,delay}, fit_percent}]}
 "$PNEUMID" identify "$DATA/fopdt.csv" --method reaction-curve,fit-p1d,ptn --order 2 --json \
-  -o "$TMP/models.json" > "$TMP/out.json" || fail "identify --json"
-$PY - "$TMP/out.json" "$TMP/models.json" <<'PYEOF' || fail "JSON contract"
+  > "$TMP/out.json" || fail "identify --json"
+# --json -o FILE: the models go to the file, stdout gets a short summary (the
+# file name and each model's method, structure and fit), not the same JSON twice.
+"$PNEUMID" identify "$DATA/fopdt.csv" --methods reaction-curve,fit-p1d,ptn --order 2 --json \
+  -o "$TMP/models.json" > "$TMP/brief.json" || fail "identify --json -o"
+$PY - "$TMP/out.json" "$TMP/models.json" "$TMP/brief.json" "$TMP/models.json" <<'PYEOF' || fail "JSON contract"
 import json, sys
 j = json.load(open(sys.argv[1]))
-assert json.load(open(sys.argv[2])) == j, "-o file differs from stdout"
+assert json.load(open(sys.argv[2])) == j, "-o file differs from --json without -o"
+brief = json.load(open(sys.argv[3]))
+assert brief["output"] == sys.argv[4], brief
+assert [m["method"] for m in brief["models"]] == [m["method"] for m in j["models"]], brief
+assert set(brief["models"][0]) == {"method", "structure", "fit_percent"}, brief
 models = j["models"]
 assert [m["method"] for m in models][0] == "fit-p1d", models[0]["method"]
 fits = [m["fit_percent"] for m in models]
@@ -51,8 +53,8 @@ PYEOF
 # --plot writes a PNG.
 "$PNEUMID" identify "$DATA/sopdt.csv" --method sopdt,fit-p2d --plot "$TMP/fig.png" > /dev/null \
   || fail "identify --plot"
-[ -s "$TMP/fig.png" ] || fail "no plot file"
-head -c 8 "$TMP/fig.png" | od -An -c | grep -q "P   N   G" || fail "plot is not a PNG"
+check_png "$TMP/fig.png"
+expect_error "plot extension" "must end in .png or .svg" identify "$DATA/fopdt.csv" --plot "$TMP/fig.bmp"
 
 # Errors: unknown method, no step, not settled; non-zero exit and a message on stderr.
 if "$PNEUMID" identify "$DATA/fopdt.csv" --method bogus > /dev/null 2> "$TMP/err"; then
@@ -79,4 +81,4 @@ if "$PNEUMID" identify "$TMP/slow.csv" --method smith > /dev/null 2> "$TMP/err";
   fail "unsettled data accepted"
 fi
 grep -q "not settled" "$TMP/err" || fail "not-settled message: $(cat "$TMP/err")"
-echo "identify CLI tests passed"
+finish

@@ -2,33 +2,8 @@
 # CLI test of `pneumid info`: a good file gives its summary; every bad input
 # gives a non-zero exit and an error on stderr naming file, line and column.
 # Usage: bash info_test.sh /path/to/pneumid
-set -u
-PNEUMID=${1:?usage: info_test.sh /path/to/pneumid}
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-failures=0
-
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
-
-# expect_ok NAME ARGS... : exit 0
-expect_ok() {
-  local name=$1; shift
-  if ! "$PNEUMID" "$@" >"$dir/out" 2>"$dir/err"; then
-    fail "$name: exit $? (expected 0): $(cat "$dir/err")"
-  fi
-}
-
-# expect_error NAME "stderr substring" ARGS... : non-zero exit, substring on stderr, nothing on stdout
-expect_error() {
-  local name=$1 pattern=$2; shift 2
-  "$PNEUMID" "$@" >"$dir/out" 2>"$dir/err"
-  local rc=$?
-  if [ "$rc" -eq 0 ]; then
-    fail "$name: exit 0 (expected an error)"
-  elif ! grep -qF -- "$pattern" "$dir/err"; then
-    fail "$name: stderr lacks '$pattern': $(cat "$dir/err")"
-  fi
-}
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+dir=$TMP
 
 # A step test: duty 0.61 -> 82 % at t = 0.30 s, force rising to 129 N.
 good="$dir/step.csv"
@@ -67,20 +42,24 @@ PY
 # Selection by index, semicolon delimiter, no time column.
 printf 'a;b;c\n1;0;5\n2;1;6\n3;1;7\n' >"$dir/semi.csv"
 expect_ok "by index" info "$dir/semi.csv" --time-col 0 --input-col 1 --output-col 2,0
-expect_ok "sample time" info "$dir/semi.csv" --sample-time 0.5 --input-col b --output-col c --json
+expect_ok "sample time" info "$dir/semi.csv" --Ts 0.5 --input-col b --output-col c --json
 grep -q '"sample_time": 0.5' "$dir/out" || fail "sample time 0.5: $(cat "$dir/out")"
+# --sample-time stays an alias of --Ts.
+expect_ok "sample time alias" info "$dir/semi.csv" --sample-time 0.5 --input-col b --output-col c --json
+grep -q '"sample_time": 0.5' "$dir/out" || fail "--sample-time alias: $(cat "$dir/out")"
+expect_error "negative Ts" "--Ts: must be >= 0, got -1" info "$dir/semi.csv" --Ts -1
 
 # Non-uniform sampling: summary says so and how to resample; --strict fails.
 printf 't,u,y\n0,0,0\n0.01,1,0\n0.02,1,1\n0.05,1,2\n0.06,1,3\n' >"$dir/gap.csv"
 expect_ok "non-uniform" info "$dir/gap.csv"
 grep -q "uniform: *no" "$dir/out" || fail "non-uniform not reported"
-grep -qF -- "--resample 0.01 --save" "$dir/out" || fail "no resampling hint: $(cat "$dir/out")"
+grep -qF -- "--resample 0.01 -o" "$dir/out" || fail "no resampling hint: $(cat "$dir/out")"
 expect_error "strict" "gap.csv:5: column 't': sampling is not uniform" info "$dir/gap.csv" --strict
-expect_ok "resample" info "$dir/gap.csv" --resample 0.01 --save "$dir/fixed.csv"
+expect_ok "resample" info "$dir/gap.csv" --resample 0.01 -o "$dir/fixed.csv"
 expect_ok "resampled is uniform" info "$dir/fixed.csv" --strict
 grep -q "samples: *7" "$dir/out" || fail "resampled size: $(cat "$dir/out")"
 
-# MAT round trip through --save.
+# MAT round trip through --save (the older spelling of -o/--output).
 expect_ok "save mat" info "$good" --window 0,1 --save "$dir/step.mat"
 expect_ok "read mat" info "$dir/step.mat" --json
 grep -q '"samples": 101' "$dir/out" || fail "mat samples: $(cat "$dir/out")"
@@ -109,12 +88,8 @@ printf 'x' >"$dir/data.xlsx"
 expect_error "extension" "unknown data file extension '.xlsx'" info "$dir/data.xlsx"
 expect_error "not a mat file" "cannot open as a MAT file" info "$dir/nan.csv" --format mat
 expect_error "bad delimiter" "--delimiter" info "$good" --delimiter x
+expect_error "bad decimate" "--decimate: must be an integer >= 1, got 0" info "$good" --decimate 0
+expect_error "bad resample" "--resample: must be >= 0, got -0.5" info "$good" --resample=-0.5
 
-"$PNEUMID" info --help >"$dir/out" 2>&1 || fail "--help exit"
-grep -q -- "--input-col" "$dir/out" || fail "--help lacks --input-col"
-
-if [ "$failures" -ne 0 ]; then
-  echo "$failures failure(s)" >&2
-  exit 1
-fi
-echo "info_test: all passed"
+check_help info --input-col "--Ts,--sample-time" "-o,--output,--save"
+finish

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # pneumid orders: ARX order selection on data of the paper's ARX(3,3,1) model.
 # Usage: bash orders_test.sh /path/to/pneumid
-set -euo pipefail
-pneumid="$1"
-dir="$(mktemp -d)"
-trap 'rm -rf "$dir"' EXIT
-/usr/bin/python3 - "$dir/prbs.csv" <<'PY'
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+set -eo pipefail
+pneumid=$PNEUMID
+dir=$TMP
+"$PY" - "$dir/prbs.csv" <<'PY'
 import sys
 import numpy as np
 from scipy.signal import lfilter
@@ -16,7 +16,6 @@ a = [1, -0.6087, -0.2702, -0.06021]
 y = lfilter([0, 0.03938, 0.04506, 0.01286], a, u) + lfilter([1], a, rng.normal(0, 0.3, n))
 np.savetxt(sys.argv[1], np.c_[np.arange(n) * 0.01, u, y], delimiter=",", header="t,u,y", comments="")
 PY
-fail() { echo "FAIL: $*" >&2; exit 1; }
 
 "$pneumid" orders --help | grep -q -- "--na-range" || fail "--help lacks --na-range"
 out="$("$pneumid" orders "$dir/prbs.csv" --na-range 1:4 --nb-range 1:4 --nk-range 0:2)"
@@ -24,7 +23,7 @@ grep -q "48 candidates" <<<"$out" || fail "expected 48 candidates: $out"
 grep -qE "mdl +na = 3, nb = 3, nk = 1" <<<"$out" || fail "MDL should pick ARX(3,3,1): $out"
 
 json="$("$pneumid" orders "$dir/prbs.csv" --na-range 1:4 --nb-range 1:4 --nk-range 0:2 --json)"
-/usr/bin/python3 - "$json" <<'PY' || fail "JSON output"
+"$PY" - "$json" <<'PY' || fail "JSON output"
 import json, sys
 j = json.loads(sys.argv[1])
 assert len(j["candidates"]) == 48, len(j["candidates"])
@@ -44,4 +43,5 @@ grep -q "min 5 > max 1" "$dir/err" || fail "range error message: $(cat "$dir/err
 [[ ! -s "$dir/out" ]] || fail "stdout not empty on error"
 if "$pneumid" orders "$dir/missing.csv" 2>"$dir/err"; then fail "accepted a missing file"; fi
 grep -q "missing.csv" "$dir/err" || fail "missing-file message: $(cat "$dir/err")"
-echo "orders_test: ok"
+expect_error "negative top" "--top: must be an integer >= 0, got -1" orders "$dir/prbs.csv" --top -1
+finish

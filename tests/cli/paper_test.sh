@@ -1,12 +1,9 @@
 #!/usr/bin/env bash
 # pneumid paper: the paper's table and Figures 4-6.
 # Usage: bash paper_test.sh /path/to/pneumid   (cwd: build directory)
-set -u
-PNEUMID=${1:?usage: paper_test.sh /path/to/pneumid}
-PY=/usr/bin/python3
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/pneumid-paper-test.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+WORK=$TMP/work
+mkdir "$WORK"
 
 "$PNEUMID" paper -o "$WORK/figs" >"$WORK/out" 2>"$WORK/err" || { cat "$WORK/err"; fail "exit $?"; }
 grep -q "paper success" "$WORK/out" || { cat "$WORK/out"; fail "not successful"; }
@@ -17,7 +14,8 @@ for f in fig4 fig5 fig6; do
   for ext in png svg; do
     [ -s "$WORK/figs/$f.$ext" ] || fail "$f.$ext missing"
   done
-  head -c 8 "$WORK/figs/$f.png" | od -An -tx1 | grep -q "89 50 4e 47 0d 0a 1a 0a" || fail "$f.png is not a PNG"
+  check_png "$WORK/figs/$f.png"
+  check_svg "$WORK/figs/$f.svg"
 done
 
 "$PNEUMID" paper --json --no-figures >"$WORK/json" || fail "--json failed"
@@ -36,4 +34,5 @@ PYEOF
 
 "$PNEUMID" paper --ipa-config "$WORK/none.toml" 2>"$WORK/err" && fail "missing config accepted"
 grep -q "none.toml" "$WORK/err" || fail "error does not name the config file"
-echo "paper_test: OK"
+check_help paper "-o,--output-dir"
+finish

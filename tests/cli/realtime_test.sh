@@ -1,17 +1,11 @@
 #!/usr/bin/env bash
 # CLI tests of the real-time commands: run, experiment, plant-server.
 # Usage: bash realtime_test.sh /path/to/pneumid   (cwd: a scratch/build directory)
-set -u
-PNEUMID=${1:?usage: realtime_test.sh /path/to/pneumid}
-TMP=$(mktemp -d)
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 SERVER_PID=""
-cleanup() {
+cleanup() {  # called by lib.sh on exit
   if [ -n "$SERVER_PID" ]; then kill "$SERVER_PID" 2>/dev/null; wait "$SERVER_PID" 2>/dev/null; fi
-  rm -rf "$TMP"
 }
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-data_rows() { grep -v '^#' "$1" | tail -n +2 | wc -l; }
 
 start_server() {  # start_server [extra flags]; sets SERVER_PID and PORT
   "$PNEUMID" plant-server --plant ipa --port 0 "$@" > "$TMP/server.txt" 2>&1 &
@@ -21,17 +15,17 @@ start_server() {  # start_server [extra flags]; sets SERVER_PID and PORT
     [ -n "$PORT" ] && return 0
     sleep 0.1
   done
-  fail "plant-server did not start: $(cat "$TMP/server.txt")"
+  die "plant-server did not start: $(cat "$TMP/server.txt")"
 }
 stop_server() {
   kill -INT "$SERVER_PID"; wait "$SERVER_PID"; SERVER_PID=""
 }
 
-# --help everywhere
-for c in run experiment plant-server; do
-  "$PNEUMID" $c --help > "$TMP/help.txt" || fail "$c --help"
-  grep -q -- "--io\|--port" "$TMP/help.txt" || fail "$c --help lacks its options"
+# --help everywhere: the shared real-time options under their canonical names
+for c in run experiment; do
+  check_help $c --io "--Ts,--period,--sample-time" --duration --log --json --safe-state --config
 done
+check_help plant-server --port "--Ts,--period,--sample-time"
 
 # experiment: a data set with t,u,y that the identification reads
 "$PNEUMID" experiment step --fast --duration 2 -o "$TMP/step.csv" > "$TMP/out.txt" || fail "experiment step"
@@ -52,7 +46,7 @@ start_server
 "$PNEUMID" run --controller dmc --model fopdt-paper --io "udp://127.0.0.1:$PORT" \
   --setpoint step:from=0,to=100,at=0.2 --duration 1 --max-overruns -1 \
   --log "$TMP/udp.csv" --json > "$TMP/udp.json" || fail "run over udp: $(cat "$TMP/udp.json")"
-for key in '"samples": 100' '"termination": "completed"' '"jitter_p99_us"' '"jitter_max_us"' '"overruns"'; do
+for key in '"samples": 100' '"termination": "success"' '"jitter_p99_us"' '"jitter_max_us"' '"overruns"'; do
   grep -q "$key" "$TMP/udp.json" || fail "run --json lacks $key"
 done
 [ "$(data_rows "$TMP/udp.csv")" -eq 100 ] || fail "udp log rows: $(data_rows "$TMP/udp.csv")"
@@ -111,8 +105,37 @@ grep -q "unknown backend" "$TMP/e1" || fail "bad --io message: $(cat "$TMP/e1")"
 grep -q "/dev/comedi_pneumid_missing" "$TMP/e2" || fail "missing device message: $(cat "$TMP/e2")"
 "$PNEUMID" run --io udp://127.0.0.1:1 --duration 1 2> "$TMP/e3" && fail "no server accepted"
 grep -q "no answer from a plant server" "$TMP/e3" || fail "no-server message: $(cat "$TMP/e3")"
-"$PNEUMID" run --period 0 --duration 1 2> "$TMP/e4" && fail "--period 0 accepted"
-grep -q "period" "$TMP/e4" || fail "--period message"
+expect_error "--period 0" "--Ts: must be in [0.0001, 10], got 0" run --period 0 --duration 1
+expect_error "--Ts 0" "--Ts: must be in [0.0001, 10], got 0" experiment step --Ts 0 --duration 1 -o "$TMP/x.csv"
+expect_error "negative duration" "--duration: must be > 0, got -1" run --fast --duration -1
+expect_error "max-overruns" "--max-overruns: must be an integer >= -1, got -2" run --fast --max-overruns -2
+expect_error "prbs clock" "--clock: must be > 0, got 0" experiment prbs --fast --clock 0 -o "$TMP/x.csv"
 "$PNEUMID" experiment step --io udp://127.0.0.1:9 --fast -o "$TMP/x.csv" 2> "$TMP/e5" && fail "--fast with udp accepted"
 grep -q "fast" "$TMP/e5" || fail "--fast message"
-echo "realtime CLI tests passed"
+
+# --Ts, --period and --sample-time name the same loop period.
+for flag in --Ts --period --sample-time; do
+  expect_ok "experiment $flag" experiment step --fast --duration 1 $flag 0.02 -o "$TMP/p.csv"
+  [ "$(data_rows "$TMP/p.csv")" -eq 50 ] || fail "experiment $flag 0.02: $(data_rows "$TMP/p.csv") rows"
+done
+
+# Safe states: generic hold/release, the IPA's names as aliases; messages use the
+# plant's names (the IPA: valves-closed/exhaust-open, a linear plant: hold/release).
+"$PNEUMID" run --controller pid --model fopdt-paper --io sim --fast --duration 0.5 \
+  --safe-state release --json > "$TMP/rel.json" || fail "--safe-state release"
+grep -q '"safe_state": "exhaust-open"' "$TMP/rel.json" || fail "IPA release name: $(cat "$TMP/rel.json")"
+"$PNEUMID" run --controller pid --model fopdt-paper --io sim --plant fopdt-paper --fast \
+  --duration 0.5 --safe-state exhaust-open --json > "$TMP/rel2.json" || fail "--safe-state exhaust-open"
+grep -q '"safe_state": "release"' "$TMP/rel2.json" || fail "generic release name: $(cat "$TMP/rel2.json")"
+"$PNEUMID" run --controller pid --model fopdt-paper --io sim --plant fopdt-paper --fast \
+  --duration 0.5 --log "$TMP/hold.csv" > /dev/null || fail "linear plant run"
+grep -q '^# safety: u in \[0, 100\], .*safe state hold$' "$TMP/hold.csv" ||
+  fail "safety header of a linear plant: $(grep '^# safety' "$TMP/hold.csv")"
+
+# The settings mean the same in run as in control (one rule inference): --P --M
+# --lambda all given is the explicit rule, otherwise they override shridhar-cooper.
+"$PNEUMID" run --fast --duration 0.2 --P 50 --M 4 --lambda 1.5 --json > "$TMP/x.json" || fail "run explicit"
+grep -q '"controller": "dmc P=50 M=4 lambda=1.5' "$TMP/x.json" || fail "run explicit: $(grep controller "$TMP/x.json")"
+"$PNEUMID" run --fast --duration 0.2 --P 50 --json > "$TMP/y.json" || fail "run override"
+grep -q '"controller": "dmc P=50 M=5 lambda=' "$TMP/y.json" || fail "run override: $(grep controller "$TMP/y.json")"
+finish

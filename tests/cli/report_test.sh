@@ -3,12 +3,9 @@
 # renders with every plot and table present (DOM counts, screenshot size and
 # content), and rejects bad input with a clear error.
 # Usage: bash report_test.sh /path/to/pneumid   (cwd: build directory)
-set -u
-PNEUMID=${1:?usage: report_test.sh /path/to/pneumid}
-PY=/usr/bin/python3
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/pneumid-report-test.XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+WORK=$TMP/work
+mkdir "$WORK"
 
 # The paper's step test on a first-order plant 1.6 / (0.245 s + 1): duty
 # 0.61 -> 82 % at t = 0.5 s, force with 0.3 N Gaussian noise (seeded).
@@ -52,6 +49,13 @@ assert d['termination']=='success', d
 assert [m['method'] for m in d['models']]==['reaction-curve','arx'], d['models']
 assert d['figures']==4 and d['tables']==3, d
 " "$WORK/json" || fail "--json output wrong"
+
+# Canonical flag names, the older ones as aliases; the report's command line uses the canonical ones.
+grep -q -- "--method reaction-curve,arx --output-dir" "$WORK/out2/report.html" \
+  || fail "report command line does not use --method/--output-dir"
+expect_error "max-lag" "--max-lag: must be an integer >= 1, got 0" report "$WORK/step.csv" \
+  --output-col F --output-dir "$WORK/o5" --max-lag 0
+check_help report "-m,--method,--methods" "-o,--output-dir" "--Ts,--sample-time"
 
 # 3. Headless Chromium renders the page: DOM has every plot and table.
 CHROME=$(command -v chromium || command -v chromium-browser || true)
@@ -110,4 +114,4 @@ grep -q "missing.csv" "$WORK/err" || fail "error does not name the missing file"
   && fail "unknown method accepted"
 grep -q "nonsense" "$WORK/err" || fail "error does not name the unknown method"
 "$PNEUMID" report "$WORK/step.csv" 2>/dev/null && fail "missing -o accepted"
-echo "report_test: OK"
+finish

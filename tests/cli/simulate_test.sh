@@ -1,10 +1,7 @@
 #!/usr/bin/env bash
 # CLI test of `pneumid simulate` (run by ctest as: bash simulate_test.sh /path/to/pneumid).
-set -euo pipefail
-PNEUMID=${1:?usage: simulate_test.sh /path/to/pneumid}
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+set -eo pipefail
 
 # --help documents the signal syntax and the plants.
 "$PNEUMID" simulate --help > "$TMP/help.txt"
@@ -54,19 +51,40 @@ TOML
 grep -q "position mode, switching PWM 100 Hz" "$TMP/pos.txt" || fail "config file not used"
 head -3 "$TMP/pos.csv" | grep -q "y \[m\]" || fail "position output unit"
 
+# --sample-time is an alias of --Ts.
+"$PNEUMID" simulate --plant arx-paper --duration 0.5 --sample-time 0.01 -o "$TMP/alias.csv" > /dev/null \
+  || fail "--sample-time alias"
+[ "$(grep -vc "^#\|^t " "$TMP/alias.csv")" -eq 51 ] || fail "--sample-time alias: rows"
+
 # Errors: clear message on stderr, non-zero exit.
-expect_error() {
+simulate_error() {
   local pattern=$1; shift
-  if "$PNEUMID" simulate "$@" > "$TMP/err.out" 2> "$TMP/err.txt"; then fail "no error for: $*"; fi
-  grep -q -- "$pattern" "$TMP/err.txt" || { cat "$TMP/err.txt" >&2; fail "error for '$*' lacks '$pattern'"; }
+  expect_error "simulate $*" "$pattern" simulate "$@"
 }
-expect_error "unknown plant 'nope'" --plant nope
-expect_error "'to' is not a number" --input step:to=x
-expect_error "unknown kind 'sine'" --input sine:f=1
-expect_error "duration must be at least one sample period" --duration 0
+simulate_error "unknown plant 'nope'" --plant nope
+simulate_error "key 'to': not a finite number" --input step:to=x
+simulate_error "unknown kind 'sine'" --input sine:f=1
+simulate_error "--duration: must be > 0, got 0" --duration 0
+simulate_error "duration must be at least one sample period" --duration 0.001
+simulate_error "--Ts: must be > 0, got 0" --Ts 0
+simulate_error "--noise: must be >= 0, got -1" --noise -1
 printf '[valves]\nfoo = 1\n' > "$TMP/bad.toml"
-expect_error "bad.toml:2:7: unknown key 'valves.foo'" --plant-config "$TMP/bad.toml"
-expect_error "missing.toml" --plant-config "$TMP/missing.toml"
-expect_error "applies to the ipa plant only" --plant arx-paper --mode averaged
-expect_error "discrete model has Ts = 0.01" --plant arx-paper --Ts 0.02
-echo "simulate_test: OK"
+simulate_error "bad.toml:2:7: unknown key 'valves.foo'" --plant-config "$TMP/bad.toml"
+simulate_error "missing.toml" --plant-config "$TMP/missing.toml"
+simulate_error "applies to the ipa plant only" --plant arx-paper --mode averaged
+simulate_error "discrete model has Ts = 0.01" --plant arx-paper --Ts 0.02
+
+# Signals far beyond their sample time: bounded time, defined results, clear errors.
+timeout 30 "$PNEUMID" simulate --plant fopdt-paper --input prbs:order=32,clock=1e-9 --duration 1 \
+  -o "$TMP/fast_prbs.csv" >/dev/null || fail "prbs with a 1 ns clock: no result in 30 s"
+simulate_error "beyond the exact integers of a double" --plant fopdt-paper \
+  --input prbs:order=7,clock=1e-300 --duration 1
+"$PNEUMID" simulate --plant fopdt-paper --input "staircase:levels=1 2,dwell=1e-300" \
+  --duration 0.05 -o "$TMP/stairs.csv" >/dev/null || fail "staircase with dwell 1e-300"
+[ "$(grep -v '^#\|^t' "$TMP/stairs.csv" | tail -1 | cut -d, -f2)" = "2" ] \
+  || fail "staircase with dwell 1e-300: last level expected"
+simulate_error "above the Nyquist frequency 500 Hz" --plant fopdt-paper \
+  --input chirp:from=0,to=1,f0=1,f1=600 --Ts 0.001 --duration 1
+"$PNEUMID" simulate --plant fopdt-paper --input "staircase:levels=0,1,2,dwell=0.01" \
+  --duration 0.05 -o "$TMP/comma.csv" >/dev/null || fail "levels separated by commas"
+finish

@@ -1,10 +1,7 @@
 #!/usr/bin/env bash
 # pneumid tune: the paper's conventional settings (docs/paper.md, reference value 6),
 # the modified settings, and error handling. Usage: bash tune_test.sh PNEUMID
-set -u
-PNEUMID=${1:?usage: tune_test.sh /path/to/pneumid}
-PY=/usr/bin/python3
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 
 out=$("$PNEUMID" tune --model fopdt:K=1.6,tau=0.245,theta=0.001 --Ts 0.01 --rule shridhar-cooper --M 5 --json) \
   || fail "tune shridhar-cooper exited non-zero"
@@ -34,6 +31,9 @@ assert "not published" in j["formula"]
 # Errors: non-zero exit and a message on stderr.
 err=$("$PNEUMID" tune --model fopdt-paper --Ts 0.01 --rule nonsense 2>&1 >/dev/null) && fail "bad rule accepted"
 echo "$err" | grep -q "shridhar-cooper" || fail "bad rule message: $err"
-"$PNEUMID" tune --model fopdt-paper --Ts -1 >/dev/null 2>&1 && fail "negative Ts accepted"
+expect_error "negative Ts" "--Ts: must be > 0, got -1" tune --model fopdt-paper --Ts -1
 "$PNEUMID" tune --model fopdt-paper --Ts 0.01 --rule explicit >/dev/null 2>&1 && fail "explicit without P accepted"
-echo "tune_test: OK"
+# --sample-time is an alias of --Ts.
+expect_ok "sample-time alias" tune --model fopdt-paper --sample-time 0.01 --json
+check_json "sample-time alias" "j['P'] == 126"
+finish

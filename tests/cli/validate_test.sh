@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # pneumid validate: fit and residual tests of an identified model.
 # Usage: bash validate_test.sh /path/to/pneumid
-set -euo pipefail
-pneumid="$1"
-dir="$(mktemp -d)"
-trap 'rm -rf "$dir"' EXIT
-/usr/bin/python3 - "$dir/prbs.csv" <<'PY'
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+set -eo pipefail
+pneumid=$PNEUMID
+dir=$TMP
+"$PY" - "$dir/prbs.csv" <<'PY'
 import sys
 import numpy as np
 from scipy.signal import lfilter
@@ -16,7 +16,6 @@ a = [1, -0.6087, -0.2702, -0.06021]
 y = lfilter([0, 0.03938, 0.04506, 0.01286], a, u) + lfilter([1], a, rng.normal(0, 0.3, n))
 np.savetxt(sys.argv[1], np.c_[np.arange(n) * 0.01, u, y], delimiter=",", header="t,u,y", comments="")
 PY
-fail() { echo "FAIL: $*" >&2; exit 1; }
 
 "$pneumid" validate --help | grep -q -- "--plot" || fail "--help lacks --plot"
 "$pneumid" identify "$dir/prbs.csv" --method arx --na 3 --nb 3 --nk 1 -o "$dir/arx.json" >/dev/null
@@ -28,7 +27,7 @@ grep -q "5-step prediction fit" <<<"$out" || fail "no k-step fit: $out"
 [[ -s "$dir/v.png" ]] || fail "no plot written"
 
 json="$("$pneumid" validate "$dir/arx1.json" "$dir/prbs.csv" --json)"
-/usr/bin/python3 - "$json" <<'PY' || fail "JSON of the under-modelled ARX(1,1,1)"
+"$PY" - "$json" <<'PY' || fail "JSON of the under-modelled ARX(1,1,1)"
 import json, sys
 j = json.loads(sys.argv[1])
 assert j["residuals"]["passed"] is False, j["residuals"]["passed"]
@@ -45,4 +44,6 @@ grep -q "horizon" "$dir/err" || fail "horizon message: $(cat "$dir/err")"
 echo '{"models": []}' >"$dir/empty.json"
 if "$pneumid" validate "$dir/empty.json" "$dir/prbs.csv" 2>"$dir/err"; then fail "accepted empty models"; fi
 grep -q "empty" "$dir/err" || fail "empty-models message: $(cat "$dir/err")"
-echo "validate_test: ok"
+expect_error "max-lag" "--max-lag: must be an integer >= 1, got 0" validate arx-paper "$dir/prbs.csv" --max-lag 0
+expect_error "plot extension" "must end in .png or .svg" validate arx-paper "$dir/prbs.csv" --plot "$dir/v.eps"
+finish

@@ -2,6 +2,7 @@
 // Identification and Control toolboxes, built on the figure API (plot.hpp):
 //
 //   StepResponseFigure       step responses of models (Fig. 4), optionally with the data
+//   ImpulseResponseFigure    impulse responses of models
 //   ModelComparisonFigure    measured data and models simulated on its input (Fig. 5)
 //   ResidualFigure           residual auto-correlation and input-residual
 //                            cross-correlation with confidence bands [2]
@@ -63,6 +64,13 @@ struct StepFigureOptions {
 /// @throws InvalidArgument when `models` is empty or options are invalid.
 Figure StepResponseFigure(const std::vector<NamedModel>& models,
                           const StepFigureOptions& options = {}, const Dataset* data = nullptr);
+
+/// Responses of each model to an impulse of area `amplitude` at t = 0 (a
+/// discrete impulse of that area for discrete models; drawn as staircases).
+/// The options are those of the step figure (set `title`, e.g. "Impulse response").
+/// @throws InvalidArgument when `models` is empty or options are invalid.
+Figure ImpulseResponseFigure(const std::vector<NamedModel>& models,
+                             const StepFigureOptions& options = {});
 
 struct ComparisonFigureOptions {
   std::string title = "Model comparison";

@@ -54,10 +54,9 @@ struct Color {
 Color PaletteColor(int i);
 
 /// One curve y(x) of a subplot. `label` empty = not listed in the legend.
-/// (A translation unit that also includes pneumid/lti/interconnect.hpp sees
-/// the function pneumid::Series too; refer to this type as `struct Series`
-/// or use `auto&` there.)
-struct Series {
+/// (Named Curve, not Series: pneumid::Series is the series connection of two
+/// transfer functions, pneumid/lti/interconnect.hpp.)
+struct Curve {
   Eigen::VectorXd x;
   Eigen::VectorXd y;
   std::string label;
@@ -101,16 +100,16 @@ struct Axes {
   /// Axis limits; unset = data range (y with a 5 % margin).
   std::optional<double> xmin, xmax, ymin, ymax;
 
-  std::vector<Series> series;
+  std::vector<Curve> series;
   std::vector<HorizontalLine> hlines;
   std::vector<Band> bands;
 
   /// Adds a line. Throws InvalidArgument when x and y differ in length or are
   /// empty. Returns the new series for further styling.
-  Series& AddLine(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label = {},
+  Curve& AddLine(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label = {},
                   LineStyle style = LineStyle::kSolid);
   /// Adds a zero-order-hold staircase (sampled inputs). Same checks as AddLine.
-  Series& AddStairs(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label = {});
+  Curve& AddStairs(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label = {});
   /// Adds a horizontal reference line (dashed by default).
   HorizontalLine& AddHorizontalLine(double y, std::string label = {},
                                     LineStyle style = LineStyle::kDashed);

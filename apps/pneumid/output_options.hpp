@@ -1,0 +1,27 @@
+// Output flags shared by the commands that write results:
+//
+//   --plot FILE.png|svg   a figure (format by extension, checked when parsing)
+//   -o FILE               one output file; --output-dir DIR where a command
+//                         writes several files
+//   --json                JSON on stdout; with -o FILE the JSON goes to the file
+//                         and stdout gets a short summary (never the same JSON twice)
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+namespace pneumid::cli {
+
+/// Adds --plot FILE (PNG or SVG by extension) describing `what` is drawn.
+CLI::Option* AddPlotOption(CLI::App& app, std::string& path, const std::string& what);
+
+/// `v`, or null when it is not finite (JSON has no NaN/Inf).
+nlohmann::json JsonNumber(double v);
+
+/// Writes `j` (indented) to `path`. @throws DataError when it cannot be written.
+void WriteJsonFile(const nlohmann::json& j, const std::string& path);
+void WriteJsonFile(const nlohmann::ordered_json& j, const std::string& path);
+
+}  // namespace pneumid::cli
