@@ -216,7 +216,7 @@ void WritePlot(const std::string& path, const std::vector<Run>& runs) {
   fig.title = "Closed loop";
   Axes& ay = fig.axes(0);
   ay.ylabel = "Output y";
-  Series& sp = ay.AddStairs(runs[0].result.t, runs[0].result.r, "set-point");
+  Curve& sp = ay.AddStairs(runs[0].result.t, runs[0].result.r, "set-point");
   sp.color = Color{90, 90, 90};
   sp.style = LineStyle::kDashed;
   for (std::size_t i = 0; i < runs.size(); ++i)
