@@ -8,7 +8,8 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
-#include <sstream>
+#include <type_traits>
+#include <variant>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
@@ -16,10 +17,10 @@
 
 #include "command.hpp"
 #include "data_options.hpp"
+#include "output_options.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/identified_model.hpp"
-#include "pneumid/identify/parametric.hpp"
-#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/identify.hpp"
 #include "pneumid/report/plot.hpp"
 
 namespace pneumid::cli {
@@ -35,55 +36,31 @@ struct IdentifyArgs {
   std::string output;
 };
 
-std::vector<std::string> AllMethods() {
-  std::vector<std::string> all = StepMethodNames();
-  for (const std::string& m : ParametricMethodNames()) all.push_back(m);
-  return all;
-}
-
-std::vector<std::string> SplitMethods(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream ss(list);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    item.erase(0, item.find_first_not_of(" \t"));
-    item.erase(item.find_last_not_of(" \t") + 1);
-    if (item.empty()) continue;
-    if (item == "all") {
-      for (const std::string& m : AllMethods()) out.push_back(m);
-      continue;
-    }
-    if (!IsStepMethod(item) && !IsParametricMethod(item)) {
-      throw InvalidArgument(fmt::format("unknown method '{}' (valid: {}, or all)", item,
-                                        fmt::join(AllMethods(), ", ")));
-    }
-    out.push_back(item);
-  }
-  PNEUMID_CHECK(!out.empty(), "--method needs at least one method name, got '{}'", list);
-  // Keep the first occurrence of each method.
-  std::vector<std::string> unique;
-  for (const std::string& m : out) {
-    if (std::find(unique.begin(), unique.end(), m) == unique.end()) unique.push_back(m);
-  }
-  return unique;
-}
-
-std::string FormatParams(const nlohmann::json& params) {
+// "K=1.6 a=[1 -0.6 0.2] A=[[0.9] [0.1]] t=[200 values]": numbers with 4
+// significant digits, arrays of more than 8 values by their size.
+std::string FormatParams(const ModelParams& params) {
+  auto array = [](const auto& xs, auto&& item) {
+    if (xs.size() > 8) return fmt::format("[{} values]", xs.size());
+    std::vector<std::string> items;
+    for (const auto& x : xs) items.push_back(item(x));
+    return fmt::format("[{}]", fmt::join(items, " "));
+  };
+  auto number = [](double x) { return fmt::format("{:.4g}", x); };
   std::vector<std::string> parts;
-  for (const auto& [key, value] : params.items()) {
-    if (value.is_number()) {
-      parts.push_back(fmt::format("{}={:.4g}", key, value.get<double>()));
-    } else if (value.is_array() && value.size() > 8) {
-      parts.push_back(fmt::format("{}=[{} values]", key, value.size()));
-    } else if (value.is_array()) {
-      std::vector<std::string> xs;
-      for (const auto& x : value) {
-        xs.push_back(x.is_number() ? fmt::format("{:.4g}", x.get<double>()) : x.dump());
-      }
-      parts.push_back(fmt::format("{}=[{}]", key, fmt::join(xs, " ")));
-    } else {
-      parts.push_back(fmt::format("{}={}", key, value.dump()));
-    }
+  for (const auto& [key, value] : params) {
+    const std::string text = std::visit(
+        [&](const auto& v) -> std::string {
+          using T = std::decay_t<decltype(v)>;
+          if constexpr (std::is_same_v<T, std::vector<std::vector<double>>>) {
+            return array(v, [&](const std::vector<double>& row) { return array(row, number); });
+          } else if constexpr (std::is_arithmetic_v<T>) {
+            return number(v);
+          } else {
+            return array(v, number);
+          }
+        },
+        value);
+    parts.push_back(key + "=" + text);
   }
   return fmt::format("{}", fmt::join(parts, " "));
 }
@@ -124,8 +101,7 @@ void WritePlot(const std::string& path, const Dataset& data, const IdentifyReque
   for (const IdentifiedModel& m : models) {
     if (drawn >= 8 || !(m.fit_percent > 0.0)) break;
     ++drawn;
-    double y0 = std::numeric_limits<double>::quiet_NaN();
-    if (m.params.contains("y0") && m.params["y0"].is_number()) y0 = m.params["y0"].get<double>();
+    const double y0 = m.params.FindScalar("y0").value_or(std::numeric_limits<double>::quiet_NaN());
     try {
       const Eigen::VectorXd yhat =
           SimulateOnData(m.discrete ? *m.discrete : m.tf, data, request.input, request.output, y0);
@@ -147,22 +123,18 @@ void WritePlot(const std::string& path, const Dataset& data, const IdentifyReque
 void Run(const IdentifyArgs& args) {
   std::string why;
   PNEUMID_CHECK(args.request.IsValid(&why), "{}", why);
-  const std::vector<std::string> methods = SplitMethods(args.methods);
+  const std::vector<std::string> methods = ParseMethodList(args.methods);
   const bool all_requested = args.methods.find("all") != std::string::npos;
   const Dataset data = LoadFromOptions(args.data);
-  StepMethodOptions step_options;
-  step_options.fit.loss = RobustLossFromString(args.loss);
+  IdentifyOptions options;
+  options.step.fit.loss = RobustLossFromString(args.loss);
 
   std::vector<IdentifiedModel> models;
   for (std::size_t i = 0; i < methods.size(); ++i) {
     Progress(i, methods.size(), methods[i]);
     const std::string& m = methods[i];
     try {
-      if (IsStepMethod(m)) {
-        models.push_back(IdentifyStepMethod(m, data, args.request, step_options));
-      } else {
-        models.push_back(IdentifyParametric(m, data, args.request));
-      }
+      models.push_back(Identify(m, data, args.request, options));
     } catch (const std::exception& e) {
       // With "all", a method that does not suit the data is skipped with a
       // warning; a method asked for by name fails the command.
@@ -179,15 +151,22 @@ void Run(const IdentifyArgs& args) {
 
   nlohmann::json j;
   j["models"] = nlohmann::json::array();
-  for (const IdentifiedModel& m : models) j["models"].push_back(m.ToJson());
-  if (!args.output.empty()) {
-    std::ofstream f(args.output);
-    if (!f) throw DataError(fmt::format("{}: cannot open for writing", args.output));
-    f << j.dump(2) << "\n";
-    if (!f) throw DataError(fmt::format("{}: write failed", args.output));
-  }
+  for (const IdentifiedModel& m : models) j["models"].push_back(ToJson(m));
+  if (!args.output.empty()) WriteJsonFile(j, args.output);
   if (!args.plot.empty()) WritePlot(args.plot, data, args.request, models);
 
+  if (args.json && !args.output.empty()) {
+    // The models are in the file: a short summary here, not the same JSON twice.
+    nlohmann::ordered_json brief;
+    brief["output"] = args.output;
+    brief["models"] = nlohmann::json::array();
+    for (const IdentifiedModel& m : models)
+      brief["models"].push_back(
+          {{"method", m.method}, {"structure", m.structure}, {"fit_percent", m.fit_percent}});
+    if (!args.plot.empty()) brief["plot"] = args.plot;
+    std::cout << brief.dump(2) << "\n";
+    return;
+  }
   if (args.json) {
     std::cout << j.dump(2) << "\n";
     return;
@@ -210,7 +189,7 @@ static Registrar reg(
     [](CLI::App& app) {
       auto args = std::make_shared<IdentifyArgs>();
       AddDataOptions(app, args->data);
-      app.add_option("-m,--method", args->methods,
+      app.add_option("-m,--method,--methods", args->methods,
                      "Comma-separated methods, or all: reaction-curve, tangent, smith, "
                      "sundaresan, broida, sopdt, ptn, strejc, areas, fit-p1d, fit-p2d, fit-p2du, "
                      "fit-p3d, fit-p1di, arx, armax, oe, bj, iv4, n4sid, cra, spa")
@@ -227,11 +206,13 @@ static Registrar reg(
       app.add_option("--nf", args->request.nf, "F order (oe, bj)")->capture_default_str();
       app.add_option("--loss", args->loss, "Loss of the fit-* methods: none, huber, cauchy")
           ->capture_default_str();
-      app.add_flag("--json", args->json, "Print {\"models\": [...]} as JSON, best first");
-      app.add_option("--plot", args->plot,
-                     "Plot the data and the responses of the (up to 8) best models with a "
-                     "positive fit, PNG or SVG by extension");
-      app.add_option("-o,--output", args->output, "Write the models as JSON to this file");
+      app.add_flag("--json", args->json,
+                   "Print {\"models\": [...]} as JSON, best first (with -o: the file name and "
+                   "each model's method, structure and fit_percent)");
+      AddPlotOption(app, args->plot,
+                    "the data and the responses of the (up to 8) best models with a positive fit");
+      app.add_option("-o,--output", args->output,
+                     "Write the models as JSON ({\"models\": [...]}) to this file");
       app.callback([args] { Run(*args); });
     });
 

@@ -10,8 +10,11 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "validators.hpp"
 #include "data_options.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/strings.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/report/identification_report.hpp"
 
 namespace {
@@ -26,14 +29,8 @@ std::string ShellQuote(const std::string& s) {
 }
 
 std::vector<std::string> SplitComma(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    const auto b = item.find_first_not_of(' ');
-    const auto e = item.find_last_not_of(' ');
-    if (b != std::string::npos) out.push_back(item.substr(b, e - b + 1));
-  }
+  std::vector<std::string> out = pneumid::Split(s, ',');
+  std::erase(out, std::string());
   return out;
 }
 
@@ -66,16 +63,16 @@ void Run(const ReportArgs& a) {
   if (a.data.input_col != defaults.input_col) cmd += " --input-col " + ShellQuote(a.data.input_col);
   if (a.data.output_col != defaults.output_col)
     cmd += " --output-col " + ShellQuote(a.data.output_col);
-  if (a.data.sample_time > 0) cmd += fmt::format(" --sample-time {}", a.data.sample_time);
+  if (a.data.sample_time > 0) cmd += fmt::format(" --Ts {}", a.data.sample_time);
   if (!a.data.delimiter.empty()) cmd += " --delimiter " + ShellQuote(a.data.delimiter);
   if (a.data.format != defaults.format) cmd += " --format " + a.data.format;
-  cmd += " --methods " + ShellQuote(a.methods);
+  cmd += " --method " + ShellQuote(a.methods);
   if (a.order != 2) cmd += fmt::format(" --order {}", a.order);
   if (a.na != 3 || a.nb != 3 || a.nk != 1)
     cmd += fmt::format(" --na {} --nb {} --nk {}", a.na, a.nb, a.nk);
   if (a.max_lag != 25) cmd += fmt::format(" --max-lag {}", a.max_lag);
   if (!a.title.empty()) cmd += " --title " + ShellQuote(a.title);
-  cmd += " -o " + ShellQuote(a.out_dir);
+  cmd += " --output-dir " + ShellQuote(a.out_dir);
   o.commands = {cmd};
 
   const Dataset data = cli::LoadFromOptions(a.data);
@@ -90,7 +87,7 @@ void Run(const ReportArgs& a) {
     j["figures"] = s.num_figures;
     j["tables"] = s.num_tables;
     j["models"] = nlohmann::json::array();
-    for (const auto& m : s.models) j["models"].push_back(m.ToJson());
+    for (const auto& m : s.models) j["models"].push_back(ToJson(m));
     j["failures"] = nlohmann::json::array();
     for (const auto& [m, e] : s.failures) j["failures"].push_back({{"method", m}, {"error", e}});
     std::cout << j.dump(2) << "\n";
@@ -114,11 +111,11 @@ const pneumid::cli::Registrar reg(
     [](CLI::App& app) {
       auto a = std::make_shared<ReportArgs>();
       pneumid::cli::AddDataOptions(app, a->data);
-      app.add_option("--methods,-m", a->methods,
+      app.add_option("-m,--method,--methods", a->methods,
                      "Comma-separated identification methods (names of `pneumid identify "
                      "--method`)")
           ->capture_default_str();
-      app.add_option("-o,--output-dir", a->out_dir,
+      app.add_option("--output-dir,-o", a->out_dir,
                      "Directory for report.html and models.json (created when missing)")
           ->required();
       app.add_option("--order", a->order, "PTn order")->capture_default_str();
@@ -126,7 +123,8 @@ const pneumid::cli::Registrar reg(
       app.add_option("--nb", a->nb, "ARX order of B")->capture_default_str();
       app.add_option("--nk", a->nk, "ARX input delay in samples")->capture_default_str();
       app.add_option("--max-lag", a->max_lag, "Largest lag of the residual correlations")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(pneumid::cli::AtLeast(1));
       app.add_option("--title", a->title, "Report title (default: from the data file)");
       app.add_flag("--json", a->json, "Print the summary as JSON");
       app.callback([a]() { Run(*a); });

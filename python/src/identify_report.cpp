@@ -6,6 +6,8 @@
 #include "bindings.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/identified_model.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/identify.hpp"
 #include "pneumid/identify/step_analysis.hpp"
 #include "pneumid/identify/step_methods.hpp"
 #include "pneumid/report/figures.hpp"
@@ -26,6 +28,15 @@ std::vector<NamedModel> ToNamed(const std::vector<std::pair<std::string, Transfe
   return out;
 }
 
+// {name: float | int | list}, as the JSON form.
+py::dict ParamsToPython(const ModelParams& params) {
+  py::dict d;
+  for (const auto& [name, value] : params) {
+    d[py::str(name)] = std::visit([](const auto& v) { return py::cast(v); }, value);
+  }
+  return d;
+}
+
 void SaveFigure(const Figure& fig, const std::string& path) {
   py::gil_scoped_release release;
   fig.Save(path);
@@ -40,10 +51,10 @@ void BindIdentify(py::module_& m) {
       .def_readonly("method", &IdentifiedModel::method)
       .def_readonly("structure", &IdentifiedModel::structure)
       .def_property_readonly(
-          "params", [](const IdentifiedModel& r) { return JsonToPython(r.params); },
+          "params", [](const IdentifiedModel& r) { return ParamsToPython(r.params); },
           "Named parameters (dict), e.g. {'K': 1.6, 'tau': 0.245, 'theta': 0.001}.")
       .def_property_readonly("param_std",
-                             [](const IdentifiedModel& r) { return JsonToPython(r.param_std); })
+                             [](const IdentifiedModel& r) { return ParamsToPython(r.param_std); })
       .def_readonly("tf", &IdentifiedModel::tf, "Model (continuous when it exists).")
       .def_readonly("discrete", &IdentifiedModel::discrete,
                     "Discrete form of polynomial models, else None.")
@@ -51,13 +62,13 @@ void BindIdentify(py::module_& m) {
       .def_readonly("iae", &IdentifiedModel::iae, "Integrated absolute error [units s].")
       .def_readonly("notes", &IdentifiedModel::notes)
       .def(
-          "to_dict", [](const IdentifiedModel& r) { return JsonToPython(r.ToJson()); },
+          "to_dict", [](const IdentifiedModel& r) { return JsonToPython(ToJson(r)); },
           "The JSON form of `pneumid identify --json`.")
       .def("__repr__", [](const IdentifiedModel& r) {
         return "<IdentifiedModel " + r.method + " " + r.structure + ": " + r.tf.ToString(5) + ">";
       });
 
-  m.def("identify_methods", &ReportMethodNames,
+  m.def("identify_methods", &IdentifyMethodNames,
         "Names of the identification methods (as `pneumid identify --method`).");
   m.def(
       "identify",
@@ -74,7 +85,7 @@ void BindIdentify(py::module_& m) {
         r.nd = nd;
         r.nf = nf;
         py::gil_scoped_release release;
-        return IdentifyByName(method, data, r);
+        return Identify(method, data, r);
       },
       "method"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3, "nb"_a = 3,
       "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3,

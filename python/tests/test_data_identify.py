@@ -68,6 +68,10 @@ def test_arx_recovers_paper_model_from_prbs_data():
     m = pneumid.identify("arx", pneumid.Dataset.from_uniform(TS, u, y), na=3, nb=3, nk=1)
     np.testing.assert_allclose(m.params["a"], [1.0, -0.60870, -0.27020, -0.06021], atol=1e-6)
     assert m.fit_percent > 99.9
+    # typed parameters: integers stay int, coefficients are lists, as in the JSON form
+    assert m.params["nk"] == 1 and isinstance(m.params["nk"], int)
+    assert isinstance(m.params["a"], list) and isinstance(m.params["Ts"], float)
+    assert m.to_dict()["params"] == m.params
 
 
 def test_identify_unknown_method_lists_valid_names():
@@ -75,6 +79,8 @@ def test_identify_unknown_method_lists_valid_names():
     with pytest.raises(ValueError, match="reaction-curve"):
         pneumid.identify("magic", pneumid.Dataset.from_uniform(TS, u, y))
     assert "arx" in pneumid.identify_methods()
+    assert pneumid.identify_methods()[0] == "reaction-curve"
+    assert pneumid.identify_methods()[-1] == "spa"
 
 
 def test_identify_releases_the_gil():

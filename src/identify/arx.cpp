@@ -7,6 +7,7 @@
 #include <Eigen/SVD>
 
 #include "pneumid/common/check.hpp"
+#include "tall_skinny_qr.hpp"
 
 namespace pneumid {
 
@@ -59,6 +60,8 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void ReduceKernel(do
 
 }  // namespace
 
+namespace internal {
+
 TallSkinnyQr::TallSkinnyQr(int cols) {
   PNEUMID_CHECK(cols >= 1, "a QR factorization needs >= 1 column, got {}", cols);
   R_ = Eigen::MatrixXd::Zero(cols, cols);
@@ -74,6 +77,8 @@ void TallSkinnyQr::AddRows(const Eigen::Ref<const Eigen::MatrixXd>& rows) {
     num_rows_ += m;
   }
 }
+
+}  // namespace internal
 
 bool ArxOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& msg) {

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/areas.hpp"
 #include "pneumid/identify/reaction_curve.hpp"
 #include "pneumid/identify/sopdt.hpp"
@@ -94,31 +95,24 @@ FopdtParams TangentFopdt(const StepAnalysis& step, const TangentResult& tangent)
 }
 
 // ---------------------------------------------------------------- two-point
-std::string ToString(TwoPointMethod method) {
-  switch (method) {
-    case TwoPointMethod::kSmith:
-      return "smith";
-    case TwoPointMethod::kSundaresanKrishnaswamy:
-      return "sundaresan";
-    case TwoPointMethod::kBroida:
-      return "broida";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<TwoPointMethod> kTwoPointMethodNames[] = {
+    {TwoPointMethod::kSmith, "smith"},
+    {TwoPointMethod::kSundaresanKrishnaswamy, "sundaresan"},
+    {TwoPointMethod::kBroida, "broida"},
+};
+}  // namespace
+
+std::string ToString(TwoPointMethod v) { return std::string(EnumToString(kTwoPointMethodNames, v)); }
 
 TwoPointMethod TwoPointMethodFromString(const std::string& name) {
-  for (auto m :
-       {TwoPointMethod::kSmith, TwoPointMethod::kSundaresanKrishnaswamy, TwoPointMethod::kBroida}) {
-    if (ToString(m) == name) return m;
-  }
-  PNEUMID_CHECK(false, "unknown two-point method '{}' (valid: smith, sundaresan, broida)", name);
-  return TwoPointMethod::kSmith;
+  return EnumFromString(kTwoPointMethodNames, name, "two-point method");
 }
 
 std::pair<double, double> TwoPointLevels(TwoPointMethod method) {
   switch (method) {
     case TwoPointMethod::kSmith:
-      return {0.283, 0.632};
+      return {kSmithLevel1, kSmithLevel2};
     case TwoPointMethod::kSundaresanKrishnaswamy:
       return {0.353, 0.853};
     case TwoPointMethod::kBroida:
@@ -135,8 +129,7 @@ FopdtParams TwoPoint(const StepAnalysis& step, TwoPointMethod method) {
   p.K = step.gain;
   switch (method) {
     case TwoPointMethod::kSmith:
-      p.tau = 1.5 * (t2 - t1);
-      p.theta = t2 - p.tau;
+      p = SmithTwoPoint(step.gain, t1, t2);
       break;
     case TwoPointMethod::kSundaresanKrishnaswamy:
       p.tau = 0.67 * (t2 - t1);

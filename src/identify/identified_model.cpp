@@ -2,22 +2,45 @@
 
 #include <fmt/format.h>
 
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/common/check.hpp"
 
 namespace pneumid {
 
-nlohmann::json IdentifiedModel::ToJson() const {
-  nlohmann::json j;
-  j["method"] = method;
-  j["structure"] = structure;
-  j["params"] = params;
-  if (!param_std.empty()) j["param_std"] = param_std;
-  j["tf"] = pneumid::ToJson(tf);
-  if (discrete) j["discrete"] = pneumid::ToJson(*discrete);
-  j["fit_percent"] = fit_percent;
-  j["iae"] = iae;
-  if (!notes.empty()) j["notes"] = notes;
-  return j;
+namespace {
+
+std::string Names(const ModelParams& p) {
+  std::string names;
+  for (const auto& [name, value] : p) names += (names.empty() ? "" : ", ") + name;
+  return names.empty() ? "none" : names;
+}
+
+}  // namespace
+
+const ParamValue& ModelParams::at(const std::string& name) const {
+  const auto it = values_.find(name);
+  PNEUMID_CHECK(it != values_.end(), "no parameter '{}' (parameters: {})", name, Names(*this));
+  return it->second;
+}
+
+std::optional<double> ModelParams::FindScalar(const std::string& name) const {
+  const auto it = values_.find(name);
+  if (it == values_.end()) return std::nullopt;
+  if (const double* d = std::get_if<double>(&it->second)) return *d;
+  if (const int* i = std::get_if<int>(&it->second)) return *i;
+  return std::nullopt;
+}
+
+double ModelParams::Scalar(const std::string& name) const {
+  at(name);  // names the available parameters when missing
+  const std::optional<double> v = FindScalar(name);
+  PNEUMID_CHECK(v.has_value(), "parameter '{}' is not a number", name);
+  return *v;
+}
+
+const std::vector<double>& ModelParams::Vector(const std::string& name) const {
+  const auto* v = std::get_if<std::vector<double>>(&at(name));
+  PNEUMID_CHECK(v != nullptr, "parameter '{}' is not a coefficient vector", name);
+  return *v;
 }
 
 bool IdentifyRequest::IsValid(std::string* error) const {

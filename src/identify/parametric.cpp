@@ -7,6 +7,7 @@
 #include "pneumid/identify/arx.hpp"
 #include "pneumid/identify/cra.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/iv.hpp"
 #include "pneumid/identify/nonparametric_freq.hpp"
 #include "pneumid/identify/pem.hpp"
@@ -57,7 +58,7 @@ IdentifiedModel ToIdentifiedModel(const std::string& method, const PolynomialMod
   IdentifiedModel r;
   r.method = method;
   r.structure = model.structure;
-  r.params = model.ParamsJson();
+  r.params = ModelParamsFromJson(model.ParamsJson());
   const Eigen::VectorXd sd = model.ParameterStd();
   if (sd.size() > 0) {
     const auto names = model.ParameterNames();
@@ -188,7 +189,7 @@ IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& dat
     m.method = method;
     m.structure = "SS";
     auto mat = [](const Eigen::MatrixXd& x) {
-      nlohmann::json rows = nlohmann::json::array();
+      std::vector<std::vector<double>> rows;
       for (Eigen::Index i = 0; i < x.rows(); ++i) {
         std::vector<double> row(x.cols());
         for (Eigen::Index k = 0; k < x.cols(); ++k) row[k] = x(i, k);
@@ -211,7 +212,7 @@ IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& dat
     IdentifiedModel m;
     m.method = method;
     m.structure = "FIR";
-    m.params = r.ToJson();
+    m.params = ModelParamsFromJson(r.ToJson());
     std::vector<double> g(r.impulse.data(), r.impulse.data() + r.impulse.size());
     EstimationSummary s;
     s.termination = EstimationTermination::kConvergence;
@@ -227,7 +228,7 @@ IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& dat
   IdentifiedModel m;
   m.method = method;
   m.structure = "FRD";
-  m.params = r.ToJson();
+  m.params = ModelParamsFromJson(r.ToJson());
   const int K = static_cast<int>(r.response.size());
   const int taps = 2 * K;
   std::vector<double> g(taps, 0.0);

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/lti/response.hpp"
 
 namespace pneumid {
 namespace {
@@ -75,19 +76,6 @@ bool StepAnalysisOptions::IsValid(std::string* error) const {
   return true;
 }
 
-double FirstCrossing(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double level,
-                     Eigen::Index start) {
-  PNEUMID_CHECK(t.size() == x.size(), "FirstCrossing: t has {} samples, x has {}", t.size(),
-                x.size());
-  for (Eigen::Index k = std::max<Eigen::Index>(start, 0); k < x.size(); ++k) {
-    if (x[k] >= level) {
-      if (k == start || x[k] == x[k - 1]) return t[k];
-      return t[k - 1] + (level - x[k - 1]) / (x[k] - x[k - 1]) * (t[k] - t[k - 1]);
-    }
-  }
-  return std::numeric_limits<double>::quiet_NaN();
-}
-
 double StepAnalysis::CrossingTime(double level) const {
   PNEUMID_CHECK(level > 0.0 && level < 1.5, "crossing level must be in (0, 1.5), got {}", level);
   const double first = FirstCrossing(t, r, level, step_index);
@@ -107,7 +95,7 @@ double StepAnalysis::CrossingTime(double level) const {
   double last = first;
   for (Eigen::Index k = step_index + 1; k <= k_hi; ++k) {
     if (r[k - 1] < level && r[k] >= level) {
-      last = t[k - 1] + (level - r[k - 1]) / (r[k] - r[k - 1]) * (t[k] - t[k - 1]);
+      last = FirstCrossing(t, r, level, k - 1);
     }
   }
   return 0.5 * (first + last);
@@ -129,6 +117,7 @@ StepAnalysis AnalyzeStep(const Dataset& data, int input, int output,
   PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
                 "output column {} out of range (the data has {} outputs)", output,
                 data.num_outputs());
+  data.RequireNumericScale();
   const std::string src = SourceName(data);
   const Eigen::Index n = data.size();
   if (n < 2 * options.min_tail_samples + 2) {

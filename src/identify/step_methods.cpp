@@ -23,7 +23,7 @@ IdentifiedModel FromFopdt(const std::string& method, const FopdtParams& p) {
   m.method = method;
   m.structure = "FOPDT";
   m.params = {{"K", p.K}, {"tau", p.tau}, {"theta", p.theta}};
-  m.tf = TransferFunction::Fopdt(p.K, p.tau, p.theta);
+  m.tf = p.ToTransferFunction();
   return m;
 }
 
@@ -72,10 +72,8 @@ Eigen::VectorXd SimulateOnData(const TransferFunction& g, const Dataset& data, i
 
 void ScoreModel(const Dataset& data, int input, int output, IdentifiedModel* model) {
   PNEUMID_CHECK(model != nullptr, "ScoreModel: model must not be null");
-  double y0 = std::numeric_limits<double>::quiet_NaN();
-  if (model->params.contains("y0") && model->params["y0"].is_number()) {
-    y0 = model->params["y0"].get<double>();
-  }
+  const double y0 =
+      model->params.FindScalar("y0").value_or(std::numeric_limits<double>::quiet_NaN());
   const TransferFunction& g = model->discrete ? *model->discrete : model->tf;
   const Eigen::VectorXd yhat = SimulateOnData(g, data, input, output, y0);
   const Eigen::VectorXd y = data.y(output);

@@ -6,6 +6,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/arx.hpp"
+#include "tall_skinny_qr.hpp"
 
 namespace pneumid {
 
@@ -39,7 +40,7 @@ SubspaceResult EstimateSubspace(const Eigen::VectorXd& y, const Eigen::VectorXd&
   PNEUMID_CHECK(j >= 8 * s, "{} samples are too few for horizon {} (need at least {})", N, s,
                 10 * s);
   // QR of the j x 4s matrix H' whose row t is [U_f U_p Y_p Y_f] at column t.
-  TallSkinnyQr qr(4 * s);
+  internal::TallSkinnyQr qr(4 * s);
   const Eigen::Index kChunk = 1024;
   Eigen::MatrixXd rows(kChunk, 4 * s);
   for (Eigen::Index t0 = 0; t0 < j; t0 += kChunk) {
@@ -83,7 +84,7 @@ SubspaceResult EstimateSubspace(const Eigen::VectorXd& y, const Eigen::VectorXd&
   // X_{t+1} = A X_t + I u(t), X_0 = 0.
   const int nd = o.feedthrough ? 1 : 0;
   const int p = 2 * n + nd;
-  TallSkinnyQr qr2(p + 1);
+  internal::TallSkinnyQr qr2(p + 1);
   Eigen::MatrixXd block(kChunk, p + 1);
   Eigen::RowVectorXd cat = C;  // C A^t
   Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n, n);

@@ -20,6 +20,10 @@ using Eigen::VectorXd;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr Eigen::Index kMaxDefaultSamples = 200000;
+// Work of an automatic horizon, samples x (states + 1)^2 multiply-adds: about a
+// second. A chosen horizon may take up to kMaxWork.
+constexpr double kMaxDefaultWork = 2e9;
+constexpr double kMaxWork = 1e11;
 
 void CheckDiscreteStep(double Ts, double dt) {
   PNEUMID_CHECK(std::abs(dt - Ts) <= 1e-9 * Ts,
@@ -85,27 +89,66 @@ void ChooseGrid(const TransferFunction& g, double* t_final, double* dt) {
   PNEUMID_CHECK(std::isfinite(*dt) && *dt >= 0.0,
                 "time response: dt must be >= 0 s (0 = automatic), got {}", *dt);
   double slow = 1.0, fast = 1.0;
-  if (*t_final == 0.0 || *dt == 0.0) TimeScales(g, &slow, &fast);
-  if (*t_final == 0.0) *t_final = 7.0 * slow + g.delay();
-  if (*dt == 0.0) {
+  const bool auto_horizon = *t_final == 0.0, auto_dt = *dt == 0.0;
+  if (auto_horizon || auto_dt) TimeScales(g, &slow, &fast);
+  if (auto_horizon) *t_final = 7.0 * slow + g.delay();
+  // Samples an automatic choice may take: bounded in number and in work, so
+  // that a high order or a pole near the stability limit cannot run for hours.
+  const double states = std::max(1, g.Order()) + 1.0;
+  const double max_auto_samples =
+      std::min(static_cast<double>(kMaxDefaultSamples), kMaxDefaultWork / (states * states));
+  if (auto_dt) {
     if (g.IsDiscrete()) {
       *dt = g.Ts();
     } else {
       *dt = std::min(slow / 200.0, fast / 20.0);
-      if (*t_final / *dt > kMaxDefaultSamples) *dt = *t_final / kMaxDefaultSamples;
+      if (*t_final / *dt > max_auto_samples) *dt = *t_final / max_auto_samples;
     }
   }
   if (g.IsDiscrete()) CheckDiscreteStep(g.Ts(), *dt);
-  PNEUMID_CHECK(*t_final / *dt < 1e8,
-                "time response: t_final / dt = {} samples is too many (t_final = {}, dt = {})",
-                *t_final / *dt, *t_final, *dt);
+  if (auto_horizon && *t_final / *dt > max_auto_samples) *t_final = *dt * max_auto_samples;
+  PNEUMID_CHECK(*t_final / *dt < 1e8 && *t_final / *dt * states * states < kMaxWork,
+                "time response: t_final / dt = {:.4g} samples of a model of order {} is too much "
+                "work (t_final = {} s, dt = {} s); shorten t_final or lengthen dt",
+                *t_final / *dt, g.Order(), *t_final, *dt);
 }
 
 Eigen::Index NumSamples(double t_final, double dt) {
   return static_cast<Eigen::Index>(std::ceil(t_final / dt - 1e-9)) + 1;
 }
 
+// A response of a finite input must be finite: NaN or Inf means the model
+// could not be simulated at this step (ill-conditioned, or unstable and overflowing).
+void CheckFinite(const TransferFunction& g, const TimeResponse& r, const char* what) {
+  for (Eigen::Index k = 0; k < r.y.size(); ++k) {
+    PNEUMID_CHECK(std::isfinite(r.y[k]),
+                  "{} response: not finite ({}) from t = {} s on: the order-{} {} model is "
+                  "{} at dt = {} s",
+                  what, r.y[k], r.t[k], g.Order(), g.IsDiscrete() ? "discrete" : "continuous",
+                  g.IsStable() ? "numerically ill-conditioned (try a lower order or a balanced "
+                                 "form)"
+                               : "unstable and its response overflows",
+                  r.t.size() > 1 ? r.t[1] - r.t[0] : 0.0);
+  }
+}
+
 }  // namespace
+
+double FirstCrossing(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double level,
+                     Eigen::Index start, Eigen::Index* index) {
+  PNEUMID_CHECK(t.size() == x.size(), "FirstCrossing: t has {} samples, x has {}", t.size(),
+                x.size());
+  start = std::max<Eigen::Index>(start, 0);
+  for (Eigen::Index k = start; k < x.size(); ++k) {
+    if (x[k] >= level) {
+      if (index) *index = k;
+      if (k == start || x[k] == x[k - 1]) return t[k];
+      return t[k - 1] + (level - x[k - 1]) / (x[k] - x[k - 1]) * (t[k] - t[k - 1]);
+    }
+  }
+  if (index) *index = x.size();
+  return std::numeric_limits<double>::quiet_NaN();
+}
 
 Eigen::MatrixXd Lsim(const StateSpace& g, const Eigen::MatrixXd& u, double dt,
                      const Eigen::VectorXd& x0) {
@@ -155,6 +198,7 @@ TimeResponse Step(const TransferFunction& g, double t_final, double dt) {
   TimeResponse r;
   r.t = VectorXd::LinSpaced(N, 0.0, (N - 1) * dt);
   r.y = Lsim(g, VectorXd::Ones(N), dt);
+  CheckFinite(g, r, "step");
   return r;
 }
 
@@ -167,6 +211,7 @@ TimeResponse Impulse(const TransferFunction& g, double t_final, double dt) {
     VectorXd u = VectorXd::Zero(N);
     u[0] = 1.0;
     r.y = Lsim(g, u, dt);
+    CheckFinite(g, r, "impulse");
     return r;
   }
   // Continuous: the impulse response of the strictly proper part G - D is the
@@ -179,6 +224,7 @@ TimeResponse Impulse(const TransferFunction& g, double t_final, double dt) {
   VectorXd snum = VectorXd::Zero(den.size());
   snum.head(den.size() - 1) = num.tail(den.size() - 1);
   r.y = Lsim(TransferFunction(snum, den, 0.0, g.delay()), VectorXd::Ones(N), dt);
+  CheckFinite(g, r, "impulse");
   return r;
 }
 
@@ -235,25 +281,10 @@ StepInfo ComputeStepInfo(const Eigen::VectorXd& t, const Eigen::VectorXd& y,
   const double mag = std::abs(step);
   const double sign = step > 0 ? 1.0 : -1.0;
   // Normalized response r = (y - y0) / step rises from 0 towards 1.
-  auto r = [&](Eigen::Index k) { return (y[k] - y0) / step; };
-  auto first_crossing = [&](double level, Eigen::Index* index) -> double {
-    if (r(0) >= level) {
-      *index = 0;
-      return t[0];
-    }
-    for (Eigen::Index k = 1; k < N; ++k) {
-      if (r(k) >= level) {
-        *index = k;
-        const double f = (level - r(k - 1)) / (r(k) - r(k - 1));
-        return t[k - 1] + f * (t[k] - t[k - 1]);
-      }
-    }
-    *index = N;
-    return kNaN;
-  };
+  const Eigen::VectorXd normalized = ((y.array() - y0) / step).matrix();
   Eigen::Index ilow = 0, ihigh = 0;
-  const double t_low = first_crossing(options.rise_low, &ilow);
-  const double t_high = first_crossing(options.rise_high, &ihigh);
+  const double t_low = FirstCrossing(t, normalized, options.rise_low, 0, &ilow);
+  const double t_high = FirstCrossing(t, normalized, options.rise_high, 0, &ihigh);
   info.rise_time = t_high - t_low;
 
   // Settling: last sample outside the band, then the interpolated band entry.
@@ -300,11 +331,23 @@ StepInfo ComputeStepInfo(const TransferFunction& g, const StepInfoOptions& optio
     info.steady_state = dc;
     return info;
   }
-  const TimeResponse r = Step(g);
   StepInfoOptions o = options;
   if (std::isnan(o.y_initial)) o.y_initial = 0.0;
   if (std::isnan(o.y_final)) o.y_final = dc;
-  return ComputeStepInfo(r.t, r.y, o);
+  // About 7 slowest time constants is short for a high order (n equal poles
+  // settle after about n + 3 sqrt(n) of them): double the horizon until the
+  // response settles, within twice the work of an automatic grid.
+  TimeResponse r = Step(g);
+  StepInfo info = ComputeStepInfo(r.t, r.y, o);
+  const double states = std::max(1, g.Order()) + 1.0;
+  for (int i = 0; i < 10 && std::isnan(info.settling_time) && dc != 0.0; ++i) {
+    const double dt = r.t[1] - r.t[0];
+    const double t_final = 2.0 * r.t[r.t.size() - 1];
+    if (t_final / dt * states * states > 2.0 * kMaxDefaultWork) break;
+    r = Step(g, t_final, dt);
+    info = ComputeStepInfo(r.t, r.y, o);
+  }
+  return info;
 }
 
 }  // namespace pneumid

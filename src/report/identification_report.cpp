@@ -9,9 +9,9 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
-#include "pneumid/identify/parametric.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/identify.hpp"
 #include "pneumid/identify/step_analysis.hpp"
-#include "pneumid/identify/step_methods.hpp"
 #include "pneumid/report/figures.hpp"
 #include "pneumid/report/html.hpp"
 
@@ -24,17 +24,17 @@ std::string Num(double v) {
   return fmt::format("{:.5g}", v);
 }
 
-// Compact text of a JSON parameter value: numbers with 5 significant digits,
+// Compact text of a parameter value: numbers with 5 significant digits,
 // arrays in brackets.
-std::string ParamText(const nlohmann::json& v) {
-  if (v.is_number()) return Num(v.get<double>());
-  if (v.is_array()) {
-    std::string s = "[";
-    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + ParamText(v[i]);
-    return s + "]";
-  }
-  if (v.is_string()) return v.get<std::string>();
-  return v.dump();
+std::string ParamText(double v) { return Num(v); }
+template <typename T>
+std::string ParamText(const std::vector<T>& v) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + ParamText(v[i]);
+  return s + "]";
+}
+std::string ParamText(const ParamValue& v) {
+  return std::visit([](const auto& x) { return ParamText(x); }, v);
 }
 
 std::string ChannelLabel(const Channel& c, const std::string& fallback) {
@@ -44,32 +44,16 @@ std::string ChannelLabel(const Channel& c, const std::string& fallback) {
 
 }  // namespace
 
-std::vector<std::string> ReportMethodNames() {
-  std::vector<std::string> names = StepMethodNames();
-  for (const auto& m : ParametricMethodNames()) names.push_back(m);
-  return names;
-}
-
-IdentifiedModel IdentifyByName(const std::string& method, const Dataset& data,
-                               const IdentifyRequest& request) {
-  if (IsStepMethod(method)) return IdentifyStepMethod(method, data, request);
-  if (IsParametricMethod(method)) return IdentifyParametric(method, data, request);
-  PNEUMID_CHECK(false, "unknown identification method '{}' (valid: {})", method,
-                fmt::join(ReportMethodNames(), ", "));
-  return {};
-}
-
 bool ReportOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& m) {
     if (error) *error = m;
     return false;
   };
   if (methods.empty()) return fail("ReportOptions::methods is empty");
-  const auto valid = ReportMethodNames();
   for (const auto& m : methods) {
-    if (std::find(valid.begin(), valid.end(), m) == valid.end())
-      return fail(
-          fmt::format("unknown identification method '{}' (valid: {})", m, fmt::join(valid, ", ")));
+    if (!IsIdentifyMethod(m))
+      return fail(fmt::format("unknown identification method '{}' (valid: {})", m,
+                              fmt::join(IdentifyMethodNames(), ", ")));
   }
   if (!request.IsValid(error)) return false;
   if (residual_max_lag < 1 || residual_max_lag > 10000)
@@ -79,18 +63,6 @@ bool ReportOptions::IsValid(std::string* error) const {
     return fail(fmt::format("ReportOptions::residual_confidence must be in (0, 1), got {}",
                             residual_confidence));
   return true;
-}
-
-std::string ToString(ReportTermination t) {
-  switch (t) {
-    case ReportTermination::kSuccess:
-      return "success";
-    case ReportTermination::kPartial:
-      return "partial";
-    case ReportTermination::kFailure:
-      return "failure";
-  }
-  return "failure";
 }
 
 std::string ReportSummary::BriefReport() const {
@@ -120,7 +92,7 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
   ReportSummary summary;
   for (const auto& method : options.methods) {
     try {
-      summary.models.push_back(IdentifyByName(method, data, options.request));
+      summary.models.push_back(Identify(method, data, options.request));
     } catch (const InvalidArgument& e) {
       summary.failures.emplace_back(method, e.what());
     } catch (const DataError& e) {
@@ -170,10 +142,10 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
     pt.header = {"method", "structure", "parameters", "transfer function"};
     for (const auto& m : summary.models) {
       std::string params;
-      for (const auto& [k, v] : m.params.items()) {
+      for (const auto& [k, v] : m.params) {
         if (!params.empty()) params += ", ";
         params += k + " = " + ParamText(v);
-        if (m.param_std.contains(k)) params += " ± " + ParamText(m.param_std[k]);
+        if (m.param_std.contains(k)) params += " ± " + ParamText(m.param_std.at(k));
       }
       pt.rows.push_back({m.method, m.structure, params, m.tf.ToString(5)});
     }
@@ -276,7 +248,7 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
   nlohmann::json j;
   j["data"] = source;
   j["models"] = nlohmann::json::array();
-  for (const auto& m : summary.models) j["models"].push_back(m.ToJson());
+  for (const auto& m : summary.models) j["models"].push_back(ToJson(m));
   j["failures"] = nlohmann::json::array();
   for (const auto& [m, e] : summary.failures)
     j["failures"].push_back({{"method", m}, {"error", e}});

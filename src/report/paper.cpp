@@ -12,8 +12,7 @@
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/tuning.hpp"
-#include "pneumid/identify/parametric.hpp"
-#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/identify/identify.hpp"
 #include "pneumid/lti/conversion.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/lti/response.hpp"
@@ -116,10 +115,6 @@ bool PaperOptions::IsValid(std::string* error) const {
   return true;
 }
 
-std::string ToString(PaperTermination t) {
-  return t == PaperTermination::kSuccess ? "success" : "partial";
-}
-
 std::string PaperResult::BriefReport() const {
   int differ = 0;
   for (const auto& r : rows) differ += r.note.empty() ? 0 : 1;
@@ -216,8 +211,7 @@ PaperResult RunPaper(const PaperOptions& o) {
   const IdentifiedModel* arx = nullptr;
   for (const std::string method : {"reaction-curve", "ptn", "arx"}) {
     try {
-      res.models.push_back(IsParametricMethod(method) ? IdentifyParametric(method, data, req)
-                                                      : IdentifyStepMethod(method, data, req));
+      res.models.push_back(Identify(method, data, req));
     } catch (const std::exception& e) {
       problem("identification by " + method, e);
     }
@@ -233,8 +227,8 @@ PaperResult RunPaper(const PaperOptions& o) {
   const double paper_a[] = {-0.60870, -0.27020, -0.06021};
   const double paper_b[] = {0.03938, 0.04506, 0.01286};
   if (arx) {
-    const auto a = arx->params.at("a").get<std::vector<double>>();
-    const auto b = arx->params.at("b").get<std::vector<double>>();
+    const auto a = arx->params.Vector("a");
+    const auto b = arx->params.Vector("b");
     for (int i = 0; i < 3; ++i) {
       const double ai = i + 1 < static_cast<int>(a.size()) ? a[i + 1] : NAN;
       row(S2, fmt::format("a{}", i + 1), G(paper_a[i], 4), G(ai, 5),
@@ -295,9 +289,9 @@ PaperResult RunPaper(const PaperOptions& o) {
 
   // Section 4: FOPDT.
   if (fopdt) {
-    const double K = fopdt->params.at("K").get<double>();
-    const double tau = fopdt->params.at("tau").get<double>();
-    const double theta = fopdt->params.at("theta").get<double>();
+    const double K = fopdt->params.Scalar("K");
+    const double tau = fopdt->params.Scalar("tau");
+    const double theta = fopdt->params.Scalar("theta");
     try {
       const StepAnalysis s = AnalyzeStep(data);
       row(S4, "force before -> after the step", "0 -> 129 N",
@@ -311,7 +305,7 @@ PaperResult RunPaper(const PaperOptions& o) {
     row(S4, "Kp = dy/du", "1.6 (129 / 81.39 = 1.585)", G(K, 4),
         Close(K, 1.585, 0.03) ? "" : kSimulatorNote);
     const double t63 =
-        fopdt->params.contains("t63") ? fopdt->params.at("t63").get<double>() : tau + theta;
+        fopdt->params.contains("t63") ? fopdt->params.Scalar("t63") : tau + theta;
     row(S4, "t63 (time to 63.2 % after the step)", "0.245 s", G(t63, 4) + " s",
         std::abs(t63 - 0.245) <= o.Ts ? "within one sample" : kSimulatorNote);
     row(S4, "tau", "0.245 s (= t63, theta ~ 0)", G(tau, 4) + " s",
@@ -327,11 +321,11 @@ PaperResult RunPaper(const PaperOptions& o) {
   try {
     const TransferFunction arx_ct = D2C(paper_arx, DiscretizationMethod::kZoh);
     const Dataset unit = UnitStepData(arx_ct, 2.0, o.Ts);
-    const IdentifiedModel rc = IdentifyStepMethod("reaction-curve", unit, req);
-    const IdentifiedModel tg = IdentifyStepMethod("tangent", unit, req);
+    const IdentifiedModel rc = Identify("reaction-curve", unit, req);
+    const IdentifiedModel tg = Identify("tangent", unit, req);
     row(S4, "t63 of the Eq. 5 model's unit step", "0.2306 s (reference)",
-        G(rc.params.at("t63").get<double>(), 4) + " s", "");
-    const double L = tg.params.at("L").get<double>(), T = tg.params.at("T").get<double>();
+        G(rc.params.Scalar("t63"), 4) + " s", "");
+    const double L = tg.params.Scalar("L"), T = tg.params.Scalar("T");
     row(S4, "Z-N tangent L, T of the Eq. 5 model", "L = 0.0043 s, T = 0.2315 s (reference)",
         "L = " + G(L, 2) + " s, T = " + G(T, 4) + " s",
         std::abs(L - 0.0043) <= 0.001 && std::abs(T - 0.2315) <= 0.002
@@ -345,9 +339,9 @@ PaperResult RunPaper(const PaperOptions& o) {
 
   // Section 5: PTn.
   if (ptn) {
-    const double K = ptn->params.at("K").get<double>();
-    const double td = ptn->params.at("td").get<double>();
-    const double tTL = ptn->params.at("tTL").get<double>();
+    const double K = ptn->params.Scalar("K");
+    const double td = ptn->params.Scalar("td");
+    const double tTL = ptn->params.Scalar("tTL");
     row(S5, "kp", "1.6", G(K, 4), Close(K, 1.6, 0.03) ? "" : kSimulatorNote);
     row(S5, "td + tTL (s^1)", "0.2387", G(td + tTL, 4),
         Close(td + tTL, 0.2387, 0.04) ? "" : kSimulatorNote);
@@ -368,19 +362,20 @@ PaperResult RunPaper(const PaperOptions& o) {
   TransferFunction control_model;
   if (fopdt) {
     try {
-      const double K = fopdt->params.at("K").get<double>();
+      const double K = fopdt->params.Scalar("K");
       const double t63 =
           fopdt->params.contains("t63")
-              ? fopdt->params.at("t63").get<double>()
-              : fopdt->params.at("tau").get<double>() + fopdt->params.at("theta").get<double>();
+              ? fopdt->params.Scalar("t63")
+              : fopdt->params.Scalar("tau") + fopdt->params.Scalar("theta");
       control_model = TransferFunction::Fopdt(K, t63, 0.001);
       TuningOptions to;
       to.rule = TuningRule::kShridharCooper;
       to.M = 5;
-      conv = Tune(control_model, o.Ts, to);
+      const PredictionModel sampled(control_model, o.Ts);  // one sampling for both designs
+      conv = Tune(sampled, to);
       TuningOptions tm;
       tm.rule = TuningRule::kPaperModified;
-      mod = Tune(control_model, o.Ts, tm);
+      mod = Tune(sampled, tm);
       tuned = true;
       row(S6, "controller model (paper's reading)", "1.6 exp(-0.001 s) / (0.245 s + 1)",
           fmt::format("{} exp(-0.001 s) / ({} s + 1)", G(K, 4), G(t63, 4)),
@@ -513,6 +508,7 @@ PaperResult RunPaper(const PaperOptions& o) {
         lo.load_steps.push_back({o.load_time, o.load_size});
       std::vector<ClosedLoopTrace> traces;
       Eigen::VectorXd t, r;
+      const PredictionModel sampled(control_model, o.Ts);
       for (const TuningResult* tr : {&conv, &mod}) {
         DmcOptions d;
         d.P = tr->P;
@@ -520,7 +516,7 @@ PaperResult RunPaper(const PaperOptions& o) {
         d.lambda = tr->lambda;
         d.limits.u_min = 0.0;
         d.limits.u_max = 100.0;
-        DmcController dmc(control_model, o.Ts, d);
+        DmcController dmc(sampled, d);
         IpaSimulator ipa(params, o.Ts, o.seed);
         const ClosedLoopResult cl = SimulateClosedLoop(dmc, ipa, *sp, lo);
         const bool is_conv = tr == &conv;

@@ -18,9 +18,9 @@ TEST(ParametricPlant, ArxAndD2cFromSimulatedIpaPrbsData) {
   ASSERT_GE(e.data.size(), 2000);
   const IdentifiedModel m = IdentifyParametric("arx", e.data, IdentifyRequest{});
   EXPECT_EQ(m.structure, "ARX");
-  EXPECT_EQ(m.params["a"].size(), 4u);
-  EXPECT_EQ(m.params["b"].size(), 4u);
-  EXPECT_EQ(m.params["nk"], 1);
+  EXPECT_EQ(m.params.Vector("a").size(), 4u);
+  EXPECT_EQ(m.params.Vector("b").size(), 4u);
+  EXPECT_EQ(std::get<int>(m.params.at("nk")), 1);
   ASSERT_TRUE(m.discrete.has_value());
   EXPECT_TRUE(m.discrete->IsStable());
   EXPECT_GT(m.discrete->DcGain(), 0.0);  // more duty, more force

@@ -37,8 +37,8 @@ TEST(Parametric, ArxReproducesThePaperModelAndItsContinuousForm) {
   const IdentifiedModel m = IdentifyParametric("arx", PaperArxData(2000, 0.0), IdentifyRequest{});
   EXPECT_EQ(m.method, "arx");
   EXPECT_EQ(m.structure, "ARX");
-  const std::vector<double> a = m.params["a"];
-  const std::vector<double> b = m.params["b"];
+  const std::vector<double> a = m.params.Vector("a");
+  const std::vector<double> b = m.params.Vector("b");
   ASSERT_EQ(a.size(), 4u);
   ASSERT_EQ(b.size(), 4u);
   EXPECT_NEAR(a[1], -0.60870, 1e-9);
@@ -48,8 +48,8 @@ TEST(Parametric, ArxReproducesThePaperModelAndItsContinuousForm) {
   EXPECT_NEAR(b[1], 0.03938, 1e-9);
   EXPECT_NEAR(b[2], 0.04506, 1e-9);
   EXPECT_NEAR(b[3], 0.01286, 1e-9);
-  EXPECT_EQ(m.params["nk"], 1);
-  EXPECT_DOUBLE_EQ(m.params["Ts"].get<double>(), 0.01);
+  EXPECT_EQ(std::get<int>(m.params.at("nk")), 1);
+  EXPECT_DOUBLE_EQ(m.params.Scalar("Ts"), 0.01);
   ASSERT_TRUE(m.discrete.has_value());
   EXPECT_NEAR(m.discrete->DcGain(), 1.59796, 1e-5);
   ASSERT_TRUE(m.tf.IsContinuous());

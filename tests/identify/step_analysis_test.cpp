@@ -36,14 +36,6 @@ TEST(StepAnalysisTest, BaselineFinalValueNoise) {
   EXPECT_THAT(s.BriefReport(), HasSubstr("step at t = 1 s"));
 }
 
-TEST(StepAnalysisTest, CrossingIsInterpolated) {
-  Eigen::VectorXd t(4), x(4);
-  t << 0.0, 1.0, 2.0, 3.0;
-  x << 0.0, 0.2, 0.6, 1.0;
-  EXPECT_DOUBLE_EQ(FirstCrossing(t, x, 0.4), 1.5);
-  EXPECT_TRUE(std::isnan(FirstCrossing(t, x, 1.5)));
-}
-
 TEST(StepAnalysisTest, NoStep) {
   Dataset d = Dataset::FromUniform(0.01, Eigen::VectorXd::Constant(300, 2.0),
                                    Eigen::VectorXd::LinSpaced(300, 0.0, 1.0));

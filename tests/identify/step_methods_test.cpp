@@ -15,6 +15,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "step_test_util.hpp"
 
@@ -48,7 +49,7 @@ double TrueResponseFit(const TransferFunction& g, const Dataset& noisy, const Da
 }
 
 double Param(const IdentifiedModel& m, const char* name) {
-  return m.params.contains(name) ? m.params[name].get<double>() : std::nan("");
+  return m.params.FindScalar(name).value_or(std::nan(""));
 }
 
 struct Row {
@@ -119,7 +120,7 @@ TEST(StepMethodComparison, FittedSopdtRecoversTruePlant) {
   // error must lie within three of the fit's own standard deviations, and the
   // 2 % recovery is shown on ten steps in process_model_test.cpp.
   const IdentifiedModel m = IdentifyStepMethod("fit-p2d", testing::LoadSynthetic("sopdt"), {});
-  const double sd = m.param_std["tau2"].get<double>();
+  const double sd = m.param_std.Scalar("tau2");
   EXPECT_NEAR(sd / 0.7, 0.034, 0.01);
   EXPECT_LT(std::abs(r.tau2_err / 100.0 * 0.7), 3.0 * sd);
 }
@@ -179,15 +180,15 @@ TEST(StepMethodsTest, NamesAndErrors) {
 TEST(StepMethodsTest, JsonForm) {
   const Dataset d = testing::LoadSynthetic("fopdt");
   const IdentifiedModel m = IdentifyStepMethod("reaction-curve", d, {});
-  const nlohmann::json j = m.ToJson();
+  const nlohmann::json j = ToJson(m);
   EXPECT_EQ(j["method"], "reaction-curve");
   EXPECT_EQ(j["structure"], "FOPDT");
   for (const char* key : {"K", "tau", "theta"}) EXPECT_TRUE(j["params"].contains(key)) << key;
   EXPECT_EQ(j["tf"]["Ts"], 0.0);
-  EXPECT_NEAR(j["tf"]["delay"].get<double>(), m.params["theta"].get<double>(), 1e-12);
+  EXPECT_NEAR(j["tf"]["delay"].get<double>(), m.params.Scalar("theta"), 1e-12);
   EXPECT_GT(j["fit_percent"].get<double>(), 90.0);
   const TransferFunction back = TransferFunctionFromJson(j["tf"]);
-  EXPECT_NEAR(back.DcGain(), m.params["K"].get<double>(), 1e-9);
+  EXPECT_NEAR(back.DcGain(), m.params.Scalar("K"), 1e-9);
 }
 
 }  // namespace

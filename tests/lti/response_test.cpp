@@ -130,6 +130,20 @@ TEST(ResponseTest, StateSpaceLsimWithInitialState) {
               ThrowsMessage<InvalidArgument>(HasSubstr("dt must be > 0")));
 }
 
+TEST(FirstCrossingTest, InterpolatesBetweenSamples) {
+  Eigen::VectorXd t(4), x(4);
+  t << 0.0, 1.0, 2.0, 3.0;
+  x << 0.0, 0.2, 0.6, 1.0;
+  Eigen::Index k = -1;
+  EXPECT_DOUBLE_EQ(FirstCrossing(t, x, 0.4, 0, &k), 1.5);  // 1 + (0.4 - 0.2) / 0.4
+  EXPECT_EQ(k, 2);
+  EXPECT_DOUBLE_EQ(FirstCrossing(t, x, 0.0), 0.0);  // already at the level
+  EXPECT_DOUBLE_EQ(FirstCrossing(t, x, 0.1, 2), 2.0);  // search starts at t = 2
+  EXPECT_TRUE(std::isnan(FirstCrossing(t, x, 1.5, 0, &k)));
+  EXPECT_EQ(k, 4);
+  EXPECT_THROW(FirstCrossing(t, x.head(3), 0.5), InvalidArgument);
+}
+
 TEST(StepInfoTest, MatlabDocumentationExample) {
   // MATLAB documentation, "Numeric Values of Time-Domain System Characteristics":
   // H = tf([8 18 32],[1 6 14 24]); stepinfo(H) gives RiseTime 0.2087,

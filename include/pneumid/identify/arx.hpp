@@ -58,25 +58,6 @@ struct ArxResult {
   EstimationSummary summary;
 };
 
-/// Triangular factor R of a tall matrix M = Q R given row block by row block
-/// (Householder reflections of [R; block], [3]); memory independent of the
-/// number of rows. Used by the ARX and subspace estimators.
-class TallSkinnyQr {
- public:
-  /// @throws InvalidArgument unless cols >= 1.
-  explicit TallSkinnyQr(int cols);
-  /// Appends rows (m x cols). @throws InvalidArgument on a column mismatch.
-  void AddRows(const Eigen::Ref<const Eigen::MatrixXd>& rows);
-  /// cols x cols upper-triangular factor (R' R = M' M).
-  const Eigen::MatrixXd& R() const { return R_; }
-  long long num_rows() const { return num_rows_; }
-
- private:
-  Eigen::MatrixXd R_;
-  Eigen::MatrixXd block_;
-  long long num_rows_ = 0;
-};
-
 /// Accumulates the triangular factor R of [Phi | Y] from data given in any
 /// number of experiments and chunks (constant memory), then solves for theta.
 class ArxAccumulator {

@@ -44,6 +44,7 @@
 #include <Eigen/Core>
 
 #include "pneumid/data/dataset.hpp"
+#include "pneumid/lti/fopdt.hpp"  // FopdtParams, the result of the FOPDT methods
 
 namespace pneumid {
 
@@ -105,14 +106,6 @@ struct StepAnalysis {
 StepAnalysis AnalyzeStep(const Dataset& data, int input = 0, int output = 0,
                          const StepAnalysisOptions& options = {});
 
-/// First-order-plus-dead-time model K exp(-theta s) / (tau s + 1); K in
-/// output units per input unit, tau and theta in seconds.
-struct FopdtParams {
-  double K = 0.0;
-  double tau = 0.0;
-  double theta = 0.0;
-};
-
 /// Second-order-plus-dead-time model K exp(-theta s) / ((tau1 s + 1)(tau2 s + 1)),
 /// tau1 >= tau2 >= 0 (seconds).
 struct SopdtParams {
@@ -121,10 +114,5 @@ struct SopdtParams {
   double tau2 = 0.0;
   double theta = 0.0;
 };
-
-/// Interpolated time at which the sampled signal x(t) first reaches `level`
-/// from below, searching from index `start`; NaN when it never does.
-double FirstCrossing(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double level,
-                     Eigen::Index start = 0);
 
 }  // namespace pneumid

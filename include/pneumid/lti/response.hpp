@@ -22,9 +22,25 @@ struct TimeResponse {
   Eigen::VectorXd y;  ///< output at t
 };
 
+/// Time at which the sampled signal x(t) first reaches `level` from below,
+/// searching from index `start`: t[k-1] + (level - x[k-1]) / (x[k] - x[k-1])
+/// (t[k] - t[k-1]) for the first k with x[k] >= level (t[start] when x[start]
+/// already does); NaN when it never does. `index`, when given, receives that
+/// k (x.size() when the level is never reached). A falling signal is handled
+/// by passing the normalized response (x - x0) / (x_final - x0).
+/// @throws InvalidArgument when t and x differ in size.
+double FirstCrossing(const Eigen::VectorXd& t, const Eigen::VectorXd& x, double level,
+                     Eigen::Index start = 0, Eigen::Index* index = nullptr);
+
 /// Unit step response on t = 0, dt, ..., >= t_final. dt = 0 chooses Ts for a
 /// discrete model, otherwise about 1/200 of the slowest time constant (plus
 /// delay); t_final = 0 chooses about 7 slowest time constants (plus delay).
+/// Automatic choices are bounded to 200000 samples and about 2e9 multiply-adds
+/// (samples x (order + 1)^2): the horizon of a slow or high-order discrete
+/// model is shortened, the step of a continuous one lengthened.
+/// @throws InvalidArgument for a chosen grid of more than 1e8 samples or 1e11
+///         multiply-adds, or when the response is not finite (an ill-conditioned
+///         or overflowing model), naming the time and the model order.
 TimeResponse Step(const TransferFunction& g, double t_final = 0.0, double dt = 0.0);
 /// Unit impulse response (a discrete impulse of area 1 for discrete models).
 TimeResponse Impulse(const TransferFunction& g, double t_final = 0.0, double dt = 0.0);

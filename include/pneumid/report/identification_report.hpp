@@ -11,7 +11,7 @@
 // Axis labels come from the dataset's channel names and units.
 // and DIR/models.json with the models in the form of `pneumid identify --json`.
 //
-// Methods (names of `pneumid identify --method`):
+// Methods (names of `pneumid identify --method`, identify/identify.hpp):
 //   reaction-curve   FOPDT by the process reaction curve [1, Eq. 2]
 //   tangent          FOPDT from the inflection tangent (Ziegler-Nichols)
 //   ptn              PTn by the tangent-line method [1, Eq. 3], order request.order
@@ -27,20 +27,11 @@
 #include <string>
 #include <vector>
 
+#include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/identified_model.hpp"
 
 namespace pneumid {
-
-/// Identifies with one method by name (see above) and fills fit_percent and
-/// iae from the model simulated on the data (deviation variables).
-/// @throws InvalidArgument for an unknown method; DataError / InvalidArgument
-///         from the method itself.
-IdentifiedModel IdentifyByName(const std::string& method, const Dataset& data,
-                               const IdentifyRequest& request = {});
-
-/// The method names IdentifyByName accepts.
-std::vector<std::string> ReportMethodNames();
 
 struct ReportOptions {
   /// Methods in table order (default: the paper's three).
@@ -54,9 +45,9 @@ struct ReportOptions {
   bool IsValid(std::string* error) const;
 };
 
-enum class ReportTermination { kSuccess, kPartial, kFailure };
-/// "success", "partial", "failure".
-std::string ToString(ReportTermination t);
+/// kSuccess, kPartial or kFailure ("success", "partial", "failure";
+/// common/termination.hpp).
+using ReportTermination = Termination;
 
 struct ReportSummary {
   /// kSuccess: every method gave a model; kPartial: some failed;

@@ -1,0 +1,39 @@
+// JSON form of identified models: one element of the "models" array written by
+// `pneumid identify --json` / `-o FILE` and `pneumid report` (models.json):
+//
+//   {"method": "reaction-curve", "structure": "FOPDT",
+//    "params": {"K": 1.6, "t63": 0.246, "tau": 0.245, "theta": 0.001},
+//    "param_std": {...}                        (only when known)
+//    "tf": {"num": [...], "den": [...], "Ts": 0, "delay": 0.001},
+//    "discrete": {...}                         (polynomial models only)
+//    "fit_percent": 97.1, "iae": 0.8, "notes": [...]   (notes only when any)}
+//
+// The keys are a file format read back by `pneumid step/bode/control --model
+// FILE` (lti/model_io.hpp reads "tf") and `pneumid validate` (the polynomial
+// "params"); keep them. Parameters map to JSON numbers (integers stay
+// integers), arrays and arrays of arrays, in the order of their names.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "pneumid/identify/identified_model.hpp"
+
+namespace pneumid {
+
+/// {"name": value, ...}.
+nlohmann::json ToJson(const ModelParams& params);
+
+/// Inverse of ToJson(const ModelParams&): integers become int, other numbers
+/// double, arrays of integers std::vector<int>, other arrays of numbers
+/// std::vector<double>, arrays of arrays of numbers rows.
+/// @throws InvalidArgument naming the key for any other JSON value.
+ModelParams ModelParamsFromJson(const nlohmann::json& j);
+
+/// The JSON form above.
+nlohmann::json ToJson(const IdentifiedModel& model);
+
+/// Inverse of ToJson(const IdentifiedModel&).
+/// @throws InvalidArgument naming the key that is missing or malformed.
+IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j);
+
+}  // namespace pneumid

@@ -1,0 +1,98 @@
+#include "pneumid/identify/identified_model_io.hpp"
+
+#include <limits>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/lti/model_io.hpp"
+
+namespace pneumid {
+
+namespace {
+
+std::vector<double> Numbers(const nlohmann::json& a, const std::string& key) {
+  std::vector<double> v;
+  v.reserve(a.size());
+  for (const auto& x : a) {
+    PNEUMID_CHECK(x.is_number(), "parameter '{}': expected numbers, got a JSON {}", key,
+                  x.type_name());
+    v.push_back(x.get<double>());
+  }
+  return v;
+}
+
+ParamValue ParamFromJson(const nlohmann::json& v, const std::string& key) {
+  if (v.is_number_integer()) return v.get<int>();
+  if (v.is_number()) return v.get<double>();
+  PNEUMID_CHECK(v.is_array(), "parameter '{}': expected a number or an array, got a JSON {}",
+                key, v.type_name());
+  if (!v.empty() && v[0].is_array()) {
+    std::vector<std::vector<double>> rows;
+    for (const auto& row : v) {
+      PNEUMID_CHECK(row.is_array(), "parameter '{}': expected an array of arrays", key);
+      rows.push_back(Numbers(row, key));
+    }
+    return rows;
+  }
+  bool integers = !v.empty();
+  for (const auto& x : v) integers = integers && x.is_number_integer();
+  if (integers) return v.get<std::vector<int>>();
+  return Numbers(v, key);
+}
+
+}  // namespace
+
+nlohmann::json ToJson(const ModelParams& params) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& [name, value] : params) {
+    std::visit([&j, &name = name](const auto& x) { j[name] = x; }, value);
+  }
+  return j;
+}
+
+ModelParams ModelParamsFromJson(const nlohmann::json& j) {
+  PNEUMID_CHECK(j.is_object(), "model parameters must be a JSON object, got a JSON {}",
+                j.type_name());
+  ModelParams p;
+  for (const auto& [key, value] : j.items()) p[key] = ParamFromJson(value, key);
+  return p;
+}
+
+nlohmann::json ToJson(const IdentifiedModel& model) {
+  nlohmann::json j;
+  j["method"] = model.method;
+  j["structure"] = model.structure;
+  j["params"] = ToJson(model.params);
+  if (!model.param_std.empty()) j["param_std"] = ToJson(model.param_std);
+  j["tf"] = ToJson(model.tf);
+  if (model.discrete) j["discrete"] = ToJson(*model.discrete);
+  j["fit_percent"] = model.fit_percent;
+  j["iae"] = model.iae;
+  if (!model.notes.empty()) j["notes"] = model.notes;
+  return j;
+}
+
+IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
+  PNEUMID_CHECK(j.is_object(), "an identified model must be a JSON object, got a JSON {}",
+                j.type_name());
+  for (const char* key : {"method", "structure", "params", "tf"}) {
+    PNEUMID_CHECK(j.contains(key), "identified model without the key '{}'", key);
+  }
+  IdentifiedModel m;
+  m.method = j.at("method").get<std::string>();
+  m.structure = j.at("structure").get<std::string>();
+  m.params = ModelParamsFromJson(j.at("params"));
+  if (j.contains("param_std")) m.param_std = ModelParamsFromJson(j.at("param_std"));
+  m.tf = TransferFunctionFromJson(j.at("tf"));
+  if (j.contains("discrete")) m.discrete = TransferFunctionFromJson(j.at("discrete"));
+  // A model that could not be scored is written with fit -inf / iae inf, which
+  // JSON stores as null.
+  auto number = [&j](const char* key, double missing) {
+    return j.contains(key) && j.at(key).is_number() ? j.at(key).get<double>() : missing;
+  };
+  m.fit_percent = number("fit_percent", -std::numeric_limits<double>::infinity());
+  m.iae = number("iae", std::numeric_limits<double>::infinity());
+  if (j.contains("notes")) m.notes = j.at("notes").get<std::vector<std::string>>();
+  return m;
+}
+
+}  // namespace pneumid

@@ -1,0 +1,103 @@
+// JSON form of identified models: the keys of the model files written by
+// `pneumid identify -o` (a file format read back by --model FILE), typed
+// parameters that survive the round trip, and errors that name the key.
+#include "pneumid/identify/identified_model_io.hpp"
+
+#include <filesystem>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/identify/identify.hpp"
+#include "pneumid/lti/model_io.hpp"
+#include "step_test_util.hpp"
+
+namespace pneumid {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
+
+// One model as `pneumid identify --json` wrote it before the parameters were
+// typed (numbers, integers, vectors and rows).
+const char* kWritten = R"({
+  "method": "n4sid", "structure": "SS",
+  "params": {"A": [[0.5, 0.1], [0.0, 0.25]], "K": 1.6, "Ts": 0.01, "a": [1.0, -0.6],
+             "nk": 1, "nks": [1, 2], "order": 2},
+  "param_std": {"K": 0.01},
+  "tf": {"num": [0.2, 0.0], "den": [1.0, -0.8], "Ts": 0.01, "delay": 0.0},
+  "discrete": {"num": [0.2, 0.0], "den": [1.0, -0.8], "Ts": 0.01, "delay": 0.0},
+  "fit_percent": 91.5, "iae": 0.25, "notes": ["a note"]})";
+
+TEST(IdentifiedModelIoTest, ReadsAndWritesTheModelFileForm) {
+  const nlohmann::json written = nlohmann::json::parse(kWritten);
+  const IdentifiedModel m = IdentifiedModelFromJson(written);
+  EXPECT_EQ(m.method, "n4sid");
+  EXPECT_DOUBLE_EQ(m.params.Scalar("K"), 1.6);
+  EXPECT_EQ(std::get<int>(m.params.at("nk")), 1);
+  EXPECT_EQ(std::get<int>(m.params.at("order")), 2);
+  EXPECT_EQ(std::get<std::vector<int>>(m.params.at("nks")), (std::vector<int>{1, 2}));
+  EXPECT_EQ(m.params.Vector("a"), (std::vector<double>{1.0, -0.6}));
+  EXPECT_EQ(std::get<std::vector<std::vector<double>>>(m.params.at("A"))[1][1], 0.25);
+  EXPECT_DOUBLE_EQ(m.param_std.Scalar("K"), 0.01);
+  ASSERT_TRUE(m.discrete.has_value());
+  EXPECT_EQ(m.notes, std::vector<std::string>{"a note"});
+  // Written back: the same keys and values (integers stay integers).
+  EXPECT_EQ(ToJson(m), written);
+  EXPECT_EQ(ToJson(m)["params"]["nk"].dump(), "1");
+}
+
+TEST(IdentifiedModelIoTest, ModelFilesOfIdentifyStayReadableAsModelSpecs) {
+  const Dataset d = testing::LoadSynthetic("fopdt");
+  const IdentifiedModel rc = Identify("reaction-curve", d);
+  const IdentifiedModel arx = Identify("arx", d);
+  const nlohmann::json j = {{"models", {ToJson(arx), ToJson(rc)}}};
+  for (const char* key : {"method", "structure", "params", "tf", "fit_percent", "iae"}) {
+    EXPECT_TRUE(j["models"][1].contains(key)) << key;
+  }
+  for (const char* key : {"K", "tau", "theta", "t63"}) {
+    EXPECT_TRUE(j["models"][1]["params"][key].is_number_float()) << key;
+  }
+  for (const char* key : {"a", "b", "nk", "Ts"}) EXPECT_TRUE(j["models"][0]["params"].contains(key));
+  EXPECT_TRUE(j["models"][0]["params"]["nk"].is_number_integer());
+  const auto path = std::filesystem::temp_directory_path() / "pneumid_identified_model_io.json";
+  std::ofstream(path) << j.dump(2);
+  const TransferFunction first = ParseModelSpec(path.string());
+  EXPECT_TRUE(first.IsContinuous() || first.IsDiscrete());
+  const TransferFunction fopdt = ParseModelSpec(path.string() + "#reaction-curve");
+  EXPECT_NEAR(fopdt.DcGain(), rc.params.Scalar("K"), 1e-9);
+  EXPECT_NEAR(fopdt.delay(), rc.params.Scalar("theta"), 1e-12);
+  std::filesystem::remove(path);
+  // And back to typed models.
+  EXPECT_EQ(IdentifiedModelFromJson(ToJson(rc)).params, rc.params);
+  EXPECT_EQ(IdentifiedModelFromJson(ToJson(arx)).params, arx.params);
+}
+
+TEST(IdentifiedModelIoTest, ErrorsNameTheKey) {
+  EXPECT_THAT([] { ModelParamsFromJson(nlohmann::json{{"K", "big"}}); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("parameter 'K'")));
+  EXPECT_THAT([] { ModelParamsFromJson(nlohmann::json{{"a", {1.0, "x"}}}); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("parameter 'a'")));
+  nlohmann::json no_tf = nlohmann::json::parse(kWritten);
+  no_tf.erase("tf");
+  EXPECT_THAT([&] { IdentifiedModelFromJson(no_tf); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("'tf'")));
+}
+
+TEST(ModelParamsTest, TypedAccessors) {
+  ModelParams p{{"K", 2.0}, {"n", 3}, {"a", std::vector<double>{1.0, 0.5}}};
+  EXPECT_DOUBLE_EQ(p.Scalar("K"), 2.0);
+  EXPECT_DOUBLE_EQ(p.Scalar("n"), 3.0);
+  EXPECT_FALSE(p.FindScalar("a").has_value());
+  EXPECT_FALSE(p.FindScalar("y0").has_value());
+  EXPECT_EQ(p.Vector("a").size(), 2u);
+  EXPECT_THAT([&] { p.Scalar("tau"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("no parameter 'tau' (parameters: K, a, n)")));
+  EXPECT_THAT([&] { p.Vector("K"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("'K' is not a coefficient vector")));
+}
+
+}  // namespace
+}  // namespace pneumid
