@@ -14,6 +14,10 @@ void BindReport(pybind11::module_& m);
 /// Plant, control and closed-loop bindings.
 void BindExtras(pybind11::module_& m);
 
+/// Throws InvalidArgument (Python: pneumid.InvalidArgument, a ValueError)
+/// "function: argument is empty (...)" when an array argument has no elements.
+void RequireNonEmpty(long size, const char* function, const char* argument);
+
 /// JSON value <-> Python object (through the json module).
 pybind11::object JsonToPython(const nlohmann::json& j);
 nlohmann::json PythonToJson(const pybind11::handle& obj);

@@ -51,6 +51,7 @@ void BindData(py::module_& m) {
                        std::vector<std::string> input_names, std::vector<std::string> input_units,
                        std::vector<std::string> output_names,
                        std::vector<std::string> output_units) {
+             RequireNonEmpty(time.size(), "Dataset", "time");
              return Dataset(std::move(time), std::move(inputs), std::move(outputs),
                             Channels(input_names, input_units),
                             Channels(output_names, output_units));
@@ -67,6 +68,7 @@ void BindData(py::module_& m) {
           [](double Ts, const Eigen::VectorXd& u, const Eigen::VectorXd& y, double t0,
              const std::string& input_name, const std::string& input_unit,
              const std::string& output_name, const std::string& output_unit) {
+            RequireNonEmpty(u.size(), "Dataset.from_uniform", "u");
             return Dataset::FromUniform(Ts, u, y, t0, {input_name, input_unit},
                                         {output_name, output_unit});
           },
@@ -238,6 +240,7 @@ void BindLti(py::module_& m) {
   m.def(
       "lsim",
       [](const TransferFunction& g, const Eigen::VectorXd& u, double dt) {
+        RequireNonEmpty(u.size(), "lsim", "u");
         py::gil_scoped_release release;
         return Lsim(g, u, dt);
       },
@@ -247,6 +250,7 @@ void BindLti(py::module_& m) {
   m.def(
       "lsim",
       [](const StateSpace& g, const Eigen::MatrixXd& u, double dt, const Eigen::VectorXd& x0) {
+        RequireNonEmpty(u.size(), "lsim", "u");
         py::gil_scoped_release release;
         return Lsim(g, u, dt, x0);
       },

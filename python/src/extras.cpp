@@ -1,5 +1,7 @@
 // Bindings of the plant and control areas, frequency responses and block
 // diagrams.
+#include <optional>
+
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -46,13 +48,16 @@ void BindExtras(py::module_& m) {
   m.def("log_space", &LogSpace, "lo"_a, "hi"_a, "n"_a, "n points from 10^lo to 10^hi.");
   m.def(
       "bode",
-      [](const TransferFunction& g, const Eigen::VectorXd& omega) {
-        const BodeData b = Bode(g, omega);
+      [](const TransferFunction& g, const std::optional<Eigen::VectorXd>& omega) {
+        // None: an automatic grid; an explicit array must hold frequencies.
+        if (omega) RequireNonEmpty(omega->size(), "bode", "omega");
+        const BodeData b = Bode(g, omega.value_or(Eigen::VectorXd()));
         return py::dict("omega"_a = b.omega, "magnitude"_a = b.magnitude,
                         "magnitude_db"_a = b.magnitude_db, "phase_deg"_a = b.phase_deg);
       },
-      "g"_a, "omega"_a = Eigen::VectorXd(),
-      "Frequency response: dict of omega [rad/s], magnitude, magnitude_db, phase_deg.");
+      "g"_a, "omega"_a = py::none(),
+      "Frequency response: dict of omega [rad/s], magnitude, magnitude_db, phase_deg "
+      "(omega None: an automatic grid).");
   m.def(
       "compute_margins",
       [](const TransferFunction& g) {

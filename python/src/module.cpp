@@ -31,6 +31,11 @@ nlohmann::json PythonToJson(const py::handle& obj) {
   return nlohmann::json::parse(s);
 }
 
+void RequireNonEmpty(long size, const char* function, const char* argument) {
+  PNEUMID_CHECK(size > 0, "{}: {} is empty (an array of at least one sample is needed)", function,
+                argument);
+}
+
 }  // namespace pneumid::python
 
 PYBIND11_MODULE(pneumid, m) {
