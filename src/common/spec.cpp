@@ -37,6 +37,18 @@ bool IsNumberList(std::string_view item) {
 
 }  // namespace
 
+std::vector<double> ParseNumberList(std::string_view what, std::string_view text) {
+  std::vector<double> out;
+  for (std::string_view token : ListTokens(text)) {
+    const auto v = ParseDouble(token);
+    PNEUMID_CHECK(v && std::isfinite(*v), "{}: value {} is not a finite number: '{}' (in '{}')",
+                  what, out.size() + 1, token, Trim(text));
+    out.push_back(*v);
+  }
+  PNEUMID_CHECK(!out.empty(), "{}: no values", what);
+  return out;
+}
+
 Spec::Spec(std::string what, std::string_view text_in, Options options)
     : what_(std::move(what)), text_(Trim(text_in)) {
   std::string_view body = text_;
@@ -56,8 +68,8 @@ Spec::Spec(std::string what, std::string_view text_in, Options options)
     if (item.empty()) continue;
     const std::size_t eq = item.find('=');
     if (eq == std::string::npos) {
-      PNEUMID_CHECK(!fields_.empty() && IsNumberList(item),
-                    "{}: expected key=value, got '{}'{}", Context(), item,
+      PNEUMID_CHECK(!fields_.empty() && IsNumberList(item), "{}: expected key=value, got '{}'{}",
+                    Context(), item,
                     fields_.empty() ? ""
                                     : " (values of a list may follow its key=: 'levels=0,1,2' "
                                       "or 'levels=0 1 2')");
@@ -123,15 +135,8 @@ double Spec::Bound(const std::string& key, double fallback) {
 
 std::vector<double> Spec::List(const std::string& key) {
   const std::string& value = Take(key);
-  std::vector<double> out;
-  for (std::string_view token : ListTokens(value)) {
-    const auto v = ParseDouble(token);
-    PNEUMID_CHECK(v && std::isfinite(*v), "{}: key '{}': not a finite number: '{}'", Context(),
-                  key, token);
-    out.push_back(*v);
-  }
-  PNEUMID_CHECK(!out.empty(), "{}: key '{}' has no values", Context(), key);
-  return out;
+  PNEUMID_CHECK(!ListTokens(value).empty(), "{}: key '{}' has no values", Context(), key);
+  return ParseNumberList(fmt::format("{}: key '{}'", Context(), key), value);
 }
 
 std::string Spec::Text(const std::string& key) { return Take(key); }

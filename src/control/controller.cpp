@@ -6,27 +6,24 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 namespace pneumid {
 
-std::string ToString(ControllerType type) {
-  switch (type) {
-    case ControllerType::kDmc:
-      return "dmc";
-    case ControllerType::kGpc:
-      return "gpc";
-    case ControllerType::kPid:
-      return "pid";
-  }
-  return "unknown";
+namespace {
+constexpr EnumName<ControllerType> kControllerTypeNames[] = {
+    {ControllerType::kDmc, "dmc"},
+    {ControllerType::kGpc, "gpc"},
+    {ControllerType::kPid, "pid"},
+};
+}  // namespace
+
+std::string ToString(ControllerType v) {
+  return std::string(EnumToString(kControllerTypeNames, v));
 }
 
 ControllerType ControllerTypeFromString(const std::string& name) {
-  for (ControllerType t : {ControllerType::kDmc, ControllerType::kGpc, ControllerType::kPid}) {
-    if (ToString(t) == name) return t;
-  }
-  PNEUMID_CHECK(false, "unknown controller '{}'; valid: dmc, gpc, pid", name);
-  return ControllerType::kDmc;
+  return EnumFromString(kControllerTypeNames, name, "controller");
 }
 
 bool InputLimits::IsValid(std::string* error) const {

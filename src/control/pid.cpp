@@ -6,25 +6,21 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 namespace pneumid {
 
-std::string ToString(PidTuningRule rule) {
-  switch (rule) {
-    case PidTuningRule::kSimc:
-      return "simc";
-    case PidTuningRule::kImc:
-      return "imc";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<PidTuningRule> kPidTuningRuleNames[] = {
+    {PidTuningRule::kSimc, "simc"},
+    {PidTuningRule::kImc, "imc"},
+};
+}  // namespace
+
+std::string ToString(PidTuningRule v) { return std::string(EnumToString(kPidTuningRuleNames, v)); }
 
 PidTuningRule PidTuningRuleFromString(const std::string& name) {
-  for (PidTuningRule r : {PidTuningRule::kSimc, PidTuningRule::kImc}) {
-    if (ToString(r) == name) return r;
-  }
-  PNEUMID_CHECK(false, "unknown PID tuning rule '{}'; valid: simc, imc", name);
-  return PidTuningRule::kSimc;
+  return EnumFromString(kPidTuningRuleNames, name, "PID tuning rule");
 }
 
 PidGains TunePid(double K, double tau, double theta, double Ts, PidTuningRule rule, double tau_c) {

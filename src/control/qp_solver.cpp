@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 namespace pneumid {
 
@@ -14,32 +15,20 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
-std::string ToString(QpStatus status) {
-  switch (status) {
-    case QpStatus::kSolved:
-      return "solved";
-    case QpStatus::kInfeasible:
-      return "infeasible";
-    case QpStatus::kMaxIterations:
-      return "max_iterations";
-    case QpStatus::kNotConvex:
-      return "not_convex";
-    case QpStatus::kNotSetUp:
-      return "not_set_up";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<QpStatus> kQpStatusNames[] = {
+    {QpStatus::kSolved, "solved"},
+    {QpStatus::kInfeasible, "infeasible"},
+    {QpStatus::kMaxIterations, "max_iterations"},
+    {QpStatus::kNotConvex, "not_convex"},
+    {QpStatus::kNotSetUp, "not_set_up"},
+};
+}  // namespace
+
+std::string ToString(QpStatus v) { return std::string(EnumToString(kQpStatusNames, v)); }
 
 QpStatus QpStatusFromString(const std::string& name) {
-  for (QpStatus s : {QpStatus::kSolved, QpStatus::kInfeasible, QpStatus::kMaxIterations,
-                     QpStatus::kNotConvex, QpStatus::kNotSetUp}) {
-    if (ToString(s) == name) return s;
-  }
-  PNEUMID_CHECK(false,
-                "unknown QP status '{}'; valid: solved, infeasible, max_iterations, not_convex, "
-                "not_set_up",
-                name);
-  return QpStatus::kNotSetUp;
+  return EnumFromString(kQpStatusNames, name, "QP status");
 }
 
 bool QpSolverOptions::IsValid(std::string* error) const {

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 namespace pneumid {
 namespace {
@@ -65,24 +66,18 @@ Dataset OffsetFromFirst(const Dataset& data, Eigen::Index n, ChannelSet which,
 
 }  // namespace
 
-std::string ToString(ChannelSet s) {
-  switch (s) {
-    case ChannelSet::kInputs:
-      return "inputs";
-    case ChannelSet::kOutputs:
-      return "outputs";
-    case ChannelSet::kBoth:
-      return "both";
-  }
-  return "both";
-}
+namespace {
+constexpr EnumName<ChannelSet> kChannelSetNames[] = {
+    {ChannelSet::kInputs, "inputs"},
+    {ChannelSet::kOutputs, "outputs"},
+    {ChannelSet::kBoth, "both"},
+};
+}  // namespace
 
-ChannelSet ChannelSetFromString(const std::string& s) {
-  if (s == "inputs") return ChannelSet::kInputs;
-  if (s == "outputs") return ChannelSet::kOutputs;
-  if (s == "both") return ChannelSet::kBoth;
-  PNEUMID_CHECK(false, "unknown channel set '{}' (expected inputs, outputs or both)", s);
-  return ChannelSet::kBoth;
+std::string ToString(ChannelSet v) { return std::string(EnumToString(kChannelSetNames, v)); }
+
+ChannelSet ChannelSetFromString(const std::string& name) {
+  return EnumFromString(kChannelSetNames, name, "channel set");
 }
 
 Dataset RemoveMeans(const Dataset& data, ChannelSet which, OperatingPoint* removed) {

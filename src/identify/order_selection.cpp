@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/arx.hpp"
 
 namespace pneumid {
@@ -35,28 +36,19 @@ OrderRange OrderRange::Parse(const std::string& text) {
 
 std::string OrderRange::ToString() const { return fmt::format("{}:{}", min, max); }
 
-std::string ToString(OrderCriterion c) {
-  switch (c) {
-    case OrderCriterion::kLoss:
-      return "loss";
-    case OrderCriterion::kAic:
-      return "aic";
-    case OrderCriterion::kAicc:
-      return "aicc";
-    case OrderCriterion::kFpe:
-      return "fpe";
-    case OrderCriterion::kMdl:
-      return "mdl";
-  }
-  return "loss";
+namespace {
+constexpr EnumName<OrderCriterion> kOrderCriterionNames[] = {
+    {OrderCriterion::kLoss, "loss"}, {OrderCriterion::kAic, "aic"}, {OrderCriterion::kAicc, "aicc"},
+    {OrderCriterion::kFpe, "fpe"},   {OrderCriterion::kMdl, "mdl"},
+};
+}  // namespace
+
+std::string ToString(OrderCriterion v) {
+  return std::string(EnumToString(kOrderCriterionNames, v));
 }
 
 OrderCriterion OrderCriterionFromString(const std::string& name) {
-  for (auto c : {OrderCriterion::kLoss, OrderCriterion::kAic, OrderCriterion::kAicc,
-                 OrderCriterion::kFpe, OrderCriterion::kMdl})
-    if (ToString(c) == name) return c;
-  PNEUMID_CHECK(false, "unknown criterion '{}'; valid: loss, aic, aicc, fpe, mdl", name);
-  return OrderCriterion::kLoss;
+  return EnumFromString(kOrderCriterionNames, name, "criterion");
 }
 
 bool OrderSelectionOptions::IsValid(std::string* error) const {

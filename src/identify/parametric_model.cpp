@@ -229,31 +229,6 @@ Eigen::VectorXd Predict(const PolynomialModel& model, const Eigen::VectorXd& y,
 
 namespace pneumid {
 
-std::string ToString(EstimationTermination t) {
-  switch (t) {
-    case EstimationTermination::kConvergence:
-      return "convergence";
-    case EstimationTermination::kNoConvergence:
-      return "no_convergence";
-    case EstimationTermination::kRankDeficient:
-      return "rank_deficient";
-    case EstimationTermination::kFailure:
-      return "failure";
-  }
-  return "failure";
-}
-
-EstimationTermination EstimationTerminationFromString(const std::string& name) {
-  for (auto t : {EstimationTermination::kConvergence, EstimationTermination::kNoConvergence,
-                 EstimationTermination::kRankDeficient, EstimationTermination::kFailure})
-    if (ToString(t) == name) return t;
-  PNEUMID_CHECK(false,
-                "unknown termination '{}'; valid: convergence, no_convergence, rank_deficient, "
-                "failure",
-                name);
-  return EstimationTermination::kFailure;
-}
-
 std::string EstimationSummary::BriefReport() const {
   std::string s = fmt::format("{}: N = {}, {} parameters, loss {:.6g}", ToString(termination),
                               num_rows, num_parameters, loss);

@@ -8,32 +8,28 @@
 
 #include "parametric_filter.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/arx.hpp"
 #include "pneumid/identify/iv.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
 
-std::string ToString(PolynomialStructure s) {
-  switch (s) {
-    case PolynomialStructure::kArx:
-      return "arx";
-    case PolynomialStructure::kArmax:
-      return "armax";
-    case PolynomialStructure::kOe:
-      return "oe";
-    case PolynomialStructure::kBj:
-      return "bj";
-  }
-  return "arx";
+namespace {
+constexpr EnumName<PolynomialStructure> kPolynomialStructureNames[] = {
+    {PolynomialStructure::kArx, "arx"},
+    {PolynomialStructure::kArmax, "armax"},
+    {PolynomialStructure::kOe, "oe"},
+    {PolynomialStructure::kBj, "bj"},
+};
+}  // namespace
+
+std::string ToString(PolynomialStructure v) {
+  return std::string(EnumToString(kPolynomialStructureNames, v));
 }
 
 PolynomialStructure PolynomialStructureFromString(const std::string& name) {
-  for (auto s : {PolynomialStructure::kArx, PolynomialStructure::kArmax, PolynomialStructure::kOe,
-                 PolynomialStructure::kBj})
-    if (ToString(s) == name) return s;
-  PNEUMID_CHECK(false, "unknown model structure '{}'; valid: arx, armax, oe, bj", name);
-  return PolynomialStructure::kArx;
+  return EnumFromString(kPolynomialStructureNames, name, "model structure");
 }
 
 bool PemOptions::IsValid(std::string* error) const {

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/reaction_curve.hpp"
 #include "pneumid/identify/sopdt.hpp"
 #include "pneumid/identify/step_analysis.hpp"
@@ -92,11 +93,6 @@ std::string SlotName(ProcessStructure s, Slot slot) {
       return "y0";
   }
   return "?";
-}
-
-std::string Lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
 }
 
 // Input before its first change, and the index of that change (n if none).
@@ -240,71 +236,38 @@ class SampleResidual : public ceres::CostFunction {
 
 }  // namespace
 
+namespace {
+constexpr EnumName<ProcessStructure> kProcessStructureNames[] = {
+    {ProcessStructure::kP1D, "P1D"},   {ProcessStructure::kP2D, "P2D"},
+    {ProcessStructure::kP2DU, "P2DU"}, {ProcessStructure::kP3D, "P3D"},
+    {ProcessStructure::kP1DI, "P1DI"},
+};
+constexpr EnumName<RobustLoss> kRobustLossNames[] = {
+    {RobustLoss::kNone, "none"}, {RobustLoss::kHuber, "huber"}, {RobustLoss::kCauchy, "cauchy"}};
+}  // namespace
+
 std::string ToString(ProcessStructure structure) {
-  switch (structure) {
-    case ProcessStructure::kP1D:
-      return "P1D";
-    case ProcessStructure::kP2D:
-      return "P2D";
-    case ProcessStructure::kP2DU:
-      return "P2DU";
-    case ProcessStructure::kP3D:
-      return "P3D";
-    case ProcessStructure::kP1DI:
-      return "P1DI";
-  }
-  return "?";
+  return std::string(EnumToString(kProcessStructureNames, structure));
 }
 
 ProcessStructure ProcessStructureFromString(const std::string& name, bool* zero) {
-  std::string n = Lower(name);
-  bool z = false;
-  for (auto s : {ProcessStructure::kP1D, ProcessStructure::kP2D, ProcessStructure::kP2DU,
-                 ProcessStructure::kP3D, ProcessStructure::kP1DI}) {
-    const std::string base = Lower(ToString(s));
-    if (n == base || n == base + "z") {
-      z = n.size() > base.size();
-      if (zero) *zero = z;
-      return s;
-    }
-  }
-  PNEUMID_CHECK(false,
-                "unknown process model structure '{}' (valid: P1D, P2D, P2DU, P3D, P1DI, each "
-                "optionally followed by Z for a zero)",
-                name);
-  return ProcessStructure::kP1D;
+  // A trailing Z (no structure name ends in Z) adds a zero: P2DZ = P2D with (1 + Tz s).
+  const bool z = !name.empty() && (name.back() == 'z' || name.back() == 'Z');
+  const auto s = EnumLookup(kProcessStructureNames,
+                            std::string_view(name).substr(0, name.size() - (z ? 1 : 0)),
+                            /*ignore_case=*/true);
+  PNEUMID_CHECK(s.has_value(),
+                "unknown process model structure '{}' (valid: {}, each optionally followed by Z "
+                "for a zero)",
+                name, EnumNameList(kProcessStructureNames));
+  if (zero) *zero = z;
+  return *s;
 }
 
-std::string ToString(RobustLoss loss) {
-  switch (loss) {
-    case RobustLoss::kNone:
-      return "none";
-    case RobustLoss::kHuber:
-      return "huber";
-    case RobustLoss::kCauchy:
-      return "cauchy";
-  }
-  return "?";
-}
+std::string ToString(RobustLoss loss) { return std::string(EnumToString(kRobustLossNames, loss)); }
 
 RobustLoss RobustLossFromString(const std::string& name) {
-  for (auto l : {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy}) {
-    if (ToString(l) == Lower(name)) return l;
-  }
-  PNEUMID_CHECK(false, "unknown robust loss '{}' (valid: none, huber, cauchy)", name);
-  return RobustLoss::kNone;
-}
-
-std::string ToString(FitTermination termination) {
-  switch (termination) {
-    case FitTermination::kConvergence:
-      return "CONVERGENCE";
-    case FitTermination::kNoConvergence:
-      return "NO_CONVERGENCE";
-    case FitTermination::kFailure:
-      return "FAILURE";
-  }
-  return "?";
+  return EnumFromString(kRobustLossNames, name, "robust loss", /*ignore_case=*/true);
 }
 
 bool ProcessFitOptions::IsValid(std::string* error) const {

@@ -11,6 +11,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 namespace pneumid {
 
@@ -138,36 +139,25 @@ TransferFunction C2DMatched(const TransferFunction& g, double Ts) {
 
 }  // namespace
 
-std::string ToString(DiscretizationMethod method) {
-  switch (method) {
-    case DiscretizationMethod::kZoh:
-      return "zoh";
-    case DiscretizationMethod::kFoh:
-      return "foh";
-    case DiscretizationMethod::kTustin:
-      return "tustin";
-    case DiscretizationMethod::kEuler:
-      return "euler";
-    case DiscretizationMethod::kBackwardDiff:
-      return "backward_diff";
-    case DiscretizationMethod::kMatched:
-      return "matched";
-  }
-  return "unknown";
+namespace {
+constexpr EnumName<DiscretizationMethod> kDiscretizationMethodNames[] = {
+    {DiscretizationMethod::kZoh, "zoh"},
+    {DiscretizationMethod::kFoh, "foh"},
+    {DiscretizationMethod::kTustin, "tustin"},
+    {DiscretizationMethod::kEuler, "euler"},
+    {DiscretizationMethod::kBackwardDiff, "backward_diff"},
+    {DiscretizationMethod::kMatched, "matched"},
+    {DiscretizationMethod::kTustin, "bilinear"},
+    {DiscretizationMethod::kEuler, "forward_diff"},
+};
+}  // namespace
+
+std::string ToString(DiscretizationMethod v) {
+  return std::string(EnumToString(kDiscretizationMethodNames, v));
 }
 
 DiscretizationMethod DiscretizationMethodFromString(const std::string& name) {
-  if (name == "zoh") return DiscretizationMethod::kZoh;
-  if (name == "foh") return DiscretizationMethod::kFoh;
-  if (name == "tustin" || name == "bilinear") return DiscretizationMethod::kTustin;
-  if (name == "euler" || name == "forward_diff") return DiscretizationMethod::kEuler;
-  if (name == "backward_diff") return DiscretizationMethod::kBackwardDiff;
-  if (name == "matched") return DiscretizationMethod::kMatched;
-  PNEUMID_CHECK(false,
-                "unknown discretization method '{}'; valid: zoh, foh, tustin (bilinear), euler "
-                "(forward_diff), backward_diff, matched",
-                name);
-  return DiscretizationMethod::kZoh;
+  return EnumFromString(kDiscretizationMethodNames, name, "discretization method");
 }
 
 StateSpace ToStateSpace(const TransferFunction& tf) {

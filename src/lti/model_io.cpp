@@ -1,88 +1,22 @@
 #include "pneumid/lti/model_io.hpp"
 
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
-#include <map>
-#include <sstream>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/spec.hpp"
+#include "pneumid/common/strings.hpp"
 #include "pneumid/lti/conversion.hpp"
 
 namespace pneumid {
 
 namespace {
-
-std::string Trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
-double ParseNumber(const std::string& spec, const std::string& field, const std::string& text) {
-  const std::string t = Trim(text);
-  double v = 0.0;
-  const char* first = t.data();
-  const char* last = t.data() + t.size();
-  if (!t.empty() && *first == '+') ++first;
-  const auto [ptr, ec] = std::from_chars(first, last, v);
-  PNEUMID_CHECK(!t.empty() && ec == std::errc() && ptr == last && std::isfinite(v),
-                "model spec '{}': field '{}': not a finite number: '{}'", spec, field, t);
-  return v;
-}
-
-std::vector<double> ParseList(const std::string& spec, const std::string& field,
-                              const std::string& text) {
-  std::vector<double> out;
-  std::string token;
-  std::istringstream in(text);
-  std::string cleaned = text;
-  for (char& c : cleaned) {
-    if (c == ';') c = ' ';
-  }
-  std::istringstream words(cleaned);
-  while (words >> token) out.push_back(ParseNumber(spec, field, token));
-  PNEUMID_CHECK(!out.empty(), "model spec '{}': field '{}' has no coefficients", spec, field);
-  return out;
-}
-
-// "key=value,key=value" -> map; values may contain spaces or ';'.
-std::map<std::string, std::string> ParseFields(const std::string& spec, const std::string& body,
-                                               const std::vector<std::string>& allowed) {
-  std::map<std::string, std::string> fields;
-  std::size_t pos = 0;
-  while (pos <= body.size()) {
-    const std::size_t comma = body.find(',', pos);
-    const std::string item =
-        Trim(body.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos));
-    pos = comma == std::string::npos ? body.size() + 1 : comma + 1;
-    if (item.empty()) continue;
-    const std::size_t eq = item.find('=');
-    PNEUMID_CHECK(eq != std::string::npos, "model spec '{}': expected key=value, got '{}'", spec,
-                  item);
-    const std::string key = Trim(item.substr(0, eq));
-    bool ok = false;
-    for (const auto& a : allowed) ok = ok || a == key;
-    PNEUMID_CHECK(ok, "model spec '{}': unknown field '{}' (valid: {})", spec, key,
-                  fmt::join(allowed, ", "));
-    PNEUMID_CHECK(fields.count(key) == 0, "model spec '{}': field '{}' given twice", spec, key);
-    fields[key] = item.substr(eq + 1);
-  }
-  return fields;
-}
-
-const std::string& Require(const std::map<std::string, std::string>& fields,
-                           const std::string& spec, const std::string& key) {
-  const auto it = fields.find(key);
-  PNEUMID_CHECK(it != fields.end(), "model spec '{}': missing field '{}'", spec, key);
-  return it->second;
-}
 
 std::vector<double> JsonNumbers(const nlohmann::json& j, const char* key) {
   PNEUMID_CHECK(j.contains(key), "model JSON: missing key '{}'", key);
@@ -143,27 +77,43 @@ TransferFunction ParseFile(const std::string& spec) {
     path = spec.substr(0, hash);
     select = spec.substr(hash + 1);
   }
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw DataError(fmt::format("{}: is a directory, not a model file", path));
+  }
   std::ifstream in(path);
   if (!in) {
     throw DataError(fmt::format("{}: cannot open model file: {}", path, std::strerror(errno)));
   }
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw DataError(fmt::format("{}: cannot read model file", path));
   nlohmann::json j;
   try {
-    in >> j;
-  } catch (const nlohmann::json::parse_error& e) {
-    // e.byte is the 1-based offset of the error; report line and column.
-    std::ifstream again(path);
-    std::string text((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
-    std::size_t line = 1, col = 1;
-    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    // A parse error knows its 1-based byte offset: report line and column.
+    std::size_t byte = 0;
+    if (const auto* pe = dynamic_cast<const nlohmann::json::parse_error*>(&e)) byte = pe->byte;
+    std::string where = path;
+    if (byte > 0) {
+      std::size_t line = 1, col = 1;
+      for (std::size_t i = 0; i + 1 < byte && i < text.size(); ++i) {
+        if (text[i] == '\n') {
+          ++line;
+          col = 1;
+        } else {
+          ++col;
+        }
       }
+      where = fmt::format("{}:{}:{}", path, line, col);
     }
-    throw DataError(fmt::format("{}:{}:{}: invalid JSON: {}", path, line, col, e.what()));
+    // nlohmann's messages start with "[json.exception.<kind>.<id>] ".
+    std::string what = e.what();
+    if (const std::size_t bracket = what.find("] ");
+        what.rfind("[json.", 0) == 0 && bracket != std::string::npos) {
+      what = what.substr(bracket + 2);
+    }
+    throw DataError(fmt::format("{}: invalid model JSON: {}", where, what));
   }
   try {
     return FromModelJson(j, path, select);
@@ -182,7 +132,7 @@ TransferFunction PaperArxModel() {
 TransferFunction PaperFopdtModel() { return TransferFunction::Fopdt(1.6, 0.245, 0.001); }
 
 TransferFunction ParseModelSpec(const std::string& spec_in) {
-  const std::string spec = Trim(spec_in);
+  const std::string spec(Trim(spec_in));
   PNEUMID_CHECK(!spec.empty(),
                 "model spec is empty; give a built-in name (arx-paper, "
                 "arx-paper-ct, fopdt-paper), fopdt:/sopdt:/tf: or a JSON file");
@@ -191,32 +141,31 @@ TransferFunction ParseModelSpec(const std::string& spec_in) {
   if (spec == "fopdt-paper") return PaperFopdtModel();
   const std::size_t colon = spec.find(':');
   const std::string kind = colon == std::string::npos ? "" : spec.substr(0, colon);
-  const std::string body = colon == std::string::npos ? "" : spec.substr(colon + 1);
-  if (kind == "fopdt") {
-    const auto f = ParseFields(spec, body, {"K", "tau", "theta"});
-    const double theta = f.count("theta") ? ParseNumber(spec, "theta", f.at("theta")) : 0.0;
-    return TransferFunction::Fopdt(ParseNumber(spec, "K", Require(f, spec, "K")),
-                                   ParseNumber(spec, "tau", Require(f, spec, "tau")), theta);
-  }
-  if (kind == "sopdt") {
-    const auto f = ParseFields(spec, body, {"K", "tau1", "tau2", "theta"});
-    const double theta = f.count("theta") ? ParseNumber(spec, "theta", f.at("theta")) : 0.0;
-    return TransferFunction::Sopdt(ParseNumber(spec, "K", Require(f, spec, "K")),
-                                   ParseNumber(spec, "tau1", Require(f, spec, "tau1")),
-                                   ParseNumber(spec, "tau2", Require(f, spec, "tau2")), theta);
-  }
-  if (kind == "tf") {
-    const auto f = ParseFields(spec, body, {"num", "den", "Ts", "delay"});
-    const std::vector<double> num = ParseList(spec, "num", Require(f, spec, "num"));
-    const std::vector<double> den = ParseList(spec, "den", Require(f, spec, "den"));
-    const double Ts = f.count("Ts") ? ParseNumber(spec, "Ts", f.at("Ts")) : 0.0;
-    const double delay = f.count("delay") ? ParseNumber(spec, "delay", f.at("delay")) : 0.0;
-    return TransferFunction(Eigen::Map<const Eigen::VectorXd>(num.data(), num.size()),
-                            Eigen::Map<const Eigen::VectorXd>(den.data(), den.size()), Ts, delay);
+  if (kind == "fopdt" || kind == "sopdt" || kind == "tf") {
+    Spec f("model spec", spec);
+    TransferFunction g;
+    if (kind == "fopdt") {
+      const double K = f.Number("K"), tau = f.Number("tau");
+      g = TransferFunction::Fopdt(K, tau, f.Number("theta", 0.0));
+    } else if (kind == "sopdt") {
+      const double K = f.Number("K"), tau1 = f.Number("tau1"), tau2 = f.Number("tau2");
+      g = TransferFunction::Sopdt(K, tau1, tau2, f.Number("theta", 0.0));
+    } else {
+      const std::vector<double> num = f.List("num");
+      const std::vector<double> den = f.List("den");
+      const double Ts = f.Number("Ts", 0.0);
+      const double delay = f.Number("delay", 0.0);
+      f.Finish();
+      return TransferFunction(Eigen::Map<const Eigen::VectorXd>(num.data(), num.size()),
+                              Eigen::Map<const Eigen::VectorXd>(den.data(), den.size()), Ts, delay);
+    }
+    f.Finish();
+    return g;
   }
   const std::string path = spec.substr(0, spec.rfind('#'));
   const bool looks_like_file = path.size() > 5 && path.substr(path.size() - 5) == ".json";
-  if (looks_like_file || std::ifstream(path).good()) return ParseFile(spec);
+  std::error_code ec;
+  if (looks_like_file || std::filesystem::exists(path, ec)) return ParseFile(spec);
   PNEUMID_CHECK(false,
                 "unknown model spec '{}'; valid: arx-paper, arx-paper-ct, fopdt-paper, "
                 "fopdt:K=..,tau=..,theta=.., sopdt:K=..,tau1=..,tau2=..,theta=.., "

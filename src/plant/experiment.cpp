@@ -45,6 +45,7 @@ Experiment RunExperiment(Plant& plant, const Signal& input, double duration,
   PNEUMID_CHECK(steps < 1e8, "duration {} s at Ts = {} s gives too many samples ({})", duration, Ts,
                 steps);
   const auto n = static_cast<Eigen::Index>(steps) + 1;
+  input.CheckSampleTime(Ts);
   if (options.reset) plant.Reset();
   const double t0 = plant.time();
 

@@ -40,6 +40,35 @@ std::uint8_t MaxLengthSequenceGenerator::Next() {
   return out;
 }
 
+std::uint8_t MaxLengthSequenceBit(int order, std::uint64_t seed, std::uint64_t k) {
+  const MaxLengthSequenceGenerator check(order, seed);  // validates order and seed
+  // Polynomials over GF(2) as bit masks; P(x) = x^n + sum_tap x^tap + 1.
+  const int n = order;
+  std::uint64_t low = 1;  // P without its leading term x^n
+  for (int tap : PrbsTaps(order)) low ^= std::uint64_t{1} << tap;
+  const std::uint64_t top = std::uint64_t{1} << (n - 1);
+  const std::uint64_t mask = (std::uint64_t{1} << n) - 1;  // n <= 32
+  // a * b mod P for a, b of degree < n.
+  const auto mul = [&](std::uint64_t a, std::uint64_t b) {
+    std::uint64_t r = 0;
+    for (int i = n - 1; i >= 0; --i) {
+      const bool carry = (r & top) != 0;
+      r = (r << 1) & mask;
+      if (carry) r ^= low;
+      if ((b >> i) & 1u) r ^= a;
+    }
+    return r;
+  };
+  std::uint64_t result = 1;  // x^0
+  std::uint64_t base = 2;    // x (n >= 2)
+  for (std::uint64_t e = k; e != 0; e >>= 1) {
+    if (e & 1u) result = mul(result, base);
+    base = mul(base, base);
+  }
+  // b[k] = sum_i c_i b[i], and b[0..n-1] are the seed bits.
+  return static_cast<std::uint8_t>(__builtin_parityll(result & seed));
+}
+
 std::vector<std::uint8_t> MaxLengthSequence(int order, std::uint64_t seed, std::int64_t length) {
   MaxLengthSequenceGenerator gen(order, seed);
   if (length < 0) {

@@ -3,19 +3,18 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <limits>
-#include <map>
 #include <numbers>
 #include <set>
-#include <sstream>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/spec.hpp"
+#include "pneumid/common/strings.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/plant/prbs.hpp"
 
@@ -24,6 +23,7 @@ namespace pneumid {
 Eigen::VectorXd Signal::Sample(double Ts, Eigen::Index n, double t0) const {
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
   PNEUMID_CHECK(n >= 0, "number of samples must be non-negative, got n = {}", n);
+  CheckSampleTime(Ts);
   Eigen::VectorXd v(n);
   for (Eigen::Index k = 0; k < n; ++k) v[k] = (*this)(t0 + static_cast<double>(k) * Ts);
   return v;
@@ -40,13 +40,6 @@ bool Reached(double t, double edge) { return t >= edge - kEdgeTol * std::max(1.0
 
 std::string Num(double v) { return fmt::format("{:g}", v); }
 
-std::string Trim(const std::string& s) {
-  auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
 /// Common post-processing: value = clamp(raw + offset, min, max).
 struct Shaping {
   double offset = 0.0;
@@ -62,82 +55,19 @@ struct Shaping {
   }
 };
 
-/// key=value pairs of one spec, consumed one by one so unknown keys can be reported.
-class Params {
- public:
-  Params(std::string spec, std::string kind) : spec_(std::move(spec)), kind_(std::move(kind)) {}
+/// value = clamp(raw + offset, min, max) from the offset=, min=, max= keys of a spec.
+Shaping TakeShaping(Spec& p) {
+  Shaping s;
+  s.offset = p.Number("offset", 0.0);
+  s.min = p.Bound("min", -kInf);
+  s.max = p.Bound("max", kInf);
+  PNEUMID_CHECK(s.min <= s.max, "{}: min = {} exceeds max = {}", p.Context(), s.min, s.max);
+  return s;
+}
 
-  void Add(const std::string& key, const std::string& value) {
-    PNEUMID_CHECK(!key.empty(), "signal '{}': empty key in '{}={}'", spec_, key, value);
-    PNEUMID_CHECK(values_.count(key) == 0, "signal '{}': key '{}' given twice", spec_, key);
-    values_[key] = value;
-  }
-  bool Has(const std::string& key) const { return values_.count(key) != 0; }
-
-  double Number(const std::string& key) {
-    auto it = values_.find(key);
-    PNEUMID_CHECK(it != values_.end(), "signal '{}': {} needs '{}=' (see --help for the syntax)",
-                  spec_, kind_, key);
-    double v = Parse(key, it->second);
-    values_.erase(it);
-    return v;
-  }
-  double Number(const std::string& key, double fallback) {
-    return Has(key) ? Number(key) : fallback;
-  }
-  std::vector<double> List(const std::string& key) {
-    auto it = values_.find(key);
-    PNEUMID_CHECK(it != values_.end(), "signal '{}': {} needs '{}=' (see --help for the syntax)",
-                  spec_, kind_, key);
-    std::string text = it->second;
-    values_.erase(it);
-    std::replace(text.begin(), text.end(), ';', ' ');
-    std::istringstream in(text);
-    std::vector<double> out;
-    std::string tok;
-    while (in >> tok) out.push_back(Parse(key, tok));
-    PNEUMID_CHECK(!out.empty(), "signal '{}': '{}' needs at least one value", spec_, key);
-    return out;
-  }
-  std::string Text(const std::string& key, const std::string& fallback) {
-    auto it = values_.find(key);
-    if (it == values_.end()) return fallback;
-    std::string v = it->second;
-    values_.erase(it);
-    return v;
-  }
-  Shaping TakeShaping() {
-    Shaping s;
-    s.offset = Number("offset", 0.0);
-    s.min = Number("min", -kInf);
-    s.max = Number("max", kInf);
-    PNEUMID_CHECK(s.min <= s.max, "signal '{}': min = {} exceeds max = {}", spec_, s.min, s.max);
-    return s;
-  }
-  /// Throws when keys are left that the kind does not know.
-  void Finish(const std::string& allowed) const {
-    if (values_.empty()) return;
-    PNEUMID_CHECK(false, "signal '{}': unknown key '{}' for {} (allowed: {})", spec_,
-                  values_.begin()->first, kind_, allowed);
-  }
-  const std::string& spec() const { return spec_; }
-
- private:
-  double Parse(const std::string& key, const std::string& text) const {
-    std::string t = Trim(text);
-    double v = 0.0;
-    auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-    PNEUMID_CHECK(ec == std::errc() && ptr == t.data() + t.size() && !t.empty(),
-                  "signal '{}': '{}' is not a number: '{}'", spec_, key, text);
-    PNEUMID_CHECK(std::isfinite(v) || key == "min" || key == "max",
-                  "signal '{}': '{}' must be finite, got '{}'", spec_, key, text);
-    return v;
-  }
-
-  std::string spec_;
-  std::string kind_;
-  std::map<std::string, std::string> values_;
-};
+/// floor(pos) with the edge tolerance of Reached(), as a double (exact for
+/// |pos| < 2^53, where the caller may cast it to an integer).
+double EdgeFloor(double pos) { return std::floor(pos + kEdgeTol * std::max(1.0, std::abs(pos))); }
 
 // ---------------------------------------------------------------------------
 
@@ -161,14 +91,17 @@ class StaircaseSignal final : public Signal {
   double operator()(double t) const override {
     if (!Reached(t, at_)) return s_.Apply(levels_.front());
     // Index of the current level, with the same edge tolerance as Reached().
-    double pos = (t - at_) / dwell_;
-    auto k = static_cast<long long>(std::floor(pos + kEdgeTol * std::max(1.0, std::abs(pos))));
-    k = std::clamp<long long>(k, 0, static_cast<long long>(levels_.size()) - 1);
+    // Clamped in double before the cast: (t - at) / dwell may exceed any integer.
+    const double k =
+        std::clamp(EdgeFloor((t - at_) / dwell_), 0.0, static_cast<double>(levels_.size() - 1));
     return s_.Apply(levels_[static_cast<std::size_t>(k)]);
   }
   std::string ToString() const override {
     std::string lv;
-    for (std::size_t i = 0; i < levels_.size(); ++i) lv += (i ? " " : "") + Num(levels_[i]);
+    for (std::size_t i = 0; i < levels_.size(); ++i) {
+      if (i > 0) lv += ' ';
+      lv += Num(levels_[i]);
+    }
     return "staircase:levels=" + lv + ",dwell=" + Num(dwell_) + ",at=" + Num(at_) + s_.Suffix();
   }
 
@@ -192,12 +125,19 @@ class PrbsSignal final : public Signal {
         gen_(order, seed) {}
   double operator()(double t) const override {
     if (!Reached(t, at_)) return s_.Apply(low_);
-    double pos = (t - at_) / clock_;
-    auto k = static_cast<long long>(std::floor(pos + kEdgeTol * std::max(1.0, std::abs(pos))));
-    k = std::max<long long>(k, 0) % static_cast<long long>(gen_.period());
-    // Bits are generated on demand (a full period of a high order is huge).
-    while (static_cast<long long>(bits_.size()) <= k) bits_.push_back(gen_.Next());
-    return s_.Apply(bits_[static_cast<std::size_t>(k)] ? high_ : low_);
+    const double pos = std::max(EdgeFloor((t - at_) / clock_), 0.0);
+    PNEUMID_CHECK(pos < kMaxExactIndex,
+                  "signal '{}': t = {} s is {:g} clock periods of {} s, beyond the exact "
+                  "integers of a double (2^53): use a clock of at least {:g} s",
+                  ToString(), t, pos, clock_, (t - at_) / kMaxExactIndex);
+    const auto k = static_cast<std::uint64_t>(std::fmod(pos, static_cast<double>(gen_.period())));
+    // The first bits are cached as they are generated; later ones (a period
+    // of a high order is huge) are computed directly in O(order log k).
+    if (k < kCachedBits) {
+      while (bits_.size() <= k) bits_.push_back(gen_.Next());
+      return s_.Apply(bits_[static_cast<std::size_t>(k)] ? high_ : low_);
+    }
+    return s_.Apply(MaxLengthSequenceBit(order_, seed_, k) ? high_ : low_);
   }
   std::string ToString() const override {
     return "prbs:low=" + Num(low_) + ",high=" + Num(high_) + ",order=" + std::to_string(order_) +
@@ -208,6 +148,8 @@ class PrbsSignal final : public Signal {
  private:
   double low_, high_;
   int order_;
+  static constexpr double kMaxExactIndex = 9007199254740992.0;  // 2^53
+  static constexpr std::uint64_t kCachedBits = std::uint64_t{1} << 20;
   double clock_;
   std::uint64_t seed_;
   double at_;
@@ -229,6 +171,13 @@ class ChirpSignal final : public Signal {
     const double phase =
         2.0 * std::numbers::pi * (f0_ * tau + 0.5 * (f1_ - f0_) * tau * tau / duration_);
     return s_.Apply(mid + amp * std::sin(phase));
+  }
+  void CheckSampleTime(double Ts) const override {
+    const double f_max = std::max(f0_, f1_);
+    PNEUMID_CHECK(f_max <= 0.5 / Ts,
+                  "signal '{}': the chirp reaches {} Hz, above the Nyquist frequency {} Hz of "
+                  "the sample time Ts = {} s (it would be aliased): lower f0/f1 or Ts",
+                  ToString(), f_max, 0.5 / Ts, Ts);
   }
   std::string ToString() const override {
     return "chirp:from=" + Num(from_) + ",to=" + Num(to_) + ",f0=" + Num(f0_) + ",f1=" + Num(f1_) +
@@ -302,59 +251,33 @@ class FileSignal final : public Signal {
 }  // namespace
 
 std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
-  const std::string spec = Trim(spec_in);
-  PNEUMID_CHECK(!spec.empty(), "empty signal spec (expected e.g. 'step:from=0,to=1,at=1')");
-  const auto colon = spec.find(':');
-  std::string kind = Trim(spec.substr(0, colon));
-  std::transform(kind.begin(), kind.end(), kind.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  const std::string rest = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  const std::string_view trimmed = Trim(spec_in);
+  PNEUMID_CHECK(!trimmed.empty(), "empty signal spec (expected e.g. 'step:from=0,to=1,at=1')");
+  const std::string kind = ToLower(Trim(trimmed.substr(0, trimmed.find(':'))));
   static const std::set<std::string> kinds = {"step",  "staircase", "multistep", "prbs",
                                               "chirp", "ramp",      "file"};
   PNEUMID_CHECK(kinds.count(kind) != 0,
                 "signal '{}': unknown kind '{}' (expected step, staircase, multistep, prbs, "
                 "chirp, ramp or file)",
-                spec, kind);
-
-  Params p(spec, kind);
-  std::string file_path;
-  {
-    std::vector<std::string> items;
-    std::string cur;
-    std::istringstream in(rest);
-    while (std::getline(in, cur, ',')) items.push_back(cur);
-    std::size_t first = 0;
-    if (kind == "file") {
-      PNEUMID_CHECK(!items.empty() && !Trim(items[0]).empty(),
-                    "signal '{}': file needs a path, e.g. 'file:data.csv,col=u'", spec);
-      file_path = Trim(items[0]);
-      first = 1;
-    }
-    for (std::size_t i = first; i < items.size(); ++i) {
-      std::string item = Trim(items[i]);
-      if (item.empty()) continue;
-      auto eq = item.find('=');
-      PNEUMID_CHECK(eq != std::string::npos, "signal '{}': expected key=value, got '{}'", spec,
-                    item);
-      p.Add(Trim(item.substr(0, eq)), Trim(item.substr(eq + 1)));
-    }
-  }
+                trimmed, kind);
+  Spec p("signal", trimmed, {.has_kind = true, .has_head = kind == "file"});
+  const std::string& spec = p.text();
 
   std::unique_ptr<Signal> out;
   if (kind == "step") {
     double from = p.Number("from", 0.0);
     double to = p.Number("to");
     double at = p.Number("at", 0.0);
-    Shaping s = p.TakeShaping();
-    p.Finish("from, to, at, offset, min, max");
+    Shaping s = TakeShaping(p);
+    p.Finish();
     out = std::make_unique<StepSignal>(from, to, at, s);
   } else if (kind == "staircase" || kind == "multistep") {
     auto levels = p.List("levels");
     double dwell = p.Number("dwell");
     PNEUMID_CHECK(dwell > 0.0, "signal '{}': dwell must be positive, got {}", spec, dwell);
     double at = p.Number("at", 0.0);
-    Shaping s = p.TakeShaping();
-    p.Finish("levels, dwell, at, offset, min, max");
+    Shaping s = TakeShaping(p);
+    p.Finish();
     out = std::make_unique<StaircaseSignal>(std::move(levels), dwell, at, s);
   } else if (kind == "prbs") {
     double low = p.Number("low", 0.0);
@@ -371,8 +294,8 @@ std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
                   "signal '{}': seed must be an integer in 1..2^order-1 = {}, got {}", spec,
                   all_ones, seed_d);
     double at = p.Number("at", 0.0);
-    Shaping s = p.TakeShaping();
-    p.Finish("low, high, order, clock, seed, at, offset, min, max");
+    Shaping s = TakeShaping(p);
+    p.Finish();
     out = std::make_unique<PrbsSignal>(low, high, order, clock, static_cast<std::uint64_t>(seed_d),
                                        at, s);
   } else if (kind == "chirp") {
@@ -385,8 +308,8 @@ std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
     double at = p.Number("at", 0.0);
     double duration = p.Number("duration", 10.0);
     PNEUMID_CHECK(duration > 0.0, "signal '{}': duration must be positive, got {}", spec, duration);
-    Shaping s = p.TakeShaping();
-    p.Finish("from, to, f0, f1, at, duration, offset, min, max");
+    Shaping s = TakeShaping(p);
+    p.Finish();
     out = std::make_unique<ChirpSignal>(from, to, f0, f1, at, duration, s);
   } else if (kind == "ramp") {
     double from = p.Number("from", 0.0);
@@ -394,15 +317,17 @@ std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
     double at = p.Number("at", 0.0);
     double duration = p.Number("duration");
     PNEUMID_CHECK(duration > 0.0, "signal '{}': duration must be positive, got {}", spec, duration);
-    Shaping s = p.TakeShaping();
-    p.Finish("from, to, at, duration, offset, min, max");
+    Shaping s = TakeShaping(p);
+    p.Finish();
     out = std::make_unique<RampSignal>(from, to, at, duration, s);
   } else {  // file
+    PNEUMID_CHECK(!p.head().empty(), "signal '{}': file needs a path, e.g. 'file:data.csv,col=u'",
+                  spec);
     std::string col = p.Text("col", "u");
     std::string time_col = p.Text("time", "t");
-    Shaping s = p.TakeShaping();
-    p.Finish("col, time, offset, min, max");
-    out = std::make_unique<FileSignal>(file_path, col, time_col, s);
+    Shaping s = TakeShaping(p);
+    p.Finish();
+    out = std::make_unique<FileSignal>(p.head(), col, time_col, s);
   }
   return out;
 }
@@ -412,7 +337,7 @@ std::string SignalSyntaxHelp() {
   step:from=A,to=B,at=T                 A before T, B from T on (from defaults to 0, at to 0)
   staircase:levels=L0 L1 ...,dwell=D[,at=T]
                                         each level held D seconds from T on, the last held
-                                        (alias multistep; levels separated by spaces or ';')
+                                        (alias multistep; levels separated by spaces, ';' or ',')
   prbs:low=A,high=B,order=N,clock=C[,seed=S][,at=T]
                                         maximal-length binary sequence from an N-bit LFSR
                                         (N = 2..32, period 2^N-1 clock periods of C seconds,

@@ -60,8 +60,9 @@ TEST(SpecTest, AmbiguousCommasSayHowToWriteIt) {
 }
 
 TEST(SpecTest, ErrorsNameTheSpecAndKey) {
-  EXPECT_THAT([] { Spec("signal", "step:to=1,to=2"); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("signal 'step:to=1,to=2': key 'to' given twice")));
+  EXPECT_THAT(
+      [] { Spec("signal", "step:to=1,to=2"); },
+      ThrowsMessage<InvalidArgument>(HasSubstr("signal 'step:to=1,to=2': key 'to' given twice")));
   EXPECT_THAT([] { Spec("signal", "step:=1"); },
               ThrowsMessage<InvalidArgument>(HasSubstr("empty key")));
   Spec s("signal", "step:to=x,speed=2");
@@ -69,9 +70,9 @@ TEST(SpecTest, ErrorsNameTheSpecAndKey) {
               ThrowsMessage<InvalidArgument>(HasSubstr("missing key 'from' (step needs 'from=')")));
   EXPECT_THAT([&] { s.Number("to"); },
               ThrowsMessage<InvalidArgument>(HasSubstr("key 'to': not a finite number: 'x'")));
-  EXPECT_THAT([&] { s.Finish(); },
-              ThrowsMessage<InvalidArgument>(
-                  HasSubstr("unknown key 'speed' for step (valid: from, to)")));
+  EXPECT_THAT(
+      [&] { s.Finish(); },
+      ThrowsMessage<InvalidArgument>(HasSubstr("unknown key 'speed' for step (valid: from, to)")));
   Spec e("model spec", "tf:num=1,den=");
   EXPECT_THAT([&] { e.List("den"); },
               ThrowsMessage<InvalidArgument>(HasSubstr("key 'den' has no values")));
@@ -97,9 +98,9 @@ TEST(EnumNamesTest, ToStringFromStringAliasesAndErrors) {
   static_assert(EnumToString(kColorNames, Color::kGreen) == "green");
   EXPECT_EQ(EnumFromString(kColorNames, "lime", "color"), Color::kGreen);
   EXPECT_EQ(EnumFromString(kColorNames, "RED", "color", true), Color::kRed);
-  EXPECT_THAT([] { EnumFromString(kColorNames, "RED", "color"); },
-              ThrowsMessage<InvalidArgument>(
-                  HasSubstr("unknown color 'RED' (valid: red, green, lime)")));
+  EXPECT_THAT(
+      [] { EnumFromString(kColorNames, "RED", "color"); },
+      ThrowsMessage<InvalidArgument>(HasSubstr("unknown color 'RED' (valid: red, green, lime)")));
   const std::string huge(100000, 'x');
   try {
     EnumFromString(kColorNames, huge, "color");

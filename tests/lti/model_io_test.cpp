@@ -13,7 +13,9 @@
 namespace pneumid {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::ThrowsMessage;
 
 std::string WriteTemp(const std::string& name, const std::string& text) {
@@ -93,18 +95,42 @@ TEST(ModelIoTest, JsonFiles) {
 
 TEST(ModelIoTest, BadSpecsNameTheField) {
   EXPECT_THAT([] { ParseModelSpec("fopdt:K=1.6,tau=abc"); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("field 'tau': not a finite number: 'abc'")));
+              ThrowsMessage<InvalidArgument>(HasSubstr("key 'tau': not a finite number: 'abc'")));
   EXPECT_THAT([] { ParseModelSpec("fopdt:K=1.6"); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("missing field 'tau'")));
+              ThrowsMessage<InvalidArgument>(HasSubstr("missing key 'tau'")));
   EXPECT_THAT([] { ParseModelSpec("fopdt:K=1,tau=1,zeta=2"); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("unknown field 'zeta'")));
+              ThrowsMessage<InvalidArgument>(HasSubstr("unknown key 'zeta'")));
   EXPECT_THAT([] { ParseModelSpec("tf:num=1,den="); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("field 'den' has no coefficients")));
+              ThrowsMessage<InvalidArgument>(HasSubstr("key 'den' has no values")));
   EXPECT_THAT([] { ParseModelSpec("fopdt:K=1,tau=-1"); },
               ThrowsMessage<InvalidArgument>(HasSubstr("tau must be > 0")));
   EXPECT_THAT([] { ParseModelSpec("arx-papr"); },
               ThrowsMessage<InvalidArgument>(HasSubstr("unknown model spec 'arx-papr'")));
   EXPECT_THAT([] { ParseModelSpec(""); }, ThrowsMessage<InvalidArgument>(HasSubstr("empty")));
+  EXPECT_THAT([] { ParseModelSpec("fopdt:K=1,2,tau=1"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("key 'K' takes one number, got '1,2'")));
+}
+
+TEST(ModelIoTest, CommasInsideCoefficientLists) {
+  // A bare number after key=value continues that key's list.
+  const TransferFunction g = ParseModelSpec("tf:num=1,den=1,-1,Ts=0.1");
+  EXPECT_EQ(g.den(), Eigen::Vector2d(1.0, -1.0));
+  EXPECT_DOUBLE_EQ(g.num()(0), 1.0);  // num = [1] (padded to the length of den)
+  EXPECT_DOUBLE_EQ(g.Ts(), 0.1);
+  EXPECT_EQ(ParseModelSpec("tf:num=1 2,den=1;3;2").den(), Eigen::Vector3d(1.0, 3.0, 2.0));
+}
+
+TEST(ModelIoTest, BadModelFilesNameTheFile) {
+  // A number beyond the range of double: the JSON library's overflow, with the file name.
+  const std::string huge = WriteTemp("huge.json", R"({"num": [72e377], "den": [1, 1]})");
+  EXPECT_THAT([&] { ParseModelSpec(huge); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("huge.json"), HasSubstr("72e377"),
+                                             Not(HasSubstr("[json.exception")))));
+  const std::string dir = ::testing::TempDir();
+  EXPECT_THAT([&] { ParseModelSpec(dir); },
+              ThrowsMessage<DataError>(HasSubstr("is a directory, not a model file")));
+  EXPECT_THAT([] { ParseModelSpec("."); },
+              ThrowsMessage<DataError>(HasSubstr(".: is a directory, not a model file")));
 }
 
 }  // namespace

@@ -17,6 +17,7 @@ namespace pneumid {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 TEST(SignalTest, StepSwitchesAtItsEdge) {
   auto s = ParseSignal("step:from=0.61,to=82,at=1.0");
@@ -185,9 +186,8 @@ TEST(SignalTest, FileInputErrorsNameTheFileAndTheInputColumn) {
   }
   // The column feeds the plant input: the error must not call it an output.
   EXPECT_THAT([&] { ParseSignal("file:" + path + ",col=p"); },
-              ::testing::ThrowsMessage<DataError>(
-                  ::testing::AllOf(HasSubstr("unknown input column 'p'"),
-                                   ::testing::Not(HasSubstr("output")))));
+              ::testing::ThrowsMessage<DataError>(::testing::AllOf(
+                  HasSubstr("unknown input column 'p'"), ::testing::Not(HasSubstr("output")))));
   std::remove(path.c_str());
 }
 
@@ -203,18 +203,67 @@ TEST(SignalTest, BadSpecsGiveClearErrors) {
   expect_error("", "empty signal spec");
   expect_error("sine:f=1", "unknown kind 'sine'");
   expect_error("step:from=0,at=1", "needs 'to='");
-  expect_error("step:from=0,to=x1,at=1", "'to' is not a number: 'x1'");
+  expect_error("step:from=0,to=x1,at=1", "key 'to': not a finite number: 'x1'");
   expect_error("step:to=1,speed=3", "unknown key 'speed'");
   expect_error("step:to=1,to=2", "given twice");
   expect_error("step:to=1,at", "expected key=value");
   expect_error("prbs:order=40,clock=0.1", "order must be an integer in 2..32");
   expect_error("prbs:order=4,clock=0.1,seed=0", "seed must be an integer in 1..2^order-1 = 15");
   expect_error("prbs:order=4,clock=0", "clock must be positive");
-  expect_error("staircase:levels=,dwell=1", "at least one value");
+  expect_error("staircase:levels=,dwell=1", "key 'levels' has no values");
+  expect_error("step:to=1,2", "key 'to' takes one number, got '1,2'");
   expect_error("ramp:to=1,duration=-1", "duration must be positive");
   expect_error("step:to=1,min=5,max=1", "min = 5 exceeds max = 1");
   expect_error("file:", "file needs a path");
   EXPECT_THAT(SignalSyntaxHelp(), HasSubstr("step:from=A,to=B,at=T"));
+}
+
+TEST(SignalTest, ListsMayBeWrittenWithCommas) {
+  const auto a = ParseSignal("staircase:levels=0,20,40,dwell=1");
+  const auto b = ParseSignal("staircase:levels=0 20 40,dwell=1");
+  EXPECT_EQ(a->ToString(), b->ToString());
+  EXPECT_DOUBLE_EQ((*a)(2.5), 40.0);
+}
+
+TEST(PrbsTest, BitAtIndexMatchesTheGenerator) {
+  for (int order : {2, 7, 12, 16, 31, 32}) {
+    const std::uint64_t seed = order == 2 ? 3 : 0x2B;
+    MaxLengthSequenceGenerator gen(order, seed);
+    for (std::uint64_t k = 0; k < 3000; ++k) {
+      ASSERT_EQ(MaxLengthSequenceBit(order, seed, k), gen.Next())
+          << "order " << order << " k " << k;
+    }
+  }
+  // Periodic with period 2^n - 1.
+  EXPECT_EQ(MaxLengthSequenceBit(20, 5, 12345), MaxLengthSequenceBit(20, 5, 12345 + 1048575));
+}
+
+TEST(SignalTest, PrbsFarBeyondItsCacheIsComputedInBoundedTime) {
+  // 1e9 clock periods in 1 s: bit by bit this took minutes and gigabytes.
+  const auto fast = ParseSignal("prbs:order=32,clock=1e-9");
+  const auto gen_seed = (std::uint64_t{1} << 32) - 1;
+  EXPECT_EQ((*fast)(1.0), MaxLengthSequenceBit(32, gen_seed, 1000000000) ? 1.0 : 0.0);
+  const Eigen::VectorXd v = fast->Sample(0.001, 1001);
+  EXPECT_EQ(v.size(), 1001);
+  EXPECT_TRUE(((v.array() == 0.0) || (v.array() == 1.0)).all());
+}
+
+TEST(SignalTest, IndicesBeyondTheIntegersAreRangeChecked) {
+  // (t - at) / dwell = 1e300: the last level, not an undefined cast.
+  const auto stairs = ParseSignal("staircase:levels=1 2,dwell=1e-300");
+  EXPECT_DOUBLE_EQ((*stairs)(0.0), 1.0);
+  EXPECT_DOUBLE_EQ((*stairs)(1.0), 2.0);
+  const auto prbs = ParseSignal("prbs:order=7,clock=1e-300");
+  EXPECT_THAT([&] { (*prbs)(1.0); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("beyond the exact integers of a double")));
+}
+
+TEST(SignalTest, ChirpAboveNyquistIsRefused) {
+  const auto chirp = ParseSignal("chirp:from=0,to=1,f0=1,f1=80,duration=1");
+  EXPECT_NO_THROW(chirp->Sample(0.005, 10));     // Nyquist 100 Hz
+  EXPECT_THAT([&] { chirp->Sample(0.01, 10); },  // Nyquist 50 Hz
+              ThrowsMessage<InvalidArgument>(
+                  HasSubstr("reaches 80 Hz, above the Nyquist frequency 50 Hz")));
 }
 
 }  // namespace

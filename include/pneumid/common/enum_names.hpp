@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -49,10 +50,10 @@ std::string EnumNameList(const EnumName<E> (&table)[N]) {
 }
 
 /// The value named `name` (exact match, or ASCII case-insensitive when
-/// `ignore_case`). @throws InvalidArgument "unknown <what> 'name' (valid: ...)".
+/// `ignore_case`), or std::nullopt.
 template <typename E, std::size_t N>
-E EnumFromString(const EnumName<E> (&table)[N], std::string_view name, std::string_view what,
-                 bool ignore_case = false) {
+constexpr std::optional<E> EnumLookup(const EnumName<E> (&table)[N], std::string_view name,
+                                      bool ignore_case = false) {
   const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c + 32) : c; };
   for (const EnumName<E>& e : table) {
     if (e.name.size() != name.size()) continue;
@@ -62,6 +63,14 @@ E EnumFromString(const EnumName<E> (&table)[N], std::string_view name, std::stri
     }
     if (same) return e.value;
   }
+  return std::nullopt;
+}
+
+/// As EnumLookup. @throws InvalidArgument "unknown <what> 'name' (valid: ...)".
+template <typename E, std::size_t N>
+E EnumFromString(const EnumName<E> (&table)[N], std::string_view name, std::string_view what,
+                 bool ignore_case = false) {
+  if (const std::optional<E> e = EnumLookup(table, name, ignore_case)) return *e;
   const std::string_view shown = name.size() > 64 ? name.substr(0, 64) : name;
   throw InvalidArgument(fmt::format("unknown {} '{}{}' (valid: {})", what, shown,
                                     shown.size() < name.size() ? "..." : "", EnumNameList(table)));

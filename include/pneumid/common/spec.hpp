@@ -25,6 +25,11 @@
 
 namespace pneumid {
 
+/// The numbers of a list separated by spaces, ';' or ',' ("1 -0.8", "1,-0.8").
+/// @throws InvalidArgument "<what>: value 2 is not a finite number: 'x' (in '1,x')"
+///         or "<what>: no values" for an empty list.
+std::vector<double> ParseNumberList(std::string_view what, std::string_view text);
+
 class Spec {
  public:
   struct Options {

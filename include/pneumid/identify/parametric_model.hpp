@@ -29,21 +29,21 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include "pneumid/common/termination.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
 
-/// How an estimator ended (after Ceres' TerminationType).
-enum class EstimationTermination {
-  kConvergence,    ///< solution found (least squares solved, or iterations converged)
-  kNoConvergence,  ///< iteration limit reached; the result is the last iterate
-  kRankDeficient,  ///< regressors not of full rank: minimum-norm solution returned
-  kFailure,        ///< no usable result (too few samples, numerical breakdown)
-};
-/// "convergence", "no_convergence", "rank_deficient", "failure".
-std::string ToString(EstimationTermination t);
-/// Inverse of ToString; throws InvalidArgument listing the valid names.
-EstimationTermination EstimationTerminationFromString(const std::string& name);
+/// How an estimator ended: kConvergence (solution found: least squares solved,
+/// or iterations converged), kNoConvergence (iteration limit; the last
+/// iterate), kRankDeficient (regressors not of full rank: minimum-norm
+/// solution) or kFailure (too few samples, numerical breakdown). The
+/// vocabulary and ToString are common/termination.hpp's.
+using EstimationTermination = Termination;
+/// Same as TerminationFromString (kept for source compatibility).
+inline EstimationTermination EstimationTerminationFromString(const std::string& name) {
+  return TerminationFromString(name);
+}
 
 /// Outcome of a parametric estimator (after Ceres' Solver::Summary).
 struct EstimationSummary {

@@ -41,6 +41,7 @@
 
 #include <Eigen/Core>
 
+#include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
@@ -87,9 +88,9 @@ struct ProcessFitOptions {
   bool IsValid(std::string* error) const;
 };
 
-enum class FitTermination { kConvergence, kNoConvergence, kFailure };
-/// "CONVERGENCE", "NO_CONVERGENCE", "FAILURE".
-std::string ToString(FitTermination termination);
+/// kConvergence, kNoConvergence or kFailure, written "convergence",
+/// "no_convergence", "failure" (common/termination.hpp).
+using FitTermination = Termination;
 
 struct ProcessFitSummary {
   FitTermination termination = FitTermination::kFailure;

@@ -4,8 +4,9 @@
 //                       fopdt-paper   1.6 exp(-0.001 s) / (0.245 s + 1) (Eq. 2)
 //   * inline specs:     fopdt:K=1.6,tau=0.245,theta=0.001
 //                       sopdt:K=..,tau1=..,tau2=..,theta=..
-//                       tf:num=1 2,den=1 3 2[,Ts=0.01][,delay=0]   (space- or ;-separated;
-//                       coefficients as in TransferFunction, delay in seconds)
+//                       tf:num=1 2,den=1 3 2[,Ts=0.01][,delay=0]   (coefficients separated
+//                       by spaces, ';' or ',': tf:num=1,den=1,-1 is den = [1, -1]; as in
+//                       TransferFunction, delay in seconds; syntax in common/spec.hpp)
 //   * a model JSON file written by pneumid (`pneumid identify --json`, a single
 //     model object, or an object {"num","den","Ts","delay"}); for a list of
 //     models the first (best) one is taken, or `FILE.json#method` selects one.
@@ -21,7 +22,8 @@
 namespace pneumid {
 
 /// Parses a model spec (see above). Throws InvalidArgument naming the spec and
-/// the offending field, or DataError for an unreadable file.
+/// the offending key, or DataError naming the file for an unreadable file,
+/// a directory or invalid JSON.
 TransferFunction ParseModelSpec(const std::string& spec);
 
 /// {"num", "den", "Ts", "delay"} with a monic denominator.

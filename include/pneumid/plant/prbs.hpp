@@ -37,6 +37,13 @@ class MaxLengthSequenceGenerator {
   int idx_ = 0;
 };
 
+/// Bit `k` (0-based) of the m-sequence of the given order and seed, without
+/// generating the k bits before it: the outputs obey b[k+n] = b[k] xor
+/// b[k+tap]... (n = order), so b[k] is the combination of the seed bits given
+/// by x^k mod (x^n + sum x^tap + 1) over GF(2), in O(n log k) operations.
+/// @throws InvalidArgument for a bad order or seed.
+std::uint8_t MaxLengthSequenceBit(int order, std::uint64_t seed, std::uint64_t k);
+
 /// The first `length` bits (default: one full period, which must then fit in
 /// memory, order <= 28) of the m-sequence of the given order and seed.
 /// @throws InvalidArgument for a bad order, seed or length.

@@ -7,7 +7,9 @@
 //   chirp:from=A,to=B,f0=0.1,f1=10[,at=T][,duration=D]   (A..B amplitude range)
 //   ramp:from=A,to=B,at=T,duration=D
 //   file:PATH[,col=u][,time=t]                          (CSV or .mat; held between samples)
-// Every kind also accepts min=, max= (amplitude limits) and offset=.
+// Every kind also accepts min=, max= (amplitude limits) and offset=. Values of
+// levels= are separated by spaces, ';' or ',' (levels=0,20,40); the grammar is
+// that of common/spec.hpp.
 #pragma once
 
 #include <memory>
@@ -24,7 +26,12 @@ class Signal {
   virtual double operator()(double t) const = 0;
   /// The spec this signal was parsed from (normalized).
   virtual std::string ToString() const = 0;
+  /// Throws InvalidArgument when the signal cannot be sampled every Ts seconds
+  /// without aliasing (a chirp above the Nyquist frequency 1/(2 Ts)). Callers
+  /// that sample a signal (experiments, closed loops, Sample) check it first.
+  virtual void CheckSampleTime(double /*Ts*/) const {}
   /// Samples at t = t0 + k Ts, k = 0..n-1.
+  /// @throws InvalidArgument for a bad Ts or n, or as CheckSampleTime.
   Eigen::VectorXd Sample(double Ts, Eigen::Index n, double t0 = 0.0) const;
 };
 
