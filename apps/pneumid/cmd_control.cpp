@@ -19,6 +19,7 @@
 
 #include "command.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/spec.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/control/dmc.hpp"
@@ -60,33 +61,11 @@ struct ControlCli {
 };
 
 LoadStep ParseLoadStep(const std::string& text) {
+  Spec fields("--load-step", text, {.has_kind = false});
   LoadStep l;
-  bool at = false, size = false;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    const auto eq = item.find('=');
-    PNEUMID_CHECK(eq != std::string::npos, "--load-step '{}': expected at=T,size=D", text);
-    const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
-    double v = 0.0;
-    try {
-      std::size_t pos = 0;
-      v = std::stod(value, &pos);
-      PNEUMID_CHECK(pos == value.size(), "--load-step '{}': '{}' is not a number", text, value);
-    } catch (const std::logic_error&) {
-      PNEUMID_CHECK(false, "--load-step '{}': '{}' is not a number", text, value);
-    }
-    if (key == "at") {
-      l.at = v;
-      at = true;
-    } else if (key == "size") {
-      l.size = v;
-      size = true;
-    } else {
-      PNEUMID_CHECK(false, "--load-step '{}': unknown key '{}' (valid: at, size)", text, key);
-    }
-  }
-  PNEUMID_CHECK(at && size, "--load-step '{}': needs both at= and size=", text);
+  l.at = fields.Number("at");
+  l.size = fields.Number("size");
+  fields.Finish();
   return l;
 }
 

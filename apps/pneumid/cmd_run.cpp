@@ -176,7 +176,7 @@ void Run(const RunOptions& o, CLI::App& app) {
       y[i] = res.records[i].y;
       u[i] = res.records[i].u;
     }
-    if (sum.termination == LoopTermination::kCompleted)
+    if (sum.termination == LoopTermination::kSuccess)
       metrics = MetricsJson(ComputeClosedLoopMetrics(t, rr, y, u, (*sp)(-Ts), 0.0, clo));
   }
   nlohmann::json offline = nullptr;
@@ -212,7 +212,7 @@ void Run(const RunOptions& o, CLI::App& app) {
     std::cout << line("metrics", metrics) << line("offline", offline);
     if (!o.log.empty()) std::cout << fmt::format("log: {} ({} rows)\n", o.log, res.log_rows);
   }
-  if (sum.termination != LoopTermination::kCompleted) {
+  if (sum.termination != LoopTermination::kSuccess) {
     std::cerr << "pneumid run: " << ToString(sum.termination) << ": " << sum.message << "\n";
     throw ExitCode{sum.ExitStatus()};
   }

@@ -8,10 +8,6 @@
 #include "pneumid/common/strings.hpp"
 
 namespace pneumid::internal {
-namespace {
-
-
-}  // namespace
 
 ColumnName ParseColumnName(const std::string& label) {
   ColumnName c{label, label, ""};
@@ -21,10 +17,11 @@ ColumnName ParseColumnName(const std::string& label) {
     if (open != '\0') {
       const auto pos = label.rfind(open);
       if (pos != std::string::npos && pos > 0) {
-        std::string name = std::string(Trim(std::string_view(label).substr(0, pos)));
+        const std::string_view text = label;
+        std::string name(Trim(text.substr(0, pos)));
         if (!name.empty()) {
           c.name = std::move(name);
-          c.unit = std::string(Trim(std::string_view(label).substr(pos + 1, label.size() - pos - 2)));
+          c.unit = std::string(Trim(text.substr(pos + 1, label.size() - pos - 2)));
         }
       }
     }

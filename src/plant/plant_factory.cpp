@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "pneumid/common/spec.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/linear_plant.hpp"
@@ -28,28 +29,11 @@ std::unique_ptr<Plant> MakeIpa(const std::string& spec, const std::string& base,
   std::optional<IpaMode> mode;
   if (base == "ipa-position") mode = IpaMode::kPosition;
   std::optional<PwmMode> pwm = options.pwm_mode;
-  const auto colon = spec.find(':');
-  if (colon != std::string::npos) {
-    std::istringstream in(spec.substr(colon + 1));
-    std::string item;
-    while (std::getline(in, item, ',')) {
-      if (item.empty()) continue;
-      const auto eq = item.find('=');
-      PNEUMID_CHECK(eq != std::string::npos, "plant '{}': expected key=value, got '{}'", spec,
-                    item);
-      const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
-      if (key == "config") {
-        config = value;
-      } else if (key == "mode") {
-        mode = IpaModeFromString(value);
-      } else if (key == "pwm") {
-        pwm = PwmModeFromString(value);
-      } else {
-        PNEUMID_CHECK(false, "plant '{}': unknown key '{}' (allowed: config, mode, pwm)", spec,
-                      key);
-      }
-    }
-  }
+  Spec fields("plant", spec);
+  config = fields.Text("config", config);
+  if (fields.Has("mode")) mode = IpaModeFromString(fields.Text("mode"));
+  if (fields.Has("pwm")) pwm = PwmModeFromString(fields.Text("pwm"));
+  fields.Finish();
   IpaParameters p = config.empty() ? IpaParameters{} : LoadIpaParameters(config);
   if (mode) p.mode = *mode;
   if (pwm) p.pwm_mode = *pwm;

@@ -5,20 +5,19 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 namespace pneumid {
 
-const char* ToString(IoKind k) {
-  switch (k) {
-    case IoKind::kSim:
-      return "sim";
-    case IoKind::kComedi:
-      return "comedi";
-    case IoKind::kUdp:
-      return "udp";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<IoKind> kIoKindNames[] = {
+    {IoKind::kSim, "sim"},
+    {IoKind::kComedi, "comedi"},
+    {IoKind::kUdp, "udp"},
+};
+}  // namespace
+
+const char* ToString(IoKind v) { return EnumToString(kIoKindNames, v).data(); }
 
 std::string IoSpec::ToString() const {
   switch (kind) {

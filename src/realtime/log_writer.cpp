@@ -10,6 +10,7 @@
 #include <matio.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 namespace pneumid {
 
@@ -23,24 +24,18 @@ std::string OneLine(std::string s) {
 }
 }  // namespace
 
-const char* ToString(LogFormat f) {
-  switch (f) {
-    case LogFormat::kCsv:
-      return "csv";
-    case LogFormat::kDataset:
-      return "dataset";
-    case LogFormat::kMat:
-      return "mat";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<LogFormat> kLogFormatNames[] = {
+    {LogFormat::kCsv, "csv"},
+    {LogFormat::kDataset, "dataset"},
+    {LogFormat::kMat, "mat"},
+};
+}  // namespace
+
+const char* ToString(LogFormat v) { return EnumToString(kLogFormatNames, v).data(); }
 
 LogFormat LogFormatFromString(const std::string& name) {
-  if (name == "csv") return LogFormat::kCsv;
-  if (name == "dataset") return LogFormat::kDataset;
-  if (name == "mat") return LogFormat::kMat;
-  throw InvalidArgument(
-      fmt::format("unknown log format '{}' (expected csv, dataset or mat)", name));
+  return EnumFromString(kLogFormatNames, name, "log format");
 }
 
 bool LogWriterOptions::IsValid(std::string* error) const {

@@ -145,28 +145,17 @@ std::int64_t LoopOptions::Samples() const {
   return std::max<std::int64_t>(1, std::llround(duration / period));
 }
 
-const char* ToString(LoopTermination t) {
-  switch (t) {
-    case LoopTermination::kCompleted:
-      return "completed";
-    case LoopTermination::kStopped:
-      return "stopped";
-    case LoopTermination::kFault:
-      return "fault";
-  }
-  return "unknown";
-}
-
 int LoopSummary::ExitStatus() const {
   switch (termination) {
-    case LoopTermination::kCompleted:
+    case LoopTermination::kSuccess:
       return 0;
     case LoopTermination::kStopped:
       return signal > 0 ? 128 + signal : 130;
-    case LoopTermination::kFault:
+    case LoopTermination::kFailure:
       return 3;
+    default:
+      return 1;
   }
-  return 1;
 }
 
 std::string LoopSummary::BriefReport() const {
@@ -321,7 +310,7 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
   summary.log_dropped = log ? log->dropped() : 0;
   summary.fault = fault;
   if (fault != Fault::kNone) {
-    summary.termination = LoopTermination::kFault;
+    summary.termination = LoopTermination::kFailure;
     summary.message = fmt::format(
         "{} at t = {:.4f} s (sample {}): y = {}, u = {}, I/O status {}; outputs set to {}{}",
         ToString(fault), static_cast<double>(fault_k) * options.period, fault_k, fault_y, fault_u,
@@ -339,7 +328,7 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
                         : std::string("request"),
         done, ToString(summary.safe_state));
   } else {
-    summary.termination = LoopTermination::kCompleted;
+    summary.termination = LoopTermination::kSuccess;
     summary.message =
         fmt::format("{} samples completed; outputs set to {}", done, ToString(summary.safe_state));
   }

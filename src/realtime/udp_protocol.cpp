@@ -1,5 +1,7 @@
 #include "pneumid/realtime/udp_protocol.hpp"
 
+#include "pneumid/common/enum_names.hpp"
+
 #include <cstring>
 
 namespace pneumid::udp {
@@ -44,41 +46,28 @@ DecodeResult Header(const std::uint8_t* d, std::size_t size, bool reply,
 
 }  // namespace
 
-const char* ToString(PacketStatus s) {
-  switch (s) {
-    case PacketStatus::kOk:
-      return "ok";
-    case PacketStatus::kBadVersion:
-      return "bad-version";
-    case PacketStatus::kBadType:
-      return "bad-type";
-    case PacketStatus::kBadTs:
-      return "bad-Ts";
-    case PacketStatus::kNoSession:
-      return "no-session";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<PacketStatus> kPacketStatusNames[] = {
+    {PacketStatus::kOk, "ok"},
+    {PacketStatus::kBadVersion, "bad-version"},
+    {PacketStatus::kBadType, "bad-type"},
+    {PacketStatus::kBadTs, "bad-Ts"},
+    {PacketStatus::kNoSession, "no-session"},
+};
+constexpr EnumName<DecodeResult> kDecodeResultNames[] = {
+    {DecodeResult::kOk, "ok"},
+    {DecodeResult::kWrongSize, "wrong size"},
+    {DecodeResult::kBadMagic, "bad magic"},
+    {DecodeResult::kBadVersion, "unsupported version"},
+    {DecodeResult::kBadType, "unknown type"},
+    {DecodeResult::kNotReply, "not a reply"},
+    {DecodeResult::kNotRequest, "not a request"},
+};
+}  // namespace
 
-const char* ToString(DecodeResult r) {
-  switch (r) {
-    case DecodeResult::kOk:
-      return "ok";
-    case DecodeResult::kWrongSize:
-      return "wrong size";
-    case DecodeResult::kBadMagic:
-      return "bad magic";
-    case DecodeResult::kBadVersion:
-      return "unsupported version";
-    case DecodeResult::kBadType:
-      return "unknown type";
-    case DecodeResult::kNotReply:
-      return "not a reply";
-    case DecodeResult::kNotRequest:
-      return "not a request";
-  }
-  return "unknown";
-}
+const char* ToString(PacketStatus s) { return EnumToString(kPacketStatusNames, s).data(); }
+
+const char* ToString(DecodeResult r) { return EnumToString(kDecodeResultNames, r).data(); }
 
 Packet Encode(const Request& r) noexcept {
   Packet p{};

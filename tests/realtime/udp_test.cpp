@@ -180,7 +180,7 @@ TEST(UdpBackend, ClosedLoopThroughThePlantServerMatchesTheOfflineSimulation) {
   log.Close(s.timing.BriefReport(), s.message);
   srv.reset();
 
-  EXPECT_EQ(s.termination, LoopTermination::kCompleted) << s.message;
+  EXPECT_EQ(s.termination, LoopTermination::kSuccess) << s.message;
   EXPECT_EQ(s.samples, 300);
   EXPECT_EQ(pi.allocations_during_run(), 0);
   // Offline: the same plant and controller in a plain loop.
@@ -238,7 +238,7 @@ TEST(UdpBackend, SilentServerIsATimeoutWithinMaxMissedPeriods) {
   const LoopSummary s = RunLoop(o, io, pi, {10.0}, safety, &log);
   log.Close(s.timing.BriefReport(), s.message);
   srv.reset();
-  EXPECT_EQ(s.termination, LoopTermination::kFault);
+  EXPECT_EQ(s.termination, LoopTermination::kFailure);
   EXPECT_EQ(s.fault, Fault::kTimeout);
   // 50 steps answered (samples 0..50 fresh), then 3 missing replies: fault at sample 53.
   EXPECT_EQ(s.samples, 54);

@@ -25,6 +25,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pneumid/common/termination.hpp"
 #include "pneumid/realtime/io_backend.hpp"
 #include "pneumid/realtime/log_writer.hpp"
 #include "pneumid/realtime/safety.hpp"
@@ -72,15 +73,14 @@ struct LoopOptions {
   std::int64_t Samples() const;
 };
 
-enum class LoopTermination {
-  kCompleted,  ///< all samples run
-  kStopped,    ///< SIGINT/SIGTERM or RequestStop()
-  kFault,      ///< a safety fault; outputs in the safe state
-};
-const char* ToString(LoopTermination t);
+/// kSuccess (all samples run), kStopped (SIGINT/SIGTERM or RequestStop()) or
+/// kFailure (a safety fault, named in LoopSummary::fault; outputs in the safe
+/// state). Written "success", "stopped", "failure" (common/termination.hpp;
+/// earlier versions wrote "completed" and "fault").
+using LoopTermination = Termination;
 
 struct LoopSummary {
-  LoopTermination termination = LoopTermination::kCompleted;
+  LoopTermination termination = LoopTermination::kSuccess;
   Fault fault = Fault::kNone;
   int signal = 0;            ///< signal number when stopped by a signal
   std::string message;       ///< what happened, e.g. "sensor-nan at t = 1.230 s (sample 123) ..."
