@@ -100,9 +100,9 @@ void CheckTextEncoding(const std::string& path, std::string_view text) {
   auto starts = [&](std::string_view bom) { return text.substr(0, bom.size()) == bom; };
   const char* encoding = starts(std::string_view("\xFF\xFE\0\0", 4))   ? "UTF-32LE"
                          : starts(std::string_view("\0\0\xFE\xFF", 4)) ? "UTF-32BE"
-                         : starts("\xFF\xFE")                         ? "UTF-16LE"
-                         : starts("\xFE\xFF")                         ? "UTF-16BE"
-                                                                      : nullptr;
+                         : starts("\xFF\xFE")                          ? "UTF-16LE"
+                         : starts("\xFE\xFF")                          ? "UTF-16BE"
+                                                                       : nullptr;
   if (encoding != nullptr) {
     throw DataError(fmt::format(
         "{}:1: the file is {} text (byte order mark); pneumid reads UTF-8 or ASCII: save it "
@@ -158,7 +158,14 @@ bool CsvReadOptions::IsValid(std::string* error) const {
   return true;
 }
 
-Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
+namespace {
+
+// The reader behind ReadCsv and ReadCsvBlocks. With `on_block`, the samples are
+// handed over in blocks of at most `block_rows` and not kept (*data is left
+// empty); without, they are returned in *data.
+Eigen::Index ReadCsvRows(const std::string& path, const CsvReadOptions& options,
+                         std::size_t block_rows,
+                         const std::function<void(const CsvBlock&)>* on_block, Dataset* data) {
   std::string error;
   PNEUMID_CHECK(options.IsValid(&error), "ReadCsv: {}", error);
   internal::MappedFile file(path);
@@ -212,10 +219,10 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
   });
   const std::size_t header_cells = ForEachCell(header, delimiter, [](std::size_t, auto) {});
   if (header_cells > kCsvMaxColumns) {
-    throw DataError(fmt::format(
-        "{}:{}: header row has {} columns (delimiter {}), more than the {} supported{}", path,
-        line, header_cells, DelimiterName(delimiter), kCsvMaxColumns,
-        numeric_header ? "; it holds numbers: is the header row missing?" : ""));
+    throw DataError(
+        fmt::format("{}:{}: header row has {} columns (delimiter {}), more than the {} supported{}",
+                    path, line, header_cells, DelimiterName(delimiter), kCsvMaxColumns,
+                    numeric_header ? "; it holds numbers: is the header row missing?" : ""));
   }
   const std::size_t num_columns = columns.size();
 
@@ -226,9 +233,10 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
   std::size_t bad_byte = 0;
   const std::string header_note =
       !IsValidUtf8(header, &bad_byte)
-          ? fmt::format(" (the header row is not valid UTF-8 text: byte 0x{:02X} at offset {}; "
-                        "save the file as UTF-8 text)",
-                        static_cast<unsigned char>(header[bad_byte]), bad_byte)
+          ? fmt::format(
+                " (the header row is not valid UTF-8 text: byte 0x{:02X} at offset {}; "
+                "save the file as UTF-8 text)",
+                static_cast<unsigned char>(header[bad_byte]), bad_byte)
       : numeric_header ? " (the first row holds numbers: is the header row missing?)"
                        : "";
   auto resolve = [&](const std::string& spec, const char* role) {
@@ -254,7 +262,7 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
     const std::size_t first_len =
         std::max<std::size_t>(4, (nl == nullptr ? end : static_cast<const char*>(nl)) - p + 1);
     const std::size_t estimate = static_cast<std::size_t>(end - p) / first_len + 16;
-    for (auto& v : values) v.reserve(estimate + estimate / 8);
+    for (auto& v : values) v.reserve(on_block ? block_rows : estimate + estimate / 8);
   }
   std::vector<double> row(num_slots);
   std::vector<Eigen::Index> break_samples;
@@ -262,6 +270,43 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
   long previous_line = -1;
   Eigen::Index n = 0;
   double previous_time = 0.0;
+
+  // The samples gathered in `values`, from sample index `first` on, as time,
+  // inputs and outputs; `values` is emptied (its memory kept for the next
+  // block when reading blocks).
+  auto take_block = [&](Eigen::Index first) {
+    const Eigen::Index rows = static_cast<Eigen::Index>(values[0].size());
+    CsvBlock b;
+    b.first_sample = first;
+    std::size_t s = 0;
+    auto take = [&](Eigen::VectorXd column) {
+      if (on_block) {
+        values[s++].clear();
+      } else {
+        std::vector<double>().swap(values[s++]);
+      }
+      return column;
+    };
+    if (has_time) {
+      b.time = take(Eigen::Map<const Eigen::VectorXd>(values[s].data(), rows));
+    } else {
+      b.time.resize(rows);
+      for (Eigen::Index i = 0; i < rows; ++i) {
+        b.time[i] = options.start_time + static_cast<double>(first + i) * options.sample_time;
+      }
+    }
+    b.inputs.resize(rows, static_cast<Eigen::Index>(options.input_columns.size()));
+    for (Eigen::Index c = 0; c < b.inputs.cols(); ++c) {
+      b.inputs.col(c) = take(Eigen::Map<const Eigen::VectorXd>(values[s].data(), rows));
+    }
+    b.outputs.resize(rows, static_cast<Eigen::Index>(options.output_columns.size()));
+    for (Eigen::Index c = 0; c < b.outputs.cols(); ++c) {
+      b.outputs.col(c) = take(Eigen::Map<const Eigen::VectorXd>(values[s].data(), rows));
+    }
+    b.fraction_read =
+        text.empty() ? 1.0 : static_cast<double>(p - text.data()) / static_cast<double>(text.size());
+    return b;
+  };
 
   auto cell_error = [&](std::size_t column, const std::string& what) {
     return DataError(
@@ -321,45 +366,58 @@ Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
     }
     previous_line = line;
     ++n;
+    if (on_block && values[0].size() == block_rows) (*on_block)(take_block(n - static_cast<Eigen::Index>(block_rows)));
   }
   if (n == 0) {
     throw DataError(
         fmt::format("{}:{}: header row only, the file has no data rows", path, header_line));
   }
-
-  Eigen::VectorXd time(n);
-  std::size_t s = 0;
-  if (has_time) {
-    time = Eigen::Map<const Eigen::VectorXd>(values[s++].data(), n);
-  } else {
-    for (Eigen::Index i = 0; i < n; ++i) {
-      time[i] = options.start_time + static_cast<double>(i) * options.sample_time;
+  if (on_block) {
+    if (!values[0].empty()) {
+      (*on_block)(take_block(n - static_cast<Eigen::Index>(values[0].size())));
     }
+    return n;
   }
-  auto fill = [&](const std::vector<std::string>& specs, std::vector<Channel>& channels) {
-    Eigen::MatrixXd m(n, static_cast<Eigen::Index>(specs.size()));
-    for (Eigen::Index c = 0; c < m.cols(); ++c, ++s) {
-      m.col(c) = Eigen::Map<const Eigen::VectorXd>(values[s].data(), n);
+
+  CsvBlock all = take_block(0);
+  auto channels = [&](std::size_t first_slot, std::size_t count) {
+    std::vector<Channel> out;
+    for (std::size_t s = first_slot; s < first_slot + count; ++s) {
       const auto& col = columns[slot_column[s]];
-      channels.push_back({col.name, col.unit});
-      std::vector<double>().swap(values[s]);
+      out.push_back({col.name, col.unit});
     }
-    return m;
+    return out;
   };
   Channel time_channel{"t", "s"};
   if (has_time) {
     const auto& col = columns[slot_column[0]];
     time_channel = {col.name, col.unit.empty() ? "s" : col.unit};
   }
-  std::vector<Channel> input_channels, output_channels;
-  Eigen::MatrixXd inputs = fill(options.input_columns, input_channels);
-  Eigen::MatrixXd outputs = fill(options.output_columns, output_channels);
-  Dataset data(std::move(time), std::move(inputs), std::move(outputs), std::move(input_channels),
-               std::move(output_channels));
-  data.set_time_channel(time_channel);
-  data.set_source(path);
-  data.set_source_lines(std::move(break_samples), std::move(break_lines));
+  const std::size_t first_input = has_time ? 1 : 0;
+  *data = Dataset(std::move(all.time), std::move(all.inputs), std::move(all.outputs),
+                  channels(first_input, options.input_columns.size()),
+                  channels(first_input + options.input_columns.size(),
+                           options.output_columns.size()));
+  data->set_time_channel(time_channel);
+  data->set_source(path);
+  data->set_source_lines(std::move(break_samples), std::move(break_lines));
+  return n;
+}
+
+}  // namespace
+
+Dataset ReadCsv(const std::string& path, const CsvReadOptions& options) {
+  Dataset data;
+  ReadCsvRows(path, options, 0, nullptr, &data);
   return data;
+}
+
+Eigen::Index ReadCsvBlocks(const std::string& path, const CsvReadOptions& options,
+                           std::size_t block_rows,
+                           const std::function<void(const CsvBlock&)>& on_block) {
+  PNEUMID_CHECK(block_rows > 0, "ReadCsvBlocks: block_rows must be > 0, got {}", block_rows);
+  PNEUMID_CHECK(static_cast<bool>(on_block), "ReadCsvBlocks: on_block must be callable");
+  return ReadCsvRows(path, options, block_rows, &on_block, nullptr);
 }
 
 bool CsvWriteOptions::IsValid(std::string* error) const {

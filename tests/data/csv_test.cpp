@@ -121,6 +121,61 @@ TEST_F(CsvTest, SampleTimeWithoutTimeColumn) {
   EXPECT_NEAR(d.SampleTime(), 0.01, 1e-15);
 }
 
+TEST_F(CsvTest, BlocksHoldTheSamplesOfReadCsv) {
+  const std::string path = Write("# c\nt,u,F [N]\n0,1,10\n0.5,2,20\n\n1,3,30\n1.5,4,40\n2,5,50\n");
+  CsvReadOptions o;
+  o.output_columns = {"F"};
+  const Dataset d = ReadCsv(path, o);
+  for (const std::size_t block_rows : {1, 2, 5, 100}) {
+    Eigen::VectorXd t(0), u(0), y(0);
+    std::vector<Eigen::Index> firsts;
+    double fraction = 0.0;
+    const Eigen::Index n = ReadCsvBlocks(path, o, block_rows, [&](const CsvBlock& b) {
+      EXPECT_LE(b.time.size(), static_cast<Eigen::Index>(block_rows));
+      EXPECT_EQ(b.inputs.rows(), b.time.size());
+      EXPECT_EQ(b.outputs.cols(), 1);
+      EXPECT_GT(b.fraction_read, fraction);
+      fraction = b.fraction_read;
+      firsts.push_back(b.first_sample);
+      const Eigen::Index k = t.size();
+      t.conservativeResize(k + b.time.size());
+      u.conservativeResize(k + b.time.size());
+      y.conservativeResize(k + b.time.size());
+      t.tail(b.time.size()) = b.time;
+      u.tail(b.time.size()) = b.inputs.col(0);
+      y.tail(b.time.size()) = b.outputs.col(0);
+    });
+    EXPECT_EQ(n, 5);
+    EXPECT_EQ(t, d.time());
+    EXPECT_EQ(u, d.u());
+    EXPECT_EQ(y, d.y());
+    EXPECT_EQ(firsts.size(), (5 + block_rows - 1) / block_rows) << block_rows;
+    EXPECT_EQ(firsts.back(), static_cast<Eigen::Index>((firsts.size() - 1) * block_rows));
+    EXPECT_DOUBLE_EQ(fraction, 1.0);
+  }
+}
+
+TEST_F(CsvTest, BlocksWithGeneratedTimeAndErrors) {
+  CsvReadOptions o;
+  o.sample_time = 0.01;
+  o.start_time = 2.0;
+  const std::string path = Write("u,y\n1,2\n3,4\n5,6\n");
+  std::vector<double> times;
+  ReadCsvBlocks(path, o, 2, [&](const CsvBlock& b) {
+    for (Eigen::Index i = 0; i < b.time.size(); ++i) times.push_back(b.time[i]);
+  });
+  ASSERT_EQ(times.size(), 3u);
+  EXPECT_DOUBLE_EQ(times[2], 2.0 + 2 * 0.01);
+  // A bad row is reported with file and line after the blocks before it.
+  const std::string bad = Write("t,u,y\n0,1,2\n1,1,2\n2,x,2\n", "bad.csv");
+  int blocks = 0;
+  EXPECT_THAT([&] { ReadCsvBlocks(bad, {}, 1, [&](const CsvBlock&) { ++blocks; }); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr(bad + ":4:"), HasSubstr("'u'"))));
+  EXPECT_EQ(blocks, 2);
+  EXPECT_THAT([&] { ReadCsvBlocks(path, o, 0, [](const CsvBlock&) {}); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("block_rows must be > 0")));
+}
+
 TEST_F(CsvTest, OutputOnlyData) {
   CsvReadOptions o;
   o.input_columns = {};

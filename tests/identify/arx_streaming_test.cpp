@@ -32,16 +32,30 @@ TEST(ArxStreaming, EqualsTheInMemoryFit) {
   }
   StreamingArxOptions o;
   o.output_column = "F";
-  o.chunk_bytes = 4096;  // many chunk boundaries inside lines
-  double last_progress = 0;
-  o.progress = [&](double p) { last_progress = p; };
-  const StreamingArxResult r = EstimateArxFromFile(path, o);
-  EXPECT_EQ(r.num_samples, n);
-  EXPECT_DOUBLE_EQ(last_progress, 1.0);
   const ArxResult mem = EstimateArx(y, Eigen::MatrixXd(u), 0.01, ArxOptions{});
-  EXPECT_NEAR(r.arx.model.Ts, 0.01, 1e-12);
-  EXPECT_LT((r.arx.model.Parameters() - mem.model.Parameters()).norm(),
-            1e-12 * mem.model.Parameters().norm());
+  // Block sizes that put block boundaries inside the regressor history (1, 2),
+  // at odd places (997) and none (one block holds the file).
+  for (const std::size_t block_rows : {std::size_t{1}, std::size_t{2}, std::size_t{997},
+                                       std::size_t{1} << 16}) {
+    o.block_rows = block_rows;
+    int calls = 0;
+    double last_progress = 0;
+    o.progress = [&](double p) {
+      EXPECT_GE(p, last_progress);
+      last_progress = p;
+      ++calls;
+    };
+    const StreamingArxResult r = EstimateArxFromFile(path, o);
+    EXPECT_EQ(r.num_samples, n);
+    EXPECT_EQ(calls, (n + static_cast<Eigen::Index>(block_rows) - 1) /
+                         static_cast<Eigen::Index>(block_rows));
+    EXPECT_DOUBLE_EQ(last_progress, 1.0);
+    EXPECT_GT(r.bytes, 0.0);
+    EXPECT_NEAR(r.arx.model.Ts, 0.01, 1e-12);
+    EXPECT_LT((r.arx.model.Parameters() - mem.model.Parameters()).norm(),
+              1e-12 * mem.model.Parameters().norm())
+        << "block_rows = " << block_rows;
+  }
   std::remove(path.c_str());
 }
 
@@ -63,9 +77,16 @@ TEST(ArxStreaming, ErrorsNameFileLineAndColumn) {
     EstimateArxFromFile(path, o);
     FAIL();
   } catch (const DataError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("input column 'v' not found (columns: t, u, y)"));
+    // The data area's message: the unknown column and the available ones.
+    EXPECT_THAT(e.what(), HasSubstr("input column 'v'"));
+    EXPECT_THAT(e.what(), HasSubstr("'t', 'u', 'y'"));
   }
   EXPECT_THROW(EstimateArxFromFile(TempPath("missing.csv"), StreamingArxOptions{}), DataError);
+  o.input_column = "u";
+  o.block_rows = 0;
+  EXPECT_THAT([&] { EstimateArxFromFile(path, o); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("block_rows must be >= 1")));
+  o.block_rows = 1 << 16;
   o.arx.nb = {3, 3};
   o.arx.nk = {1, 1};
   EXPECT_THROW(EstimateArxFromFile(path, o), InvalidArgument);

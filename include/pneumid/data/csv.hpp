@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,28 @@ struct CsvReadOptions {
 ///         (see the list at the top of this header); the message names file,
 ///         line and column.
 Dataset ReadCsv(const std::string& path, const CsvReadOptions& options = {});
+
+/// Consecutive samples of a file read by ReadCsvBlocks.
+struct CsvBlock {
+  Eigen::Index first_sample = 0;  ///< index of the block's first sample in the file
+  Eigen::VectorXd time;           ///< seconds (time column, or start_time + k sample_time)
+  Eigen::MatrixXd inputs;         ///< one column per CsvReadOptions::input_columns
+  Eigen::MatrixXd outputs;        ///< one column per CsvReadOptions::output_columns
+  double fraction_read = 0.0;     ///< fraction of the file's bytes parsed so far, (0, 1]
+};
+
+/// Reads the file of ReadCsv (same format, same checks, same messages) and
+/// hands its samples to `on_block` in blocks of at most `block_rows` samples
+/// (the last block may be shorter), keeping one block in memory at a time:
+/// memory does not grow with the number of rows, for files larger than memory
+/// (the file is memory-mapped and read once, front to back). Returns the
+/// number of samples.
+/// @throws InvalidArgument when `options` is not valid or block_rows is 0.
+/// @throws DataError as ReadCsv (a bad row is found when its block is read:
+///         earlier blocks have been handed over by then); whatever on_block throws.
+Eigen::Index ReadCsvBlocks(const std::string& path, const CsvReadOptions& options,
+                           std::size_t block_rows,
+                           const std::function<void(const CsvBlock&)>& on_block);
 
 /// One extra column written by WriteCsv beside the dataset's own columns.
 struct CsvColumn {

@@ -1,12 +1,12 @@
 // ARX estimation from a delimited text file too large for memory: the file is
-// read in chunks and each chunk's regression rows are folded into the
-// triangular factor of arx.hpp (ArxAccumulator), so memory is constant in the
-// number of samples and the estimate equals the in-memory fit on the same data.
+// read block by block through the data area (ReadCsvBlocks, data/csv.hpp) and
+// each block's regression rows are folded into the triangular factor of
+// arx.hpp (ArxAccumulator), so memory is constant in the number of samples and
+// the estimate equals the in-memory fit on the same data.
 //
-// File format: an optional header line of column names, then one sample per
-// line, fields separated by `delimiter` (',' ';' '\t' or ' '; '\0' detects it
-// from the first line); lines starting with '#' and empty lines are skipped.
-// Columns are chosen by header name or 0-based index.
+// File format: that of ReadCsv (a header row of column names, one sample per
+// line, comments after '#', the same checks and error messages). Columns are
+// chosen by header name or 0-based index.
 #pragma once
 
 #include <functional>
@@ -22,17 +22,18 @@ struct StreamingArxOptions {
   std::string output_column = "y";
   /// Time column used to find the sample time when sample_time is 0.
   std::string time_column = "t";
-  double sample_time = 0.0;           ///< seconds; 0 = from the first two time values
-  char delimiter = '\0';              ///< '\0' = detect
-  std::size_t chunk_bytes = 1 << 22;  ///< read size (>= 4096)
-  /// Called after each chunk with the fraction of the file read (0..1).
+  double sample_time = 0.0;  ///< seconds; 0 = from the first two time values
+  char delimiter = '\0';     ///< '\0' = detect (CsvReadOptions::delimiter)
+  /// Samples per block handed to the estimator (>= 1); memory grows with it.
+  std::size_t block_rows = 1 << 16;
+  /// Called after each block with the fraction of the file read (0..1].
   std::function<void(double)> progress;
   bool IsValid(std::string* error) const;
 };
 
 struct StreamingArxResult {
   ArxResult arx;
-  long long num_samples = 0;  ///< data lines read
+  long long num_samples = 0;  ///< samples (data rows) read
   double bytes = 0.0;         ///< file size
 };
 
