@@ -12,6 +12,7 @@
 
 #include "pneumid/common/check.hpp"
 
+#include "pneumid/common/enum_names.hpp"
 namespace pneumid {
 
 namespace {
@@ -25,24 +26,32 @@ constexpr double kEventTol = 1e-9;  // s, events closer than this are simultaneo
 
 }  // namespace
 
-std::string ToString(IpaMode mode) { return mode == IpaMode::kForce ? "force" : "position"; }
+namespace {
+constexpr EnumName<IpaMode> kIpaModeNames[] = {
+    {IpaMode::kForce, "force"},
+    {IpaMode::kPosition, "position"},
+};
+}  // namespace
+
+std::string ToString(IpaMode v) { return std::string(EnumToString(kIpaModeNames, v)); }
 
 IpaMode IpaModeFromString(const std::string& name) {
-  if (name == "force") return IpaMode::kForce;
-  if (name == "position") return IpaMode::kPosition;
-  PNEUMID_CHECK(false, "unknown IPA mode '{}' (expected force or position)", name);
-  return IpaMode::kForce;
+  return EnumFromString(kIpaModeNames, name, "IPA mode");
 }
 
-std::string ToString(PwmMode mode) {
-  return mode == PwmMode::kSwitching ? "switching" : "averaged";
-}
+namespace {
+constexpr EnumName<PwmMode> kPwmModeNames[] = {
+    {PwmMode::kSwitching, "switching"},
+    {PwmMode::kAveraged, "averaged"},
+    {PwmMode::kSwitching, "pwm"},
+    {PwmMode::kAveraged, "average"},
+};
+}  // namespace
+
+std::string ToString(PwmMode v) { return std::string(EnumToString(kPwmModeNames, v)); }
 
 PwmMode PwmModeFromString(const std::string& name) {
-  if (name == "switching" || name == "pwm") return PwmMode::kSwitching;
-  if (name == "averaged" || name == "average") return PwmMode::kAveraged;
-  PNEUMID_CHECK(false, "unknown PWM mode '{}' (expected switching (or pwm) or averaged)", name);
-  return PwmMode::kSwitching;
+  return EnumFromString(kPwmModeNames, name, "PWM mode");
 }
 
 double IpaParameters::AreaA() const { return std::numbers::pi / 4.0 * bore * bore; }

@@ -35,6 +35,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/identified_model.hpp"
 #include "pneumid/report/plot.hpp"
@@ -67,9 +68,8 @@ struct PaperRow {
   std::string note;      ///< empty when they agree; otherwise why they differ
 };
 
-enum class PaperTermination { kSuccess, kPartial };
-/// "success", "partial".
-std::string ToString(PaperTermination t);
+/// kSuccess or kPartial ("success", "partial"; common/termination.hpp).
+using PaperTermination = Termination;
 
 struct PaperResult {
   /// kPartial when a step failed numerically (listed in `problems`); the
