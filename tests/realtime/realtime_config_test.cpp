@@ -35,15 +35,18 @@ TEST(RealtimeConfig, OverridesDefaults) {
   EXPECT_DOUBLE_EQ(c.safety.u_max, 100.0);  // untouched default
 }
 
+/// The DataError message of parsing `text` as `source`, or "no error".
+std::string ParseError(const std::string& text, const std::string& source) {
+  try {
+    ParseRealtimeConfig(text, source);
+  } catch (const DataError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
 TEST(RealtimeConfig, ErrorsNameFileLineAndColumn) {
-  auto message = [](const std::string& text) {
-    try {
-      ParseRealtimeConfig(text, "rt.toml");
-    } catch (const DataError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  auto message = [](const std::string& text) { return ParseError(text, "rt.toml"); };
   EXPECT_THAT(message("[loop]\nperiod = \"fast\"\n"), HasSubstr("rt.toml:2:"));
   EXPECT_THAT(message("[loop]\nperiod = \"fast\"\n"), HasSubstr("must be a number"));
   EXPECT_THAT(message("[loop]\nperiodd = 1\n"), HasSubstr("unknown key 'periodd'"));
@@ -56,14 +59,7 @@ TEST(RealtimeConfig, ErrorsNameFileLineAndColumn) {
 }
 
 TEST(RealtimeConfig, IntegersOutOfRangeAreRejectedNotWrapped) {
-  auto message = [](const std::string& text) {
-    try {
-      ParseRealtimeConfig(text, "rt.toml");
-    } catch (const DataError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  auto message = [](const std::string& text) { return ParseError(text, "rt.toml"); };
   // 4294967376 = 2^32 + 80 wrapped to a valid priority of 80 before.
   EXPECT_THAT(message("[loop]\npriority = 4294967376\n"),
               HasSubstr("rt.toml:2:12: [loop] priority = 4294967376 is out of range"));
