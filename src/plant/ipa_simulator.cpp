@@ -10,9 +10,10 @@
 #include <fmt/format.h>
 #include <boost/numeric/odeint.hpp>
 
+#include "ipa_valve.hpp"
 #include "pneumid/common/check.hpp"
-
 #include "pneumid/common/enum_names.hpp"
+
 namespace pneumid {
 
 namespace {
@@ -154,11 +155,15 @@ IpaSimulator::IpaSimulator(IpaParameters parameters, double Ts, std::uint64_t se
   PNEUMID_CHECK(p_.IsValid(&error), "invalid IPA parameters: {}", error);
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
   // Fixed storage for the sample loop (see EventQueue and readings_).
-  inlet_.pending.Reserve(EventCapacity());
-  exhaust_.pending.Reserve(EventCapacity());
+  inlet_ = std::make_unique<ipa_detail::Valve>();
+  exhaust_ = std::make_unique<ipa_detail::Valve>();
+  inlet_->pending.Reserve(EventCapacity());
+  exhaust_->pending.Reserve(EventCapacity());
   readings_.resize(static_cast<std::size_t>(p_.transport_delay_samples) + 1);
   Reset();
 }
+
+IpaSimulator::~IpaSimulator() = default;
 
 std::size_t IpaSimulator::EventCapacity() const {
   // An event pending at time t was queued by a command issued after t - D,
@@ -174,27 +179,6 @@ std::size_t IpaSimulator::EventCapacity() const {
   return static_cast<std::size_t>(std::min(bound, 65536.0));
 }
 
-void IpaSimulator::EventQueue::Reserve(std::size_t capacity) {
-  ring_.assign(std::max<std::size_t>(capacity, 1), ValveEvent{});
-  head_ = size_ = 0;
-}
-
-void IpaSimulator::EventQueue::push_back(ValveEvent e) {
-  if (size_ == ring_.size()) {  // beyond EventCapacity(): grow, keeping the order
-    std::vector<ValveEvent> grown(2 * ring_.size());
-    for (std::size_t i = 0; i < size_; ++i) grown[i] = ring_[(head_ + i) % ring_.size()];
-    ring_ = std::move(grown);
-    head_ = 0;
-  }
-  ring_[(head_ + size_) % ring_.size()] = e;
-  ++size_;
-}
-
-void IpaSimulator::EventQueue::pop_front() {
-  head_ = (head_ + 1) % ring_.size();
-  --size_;
-}
-
 void IpaSimulator::Reset() {
   rng_.seed(seed_);
   normal_.reset();
@@ -208,7 +192,7 @@ void IpaSimulator::Reset() {
   dt_ = 1e-4;
   steps_ = 0;
   sample_ = 0;
-  for (Valve* v : {&inlet_, &exhaust_}) {
+  for (ipa_detail::Valve* v : {inlet_.get(), exhaust_.get()}) {
     v->open = false;
     v->command = false;
     v->pending.clear();  // keeps its storage
@@ -373,19 +357,19 @@ void IpaSimulator::Integrate(double t0, double t1, double open_in, double open_o
       throw std::runtime_error(fmt::format("IPA simulation: non-finite state at t = {} s", t1));
 }
 
-void IpaSimulator::Command(Valve& valve, bool on, double t) {
+void IpaSimulator::Command(ipa_detail::Valve& valve, bool on, double t) {
   if (valve.command == on) return;
   valve.command = on;
   const double t_phys = t + (on ? p_.open_delay : p_.close_delay);
   while (!valve.pending.empty() && valve.pending.back().time >= t_phys) valve.pending.pop_back();
-  valve.pending.push_back(ValveEvent{t_phys, on});
+  valve.pending.push_back(ipa_detail::ValveEvent{t_phys, on});
 }
 
 void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaust_cmd) {
   const double T = 1.0 / p_.pwm_frequency;
   if (!pwm) {
-    Command(inlet_, inlet_cmd, t_);
-    Command(exhaust_, exhaust_cmd, t_);
+    Command(*inlet_, inlet_cmd, t_);
+    Command(*exhaust_, exhaust_cmd, t_);
     falling_edge_ = -1.0;
   } else if (period_start_ < t_ - kEventTol) {
     period_start_ = t_;  // restart the PWM generator after manual valve commands
@@ -398,17 +382,17 @@ void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaus
       const double w_in = d * T, w_out = (1.0 - d) * T;
       const bool in_pulse = d >= 1.0 || (d > 0.0 && w_in >= p_.min_pulse_width);
       exhaust_pulse_ = d <= 0.0 || (d < 1.0 && w_out >= p_.min_pulse_width);
-      Command(inlet_, in_pulse, t_);
-      Command(exhaust_, d <= 0.0 && exhaust_pulse_, t_);
+      Command(*inlet_, in_pulse, t_);
+      Command(*exhaust_, d <= 0.0 && exhaust_pulse_, t_);
       falling_edge_ = (d > 0.0 && d < 1.0) ? t_ + w_in : -1.0;
       period_start_ += T;
     }
     if (pwm && falling_edge_ >= 0.0 && std::abs(t_ - falling_edge_) <= kEventTol) {
-      Command(inlet_, false, t_);
-      Command(exhaust_, exhaust_pulse_, t_);
+      Command(*inlet_, false, t_);
+      Command(*exhaust_, exhaust_pulse_, t_);
       falling_edge_ = -1.0;
     }
-    for (Valve* v : {&inlet_, &exhaust_}) {
+    for (ipa_detail::Valve* v : {inlet_.get(), exhaust_.get()}) {
       while (!v->pending.empty() && v->pending.front().time <= t_ + kEventTol) {
         v->open = v->pending.front().open;
         v->pending.pop_front();
@@ -420,9 +404,9 @@ void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaus
       t_next = std::min(t_next, period_start_);
       if (falling_edge_ > t_) t_next = std::min(t_next, falling_edge_);
     }
-    for (const Valve* v : {&inlet_, &exhaust_})
+    for (const ipa_detail::Valve* v : {inlet_.get(), exhaust_.get()})
       if (!v->pending.empty()) t_next = std::min(t_next, v->pending.front().time);
-    Integrate(t_, t_next, inlet_.open ? 1.0 : 0.0, exhaust_.open ? 1.0 : 0.0);
+    Integrate(t_, t_next, inlet_->open ? 1.0 : 0.0, exhaust_->open ? 1.0 : 0.0);
     t_ = t_next;
   }
   t_ = t_end;

@@ -56,6 +56,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -63,6 +64,10 @@
 #include "pneumid/plant/plant.hpp"
 
 namespace pneumid {
+
+namespace ipa_detail {
+struct Valve;  // src/plant/ipa_valve.hpp
+}  // namespace ipa_detail
 
 /// Force mode: rod fixed, output force in N (the paper's identification setup).
 /// Position mode: piston and load move, output position in m.
@@ -178,6 +183,7 @@ class IpaSimulator final : public Plant {
  public:
   /// Throws InvalidArgument when the parameters are not valid or Ts <= 0.
   IpaSimulator(IpaParameters parameters, double Ts, std::uint64_t seed = 1);
+  ~IpaSimulator() override;
 
   void Reset() override;
   double Measure() override;
@@ -216,41 +222,14 @@ class IpaSimulator final : public Plant {
   using State = std::array<double, 6>;
 
  private:
-  // Advance, AdvanceValves and Measure do not allocate: the valve event queues and
-  // the sensor delay line are ring buffers sized at construction.
+  // Advance, AdvanceValves and Measure do not allocate: the valve event queues
+  // (src/plant/ipa_valve.hpp) and the sensor delay line are ring buffers sized
+  // at construction.
 
-  /// A valve state change taking effect at `time` (s).
-  struct ValveEvent {
-    double time = 0.0;
-    bool open = false;
-  };
-  /// FIFO of pending valve events in increasing time, in a ring buffer whose
-  /// capacity is set once (Reserve); it only grows (allocates) if a push exceeds
-  /// that capacity, which EventCapacity() rules out below its cap.
-  class EventQueue {
-   public:
-    void Reserve(std::size_t capacity);
-    bool empty() const { return size_ == 0; }
-    const ValveEvent& front() const { return ring_[head_]; }
-    const ValveEvent& back() const { return ring_[(head_ + size_ - 1) % ring_.size()]; }
-    void push_back(ValveEvent e);
-    void pop_front();
-    void pop_back() { --size_; }
-    void clear() { head_ = size_ = 0; }
-
-   private:
-    std::vector<ValveEvent> ring_;
-    std::size_t head_ = 0, size_ = 0;
-  };
-  struct Valve {
-    bool open = false;     // physical state
-    bool command = false;  // command state
-    EventQueue pending;    // (time, new physical state)
-  };
   /// Upper bound on the events pending in one valve's queue: commands issued
   /// within the longest valve delay (PWM edges and sample instants).
   std::size_t EventCapacity() const;
-  void Command(Valve& valve, bool on, double t);
+  void Command(ipa_detail::Valve& valve, bool on, double t);
   void Integrate(double t0, double t1, double open_in, double open_out);
   void Rhs(const State& x, State& dxdt, double open_in, double open_out) const;
   double SenseOutput();
@@ -270,7 +249,7 @@ class IpaSimulator final : public Plant {
   double dt_ = 1e-4;  // last accepted step size
   long long steps_ = 0;
   long long sample_ = 0;
-  Valve inlet_, exhaust_;
+  std::unique_ptr<ipa_detail::Valve> inlet_, exhaust_;
   double duty_ = 0.0;             // input held now (fraction 0..1)
   double period_start_ = 0.0;     // start of the next PWM period
   double falling_edge_ = -1.0;    // pending inlet->exhaust command switch in this period
