@@ -2,13 +2,13 @@
 #include "pneumid/plant/plant_factory.hpp"
 
 #include <cmath>
-#include <sstream>
 
 #include <fmt/format.h>
 
-#include "pneumid/common/spec.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/spec.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 
 namespace pneumid {
@@ -68,16 +68,9 @@ std::unique_ptr<Plant> MakePlant(const std::string& spec, double Ts, const Plant
                                        spec);
 }
 
-Channel PlantInputChannel(const Plant& plant) {
-  if (dynamic_cast<const IpaSimulator*>(&plant)) return {"u", "%"};
-  return {"u", ""};
-}
+Channel PlantInputChannel(const Plant& plant) { return PlantActuator(plant).input; }
 
-Channel PlantOutputChannel(const Plant& plant) {
-  if (const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant))
-    return {"y", ipa->parameters().mode == IpaMode::kForce ? "N" : "m"};
-  return {"y", ""};
-}
+Channel PlantOutputChannel(const Plant& plant) { return PlantActuator(plant).output; }
 
 std::string PlantSpecHelp() {
   return R"(Plant specs:

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 #ifdef PNEUMID_HAVE_COMEDI
 #include <comedilib.h>
@@ -13,27 +14,19 @@
 
 namespace pneumid {
 
-const char* ToString(AnalogReference a) {
-  switch (a) {
-    case AnalogReference::kGround:
-      return "ground";
-    case AnalogReference::kCommon:
-      return "common";
-    case AnalogReference::kDiff:
-      return "diff";
-    case AnalogReference::kOther:
-      return "other";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<AnalogReference> kAnalogReferenceNames[] = {
+    {AnalogReference::kGround, "ground"},
+    {AnalogReference::kCommon, "common"},
+    {AnalogReference::kDiff, "diff"},
+    {AnalogReference::kOther, "other"},
+};
+}  // namespace
 
-AnalogReference AnalogReferenceFromString(const std::string& s) {
-  if (s == "ground") return AnalogReference::kGround;
-  if (s == "common") return AnalogReference::kCommon;
-  if (s == "diff") return AnalogReference::kDiff;
-  if (s == "other") return AnalogReference::kOther;
-  throw InvalidArgument(
-      fmt::format("unknown analog reference '{}' (expected ground, common, diff or other)", s));
+const char* ToString(AnalogReference v) { return EnumToString(kAnalogReferenceNames, v).data(); }
+
+AnalogReference AnalogReferenceFromString(const std::string& name) {
+  return EnumFromString(kAnalogReferenceNames, name, "analog reference");
 }
 
 bool ComediConfig::IsValid(std::string* error) const {
@@ -82,7 +75,7 @@ void ComediConfig::DutyToVolts(double u, double* inlet_v, double* exhaust_v) con
 
 void ComediConfig::SafeStateVolts(SafeState s, double* inlet_v, double* exhaust_v) const {
   *inlet_v = v_closed;
-  *exhaust_v = s == SafeState::kExhaustOpen ? v_open : v_closed;
+  *exhaust_v = s == SafeState::kRelease ? v_open : v_closed;
 }
 
 bool ComediConfig::VoltsOutOfRange(double volts) const {

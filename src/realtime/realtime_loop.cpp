@@ -169,7 +169,7 @@ nlohmann::json LoopSummary::ToJson() const {
   j["message"] = message;
   j["samples"] = samples;
   j["scheduling"] = scheduling;
-  j["safe_state"] = ToString(safe_state);
+  j["safe_state"] = safe_state_name;
   j["log_dropped"] = log_dropped;
   j["wall_time"] = wall_time;
   return j;
@@ -208,6 +208,7 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
 
   LoopSummary summary;
   summary.safe_state = safety.options().safe_state;
+  summary.safe_state_name = SafeStateName(io.actuator(), summary.safe_state);
   // Details of the fault, filled on the loop thread without allocation.
   Fault fault = Fault::kNone;
   std::int64_t fault_k = -1;
@@ -314,7 +315,7 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
     summary.message = fmt::format(
         "{} at t = {:.4f} s (sample {}): y = {}, u = {}, I/O status {}; outputs set to {}{}",
         ToString(fault), static_cast<double>(fault_k) * options.period, fault_k, fault_y, fault_u,
-        ToString(fault_io), ToString(summary.safe_state),
+        ToString(fault_io), summary.safe_state_name,
         summary.safe_state_status == IoStatus::kOk ? "" : " (safe-state write failed)");
     if (fault == Fault::kDeadlineOverruns)
       summary.message += fmt::format(" ({} overruns > max {})", summary.timing.overruns,
@@ -326,11 +327,11 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
         "stopped by {} after {} samples; outputs set to {}",
         stop_signal > 0 ? fmt::format("signal {} ({})", stop_signal, strsignal(stop_signal))
                         : std::string("request"),
-        done, ToString(summary.safe_state));
+        done, summary.safe_state_name);
   } else {
     summary.termination = LoopTermination::kSuccess;
     summary.message =
-        fmt::format("{} samples completed; outputs set to {}", done, ToString(summary.safe_state));
+        fmt::format("{} samples completed; outputs set to {}", done, summary.safe_state_name);
   }
   return summary;
 }

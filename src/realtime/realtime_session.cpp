@@ -12,16 +12,18 @@
 
 namespace pneumid {
 
-std::string DescribeSafety(const SafetyOptions& s) {
+std::string DescribeSafety(const SafetyOptions& s, const Actuator& actuator) {
+  const std::string unit = actuator.input.unit.empty() ? "" : " " + actuator.input.unit;
   return fmt::format(
-      "u in [{:g}, {:g}] %, rate {}, y in [{:g}, {:g}], frozen {}, max overruns {}, safe state {}",
-      s.u_min, s.u_max, s.rate_max > 0 ? fmt::format("<= {:g} %/s", s.rate_max) : "unlimited",
-      s.y_min, s.y_max,
+      "u in [{:g}, {:g}]{}, rate {}, y in [{:g}, {:g}], frozen {}, max overruns {}, safe state {}",
+      s.u_min, s.u_max, unit,
+      s.rate_max > 0 ? fmt::format("<= {:g}{}/s", s.rate_max, unit) : "unlimited", s.y_min,
+      s.y_max,
       s.frozen_samples > 0
           ? fmt::format("after {} samples within {:g}", s.frozen_samples, s.frozen_tolerance)
           : "off",
       s.max_overruns < 0 ? std::string("unlimited") : std::to_string(s.max_overruns),
-      ToString(s.safe_state));
+      SafeStateName(actuator, s.safe_state));
 }
 
 SessionResult RunSession(const SessionOptions& options, IoBackend& io, LoopController& controller,
@@ -42,7 +44,7 @@ SessionResult RunSession(const SessionOptions& options, IoBackend& io, LoopContr
     header.emplace_back("period", fmt::format("{:g} s", options.loop.period));
     header.emplace_back("duration", fmt::format("{:g} s ({} samples)", options.loop.duration,
                                                 options.loop.Samples()));
-    header.emplace_back("safety", DescribeSafety(options.safety));
+    header.emplace_back("safety", DescribeSafety(options.safety, io.actuator()));
     for (const auto& h : options.header) header.push_back(h);
     LogWriterOptions lo = options.log;
     lo.keep_in_memory = lo.keep_in_memory || options.keep_records;
@@ -55,17 +57,19 @@ SessionResult RunSession(const SessionOptions& options, IoBackend& io, LoopContr
   std::atomic<bool> done{false};
   std::thread printer;
   if (options.live_status) {
-    printer = std::thread([&] {
+    const Actuator actuator = io.actuator();
+    printer = std::thread([&, actuator] {
       while (!done.load()) {
         std::this_thread::sleep_for(std::chrono::milliseconds(200));
         const auto k = status.k.load();
         if (k < 0) continue;
-        std::fprintf(stderr,
-                     "\r  t %8.2f s  set point %8.2f  force %8.2f  duty %6.2f %%  jitter %6.0f us"
-                     "  overruns %lld   ",
-                     static_cast<double>(k) * options.loop.period, status.r.load(), status.y.load(),
-                     status.u.load(), status.jitter_us.load(),
-                     static_cast<long long>(status.overruns.load()));
+        const std::string line = fmt::format(
+            "\r  t {:8.2f} s  set point {:8.2f}  {} {:8.2f}  {} {:6.2f} {}  jitter {:6.0f} us  "
+            "overruns {}   ",
+            static_cast<double>(k) * options.loop.period, status.r.load(), actuator.output_label,
+            status.y.load(), actuator.input_label, status.u.load(), actuator.input.unit,
+            status.jitter_us.load(), static_cast<long long>(status.overruns.load()));
+        std::fputs(line.c_str(), stderr);
         std::fflush(stderr);
       }
       std::fputs("\n", stderr);

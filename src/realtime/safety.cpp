@@ -6,79 +6,64 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 
 namespace pneumid {
 
-const char* ToString(SafeState s) {
-  switch (s) {
-    case SafeState::kValvesClosed:
-      return "valves-closed";
-    case SafeState::kExhaustOpen:
-      return "exhaust-open";
-  }
-  return "unknown";
-}
+namespace {
+// Generic names first; the IPA's names (IpaActuator) are accepted aliases.
+constexpr EnumName<SafeState> kSafeStateNames[] = {
+    {SafeState::kHold, "hold"},
+    {SafeState::kRelease, "release"},
+    {SafeState::kHold, "valves-closed"},
+    {SafeState::kRelease, "exhaust-open"},
+};
+}  // namespace
+
+const char* ToString(SafeState v) { return EnumToString(kSafeStateNames, v).data(); }
 
 SafeState SafeStateFromString(const std::string& name) {
-  if (name == "valves-closed") return SafeState::kValvesClosed;
-  if (name == "exhaust-open") return SafeState::kExhaustOpen;
-  throw InvalidArgument(
-      fmt::format("unknown safe state '{}' (expected valves-closed or exhaust-open)", name));
+  return EnumFromString(kSafeStateNames, name, "safe state");
+}
+
+const std::string& SafeStateName(const Actuator& actuator, SafeState s) {
+  return s == SafeState::kHold ? actuator.hold_name : actuator.release_name;
+}
+
+const std::string& SafeStateMeaning(const Actuator& actuator, SafeState s) {
+  return s == SafeState::kHold ? actuator.hold_meaning : actuator.release_meaning;
 }
 
 namespace {
-constexpr Fault kAllFaults[] = {
-    Fault::kNone,    Fault::kSensorNaN, Fault::kSensorOutOfRange, Fault::kSensorFrozen,
-    Fault::kIoError, Fault::kTimeout,   Fault::kDeadlineOverruns, Fault::kControllerError};
-}
+constexpr EnumName<Fault> kFaultNames[] = {
+    {Fault::kNone, "none"},
+    {Fault::kSensorNaN, "sensor-nan"},
+    {Fault::kSensorOutOfRange, "sensor-out-of-range"},
+    {Fault::kSensorFrozen, "sensor-frozen"},
+    {Fault::kIoError, "io-error"},
+    {Fault::kTimeout, "timeout"},
+    {Fault::kDeadlineOverruns, "deadline-overruns"},
+    {Fault::kControllerError, "controller-error"},
+};
+}  // namespace
 
-const char* ToString(Fault f) {
-  switch (f) {
-    case Fault::kNone:
-      return "none";
-    case Fault::kSensorNaN:
-      return "sensor-nan";
-    case Fault::kSensorOutOfRange:
-      return "sensor-out-of-range";
-    case Fault::kSensorFrozen:
-      return "sensor-frozen";
-    case Fault::kIoError:
-      return "io-error";
-    case Fault::kTimeout:
-      return "timeout";
-    case Fault::kDeadlineOverruns:
-      return "deadline-overruns";
-    case Fault::kControllerError:
-      return "controller-error";
-  }
-  return "unknown";
-}
+const char* ToString(Fault v) { return EnumToString(kFaultNames, v).data(); }
 
 Fault FaultFromString(const std::string& name) {
-  std::string names;
-  for (Fault f : kAllFaults) {
-    if (name == ToString(f)) return f;
-    names += names.empty() ? "" : ", ";
-    names += ToString(f);
-  }
-  throw InvalidArgument(fmt::format("unknown fault '{}' (expected one of {})", name, names));
+  return EnumFromString(kFaultNames, name, "fault");
 }
 
-const char* ToString(IoStatus s) {
-  switch (s) {
-    case IoStatus::kOk:
-      return "ok";
-    case IoStatus::kStale:
-      return "stale";
-    case IoStatus::kOutOfRange:
-      return "out-of-range";
-    case IoStatus::kError:
-      return "error";
-    case IoStatus::kTimeout:
-      return "timeout";
-  }
-  return "unknown";
-}
+namespace {
+constexpr EnumName<IoStatus> kIoStatusNames[] = {
+    {IoStatus::kOk, "ok"},
+    {IoStatus::kStale, "stale"},
+    {IoStatus::kOutOfRange, "out-of-range"},
+    {IoStatus::kError, "error"},
+    {IoStatus::kTimeout, "timeout"},
+};
+}  // namespace
+
+const char* ToString(IoStatus v) { return EnumToString(kIoStatusNames, v).data(); }
 
 bool SafetyOptions::IsValid(std::string* error) const {
   auto fail = [error](std::string msg) {

@@ -40,10 +40,10 @@ IoStatus SimBackend::Write(double u) noexcept {
 
 IoStatus SimBackend::EnterSafeState(SafeState state) noexcept {
   IoStatus status = IoStatus::kOk;
-  if (!in_safe_state_ && (ipa_ || state == SafeState::kExhaustOpen)) {
+  if (!in_safe_state_ && (ipa_ || state == SafeState::kRelease)) {
     try {
       if (ipa_)
-        ipa_->AdvanceValves(false, state == SafeState::kExhaustOpen);
+        ipa_->AdvanceValves(false, state == SafeState::kRelease);
       else
         plant_->Advance(0.0);
     } catch (...) {

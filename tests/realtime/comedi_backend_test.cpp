@@ -46,10 +46,10 @@ TEST(ComediConfig, DutyToValveLevelsAndSafeStates) {
   c.exhaust_complementary = false;
   c.DutyToVolts(20.0, &vi, &ve);
   EXPECT_DOUBLE_EQ(ve, 0.0);
-  c.SafeStateVolts(SafeState::kValvesClosed, &vi, &ve);
+  c.SafeStateVolts(SafeState::kHold, &vi, &ve);
   EXPECT_DOUBLE_EQ(vi, 0.0);
   EXPECT_DOUBLE_EQ(ve, 0.0);
-  c.SafeStateVolts(SafeState::kExhaustOpen, &vi, &ve);
+  c.SafeStateVolts(SafeState::kRelease, &vi, &ve);
   EXPECT_DOUBLE_EQ(vi, 0.0);
   EXPECT_DOUBLE_EQ(ve, 5.0);
 }

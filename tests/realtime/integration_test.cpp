@@ -1,13 +1,16 @@
 // The loop with the toolkit's own plants and controllers: the IPA simulator as
 // the sim backend and a DMC designed from the paper's FOPDT, checked for
 // allocation on the loop thread and for the closed-loop result.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/pid.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/realtime/controller_adapter.hpp"
+#include "pneumid/realtime/realtime_session.hpp"
 #include "pneumid/realtime/sim_backend.hpp"
 #include "test_support.hpp"
 
@@ -40,6 +43,32 @@ TEST(Integration, DmcOnTheIpaSimulatorTracks) {
   EXPECT_TRUE(io.in_safe_state());
   // The IPA backend reports the chamber pressure (absolute, Pa) as the auxiliary channel.
   EXPECT_GT(log.records().back().aux, 1e5);
+}
+
+// The loop speaks of hold and release; the plant behind the backend names them
+// (the IPA: valves-closed, exhaust-open) and states its units.
+TEST(Integration, SafeStateNamedByThePlantBehindTheBackend) {
+  LoopOptions o;
+  o.duration = 0.1;
+  o.fast = true;
+  SafetyOptions so;
+  so.safe_state = SafeState::kRelease;
+  for (const bool ipa : {true, false}) {
+    SimBackend io(ipa ? MakePlant("ipa", 0.01)
+                      : std::unique_ptr<Plant>(
+                            std::make_unique<testing::FirstOrderPlant>(0.01, 0.96, 0.064)));
+    EXPECT_EQ(io.actuator().input.unit, ipa ? "%" : "");
+    OpenLoopInput hold(std::vector<double>(10, 50.0), "open loop");
+    SafetyMonitor safety(so);
+    const LoopSummary s = RunLoop(o, io, hold, std::vector<double>(10, 0.0), safety, nullptr);
+    EXPECT_EQ(s.safe_state, SafeState::kRelease);
+    EXPECT_EQ(s.safe_state_name, ipa ? "exhaust-open" : "release");
+    EXPECT_THAT(s.message, ::testing::HasSubstr(ipa ? "outputs set to exhaust-open"
+                                                    : "outputs set to release"));
+    EXPECT_EQ(s.ToJson()["safe_state"], s.safe_state_name);
+    EXPECT_THAT(DescribeSafety(so, io.actuator()),
+                ::testing::HasSubstr(ipa ? "u in [0, 100] %, " : "u in [0, 100], "));
+  }
 }
 
 }  // namespace

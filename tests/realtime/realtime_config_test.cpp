@@ -15,7 +15,7 @@ TEST(RealtimeConfig, TheExampleFileLoads) {
       LoadRealtimeConfig(std::string(PNEUMID_SOURCE_DIR) + "/config/realtime_example.toml");
   EXPECT_DOUBLE_EQ(c.loop.period, 0.01);
   EXPECT_EQ(c.io, "sim");
-  EXPECT_EQ(c.safety.safe_state, SafeState::kValvesClosed);
+  EXPECT_EQ(c.safety.safe_state, SafeState::kHold);
   EXPECT_DOUBLE_EQ(c.safety.y_max, 400.0);
   EXPECT_EQ(c.comedi.ai_aref, AnalogReference::kDiff);
   EXPECT_DOUBLE_EQ(c.comedi.force_offset, 294.0);
@@ -28,7 +28,7 @@ TEST(RealtimeConfig, OverridesDefaults) {
       "[io]\nbackend = \"udp://127.0.0.1:6000\"\n[comedi]\ndevice = \"/dev/comedi3\"\n",
       "t.toml");
   EXPECT_DOUBLE_EQ(c.loop.period, 0.001);
-  EXPECT_EQ(c.safety.safe_state, SafeState::kExhaustOpen);
+  EXPECT_EQ(c.safety.safe_state, SafeState::kRelease);
   EXPECT_EQ(c.safety.max_overruns, -1);
   EXPECT_EQ(c.io, "udp://127.0.0.1:6000");
   EXPECT_EQ(c.comedi.device, "/dev/comedi3");

@@ -243,12 +243,12 @@ TEST_P(FaultInjection, EndsInSafeStateWithCompleteLog) {
 INSTANTIATE_TEST_SUITE_P(
     AllFaults, FaultInjection,
     ::testing::Values(
-        FaultCase{Injected::kNaN, Fault::kSensorNaN, SafeState::kValvesClosed},
-        FaultCase{Injected::kOutOfRange, Fault::kSensorOutOfRange, SafeState::kExhaustOpen},
-        FaultCase{Injected::kRail, Fault::kSensorOutOfRange, SafeState::kValvesClosed},
-        FaultCase{Injected::kFrozen, Fault::kSensorFrozen, SafeState::kValvesClosed},
-        FaultCase{Injected::kReadError, Fault::kIoError, SafeState::kExhaustOpen},
-        FaultCase{Injected::kWriteError, Fault::kIoError, SafeState::kValvesClosed}),
+        FaultCase{Injected::kNaN, Fault::kSensorNaN, SafeState::kHold},
+        FaultCase{Injected::kOutOfRange, Fault::kSensorOutOfRange, SafeState::kRelease},
+        FaultCase{Injected::kRail, Fault::kSensorOutOfRange, SafeState::kHold},
+        FaultCase{Injected::kFrozen, Fault::kSensorFrozen, SafeState::kHold},
+        FaultCase{Injected::kReadError, Fault::kIoError, SafeState::kRelease},
+        FaultCase{Injected::kWriteError, Fault::kIoError, SafeState::kHold}),
     [](const auto& info) {
       std::string n = ToString(info.param.expected);
       n += info.param.injected == Injected::kRail         ? "_rail"

@@ -89,10 +89,31 @@ TEST(SafetyEnums, StringsRoundTrip) {
        {Fault::kNone, Fault::kSensorNaN, Fault::kSensorOutOfRange, Fault::kSensorFrozen,
         Fault::kIoError, Fault::kTimeout, Fault::kDeadlineOverruns, Fault::kControllerError})
     EXPECT_EQ(FaultFromString(ToString(f)), f);
-  EXPECT_EQ(SafeStateFromString("exhaust-open"), SafeState::kExhaustOpen);
-  EXPECT_EQ(SafeStateFromString("valves-closed"), SafeState::kValvesClosed);
+  EXPECT_EQ(SafeStateFromString("exhaust-open"), SafeState::kRelease);
+  EXPECT_EQ(SafeStateFromString("valves-closed"), SafeState::kHold);
   EXPECT_THROW(SafeStateFromString("open"), InvalidArgument);
   EXPECT_THROW(FaultFromString("boom"), InvalidArgument);
+}
+
+// The safe states are generic (hold, release); the plant names them: the IPA's
+// names are accepted on input and used in messages of IPA backends.
+TEST(SafetyEnums, GenericSafeStatesNamedByTheActuator) {
+  EXPECT_STREQ(ToString(SafeState::kHold), "hold");
+  EXPECT_STREQ(ToString(SafeState::kRelease), "release");
+  EXPECT_EQ(SafeStateFromString("hold"), SafeState::kHold);
+  EXPECT_EQ(SafeStateFromString("release"), SafeState::kRelease);
+  EXPECT_THAT([] { SafeStateFromString("vent"); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr(
+                  "valid: hold, release, valves-closed, exhaust-open")));
+  const Actuator ipa = IpaActuator();
+  EXPECT_EQ(SafeStateName(ipa, SafeState::kHold), "valves-closed");
+  EXPECT_EQ(SafeStateName(ipa, SafeState::kRelease), "exhaust-open");
+  EXPECT_THAT(SafeStateMeaning(ipa, SafeState::kRelease), ::testing::HasSubstr("exhaust open"));
+  EXPECT_EQ(ipa.input.unit, "%");
+  EXPECT_EQ(ipa.u_max, 100.0);
+  const Actuator generic;
+  EXPECT_EQ(SafeStateName(generic, SafeState::kHold), "hold");
+  EXPECT_EQ(SafeStateName(generic, SafeState::kRelease), "release");
 }
 
 }  // namespace

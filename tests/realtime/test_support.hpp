@@ -124,7 +124,7 @@ class FaultyBackend : public IoBackend {
   std::string Describe() const override { return "faulty test backend"; }
 
   int safe_calls_ = 0;
-  SafeState safe_ = SafeState::kValvesClosed;
+  SafeState safe_ = SafeState::kHold;
   bool closed_ = false;
   double last_u_ = 0.0;
 

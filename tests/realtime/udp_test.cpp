@@ -227,7 +227,7 @@ TEST(UdpBackend, SilentServerIsATimeoutWithinMaxMissedPeriods) {
   CountingPi pi(0.8, 4.0, 0.01);
   SafetyOptions safety_options;
   safety_options.max_overruns = -1;
-  safety_options.safe_state = SafeState::kExhaustOpen;
+  safety_options.safe_state = SafeState::kRelease;
   SafetyMonitor safety(safety_options);
   const std::string path = std::string(PNEUMID_BINARY_DIR) + "/realtime_test_udp_timeout.csv";
   LogWriter log(path, {});

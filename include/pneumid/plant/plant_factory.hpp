@@ -44,7 +44,8 @@ std::unique_ptr<Plant> MakePlant(const std::string& spec, double Ts,
                                  const PlantOptions& options = {});
 
 /// Input and output channel (name "u"/"y" and unit) of a plant made by MakePlant:
-/// {"u","%"} and {"y","N"} or {"y","m"} for the IPA, unit-less otherwise.
+/// {"u","%"} and {"y","N"} or {"y","m"} for the IPA, unit-less otherwise
+/// (PlantActuator(plant).input and .output, plant/actuator.hpp).
 Channel PlantInputChannel(const Plant& plant);
 Channel PlantOutputChannel(const Plant& plant);
 

@@ -14,8 +14,8 @@
 //     when exhaust = "closed". The drivers generate the PWM (analog-level mode).
 // Out-of-range readings: a raw value at either ADC rail (0 or maxdata), or a
 // voltage outside [v_min, v_max] of the transducer, give IoStatus::kOutOfRange.
-// Safe states: valves-closed writes v_closed to both outputs; exhaust-open writes
-// v_closed to the inlet and v_open to the exhaust.
+// Safe states: hold (valves-closed) writes v_closed to both outputs; release
+// (exhaust-open) writes v_closed to the inlet and v_open to the exhaust.
 //
 // What is exercised without a card: the configuration, the conversion math
 // (including comedi_to_phys/comedi_from_phys on the PCI-6221 ranges) and the
@@ -86,6 +86,8 @@ class ComediBackend : public IoBackend {
   IoStatus EnterSafeState(SafeState state) noexcept override;
   void Close() override;
   std::string Describe() const override;
+  /// The paper's rig: the IPA in force mode (IpaActuator()).
+  Actuator actuator() const override { return IpaActuator(); }
   const ComediConfig& config() const { return config_; }
 
  private:

@@ -2,9 +2,12 @@
 // acquisition card (comedi) and a remote plant server (UDP).
 //
 // Per period k the loop calls
-//   Read(&m)    -> m.y: the measured output (force, N) at t_k
-//   Write(u)    -> applies the input u (valve duty, %) until t_(k+1)
-// and on a fault or stop EnterSafeState(). Read, Write and EnterSafeState run on
+//   Read(&m)    -> m.y: the measured output at t_k
+//   Write(u)    -> applies the input u until t_(k+1)
+// and on a fault or stop EnterSafeState(). Units, input range and the names of
+// the safe states are the actuator's (actuator(), plant/actuator.hpp): for the
+// IPA (simulator, comedi rig, plant server) u is the valve duty in % and y the
+// force in N. Read, Write and EnterSafeState run on
 // the loop thread: implementations must not allocate, lock or do file I/O
 // there (system calls to the device or socket are the backend's job).
 // Open and Close run outside the loop and may allocate and throw.
@@ -20,8 +23,8 @@ namespace pneumid {
 
 /// One sample read from the plant.
 struct Measurement {
-  double y = 0.0;  ///< measured output (force, N)
-  /// Auxiliary measurement (chamber pressure, Pa) when the backend has one, else NaN.
+  double y = 0.0;  ///< measured output (actuator().output units)
+  /// Auxiliary measurement (IPA: chamber pressure, Pa) when the backend has one, else NaN.
   double aux = std::numeric_limits<double>::quiet_NaN();
 };
 
@@ -33,7 +36,7 @@ class IoBackend {
   virtual void Open(double period) = 0;
   /// Reads the current sample. Never throws; failures are returned as a status.
   virtual IoStatus Read(Measurement* m) noexcept = 0;
-  /// Applies input u (duty %) for one period. Never throws.
+  /// Applies input u (actuator().input units) for one period. Never throws.
   virtual IoStatus Write(double u) noexcept = 0;
   /// Drives the outputs to the safe state. Never throws; best effort on a broken device.
   virtual IoStatus EnterSafeState(SafeState state) noexcept = 0;
@@ -44,6 +47,9 @@ class IoBackend {
   virtual bool CanRunFast() const { return false; }
   /// Short description for logs, e.g. "udp://127.0.0.1:5000 (ipa ...)".
   virtual std::string Describe() const = 0;
+  /// The actuator behind the backend: channels, input range, safe-state names.
+  /// Default: the generic description (Actuator{}).
+  virtual Actuator actuator() const { return Actuator{}; }
 };
 
 /// Backend kinds selectable with --io.

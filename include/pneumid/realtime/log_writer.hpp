@@ -8,12 +8,13 @@
 //   # stop: ...                                  <- filled in at Close() (reserved space)
 //   t,u,y,r,u_ctrl,aux,jitter_us,compute_us,flags,fault
 //   0.00,12.5,0.31,...
-// Columns: t (s, scheduled time), u (applied duty %, after the safety layer),
-// y (measured force, N), r (set point, N), u_ctrl (controller output before the
-// safety layer, %), aux (chamber pressure, Pa, or nan), jitter_us (wake-up
-// lateness), compute_us (time of the step), flags (bit 0 clamped, 1 rate
-// limited, 2 stale sample, 3 deadline overrun, 4 safe state), fault (name, or
-// empty). The dataset format ("dataset") writes only t,u,y so that
+// Columns (in the actuator's units, IoBackend::actuator(); for the IPA duty %,
+// force N, chamber pressure Pa): t (s, scheduled time), u (applied input, after
+// the safety layer), y (measured output), r (set point), u_ctrl (controller
+// output before the safety layer), aux (auxiliary measurement, or nan),
+// jitter_us (wake-up lateness), compute_us (time of the step), flags (bit 0
+// clamped, 1 rate limited, 2 stale sample, 3 deadline overrun, 4 safe state),
+// fault (name, or empty). The dataset format ("dataset") writes only t,u,y so that
 // `pneumid identify` reads it directly.
 //
 // Durability: the writer flushes to the operating system at least every

@@ -5,8 +5,9 @@
 //
 //   [loop]    period (s), duration (s), realtime (bool), priority, cpu, fast (bool)
 //   [io]      backend = "sim" | "comedi:/dev/comedi0" | "udp://HOST:PORT", plant (sim)
-//   [safety]  u_min, u_max (%), rate_max (%/s), y_min, y_max (N), frozen_samples,
-//             frozen_tolerance (N), max_overruns, safe_state = "valves-closed" | "exhaust-open"
+//   [safety]  u_min, u_max, rate_max (per s), y_min, y_max, frozen_samples, frozen_tolerance
+//             (the actuator's units: % and N for the IPA), max_overruns,
+//             safe_state = "hold" | "release" (IPA: "valves-closed" | "exhaust-open")
 //   [udp]     max_missed, reply_wait (periods), hello_timeout (s), hello_attempts
 //   [comedi]  device, ai_subdevice, ai_channel, ai_range, ai_aref, v_min, v_max,
 //             pressure_gain, pressure_offset, force_gain, force_offset, ao_subdevice,

@@ -40,7 +40,8 @@ class LoopController {
   virtual ~LoopController() = default;
   /// Called once before the first period (may allocate). y0 is the first measurement.
   virtual void Reset() {}
-  /// Input u_k (duty, %) for set point r (N) and measurement y (N) at sample k.
+  /// Input u_k for set point r and measurement y at sample k (the actuator's units,
+  /// IoBackend::actuator(): for the IPA duty % from force N).
   virtual double Update(std::int64_t k, double r, double y) noexcept = 0;
   /// Description for the log header, e.g. "dmc P=126 M=5 lambda=2.25".
   virtual std::string Describe() const = 0;
@@ -87,7 +88,9 @@ struct LoopSummary {
   std::string scheduling;    ///< one line: real-time scheduling obtained or why not
   std::int64_t samples = 0;  ///< samples run (rows logged)
   std::int64_t log_dropped = 0;  ///< records the log could not take (ring buffer full)
-  SafeState safe_state = SafeState::kValvesClosed;
+  SafeState safe_state = SafeState::kHold;
+  /// The actuator's name of safe_state (IoBackend::actuator()), e.g. "valves-closed".
+  std::string safe_state_name = "hold";
   IoStatus safe_state_status = IoStatus::kOk;  ///< result of EnterSafeState
   TimingReport timing;
   double wall_time = 0.0;  ///< s from the first to the last sample

@@ -20,7 +20,8 @@ struct SessionOptions {
   /// Header lines (key, value) recorded in the log besides the automatic ones
   /// (io, controller, period, duration, safety).
   std::vector<std::pair<std::string, std::string>> header;
-  /// Redraw a one-line status (t, set point, force, duty, jitter) on stderr every 0.2 s.
+  /// Redraw a one-line status (t, set point, output, input, jitter; the actuator's
+  /// words, e.g. force and duty for the IPA) on stderr every 0.2 s.
   bool live_status = false;
   /// Keep the records in memory (SessionResult::records), e.g. for metrics.
   bool keep_records = false;
@@ -38,7 +39,8 @@ struct SessionResult {
 SessionResult RunSession(const SessionOptions& options, IoBackend& io, LoopController& controller,
                          const std::vector<double>& setpoint);
 
-/// Human-readable safety settings, e.g. "u in [0, 100] %, rate off, y in [..], ...".
-std::string DescribeSafety(const SafetyOptions& s);
+/// Human-readable safety settings in the actuator's units and names, e.g.
+/// "u in [0, 100] %, rate unlimited, y in [..], ..., safe state valves-closed".
+std::string DescribeSafety(const SafetyOptions& s, const Actuator& actuator);
 
 }  // namespace pneumid

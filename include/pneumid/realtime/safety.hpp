@@ -5,25 +5,34 @@
 //   2. lets the controller compute u,
 //   3. clamps u to [u_min, u_max] and limits its rate to |du/dt| <= rate_max,
 //   4. counts deadline overruns.
-// Any fault ends the run: the outputs go to the configured safe state (both
-// valves closed, or exhaust open), the reason is logged, the log is flushed and
-// the program exits non-zero.
+// Any fault ends the run: the actuator goes to the configured safe state (hold
+// or release, which the backend's plant names and explains, plant/actuator.hpp:
+// for the IPA both valves closed, or the exhaust open), the reason is logged,
+// the log is flushed and the program exits non-zero.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
+#include "pneumid/plant/actuator.hpp"
+
 namespace pneumid {
 
-/// What the outputs are driven to on a fault or stop.
+/// What the actuator is driven to on a fault or stop (plant/actuator.hpp).
 enum class SafeState {
-  kValvesClosed,  ///< inlet and exhaust valves closed: chamber pressure held
-  kExhaustOpen,   ///< inlet closed, exhaust open: chamber vents, force falls to its minimum
+  kHold = 0,     ///< stop acting, keep the plant's state (IPA: valves closed, pressure held)
+  kRelease = 1,  ///< drive the actuator to rest (IPA: exhaust open, the chamber vents)
 };
-/// "valves-closed" / "exhaust-open".
+/// "hold" / "release".
 const char* ToString(SafeState s);
-/// Inverse of ToString. @throws InvalidArgument listing the accepted names.
+/// Inverse of ToString; the IPA's names "valves-closed" (hold) and
+/// "exhaust-open" (release) are accepted too.
+/// @throws InvalidArgument listing the accepted names.
 SafeState SafeStateFromString(const std::string& name);
+/// The actuator's name of a safe state, e.g. "valves-closed" for hold on the IPA.
+const std::string& SafeStateName(const Actuator& actuator, SafeState s);
+/// The actuator's explanation of a safe state.
+const std::string& SafeStateMeaning(const Actuator& actuator, SafeState s);
 
 /// Why a run ended abnormally (kNone: no fault).
 enum class Fault : std::uint8_t {
@@ -53,9 +62,11 @@ enum class IoStatus : std::uint8_t {
 const char* ToString(IoStatus s);
 
 struct SafetyOptions {
-  double u_min = 0.0;    ///< lower output clamp (duty %, default 0)
-  double u_max = 100.0;  ///< upper output clamp (duty %, default 100)
-  /// Maximum output rate (duty % per second; 0 or infinity disables). Default: disabled.
+  /// Output clamp (input units of the actuator). Default 0..100, the range of
+  /// a duty cycle in % (the IPA's input, IpaActuator()).
+  double u_min = 0.0;
+  double u_max = 100.0;
+  /// Maximum output rate (input units per second; 0 or infinity disables). Default: disabled.
   double rate_max = 0.0;
   double y_min = -1e300;  ///< measurement range (output units, e.g. N); outside -> fault
   double y_max = 1e300;
@@ -66,7 +77,7 @@ struct SafetyOptions {
   double frozen_tolerance = 0.0;  ///< output units
   /// Fault when the number of deadline overruns exceeds this (negative: never). Default 10.
   int max_overruns = 10;
-  SafeState safe_state = SafeState::kValvesClosed;  ///< default: both valves closed
+  SafeState safe_state = SafeState::kHold;  ///< default: hold (IPA: both valves closed)
 
   bool IsValid(std::string* error) const;
 };

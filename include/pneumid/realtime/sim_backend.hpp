@@ -4,16 +4,18 @@
 // (LoopOptions::fast) since the plant keeps its own time.
 //
 // Safe state in simulation: with the IPA simulator the valves are commanded
-// directly for one period (IpaSimulator::AdvanceValves: both closed, or inlet
-// closed and exhaust open) and the plant is not advanced any further; with
-// another plant (single input) "exhaust-open" applies u = 0 % for one period
-// and "valves-closed" stops advancing it. With the IPA simulator, Read() also
+// directly for one period (IpaSimulator::AdvanceValves: hold = both closed,
+// release = inlet closed and exhaust open) and the plant is not advanced any
+// further; with another plant (single input) release applies u = 0 for one
+// period and hold stops advancing it. With the IPA simulator, Read() also
 // returns the chamber-A pressure (Pa, absolute) as the auxiliary measurement.
+// The actuator is the plant's (PlantActuator).
 #pragma once
 
 #include <memory>
 #include <string>
 
+#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/plant.hpp"
 #include "pneumid/realtime/io_backend.hpp"
@@ -33,6 +35,7 @@ class SimBackend : public IoBackend {
   void Close() override {}
   bool CanRunFast() const override { return true; }
   std::string Describe() const override;
+  Actuator actuator() const override { return PlantActuator(*plant_); }
 
   Plant& plant() { return *plant_; }
   /// True once EnterSafeState was called; which state.
@@ -43,7 +46,7 @@ class SimBackend : public IoBackend {
   std::unique_ptr<Plant> plant_;
   IpaSimulator* ipa_ = nullptr;  // plant_ when it is the IPA simulator
   bool in_safe_state_ = false;
-  SafeState safe_state_ = SafeState::kValvesClosed;
+  SafeState safe_state_ = SafeState::kHold;
 };
 
 }  // namespace pneumid

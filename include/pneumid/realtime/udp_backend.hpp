@@ -41,6 +41,8 @@ class UdpBackend : public IoBackend {
   IoStatus EnterSafeState(SafeState state) noexcept override;
   void Close() override;
   std::string Describe() const override;
+  /// The plant server's protocol carries the IPA's duty (%) and force (N): IpaActuator().
+  Actuator actuator() const override { return IpaActuator(); }
 
   std::int64_t stale_samples() const { return stale_total_; }
   /// Round-trip time of the last reply (us).

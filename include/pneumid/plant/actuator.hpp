@@ -1,0 +1,50 @@
+// What drives a plant, described for the layers that drive it without knowing
+// its physics: the real-time loop, its safety layer, its logs and status line.
+//
+// Every actuator has an input u and a measured output y (name and unit), a
+// physical input range, and two safe states the loop can leave it in after a
+// fault or a stop:
+//   hold     stop acting and keep the plant's state where it is
+//   release  drive the actuator to rest (its de-energized state)
+// A plant names and explains them in its own terms; for the IPA (IpaActuator):
+//   hold     "valves-closed": inlet and exhaust valves closed, chamber pressure held
+//   release  "exhaust-open":  inlet closed, exhaust open, the chamber vents and
+//                             the force falls to its minimum
+// with u the PWM duty cycle in % (0..100) and y the force in N (position in m
+// in position mode).
+#pragma once
+
+#include <limits>
+#include <string>
+
+#include "pneumid/data/dataset.hpp"
+#include "pneumid/plant/ipa_simulator.hpp"
+#include "pneumid/plant/plant.hpp"
+
+namespace pneumid {
+
+struct Actuator {
+  Channel input{"u", ""};   ///< name and unit of the input
+  Channel output{"y", ""};  ///< name and unit of the measured output
+  /// Words for a status line, e.g. "duty" and "force".
+  std::string input_label = "u";
+  std::string output_label = "y";
+  /// Physical input range (input units; infinite = unbounded).
+  double u_min = -std::numeric_limits<double>::infinity();
+  double u_max = std::numeric_limits<double>::infinity();
+  /// The plant's names and meanings of the hold and release safe states.
+  std::string hold_name = "hold";
+  std::string hold_meaning = "the input is no longer applied; the plant keeps its state";
+  std::string release_name = "release";
+  std::string release_meaning = "the actuator is driven to rest (input 0)";
+};
+
+/// The IPA's actuator (see the file comment); the output is force (N) in
+/// force mode, position (m) in position mode.
+Actuator IpaActuator(IpaMode mode = IpaMode::kForce);
+
+/// The actuator of a plant: IpaActuator for the IPA simulator, the generic
+/// description (u, y without units, unbounded, hold/release) otherwise.
+Actuator PlantActuator(const Plant& plant);
+
+}  // namespace pneumid
