@@ -1,0 +1,22 @@
+#include "controller_options.hpp"
+
+#include "validators.hpp"
+
+namespace pneumid::cli {
+
+void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
+  // Names are checked by the control area (the message lists the valid ones).
+  app.add_option("--controller", s.controller, "dmc, gpc or pid")->capture_default_str();
+  app.add_option("--rule", s.rule,
+                 "Tuning rule: shridhar-cooper (conventional), paper-modified, explicit "
+                 "(default: shridhar-cooper, or explicit when --P --M --lambda are all given)");
+  app.add_option("--P", s.P, "Prediction horizon (samples)")->check(AtLeast(1));
+  app.add_option("--M", s.M, "Control horizon (samples)")->check(AtLeast(1));
+  app.add_option("--lambda", s.lambda, "Move suppression")->check(NonNegative());
+  app.add_flag("--constrained", s.constrained,
+               "DMC: optimize the moves under the input limits (QDMC, QP solver) instead of "
+               "clipping");
+  app.add_option("--pid-rule", s.pid_rule, "PID tuning: simc or imc")->capture_default_str();
+}
+
+}  // namespace pneumid::cli

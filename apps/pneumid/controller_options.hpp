@@ -1,0 +1,24 @@
+// Command-line options that design a controller, shared by `control` and `run`
+// (like data_options/model_options), bound to the control area's
+// ControllerSettings (controller_factory.hpp: the rule inference and parsing
+// live there):
+//
+//   --controller dmc|gpc|pid   controller type
+//   --rule NAME                shridhar-cooper (conventional), paper-modified, explicit
+//                              (default: shridhar-cooper, or explicit when --P --M
+//                              --lambda are all given)
+//   --P N, --M N, --lambda L   horizons and move suppression (override the rule)
+//   --constrained              dmc: QDMC, moves optimized under the input limits
+//   --pid-rule simc|imc        PID tuning rule
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "pneumid/control/controller_factory.hpp"
+
+namespace pneumid::cli {
+
+/// Adds the options above, writing into `settings`.
+void AddControllerOptions(CLI::App& app, ControllerSettings& settings);
+
+}  // namespace pneumid::cli
