@@ -65,7 +65,7 @@ grep -q "timeout" "$TMP/timeout.err" || fail "timeout not reported: $(cat "$TMP/
 grep -q "exhaust-open" "$TMP/timeout.err" || fail "safe state not reported"
 [ "$(data_rows "$TMP/timeout.csv")" -eq 34 ] || fail "timeout log rows: $(data_rows "$TMP/timeout.csv")"
 tail -1 "$TMP/timeout.csv" | grep -q ',timeout$' || fail "fault reason not in the last row"
-grep -q '^# stop: fault: timeout' "$TMP/timeout.csv" || fail "fault not in the log header"
+grep -q '^# stop: failure: timeout' "$TMP/timeout.csv" || fail "fault not in the log header"
 stop_server
 
 # sensor range fault on the simulator

@@ -235,7 +235,7 @@ TEST_P(FaultInjection, EndsInSafeStateWithCompleteLog) {
   for (std::size_t k = 0; k + 1 < csv.rows.size(); ++k) EXPECT_EQ(csv.rows[k].back(), "") << k;
   bool stop_line = false;
   for (const auto& h : csv.header)
-    if (h.rfind("# stop: fault", 0) == 0 || h.find(ToString(c.expected)) != std::string::npos)
+    if (h.rfind("# stop: failure", 0) == 0 || h.find(ToString(c.expected)) != std::string::npos)
       stop_line = true;
   EXPECT_TRUE(stop_line);
 }
