@@ -33,9 +33,9 @@ constexpr std::size_t kInflatePrefix = 64 * 1024;
 /// One data element: its type, the size its tag claims, and its data.
 struct Element {
   std::uint32_t type = 0;
-  std::uint64_t nbytes = 0;       ///< as claimed by the tag
-  std::string_view data;          ///< the claimed bytes that are present
-  std::size_t size_on_disk = 0;   ///< tag + data + padding to 8 bytes
+  std::uint64_t nbytes = 0;      ///< as claimed by the tag
+  std::string_view data;         ///< the claimed bytes that are present
+  std::size_t size_on_disk = 0;  ///< tag + data + padding to 8 bytes
 };
 
 class Scanner {
@@ -49,9 +49,10 @@ class Scanner {
       name_.clear();
       const std::string_view rest = bytes.substr(offset);
       if (rest.size() < 8) {
-        Fail(fmt::format("the file ends inside the tag of variable {} ({} bytes left at offset "
-                         "{}): the file is truncated",
-                         index, rest.size(), offset));
+        Fail(
+            fmt::format("the file ends inside the tag of variable {} ({} bytes left at offset "
+                        "{}): the file is truncated",
+                        index, rest.size(), offset));
       }
       const Element e = ReadTag(rest);
       if (e.type == kMiCompressed) {
@@ -66,7 +67,7 @@ class Scanner {
         Truncated(e, offset, bytes.size());
       }
       offset += e.type == kMiCompressed ? 8 + static_cast<std::size_t>(e.nbytes)
-                                         : std::min<std::size_t>(e.size_on_disk, rest.size());
+                                        : std::min<std::size_t>(e.size_on_disk, rest.size());
     }
   }
 
@@ -106,9 +107,10 @@ class Scanner {
   }
 
   [[noreturn]] void Truncated(const Element& e, std::size_t offset, std::size_t file_size) const {
-    Fail(fmt::format("{} needs {} bytes from offset {} but the file ends at byte {}: the file "
-                     "is truncated (or not a MAT file)",
-                     Variable(), 8 + e.nbytes, offset, file_size));
+    Fail(
+        fmt::format("{} needs {} bytes from offset {} but the file ends at byte {}: the file "
+                    "is truncated (or not a MAT file)",
+                    Variable(), 8 + e.nbytes, offset, file_size));
   }
 
   /// Sets name_ from the name subelement of matrix data, when it is there.
@@ -146,9 +148,10 @@ class Scanner {
     if (inner.type != kMiMatrix) return;
     const double limit = kMaxInflateRatio * static_cast<double>(e.nbytes) + 1024.0;
     if (static_cast<double>(inner.nbytes) > limit) {
-      Fail(fmt::format("{} claims {} bytes after decompression, more than its {} compressed "
-                       "bytes can hold: the file is corrupt",
-                       Variable(), inner.nbytes, e.nbytes));
+      Fail(
+          fmt::format("{} claims {} bytes after decompression, more than its {} compressed "
+                      "bytes can hold: the file is corrupt",
+                      Variable(), inner.nbytes, e.nbytes));
     }
     CheckMatrix(inner.data, inner.nbytes, /*partial=*/true, 0);
   }
@@ -170,23 +173,26 @@ class Scanner {
     for (int k = 0; at < data.size(); ++k) {
       if (data.size() - at < 8) {
         if (partial) return;
-        Fail(fmt::format("{}: an element tag is cut off by the end of the array: the file is "
-                         "corrupt",
-                         Variable()));
+        Fail(
+            fmt::format("{}: an element tag is cut off by the end of the array: the file is "
+                        "corrupt",
+                        Variable()));
       }
       const Element e = ReadTag(data.substr(at));
       if (e.data.size() < e.nbytes) {
         if (partial && data.size() < nbytes) return;
-        Fail(fmt::format("{}: an element claims {} bytes, more than the {} bytes left in its "
-                         "array: the file is corrupt",
-                         Variable(), e.nbytes, data.size() - at - 8));
+        Fail(
+            fmt::format("{}: an element claims {} bytes, more than the {} bytes left in its "
+                        "array: the file is corrupt",
+                        Variable(), e.nbytes, data.size() - at - 8));
       }
       if (k == 0 && e.type == kMiUint32 && e.nbytes >= 4) {
         cls = U32(e.data, 0) & 0xFF;
       } else if (k == 1 && e.type == kMiInt32) {
         for (std::size_t d = 0; d + 4 <= e.data.size(); d += 4) {
           const auto n = static_cast<std::int32_t>(U32(e.data, d));
-          if (n < 0) Fail(fmt::format("{}: negative dimension {}: the file is corrupt", Variable(), n));
+          if (n < 0)
+            Fail(fmt::format("{}: negative dimension {}: the file is corrupt", Variable(), n));
           elements *= static_cast<double>(n);
           dims += (d == 0 ? "" : "x") + std::to_string(n);
         }
@@ -195,8 +201,7 @@ class Scanner {
       } else if (k == 3 && cls == kClassStruct && e.type == kMiInt32 && e.nbytes >= 4) {
         field_name_length = U32(e.data, 0);
       } else if (k == 4 && cls == kClassStruct && e.type == kMiInt8) {
-        fields = field_name_length == 0 ? 0.0
-                                        : static_cast<double>(e.nbytes / field_name_length);
+        fields = field_name_length == 0 ? 0.0 : static_cast<double>(e.nbytes / field_name_length);
       }
       if ((k == 2 && cls != kClassStruct) || (k == 4 && cls == kClassStruct)) {
         CheckElementCount(cls, elements * fields, dims, nbytes);
@@ -216,9 +221,10 @@ class Scanner {
     }
     const double min_bytes = (cls == kClassCell || cls == kClassStruct ? 8.0 : 1.0) * elements;
     if (min_bytes > static_cast<double>(nbytes)) {
-      Fail(fmt::format("{} claims dimensions {} ({} elements) but holds only {} bytes: the file "
-                       "is corrupt",
-                       Variable(), dims, elements, nbytes));
+      Fail(
+          fmt::format("{} claims dimensions {} ({} elements) but holds only {} bytes: the file "
+                      "is corrupt",
+                      Variable(), dims, elements, nbytes));
     }
   }
 
@@ -228,12 +234,58 @@ class Scanner {
   std::string name_;
 };
 
+/// MAT v4 (MAT-File Format, ch. 1, "Level 4 MAT-files"): a sequence of
+/// variables, each a 20-byte header (type MOPT, rows, columns, imaginary flag,
+/// name length), the name and the data. Headers that do not look like v4 end
+/// the check (matio then decides); sizes beyond the file are errors.
+void ScanMatV4(const std::string& path, std::string_view bytes) {
+  std::size_t offset = 0;
+  for (int index = 1; offset < bytes.size(); ++index) {
+    const std::string_view rest = bytes.substr(offset);
+    if (rest.size() < 20) {
+      if (index == 1) return;  // too short for v4: matio decides
+      throw DataError(
+          fmt::format("{}: the file ends inside the header of variable {} ({} bytes "
+                      "left): the file is truncated (or not a MAT file)",
+                      path, index, rest.size()));
+    }
+    std::int32_t h[5];
+    std::memcpy(h, rest.data(), sizeof(h));
+    auto valid = [](const std::int32_t* v) {
+      return v[0] >= 0 && v[0] < 5000 && (v[0] / 100) % 10 == 0 && (v[0] / 10) % 10 <= 5 &&
+             v[0] % 10 <= 2 && v[1] >= 0 && v[2] >= 0 && (v[3] == 0 || v[3] == 1) && v[4] >= 0;
+    };
+    if (!valid(h)) {
+      for (auto& v : h)
+        v = static_cast<std::int32_t>(__builtin_bswap32(static_cast<std::uint32_t>(v)));
+      if (!valid(h)) return;  // not v4: matio decides
+    }
+    static constexpr double kPrecisionBytes[] = {8, 4, 4, 2, 2, 1};
+    const double data = static_cast<double>(h[1]) * static_cast<double>(h[2]) *
+                        kPrecisionBytes[(h[0] / 10) % 10] * (h[3] == 1 ? 2.0 : 1.0);
+    const double need = 20.0 + static_cast<double>(h[4]) + data;
+    if (need > static_cast<double>(rest.size())) {
+      const std::size_t name_length =
+          std::min<std::size_t>(static_cast<std::size_t>(h[4]), rest.size() - 20);
+      std::string_view name = rest.substr(20, name_length);
+      name = name.substr(0, name.find('\0'));
+      throw DataError(fmt::format(
+          "{}: variable {} ('{}') claims {}x{} elements, {} bytes from offset {}, but the file "
+          "has {} bytes left: the file is truncated or corrupt",
+          path, index, Excerpt(name), h[1], h[2], need, offset, rest.size()));
+    }
+    offset += static_cast<std::size_t>(need);
+  }
+}
+
 }  // namespace
 
-void ScanMatV5(const std::string& path, std::string_view bytes) {
-  if (bytes.size() < 128) return;
+void ScanMatFile(const std::string& path, std::string_view bytes) {
+  if (bytes.size() < 128 || (bytes.substr(126, 2) != "IM" && bytes.substr(126, 2) != "MI")) {
+    ScanMatV4(path, bytes);
+    return;
+  }
   const std::string_view endian = bytes.substr(126, 2);
-  if (endian != "IM" && endian != "MI") return;  // not v5 (v4)
   const bool swap = endian == "MI";
   std::uint16_t version = 0;
   std::memcpy(&version, bytes.data() + 124, 2);

@@ -154,7 +154,7 @@ class MatReader {
     {
       // Sizes claimed by the file are checked before matio trusts them.
       const internal::MappedFile file(path);
-      internal::ScanMatV5(path, file.view());
+      internal::ScanMatFile(path, file.view());
     }
     g_matio_message.clear();
     mat_.reset(Mat_Open(path.c_str(), MAT_ACC_RDONLY));

@@ -102,7 +102,10 @@ TEST(ExcerptTest, CapsLongTextAndEscapesControlBytes) {
   EXPECT_EQ(Excerpt(std::string("a\0b\x1b", 4)), "a\\x00b\\x1B");
   EXPECT_EQ(Excerpt("\xFF\xFEz"), "\\xFF\\xFEz");
   // Valid UTF-8 is kept, and never cut inside a character.
-  EXPECT_EQ(Excerpt("T [\xC2\xB0" "C]"), "T [\xC2\xB0" "C]");
+  EXPECT_EQ(Excerpt("T [\xC2\xB0"
+                    "C]"),
+            "T [\xC2\xB0"
+            "C]");
   EXPECT_EQ(Excerpt("ab\xC2\xB0", 3), "ab... (4 bytes)");
   std::size_t bad = 0;
   EXPECT_TRUE(IsValidUtf8("F [N] \xE2\x82\xAC"));
@@ -143,19 +146,23 @@ TEST_F(BadInputTest, Utf16FileIsReportedAsSuch) {
   // Without a byte order mark, the NUL bytes give it away.
   const std::string no_bom = Write("utf16-nobom.csv", text.substr(2));
   EXPECT_THAT([&] { ReadCsv(no_bom); },
-              ThrowsMessage<DataError>(AllOf(HasSubstr(no_bom + ":1: NUL byte at offset 1"),
-                                             HasSubstr("binary file"))));
+              ThrowsMessage<DataError>(
+                  AllOf(HasSubstr(no_bom + ":1: NUL byte at offset 1"), HasSubstr("binary file"))));
 }
 
 TEST_F(BadInputTest, BinaryFileIsReportedAsBinary) {
-  const std::string path = Write("data.csv", std::string("\x7f" "ELF\x02\x01\x01\0\0\0", 10));
+  const std::string path = Write("data.csv", std::string("\x7f"
+                                                         "ELF\x02\x01\x01\0\0\0",
+                                                         10));
   EXPECT_THAT([&] { ReadCsv(path); },
               ThrowsMessage<DataError>(HasSubstr("NUL byte at offset 7: this is a binary file")));
 }
 
 TEST_F(BadInputTest, HeaderThatIsNotUtf8IsNamedWhenAColumnIsMissing) {
   // Latin-1 "Temperatur [\xB0C]": readable as long as the columns resolve.
-  const std::string ok = Write("latin1.csv", "t,u,y [\xB0" "C]\n0,1,2\n1,1,3\n");
+  const std::string ok = Write("latin1.csv",
+                               "t,u,y [\xB0"
+                               "C]\n0,1,2\n1,1,3\n");
   EXPECT_EQ(ReadCsv(ok).size(), 2);
   const std::string path = Write("mojibake.csv", "\x8F\x90,\x91\n0,1\n");
   EXPECT_THAT([&] { ReadCsv(path); },
@@ -213,10 +220,9 @@ TEST_F(BadInputTest, MissingFileIsReportedBeforeTheExtension) {
 
 TEST_F(BadInputTest, HandBuiltMatFileReads) {
   // The builder itself is right: a well-formed file reads back.
-  const std::string path =
-      Write("ok.mat", MatHeader() + DoubleMatrix("t", 3, 1, {0, 1, 2}) +
-                          Compress(DoubleMatrix("u", 3, 1, {1, 1, 1})) +
-                          DoubleMatrix("y", 1, 3, {0, 2, 3}));
+  const std::string path = Write("ok.mat", MatHeader() + DoubleMatrix("t", 3, 1, {0, 1, 2}) +
+                                               Compress(DoubleMatrix("u", 3, 1, {1, 1, 1})) +
+                                               DoubleMatrix("y", 1, 3, {0, 2, 3}));
   const Dataset d = ReadMat(path);
   EXPECT_EQ(d.size(), 3);
   EXPECT_DOUBLE_EQ(d.y()[2], 3.0);
@@ -228,15 +234,15 @@ TEST_F(BadInputTest, TruncatedMatFileIsReportedAsTruncated) {
                            DoubleMatrix("y", 4, 1, {0, 1, 2, 3});
   const std::string path = Write("cut.mat", full.substr(0, full.size() - 20));
   EXPECT_THAT([&] { ReadMat(path); },
-              ThrowsMessage<DataError>(AllOf(HasSubstr("variable 3 ('y') needs"),
-                                             HasSubstr("the file is truncated"))));
+              ThrowsMessage<DataError>(
+                  AllOf(HasSubstr("variable 3 ('y') needs"), HasSubstr("the file is truncated"))));
   // Cut inside a compressed variable.
   const std::string zfull = MatHeader() + DoubleMatrix("t", 4, 1, {0, 1, 2, 3}) +
                             Compress(DoubleMatrix("u", 4, 1, {0, 1, 1, 1}));
   const std::string zpath = Write("zcut.mat", zfull.substr(0, zfull.size() - 5));
   EXPECT_THAT([&] { ReadMat(zpath); },
-              ThrowsMessage<DataError>(AllOf(HasSubstr("variable 2 ('u') needs"),
-                                             HasSubstr("the file is truncated"))));
+              ThrowsMessage<DataError>(
+                  AllOf(HasSubstr("variable 2 ('u') needs"), HasSubstr("the file is truncated"))));
   // Cut inside the tag of the next variable.
   const std::string tpath = Write("tagcut.mat", full.substr(0, 128 + 96 + 4));
   EXPECT_THAT([&] { ReadMat(tpath); },
@@ -248,9 +254,9 @@ TEST_F(BadInputTest, MatVariableClaimingHugeDimensionsIsRejectedQuickly) {
   const std::string path =
       Write("huge.mat", MatHeader() + DoubleMatrix("t", 0x7FFFFFFF, 0x7FFFFFFF, {0, 1}));
   EXPECT_THAT([&] { ReadMat(path); },
-              ThrowsMessage<DataError>(AllOf(
-                  HasSubstr("variable 1 ('t') claims dimensions 2147483647x2147483647"),
-                  HasSubstr("the file is corrupt"))));
+              ThrowsMessage<DataError>(
+                  AllOf(HasSubstr("variable 1 ('t') claims dimensions 2147483647x2147483647"),
+                        HasSubstr("the file is corrupt"))));
   // The same inside a compressed variable, and a cell of 2^31 elements.
   std::string flags, dims;
   PutU32(&flags, 1);  // mxCELL_CLASS
@@ -261,6 +267,28 @@ TEST_F(BadInputTest, MatVariableClaimingHugeDimensionsIsRejectedQuickly) {
   const std::string zpath = Write("zhuge.mat", MatHeader() + Compress(cell));
   EXPECT_THAT([&] { ReadMat(zpath); },
               ThrowsMessage<DataError>(HasSubstr("variable 1 ('c') claims dimensions")));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+}
+
+TEST_F(BadInputTest, MatV4VariableLargerThanTheFileIsRejected) {
+  // Level-4 header: type 0 (little-endian double), rows, columns, real, name length.
+  auto v4 = [](std::uint32_t rows, const std::vector<double>& values) {
+    std::string s;
+    for (std::uint32_t h : {0u, rows, 1u, 0u, 2u}) PutU32(&s, h);
+    s += std::string("t\0", 2);
+    s.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+    return s;
+  };
+  const std::string ok = Write("ok4.mat", v4(3, {0, 1, 2}));
+  MatReadOptions o;
+  o.input_variables = {};
+  o.output_variables = {"t"};
+  EXPECT_EQ(ReadMat(ok, o).size(), 3);
+  const auto start = std::chrono::steady_clock::now();
+  const std::string path = Write("huge4.mat", v4(1000000000, {0, 1, 2}));
+  EXPECT_THAT([&] { ReadMat(path, o); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("variable 1 ('t') claims 1000000000x1"),
+                                             HasSubstr("truncated or corrupt"))));
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
 }
 
@@ -277,10 +305,10 @@ TEST_F(BadInputTest, ExtremeValuesAreNamedWithTheColumnAndRange) {
                                              HasSubstr("overflow"))));
   y << 0, 1e-300, 2e-300, 2e-300;
   const Dataset tiny(t, u, y);
-  EXPECT_THAT([&] { tiny.RequireNumericScale(); },
-              ThrowsMessage<DataError>(AllOf(HasSubstr("dataset: output column 'y'"),
-                                             HasSubstr("a spread of 2e-300"),
-                                             HasSubstr("extreme scale"))));
+  EXPECT_THAT(
+      [&] { tiny.RequireNumericScale(); },
+      ThrowsMessage<DataError>(AllOf(HasSubstr("dataset: output column 'y'"),
+                                     HasSubstr("a spread of 2e-300"), HasSubstr("extreme scale"))));
   y << 0, 1, 2, 2;
   EXPECT_NO_THROW(Dataset(t, u, y).RequireNumericScale());
   // Constant columns (no step) are left to the methods to diagnose.
