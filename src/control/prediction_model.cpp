@@ -80,16 +80,4 @@ Eigen::MatrixXd DynamicMatrix(const Eigen::VectorXd& step, int P, int M) {
   return A;
 }
 
-TransferFunction SampledModel(const TransferFunction& model, double Ts) {
-  return PredictionModel(model, Ts).sampled();
-}
-
-Eigen::VectorXd StepResponseCoefficients(const TransferFunction& model, double Ts, int n) {
-  return PredictionModel(model, Ts).StepResponse(n);
-}
-
-int SettlingModelHorizon(const TransferFunction& model, double Ts, double tol, int max_n) {
-  return PredictionModel(model, Ts).SettlingHorizon(tol, max_n);
-}
-
 }  // namespace pneumid

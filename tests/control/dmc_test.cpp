@@ -1,4 +1,4 @@
-// DMC and QDMC: step coefficients against the closed form, the paper's two
+// DMC and QDMC (step coefficients: prediction_model_test.cpp): the paper's two
 // predictive-control settings against an independent simulation
 // (gen_dmc_reference.py), offset-free tracking under model mismatch, and the
 // constraints of the QP form.
@@ -22,39 +22,6 @@ namespace {
 constexpr double kTs = 0.01;
 
 TransferFunction PaperFopdt() { return TransferFunction::Fopdt(1.6, 0.245, 0.001); }
-
-TEST(StepResponseCoefficientsTest, FopdtMatchesClosedForm) {
-  // Sampled step response of K exp(-theta s)/(tau s + 1) under a zoh:
-  // s_i = K (1 - exp(-(i Ts - theta)/tau)) for i Ts >= theta (exact).
-  const Eigen::VectorXd s = StepResponseCoefficients(PaperFopdt(), kTs, 200);
-  ASSERT_EQ(s.size(), 201);
-  EXPECT_NEAR(s(0), 0.0, 1e-12);
-  for (int i = 1; i <= 200; ++i) {
-    const double expected = 1.6 * (1.0 - std::exp(-(i * kTs - 0.001) / 0.245));
-    EXPECT_NEAR(s(i), expected, 1e-10) << "i = " << i;
-  }
-}
-
-TEST(StepResponseCoefficientsTest, DiscreteArxUsesItsDifferenceEquation) {
-  // Paper Eq. 5: y = (b1 q^-1 + b2 q^-2 + b3 q^-3) / (1 + a1 q^-1 + ...) u.
-  const TransferFunction arx = PaperArxModel();
-  const Eigen::VectorXd s = StepResponseCoefficients(arx, kTs, 400);
-  EXPECT_NEAR(s(0), 0.0, 1e-15);
-  EXPECT_NEAR(s(1), 0.03938, 1e-12);                                // b1
-  EXPECT_NEAR(s(2), 0.03938 + 0.04506 + 0.60870 * 0.03938, 1e-12);  // b1 + b2 - a1 s1
-  EXPECT_NEAR(s(400), 1.59796, 1e-4);  // static gain, docs/paper.md, reference value 2
-  EXPECT_THROW(StepResponseCoefficients(arx, 0.02, 10), InvalidArgument);
-}
-
-TEST(DynamicMatrixTest, LowerTriangularToeplitzOfStepResponse) {
-  Eigen::VectorXd s(5);
-  s << 0, 1, 3, 6, 10;
-  const Eigen::MatrixXd A = DynamicMatrix(s, 6, 3);
-  Eigen::MatrixXd expected(6, 3);
-  expected << 1, 0, 0, 3, 1, 0, 6, 3, 1, 10, 6, 3, 10, 10, 6, 10, 10, 10;
-  EXPECT_EQ(A, expected);
-  EXPECT_THROW(DynamicMatrix(s, 2, 3), InvalidArgument);
-}
 
 struct PaperCase {
   int M;

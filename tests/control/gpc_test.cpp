@@ -46,7 +46,7 @@ TEST(GpcTest, DynamicMatrixIsTheStepResponse) {
   o.lambda = 0.3;
   GpcController gpc(PaperArxModel(), kTs, o);
   const Eigen::MatrixXd A =
-      DynamicMatrix(StepResponseCoefficients(PaperArxModel(), kTs, 40), 30, 4);
+      DynamicMatrix(PredictionModel(PaperArxModel(), kTs).StepResponse(40), 30, 4);
   EXPECT_LT((gpc.dynamic_matrix() - A).cwiseAbs().maxCoeff(), 1e-12);
 }
 

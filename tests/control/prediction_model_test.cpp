@@ -27,23 +27,42 @@ constexpr double kTs = 0.01;
 TransferFunction PaperFopdt() { return TransferFunction::Fopdt(1.6, 0.245, 0.001); }
 
 TEST(PredictionModelTest, FopdtStepResponseIsTheSampledClosedForm) {
-  // zoh: s_i = K (1 - exp(-(i Ts - theta)/tau)) for i Ts >= theta.
-  const PredictionModel pm(PaperFopdt(), kTs);
-  EXPECT_TRUE(pm.sampled().Ts() == kTs);
-  EXPECT_TRUE(pm.model().IsContinuous());
-  const Eigen::VectorXd s = pm.StepResponse(150);
-  ASSERT_EQ(s.size(), 151);
+  // Sampled step response of K exp(-theta s)/(tau s + 1) under a zoh:
+  // s_i = K (1 - exp(-(i Ts - theta)/tau)) for i Ts >= theta (exact).
+  const Eigen::VectorXd s = PredictionModel(PaperFopdt(), kTs).StepResponse(200);
+  ASSERT_EQ(s.size(), 201);
   EXPECT_NEAR(s(0), 0.0, 1e-12);
-  for (int i = 1; i <= 150; ++i)
-    EXPECT_NEAR(s(i), 1.6 * (1.0 - std::exp(-(i * kTs - 0.001) / 0.245)), 1e-10) << i;
-  EXPECT_THROW(pm.StepResponse(0), InvalidArgument);
+  for (int i = 1; i <= 200; ++i) {
+    const double expected = 1.6 * (1.0 - std::exp(-(i * kTs - 0.001) / 0.245));
+    EXPECT_NEAR(s(i), expected, 1e-10) << "i = " << i;
+  }
+}
+
+TEST(PredictionModelTest, DiscreteArxUsesItsDifferenceEquation) {
+  // Paper Eq. 5: y = (b1 q^-1 + b2 q^-2 + b3 q^-3) / (1 + a1 q^-1 + ...) u.
+  const TransferFunction arx = PaperArxModel();
+  const Eigen::VectorXd s = PredictionModel(arx, kTs).StepResponse(400);
+  EXPECT_NEAR(s(0), 0.0, 1e-15);
+  EXPECT_NEAR(s(1), 0.03938, 1e-12);                                // b1
+  EXPECT_NEAR(s(2), 0.03938 + 0.04506 + 0.60870 * 0.03938, 1e-12);  // b1 + b2 - a1 s1
+  EXPECT_NEAR(s(400), 1.59796, 1e-4);  // static gain, docs/paper.md, reference value 2
+  EXPECT_THROW(PredictionModel(arx, 0.02), InvalidArgument);
+}
+
+TEST(DynamicMatrixTest, LowerTriangularToeplitzOfStepResponse) {
+  Eigen::VectorXd s(5);
+  s << 0, 1, 3, 6, 10;
+  const Eigen::MatrixXd A = DynamicMatrix(s, 6, 3);
+  Eigen::MatrixXd expected(6, 3);
+  expected << 1, 0, 0, 3, 1, 0, 6, 3, 1, 10, 6, 3, 10, 10, 6, 10, 10, 10;
+  EXPECT_EQ(A, expected);
+  EXPECT_THROW(DynamicMatrix(s, 2, 3), InvalidArgument);
 }
 
 TEST(PredictionModelTest, DynamicMatrixOfThePaperTuning) {
   const PredictionModel pm(PaperFopdt(), kTs);
   const Eigen::MatrixXd A = pm.DynamicMatrix(126, 5);
   EXPECT_EQ(A, DynamicMatrix(pm.StepResponse(126), 126, 5));
-  EXPECT_EQ(A, DynamicMatrix(StepResponseCoefficients(PaperFopdt(), kTs, 126), 126, 5));
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A.transpose() * A,
                                                            Eigen::EigenvaluesOnly);
   EXPECT_NEAR(eig.eigenvalues().maxCoeff() / 500.0, 2.250797, 1e-5);  // gen_dmc_reference.py
@@ -55,7 +74,6 @@ TEST(PredictionModelTest, DiscreteModelIsUsedAtItsOwnSampleTime) {
   const PredictionModel pm(PaperArxModel(), kTs);
   EXPECT_EQ(pm.sampled().num(), PaperArxModel().num());
   EXPECT_EQ(pm.sampled().den(), PaperArxModel().den());
-  EXPECT_NEAR(pm.StepResponse(400)(400), 1.59796, 1e-4);  // docs/paper.md, reference value 2
   EXPECT_THAT([] { PredictionModel(PaperArxModel(), 0.02); },
               ::testing::ThrowsMessage<InvalidArgument>(
                   ::testing::HasSubstr("the controller runs at Ts = 0.02 s")));

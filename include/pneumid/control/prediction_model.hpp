@@ -71,17 +71,4 @@ class PredictionModel {
 /// @throws InvalidArgument for P < 1, M < 1, M > P or empty coefficients.
 Eigen::MatrixXd DynamicMatrix(const Eigen::VectorXd& step, int P, int M);
 
-/// PredictionModel(model, Ts).sampled().
-/// @throws InvalidArgument as PredictionModel's constructor.
-TransferFunction SampledModel(const TransferFunction& model, double Ts);
-
-/// PredictionModel(model, Ts).StepResponse(n).
-/// @throws InvalidArgument as PredictionModel's constructor and StepResponse.
-Eigen::VectorXd StepResponseCoefficients(const TransferFunction& model, double Ts, int n);
-
-/// PredictionModel(model, Ts).SettlingHorizon(tol, max_n).
-/// @throws InvalidArgument as PredictionModel's constructor and SettlingHorizon.
-int SettlingModelHorizon(const TransferFunction& model, double Ts, double tol = 1e-9,
-                         int max_n = 5000);
-
 }  // namespace pneumid
