@@ -6,6 +6,9 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
+#include <utility>
+
 #include "bindings.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller_factory.hpp"
@@ -24,22 +27,29 @@ namespace pneumid::python {
 
 namespace {
 
+// TuningResult::ToJson (as `pneumid tune --json`), plus the keys earlier
+// versions had for every rule: K, tau, theta (= fopdt), lambda_condition,
+// lambda_formula, P_unrounded, tau_used (None when the rule does not use them).
 py::dict TuningToDict(const TuningResult& t) {
-  return py::dict("rule"_a = ToString(t.rule), "P"_a = t.P, "M"_a = t.M, "lambda"_a = t.lambda,
-                  "lambda_condition"_a = t.lambda_condition, "lambda_formula"_a = t.lambda_formula,
-                  "P_unrounded"_a = t.P_unrounded, "tau_used"_a = t.tau_used, "K"_a = t.fopdt.K,
-                  "tau"_a = t.fopdt.tau, "theta"_a = t.fopdt.theta, "formula"_a = t.formula);
+  py::dict d = JsonToPython(t.ToJson());
+  const bool fopdt = t.rule == TuningRule::kShridharCooper;
+  auto number = [](double v) { return std::isfinite(v) ? py::object(py::float_(v)) : py::none(); };
+  for (const auto& [key, value] :
+       {std::pair<const char*, double>{"K", fopdt ? t.fopdt.K : NAN},
+        {"tau", fopdt ? t.fopdt.tau : NAN},
+        {"theta", fopdt ? t.fopdt.theta : NAN},
+        {"lambda_condition", t.lambda_condition},
+        {"lambda_formula", t.lambda_formula},
+        {"P_unrounded", fopdt ? t.P_unrounded : NAN},
+        {"tau_used", fopdt ? t.tau_used : NAN}}) {
+    if (!d.contains(key)) d[key] = number(value);
+  }
+  return d;
 }
 
-py::dict MetricsToDict(const ClosedLoopMetrics& m) {
-  return py::dict("rise_time"_a = m.rise_time, "overshoot_percent"_a = m.overshoot_percent,
-                  "settling_time"_a = m.settling_time,
-                  "steady_state_error"_a = m.steady_state_error, "first_move"_a = m.first_move,
-                  "iae"_a = m.iae, "ise"_a = m.ise, "itae"_a = m.itae, "tv_u"_a = m.tv_u,
-                  "u_min"_a = m.u_min, "u_max"_a = m.u_max,
-                  "load_peak_deviation"_a = m.load_peak_deviation,
-                  "load_recovery_time"_a = m.load_recovery_time);
-}
+// ClosedLoopMetrics::ToJson (as `pneumid control --json`): None for a metric
+// that does not exist in the run.
+py::dict MetricsToDict(const ClosedLoopMetrics& m) { return JsonToPython(m.ToJson()); }
 
 }  // namespace
 
@@ -139,16 +149,16 @@ void BindExtras(py::module_& m) {
       "make_controller",
       [](const TransferFunction& model, double Ts, const std::string& type, const std::string& rule,
          int M, int P, double lambda, double u_min, double u_max, bool constrained) {
-        ControllerSpec s;
-        s.type = ControllerTypeFromString(type);
-        s.tuning.rule = TuningRuleFromString(rule);
-        s.tuning.M = M;
-        s.tuning.P = P;
-        s.tuning.lambda = lambda;
+        ControllerSettings s;  // as `pneumid control` and `pneumid run` read them
+        s.controller = type;
+        s.rule = rule;
+        s.M = M;
+        s.P = P;
+        s.lambda = lambda;
         s.limits.u_min = u_min;
         s.limits.u_max = u_max;
         s.constrained = constrained;
-        BuiltController b = MakeController(model, Ts, s);
+        BuiltController b = MakeController(model, Ts, ToControllerSpec(s));
         return std::move(b.controller);
       },
       "model"_a, "Ts"_a, "type"_a = "dmc", "rule"_a = "shridhar-cooper", "M"_a = 0, "P"_a = 0,

@@ -15,6 +15,19 @@ def test_tune_paper_fopdt_reproduces_p_and_lambda():
     assert (m["P"], m["M"], m["lambda"]) == (126, 10, pytest.approx(1.92))
 
 
+def test_results_are_the_json_of_the_command_line():
+    # TuningResult::ToJson (pneumid tune --json), with the flat FOPDT keys kept
+    t = pneumid.tune(pneumid.paper_fopdt_model(), 0.01, "shridhar-cooper", M=5)
+    assert t["fopdt"]["method"] == "exact" and t["tau"] == t["fopdt"]["tau"]
+    assert t["lambda_source"] == "lambda_condition" and t["Ts"] == 0.01
+    # ClosedLoopMetrics::ToJson (pneumid control --json): steps, None when absent
+    c = pneumid.make_controller(pneumid.paper_fopdt_model(), 0.01, "dmc", "shridhar-cooper", M=5)
+    p = pneumid.make_plant("fopdt-paper", 0.01)
+    m = pneumid.simulate_closed_loop(c, p, "step:from=0,to=1,at=0", 1.0)["metrics"]
+    assert m["load_peak_deviation"] is None and len(m["steps"]) == 1
+    assert m["steps"][0]["to"] == 1.0
+
+
 def test_dmc_reference_closed_loop_on_linear_plant():
     g = pneumid.paper_fopdt_model()
     c = pneumid.make_controller(g, 0.01, "dmc", "explicit", M=5, P=126, lambda_=2.25)
