@@ -20,6 +20,16 @@ bool Changed(double a, double b) { return std::abs(a - b) > 1e-12 * (1.0 + std::
 
 // A metric that does not exist in the run (NaN) is null.
 nlohmann::json Number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+// The step-response keys StepMetrics and ClosedLoopMetrics share.
+template <typename M>
+void PutStepResponse(const M& m, nlohmann::ordered_json& j) {
+  j["rise_time"] = Number(m.rise_time);
+  j["overshoot_percent"] = Number(m.overshoot_percent);
+  j["settling_time"] = Number(m.settling_time);
+  j["steady_state_error"] = Number(m.steady_state_error);
+  j["first_move"] = Number(m.first_move);
+}
 }  // namespace
 
 nlohmann::ordered_json StepMetrics::ToJson() const {
@@ -27,21 +37,13 @@ nlohmann::ordered_json StepMetrics::ToJson() const {
   j["time"] = time;
   j["from"] = from;
   j["to"] = to;
-  j["rise_time"] = Number(rise_time);
-  j["overshoot_percent"] = Number(overshoot_percent);
-  j["settling_time"] = Number(settling_time);
-  j["steady_state_error"] = Number(steady_state_error);
-  j["first_move"] = Number(first_move);
+  PutStepResponse(*this, j);
   return j;
 }
 
 nlohmann::ordered_json ClosedLoopMetrics::ToJson() const {
   nlohmann::ordered_json j;
-  j["rise_time"] = Number(rise_time);
-  j["overshoot_percent"] = Number(overshoot_percent);
-  j["settling_time"] = Number(settling_time);
-  j["steady_state_error"] = Number(steady_state_error);
-  j["first_move"] = Number(first_move);
+  PutStepResponse(*this, j);
   j["iae"] = Number(iae);
   j["ise"] = Number(ise);
   j["itae"] = Number(itae);
