@@ -40,8 +40,8 @@ void Run(const BodeOptions& o) {
   } else if (o.points > 0) {
     // --points alone: that many frequencies over the automatic range.
     const Eigen::VectorXd automatic = Bode(g).omega;
-    omega = LogSpace(std::log10(automatic[0]), std::log10(automatic[automatic.size() - 1]),
-                     o.points);
+    omega =
+        LogSpace(std::log10(automatic[0]), std::log10(automatic[automatic.size() - 1]), o.points);
   }
   const BodeData b = Bode(g, omega);
   const Margins m = ComputeMargins(g);

@@ -30,8 +30,8 @@ struct ImpulseOptions {
 };
 
 struct ImpulseInfo {
-  double peak = 0.0;       ///< y at the largest |y|
-  double peak_time = 0.0;  ///< s
+  double peak = 0.0;                    ///< y at the largest |y|
+  double peak_time = 0.0;               ///< s
   double settling_time = std::nan("");  ///< last time |y| > threshold * |peak|
   double area = 0.0;  ///< integral of y over the horizon (discrete: sum of the samples)
 };
@@ -104,14 +104,7 @@ const Registrar reg(
     [](CLI::App& app) {
       auto o = std::make_shared<ImpulseOptions>();
       AddModelOptions(app, o->model);
-      app.add_option("--t-final", o->t_final,
-                     "Simulated horizon in s (default 0: about 7 slowest time constants)")
-          ->capture_default_str()
-          ->check(NonNegative());
-      app.add_option("--dt", o->dt,
-                     "Time step in s (default 0: Ts, or 1/200 of the slowest time constant)")
-          ->capture_default_str()
-          ->check(NonNegative());
+      AddTimeGridOptions(app, o->t_final, o->dt);
       app.add_option("--settling-threshold", o->settling_threshold,
                      "Settling band as a fraction of the peak")
           ->capture_default_str()

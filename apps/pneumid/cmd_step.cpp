@@ -16,7 +16,6 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/report/figures.hpp"
-#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -139,14 +138,7 @@ const Registrar reg(
     [](CLI::App& app) {
       auto o = std::make_shared<StepOptions>();
       AddModelOptions(app, o->model);
-      app.add_option("--t-final", o->t_final,
-                     "Simulated horizon in s (default 0: about 7 slowest time constants)")
-          ->capture_default_str()
-          ->check(NonNegative());
-      app.add_option("--dt", o->dt,
-                     "Time step in s (default 0: Ts, or 1/200 of the slowest time constant)")
-          ->capture_default_str()
-          ->check(NonNegative());
+      AddTimeGridOptions(app, o->t_final, o->dt);
       app.add_option("--settling-threshold", o->settling_threshold,
                      "Settling band as a fraction of the step")
           ->capture_default_str();

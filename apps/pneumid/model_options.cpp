@@ -11,6 +11,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/spec.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 
@@ -29,6 +30,17 @@ void AddModelOptions(CLI::App& app, ModelOptions& options, bool with_ts) {
   }
   app.add_option("--delay", options.delay,
                  "Input delay in s (overrides the model's; a multiple of Ts if discrete)");
+}
+
+void AddTimeGridOptions(CLI::App& app, double& t_final, double& dt) {
+  app.add_option("--t-final", t_final,
+                 "Simulated horizon in s (default 0: about 7 slowest time constants)")
+      ->capture_default_str()
+      ->check(NonNegative());
+  app.add_option("--dt", dt,
+                 "Time step in s (default 0: Ts, or 1/200 of the slowest time constant)")
+      ->capture_default_str()
+      ->check(NonNegative());
 }
 
 std::vector<double> ParseCoefficientList(const std::string& option, const std::string& text) {

@@ -34,6 +34,10 @@ struct ModelOptions {
 /// sample time) and copies it into options.Ts when it describes the model.
 void AddModelOptions(CLI::App& app, ModelOptions& options, bool with_ts = true);
 
+/// Adds --t-final T and --dt DT (s, >= 0; 0 = automatic) of a simulated time
+/// response (lti/response.hpp: Step, Impulse), storing into the arguments.
+void AddTimeGridOptions(CLI::App& app, double& t_final, double& dt);
+
 /// Parses "1,-0.5,2" into numbers.
 /// @throws InvalidArgument naming `option` and the offending entry.
 std::vector<double> ParseCoefficientList(const std::string& option, const std::string& text);

@@ -5,10 +5,10 @@
 #include <iostream>
 
 #include "command.hpp"
-#include "validators.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/realtime/io_backend.hpp"
 #include "pneumid/realtime/safety.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 

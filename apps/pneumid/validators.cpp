@@ -37,7 +37,8 @@ CLI::Validator InRange(double lo, double hi) {
   return CLI::Validator(
       [lo, hi](std::string& text) -> std::string {
         const double v = Number(text);
-        return v >= lo && v <= hi ? "" : fmt::format("must be in [{:g}, {:g}], got {}", lo, hi, text);
+        return v >= lo && v <= hi ? ""
+                                  : fmt::format("must be in [{:g}, {:g}], got {}", lo, hi, text);
       },
       fmt::format("{:g}..{:g}", lo, hi));
 }

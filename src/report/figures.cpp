@@ -339,8 +339,8 @@ Figure ClosedLoopFigure(const Eigen::VectorXd& t, const Eigen::VectorXd& setpoin
         hi = std::max(hi, s.y.maxCoeff());
       }
       Curve& d = ax->AddLine(Eigen::Vector2d(options.disturbance_time, options.disturbance_time),
-                              Eigen::Vector2d(lo, hi), ax == &out ? "load disturbance" : "",
-                              LineStyle::kDotted);
+                             Eigen::Vector2d(lo, hi), ax == &out ? "load disturbance" : "",
+                             LineStyle::kDotted);
       d.color = Color{120, 120, 120};
       d.width = 1.2;
     }

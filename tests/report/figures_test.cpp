@@ -137,6 +137,27 @@ TEST(FiguresTest, AllFiguresRenderToPngAndSvg) {
   EXPECT_THAT(bode.ToSvg(), HasSubstr("Phase [deg]"));
 }
 
+// Impulse response of the paper's FOPDT, K/tau exp(-(t - theta)/tau) for
+// t > theta: the curve peaks at K/tau (within one sample of decay, dt = tau/200)
+// and the discrete ARX model is drawn as a staircase.
+TEST(FiguresTest, ImpulseResponseFigureDrawsEachModel) {
+  StepFigureOptions so;
+  so.t_final = 2.0;
+  so.title = "Impulse response";
+  const Figure fig =
+      ImpulseResponseFigure({{"FOPDT", PaperFopdtModel()}, {"ARX(3,3,1)", PaperArxModel()}}, so);
+  ASSERT_EQ(fig.axes(0).series.size(), 2u);
+  const Curve& fopdt = fig.axes(0).series[0];
+  EXPECT_NEAR(fopdt.y.maxCoeff() / (1.6 / 0.245), 1.0, 0.01);
+  EXPECT_GE(fopdt.x.maxCoeff(), 2.0);
+  EXPECT_FALSE(fopdt.stairs);
+  EXPECT_TRUE(fig.axes(0).series[1].stairs);
+  EXPECT_THAT(fig.ToSvg(), HasSubstr("Impulse response"));
+  EXPECT_THAT(
+      [] { ImpulseResponseFigure({}); },
+      ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("ImpulseResponseFigure: no models")));
+}
+
 TEST(FiguresTest, BodeOfDiscreteModelStopsAtNyquist) {
   const Figure bode = BodeFigure({{"ARX", PaperArxModel()}});
   const auto& x = bode.axes(0).series[0].x;
