@@ -1,11 +1,11 @@
 #include "pneumid/identify/identify.hpp"
 
 #include <algorithm>
-#include <sstream>
 
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/strings.hpp"
 #include "pneumid/identify/parametric.hpp"
 
 namespace pneumid {
@@ -31,11 +31,7 @@ std::vector<std::string> ParseMethodList(const std::string& list) {
   auto add = [&out](const std::string& m) {
     if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
   };
-  std::stringstream ss(list);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    item.erase(0, item.find_first_not_of(" \t"));
-    item.erase(item.find_last_not_of(" \t") + 1);
+  for (const std::string& item : Split(list, ',')) {
     if (item.empty()) continue;
     if (item == "all") {
       for (const std::string& m : IdentifyMethodNames()) add(m);
