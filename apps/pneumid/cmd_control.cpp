@@ -155,8 +155,8 @@ std::string ControllerLabel(const BuiltController& b) {
     return fmt::format("PID {} (Kc={:.3g}, Ti={:.3g} s, Td={:.3g} s)", ToString(b.pid_rule),
                        b.pid_gains.Kc, b.pid_gains.Ti, b.pid_gains.Td);
   }
-  return fmt::format("{} {} (P={}, M={}, lambda={:.3g})", TypeName(b.type),
-                     ToString(b.tuning.rule), b.tuning.P, b.tuning.M, b.tuning.lambda);
+  return fmt::format("{} {} (P={}, M={}, lambda={:.3g})", TypeName(b.type), ToString(b.tuning.rule),
+                     b.tuning.P, b.tuning.M, b.tuning.lambda);
 }
 
 // Output and input (units of the plant: force N or position m and duty % for
