@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -11,19 +12,23 @@
 namespace pneumid {
 
 namespace {
-// Generic names first; the IPA's names (IpaActuator) are accepted aliases.
 constexpr EnumName<SafeState> kSafeStateNames[] = {
     {SafeState::kHold, "hold"},
     {SafeState::kRelease, "release"},
-    {SafeState::kHold, "valves-closed"},
-    {SafeState::kRelease, "exhaust-open"},
 };
 }  // namespace
 
 const char* ToString(SafeState v) { return EnumToString(kSafeStateNames, v).data(); }
 
 SafeState SafeStateFromString(const std::string& name) {
-  return EnumFromString(kSafeStateNames, name, "safe state");
+  // The IPA's own names are accepted too: configurations and scripts for the rig use them.
+  const Actuator ipa = IpaActuator();
+  if (name == ipa.hold_name) return SafeState::kHold;
+  if (name == ipa.release_name) return SafeState::kRelease;
+  if (const std::optional<SafeState> s = EnumLookup(kSafeStateNames, name)) return *s;
+  throw InvalidArgument(fmt::format("unknown safe state '{}' (valid: {}; the IPA's {}, {})",
+                                    name.substr(0, 64), EnumNameList(kSafeStateNames),
+                                    ipa.hold_name, ipa.release_name));
 }
 
 const std::string& SafeStateName(const Actuator& actuator, SafeState s) {

@@ -104,7 +104,7 @@ TEST(SafetyEnums, GenericSafeStatesNamedByTheActuator) {
   EXPECT_EQ(SafeStateFromString("release"), SafeState::kRelease);
   EXPECT_THAT([] { SafeStateFromString("vent"); },
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr(
-                  "valid: hold, release, valves-closed, exhaust-open")));
+                  "valid: hold, release; the IPA's valves-closed, exhaust-open")));
   const Actuator ipa = IpaActuator();
   EXPECT_EQ(SafeStateName(ipa, SafeState::kHold), "valves-closed");
   EXPECT_EQ(SafeStateName(ipa, SafeState::kRelease), "exhaust-open");
