@@ -51,7 +51,7 @@ CLI::Validator AtLeast(long long min) {
                    ? ""
                    : fmt::format("must be an integer >= {}, got {}", min, text);
       },
-      fmt::format("INT>={}", min));
+      fmt::format(">={}", min));
 }
 
 }  // namespace pneumid::cli

@@ -137,3 +137,20 @@ check_help() {
 
 # data_rows FILE: the number of data rows of a CSV (no comments, no header).
 data_rows() { grep -v '^#' "$1" | tail -n +2 | wc -l; }
+
+# write_arx_prbs_data FILE SEED: 3000 samples (Ts = 0.01 s) of the paper's
+# ARX(3,3,1) force model (Eq. 5) driven by a PRBS between 10 and 90 % held for
+# 3 samples, with ARX noise e ~ N(0, 0.3^2) through 1/A; columns t,u,y.
+write_arx_prbs_data() {
+  "$PY" - "$1" "$2" <<'PYEOF'
+import sys
+import numpy as np
+from scipy.signal import lfilter
+rng = np.random.default_rng(int(sys.argv[2]))
+n = 3000
+u = np.repeat(np.where(rng.random(n // 3) > 0.5, 90.0, 10.0), 3)
+a = [1, -0.6087, -0.2702, -0.06021]
+y = lfilter([0, 0.03938, 0.04506, 0.01286], a, u) + lfilter([1], a, rng.normal(0, 0.3, n))
+np.savetxt(sys.argv[1], np.c_[np.arange(n) * 0.01, u, y], delimiter=",", header="t,u,y", comments="")
+PYEOF
+}

@@ -5,17 +5,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 set -eo pipefail
 pneumid=$PNEUMID
 dir=$TMP
-"$PY" - "$dir/prbs.csv" <<'PY'
-import sys
-import numpy as np
-from scipy.signal import lfilter
-rng = np.random.default_rng(1)
-n = 3000
-u = np.repeat(np.where(rng.random(n // 3) > 0.5, 90.0, 10.0), 3)
-a = [1, -0.6087, -0.2702, -0.06021]
-y = lfilter([0, 0.03938, 0.04506, 0.01286], a, u) + lfilter([1], a, rng.normal(0, 0.3, n))
-np.savetxt(sys.argv[1], np.c_[np.arange(n) * 0.01, u, y], delimiter=",", header="t,u,y", comments="")
-PY
+write_arx_prbs_data "$dir/prbs.csv" 1
 
 "$pneumid" orders --help | grep -q -- "--na-range" || fail "--help lacks --na-range"
 out="$("$pneumid" orders "$dir/prbs.csv" --na-range 1:4 --nb-range 1:4 --nk-range 0:2)"
