@@ -251,14 +251,27 @@ void ScanMatV4(const std::string& path, std::string_view bytes) {
     }
     std::int32_t h[5];
     std::memcpy(h, rest.data(), sizeof(h));
-    auto valid = [](const std::int32_t* v) {
-      return v[0] >= 0 && v[0] < 5000 && (v[0] / 100) % 10 == 0 && (v[0] / 10) % 10 <= 5 &&
-             v[0] % 10 <= 2 && v[1] >= 0 && v[2] >= 0 && (v[3] == 0 || v[3] == 1) && v[4] >= 0;
+    // The type MOPT decides the byte order, as in matio; the other fields must
+    // then be sane, or matio would allocate what they claim.
+    auto valid_type = [](std::int32_t t) {
+      return t >= 0 && t <= 4052 && (t / 100) % 10 == 0 && (t / 10) % 10 <= 5 && t % 10 <= 2;
     };
-    if (!valid(h)) {
+    if (!valid_type(h[0])) {
       for (auto& v : h)
         v = static_cast<std::int32_t>(__builtin_bswap32(static_cast<std::uint32_t>(v)));
-      if (!valid(h)) return;  // not v4: matio decides
+    }
+    if (!valid_type(h[0])) {
+      if (index == 1) return;  // not v4: matio decides
+      throw DataError(
+          fmt::format("{}: variable {} at offset {}: invalid header (type {}): the "
+                      "file is corrupt",
+                      path, index, offset, h[0]));
+    }
+    if (h[1] < 0 || h[2] < 0 || (h[3] != 0 && h[3] != 1) || h[4] < 0) {
+      throw DataError(
+          fmt::format("{}: variable {} at offset {}: invalid header (rows {}, columns "
+                      "{}, imaginary flag {}, name length {}): the file is corrupt",
+                      path, index, offset, h[1], h[2], h[3], h[4]));
     }
     static constexpr double kPrecisionBytes[] = {8, 4, 4, 2, 2, 1};
     const double data = static_cast<double>(h[1]) * static_cast<double>(h[2]) *

@@ -289,6 +289,14 @@ TEST_F(BadInputTest, MatV4VariableLargerThanTheFileIsRejected) {
   EXPECT_THAT([&] { ReadMat(path, o); },
               ThrowsMessage<DataError>(AllOf(HasSubstr("variable 1 ('t') claims 1000000000x1"),
                                              HasSubstr("truncated or corrupt"))));
+  // A second variable whose header is garbage (found by mat_fuzz: matio
+  // allocated the name length it claims).
+  std::string garbage = v4(3, {0, 1, 2});
+  for (std::uint32_t h : {0u, 5u, 0x147b0000u, 0x7ae147aeu, 0x147b3f84u}) PutU32(&garbage, h);
+  const std::string bad = Write("bad4.mat", garbage + std::string(64, '\0'));
+  EXPECT_THAT([&] { ReadMat(bad, o); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("variable 2 at offset 46: invalid header"),
+                                             HasSubstr("imaginary flag 2061584302"))));
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
 }
 
