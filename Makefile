@@ -6,7 +6,7 @@ CMAKE_FLAGS ?=
 # Lets ccache reuse objects across checkouts in different folders.
 export CCACHE_BASEDIR := $(CURDIR)
 
-.PHONY: all build demo test setup bench format clean sanitize-test
+.PHONY: all build demo test setup bench format clean sanitize-test fuzz
 
 all: build
 
@@ -38,8 +38,12 @@ sanitize-test: setup
 	  LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
 	  ctest --output-on-failure -j$(JOBS) -L unit
 
+# libFuzzer targets of the parsers (clang), each run FUZZ_SECONDS (default 30).
+fuzz: setup
+	JOBS=$(JOBS) bash tests/fuzz/run.sh
+
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')
 
 clean:
-	rm -rf $(BUILD) build-asan
+	rm -rf $(BUILD) build-asan build-fuzz
