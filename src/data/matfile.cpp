@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -114,6 +115,7 @@ std::string ClassName(matio_classes c) {
 /// Description of one variable of the file.
 struct VarInfo {
   std::string name;
+  std::string label;  ///< the name as quoted in messages (a short excerpt)
   matio_classes class_type = MAT_C_EMPTY;
   bool complex = false;
   std::vector<std::size_t> dims;
@@ -168,6 +170,7 @@ class MatReader {
       if (!v) break;
       VarInfo info;
       info.name = v->name == nullptr ? "" : v->name;
+      info.label = Excerpt(info.name);
       info.class_type = v->class_type;
       info.complex = v->isComplex != 0;
       for (int d = 0; d < v->rank; ++d) info.dims.push_back(v->dims[d]);
@@ -207,10 +210,10 @@ class MatReader {
       throw DataError(fmt::format(
           "{}: {} column index '{}' needs a file with exactly one numeric matrix variable, this "
           "one has {}; select 'name:{}' instead (variables: {})",
-          path_, role, spec, numeric.size(), index, ListVariables()));
+          path_, role, Excerpt(spec), numeric.size(), index, ListVariables()));
     }
     throw DataError(fmt::format("{}: unknown {} variable '{}'; available variables: {}", path_,
-                                role, spec, ListVariables()));
+                                role, Excerpt(spec), ListVariables()));
   }
 
   const std::string& path() const { return path_; }
@@ -226,11 +229,13 @@ class MatReader {
   std::string ListVariables() const {
     if (vars_.empty()) return "(none)";
     std::string out;
-    for (std::size_t i = 0; i < vars_.size(); ++i) {
+    const std::size_t shown = std::min(vars_.size(), internal::kMaxListedColumns);
+    for (std::size_t i = 0; i < shown; ++i) {
       const auto& v = vars_[i];
-      out += fmt::format("{}'{}' ({} {}{})", i ? ", " : "", v.name, v.shape(),
+      out += fmt::format("{}'{}' ({} {}{})", i ? ", " : "", v.label, v.shape(),
                          v.complex ? "complex " : "", ClassName(v.class_type));
     }
+    if (shown < vars_.size()) out += fmt::format(", ... ({} variables in all)", vars_.size());
     return out;
   }
 
@@ -241,7 +246,7 @@ class MatReader {
       throw DataError(
           fmt::format("{}: variable '{}': {} column {} out of range: it is {} ({} "
                       "columns)",
-                      path_, v.name, role, index, v.shape(), m.cols()));
+                      path_, v.label, role, index, v.shape(), m.cols()));
     }
     cols->push_back(m.col(static_cast<Eigen::Index>(index)));
     channels->push_back({fmt::format("{}:{}", v.name, index), ""});
@@ -252,14 +257,14 @@ class MatReader {
     if (it != cache_.end()) return it->second;
     if (!IsNumericClass(v.class_type) || v.complex) {
       throw DataError(fmt::format("{}: variable '{}' ({}): {} data must be a real numeric array",
-                                  path_, v.name,
+                                  path_, v.label,
                                   (v.complex ? "complex " : "") + ClassName(v.class_type), role));
     }
     if (v.dims.size() != 2) {
       throw DataError(
           fmt::format("{}: variable '{}' is {}-dimensional ({}); expected a vector or "
                       "an N x k matrix",
-                      path_, v.name, v.dims.size(), v.shape()));
+                      path_, v.label, v.dims.size(), v.shape()));
     }
     // A corrupt header can claim any size; zlib expands at most ~1032:1, so a
     // variable cannot hold more than about 1100 bytes per byte of file.
@@ -269,14 +274,14 @@ class MatReader {
       throw DataError(
           fmt::format("{}: variable '{}' claims {} elements ({}), more than the file "
                       "can hold: the file is corrupt",
-                      path_, v.name, v.shape(), ClassName(v.class_type)));
+                      path_, v.label, v.shape(), ClassName(v.class_type)));
     }
     Mat_Rewind(mat_.get());
     g_matio_message.clear();
     VarPtr var(Mat_VarRead(mat_.get(), v.name.c_str()));
     if (!var || var->data == nullptr) {
       throw DataError(
-          fmt::format("{}: variable '{}': cannot read its data{}", path_, v.name, MatioDetail()));
+          fmt::format("{}: variable '{}': cannot read its data{}", path_, v.label, MatioDetail()));
     }
     const std::size_t rows = var->dims[0];
     const std::size_t cols = var->dims[1];
@@ -314,14 +319,14 @@ class MatReader {
         CopyAs<std::uint64_t>(var->data, n, m);
         break;
       default:
-        throw DataError(fmt::format("{}: variable '{}': unsupported class", path_, v.name));
+        throw DataError(fmt::format("{}: variable '{}': unsupported class", path_, v.label));
     }
     if (rows == 1) m.transposeInPlace();  // a row vector is one channel
     for (Eigen::Index c = 0; c < m.cols(); ++c) {
       for (Eigen::Index r = 0; r < m.rows(); ++r) {
         if (!std::isfinite(m(r, c))) {
           throw DataError(fmt::format(
-              "{}: variable '{}' element ({}, {}) (sample {}, column {}): {} value", path_, v.name,
+              "{}: variable '{}' element ({}, {}) (sample {}, column {}): {} value", path_, v.label,
               r + 1, c + 1, r, c, std::isnan(m(r, c)) ? "NaN" : "infinite"));
         }
       }

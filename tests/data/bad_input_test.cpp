@@ -270,6 +270,40 @@ TEST_F(BadInputTest, MatVariableClaimingHugeDimensionsIsRejectedQuickly) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
 }
 
+TEST_F(BadInputTest, MatVariableListIsCappedAndLongNamesAreExcerpts) {
+  std::string file = MatHeader();
+  for (int i = 0; i < 30; ++i) file += DoubleMatrix(fmt::format("v{}", i), 1, 1, {1.0});
+  file += DoubleMatrix(std::string(300, 'n'), 1, 1, {1.0});
+  const std::string path = Write("many.mat", file);
+  const std::string m = Message([&] { ReadMat(path); });
+  EXPECT_THAT(
+      m,
+      AllOf(HasSubstr("unknown time variable 't'; available variables: 'v0' (1x1 double)"),
+            HasSubstr("'v19' (1x1 double), ... (31 variables in all)"), Not(HasSubstr("'v20'"))));
+  MatReadOptions o;
+  o.sample_time = 0.01;
+  o.input_variables = {};
+  o.output_variables = {"0"};
+  EXPECT_THAT(
+      [&] { ReadMat(path, o); },
+      ThrowsMessage<DataError>(HasSubstr("exactly one numeric matrix variable, this one has 31")));
+  // Reading a variable with a 300-character name quotes it as an excerpt.
+  std::string cell_flags;
+  PutU32(&cell_flags, 1);  // mxCELL_CLASS: not numeric
+  PutU32(&cell_flags, 0);
+  std::string dims;
+  PutU32(&dims, 1);
+  PutU32(&dims, 1);
+  const std::string name(300, 'c');
+  const std::string cell = Element(14, Element(6, cell_flags) + Element(5, dims) +
+                                           Element(1, name) + DoubleMatrix("", 1, 1, {1}));
+  const std::string cpath = Write("cell.mat", MatHeader() + cell);
+  o.output_variables = {name};
+  EXPECT_THAT([&] { ReadMat(cpath, o); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("... (300 bytes)' (cell)"),
+                                             Not(HasSubstr(std::string(41, 'c'))))));
+}
+
 TEST_F(BadInputTest, MatV4VariableLargerThanTheFileIsRejected) {
   // Level-4 header: type 0 (little-endian double), rows, columns, real, name length.
   auto v4 = [](std::uint32_t rows, const std::vector<double>& values) {
