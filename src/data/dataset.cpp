@@ -158,14 +158,14 @@ void Dataset::RequireNumericScale() const {
     const double lo = v.minCoeff();
     const double hi = v.maxCoeff();
     const double magnitude = std::max(std::abs(lo), std::abs(hi));
-    const std::string column = fmt::format("{}: {} column '{}'", SourcePrefix(source_), kind,
-                                           Excerpt(channel.name));
+    const std::string column =
+        fmt::format("{}: {} column '{}'", SourcePrefix(source_), kind, Excerpt(channel.name));
     if (magnitude > kMaxMagnitude) {
-      throw DataError(fmt::format(
-          "{}: values range from {:g} to {:g}; magnitudes above {:g} overflow in the "
-          "computations (differences and squares exceed the double range): rescale the "
-          "column (e.g. change its unit)",
-          column, lo, hi, kMaxMagnitude));
+      throw DataError(
+          fmt::format("{}: values range from {:g} to {:g}; magnitudes above {:g} overflow in the "
+                      "computations (differences and squares exceed the double range): rescale the "
+                      "column (e.g. change its unit)",
+                      column, lo, hi, kMaxMagnitude));
     }
     const double spread = hi - lo;
     if (spread > 0 && spread < kMinSpread) {

@@ -118,7 +118,6 @@ StepAnalysis AnalyzeStep(const Dataset& data, int input, int output,
                 "output column {} out of range (the data has {} outputs)", output,
                 data.num_outputs());
   data.RequireNumericScale();
-  data.RequireNumericScale();
   const std::string src = SourceName(data);
   const Eigen::Index n = data.size();
   if (n < 2 * options.min_tail_samples + 2) {

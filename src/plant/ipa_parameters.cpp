@@ -122,8 +122,9 @@ IpaParameters LoadIpaParameters(const std::string& path) {
               fmt::format("{}: key '{}': expected an integer", Where(path, node), full));
         const std::int64_t v = node.as_integer()->get();
         if (!std::in_range<int>(v))
-          throw DataError(fmt::format("{}: key '{}': {} is out of range for an integer (at most {})",
-                                      Where(path, node), full, v, std::numeric_limits<int>::max()));
+          throw DataError(
+              fmt::format("{}: key '{}': {} is out of range for an integer (at most {})",
+                          Where(path, node), full, v, std::numeric_limits<int>::max()));
         p.*(k.field) = static_cast<int>(v);
       }
       if (full == "simulation.mode" || full == "simulation.pwm_mode") {
