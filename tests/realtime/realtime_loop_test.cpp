@@ -204,7 +204,10 @@ class FaultInjection : public ::testing::TestWithParam<FaultCase> {};
 
 TEST_P(FaultInjection, EndsInSafeStateWithCompleteLog) {
   const FaultCase c = GetParam();
-  const std::string path = TempPath(std::string("fault_") + ToString(c.expected) + ".csv");
+  // One file per case: two cases expect the same fault and ctest runs them side by side.
+  std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  name = name.substr(name.rfind('/') + 1);  // "EndsInSafeStateWithCompleteLog/io_error_write"
+  const std::string path = TempPath("fault_" + name + ".csv");
   FaultyBackend io(0.01, c.injected, 40);
   CountingPi pi(0.8, 4.0, 0.01);
   SafetyOptions so;
