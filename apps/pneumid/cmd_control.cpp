@@ -27,6 +27,7 @@
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/report/figures.hpp"
@@ -190,9 +191,20 @@ void Execute(const ControlCli& c) {
   cl.noise_std = c.noise;
   cl.seed = c.seed;
   for (const std::string& l : c.load_steps) cl.load_steps.push_back(ParseLoadStep(l));
-  cl.actuator.u_min = c.controller.limits.u_min;
-  cl.actuator.u_max = c.controller.limits.u_max;
-  const ControllerSpec base = ToControllerSpec(c.controller);
+  PlantOptions po;
+  po.seed = c.seed;
+  const std::string plant_spec = c.plant.empty() ? c.model : c.plant;
+  // The plant's physical input range (IPA: duty 0..100 %) unless --u-min/--u-max say otherwise.
+  ControllerSettings settings = c.controller;
+  const Actuator actuator = PlantActuator(*MakePlant(plant_spec, c.Ts, po));
+  if (!std::isfinite(settings.limits.u_min)) settings.limits.u_min = actuator.u_min;
+  if (!std::isfinite(settings.limits.u_max)) settings.limits.u_max = actuator.u_max;
+  PNEUMID_CHECK(settings.limits.u_min <= settings.limits.u_max,
+                "--u-min {} is above --u-max {} (the plant's input range is {} .. {})",
+                settings.limits.u_min, settings.limits.u_max, actuator.u_min, actuator.u_max);
+  cl.actuator.u_min = settings.limits.u_min;
+  cl.actuator.u_max = settings.limits.u_max;
+  const ControllerSpec base = ToControllerSpec(settings);
 
   // --compare: the same controller with each rule's own settings.
   std::vector<ControllerSpec> specs;
@@ -211,9 +223,6 @@ void Execute(const ControlCli& c) {
     specs.push_back(base);
   }
 
-  PlantOptions po;
-  po.seed = c.seed;
-  const std::string plant_spec = c.plant.empty() ? c.model : c.plant;
   std::vector<Run> runs;
   for (const ControllerSpec& spec : specs) {
     Run run;
@@ -260,8 +269,8 @@ const Registrar reg(
       app.add_option("--duration", c->duration, "Simulated time in s")
           ->required()
           ->check(Positive());
-      app.add_option("--u-min", c->controller.limits.u_min, "Lower input limit (e.g. 0 % duty)");
-      app.add_option("--u-max", c->controller.limits.u_max, "Upper input limit (e.g. 100 % duty)");
+      app.add_option("--u-min", c->controller.limits.u_min, "Lower input limit (default: the plant's input range, IPA 0 % duty)");
+      app.add_option("--u-max", c->controller.limits.u_max, "Upper input limit (default: the plant's input range, IPA 100 % duty)");
       app.add_option("--du-max", c->controller.limits.du_max, "Largest input change per sample");
       app.add_option("--y-min", c->controller.y_min, "Soft lower output bound (with --constrained)");
       app.add_option("--y-max", c->controller.y_max, "Soft upper output bound (with --constrained)");

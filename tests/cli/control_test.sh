@@ -56,6 +56,19 @@ assert abs(j["steady_state_error"]) < 2.0, j["steady_state_error"]
 assert j["load_peak_deviation"] < -5, j["load_peak_deviation"]
 ' || fail "ipa metrics: $out"
 
+# The plant's input range applies by default: the IPA's duty stays within 0..100 %
+# without --u-min/--u-max (unclamped, this loop asks for 213 %).
+"$PNEUMID" control --controller dmc --model fopdt-paper --plant ipa --rule shridhar-cooper --Ts 0.01 \
+  --setpoint step:from=20,to=100,at=0.5 --duration 4 --json | $PY -c '
+import json, sys
+j = json.load(sys.stdin)
+assert j["u_min"] >= 0 and j["u_max"] <= 100, (j["u_min"], j["u_max"])
+assert j["u_max"] > 99, j["u_max"]
+' || fail "ipa default input range"
+expect_error "u-min above the plant range" "above --u-max 100" \
+  control --controller dmc --model fopdt-paper --plant ipa --Ts 0.01 --u-min 150 \
+  --setpoint step:from=0,to=50,at=0.1 --duration 1
+
 # Errors.
 err=$("$PNEUMID" control --controller mpc --model fopdt-paper --Ts 0.01 --setpoint step:from=0,to=1,at=0 \
       --duration 1 2>&1 >/dev/null) && fail "unknown controller accepted"
