@@ -303,7 +303,12 @@ void ScanMatFile(const std::string& path, std::string_view bytes) {
   std::uint16_t version = 0;
   std::memcpy(&version, bytes.data() + 124, 2);
   if (swap) version = __builtin_bswap16(version);
-  if (version != 0x0100) return;  // v7.3 (HDF5) or unknown: matio decides
+  if (version == 0x0200) return;  // v7.3 (HDF5): the HDF5 library checks its own sizes
+  if (version != 0x0100) {
+    // matio reads a header with another version as v4: check it as v4 too.
+    ScanMatV4(path, bytes);
+    return;
+  }
   Scanner(path, swap).ScanFile(bytes);
 }
 
