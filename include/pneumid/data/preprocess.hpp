@@ -1,5 +1,6 @@
 // Preprocessing of measured data before identification: offsets, trends, step
-// detection, resampling, decimation, time windows.
+// detection, resampling, decimation, time windows, zero-phase filtering, and a
+// pipeline (Preprocess) whose record re-applies the same steps to other data.
 //
 // Every function returns a new Dataset with the same channels and source();
 // the map from samples to file lines is kept only where samples keep their
@@ -18,7 +19,9 @@
 #pragma once
 
 #include <limits>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -140,5 +143,165 @@ Dataset Decimate(const Dataset& data, int factor, const DecimateOptions& options
 /// @throws InvalidArgument when t_start > t_end.
 /// @throws DataError naming the source when no sample lies in the window.
 Dataset SelectWindow(const Dataset& data, double t_start, double t_end);
+
+/// Kind of a zero-phase Butterworth filter (Filter, FilterSpec).
+enum class FilterKind { kLowpass, kBandpass };
+std::string ToString(FilterKind k);  ///< "lowpass", "bandpass"
+/// Parses "lowpass" or "bandpass"; @throws InvalidArgument otherwise.
+FilterKind FilterKindFromString(const std::string& s);
+
+/// A zero-phase Butterworth filter, written "lowpass:F" or "bandpass:F1,F2"
+/// (frequencies in Hz), optionally followed by ",order=N":
+///   lowpass:10            low-pass, cutoff 10 Hz, order 5
+///   bandpass:0.5,20       band-pass, pass band 0.5..20 Hz, order 5
+///   lowpass:10,order=2
+/// The default order 5 is that of MATLAB's idfilt. A band-pass of order N has
+/// 2N poles (as scipy.signal.butter(N, [w1, w2], 'bandpass')). Run forward
+/// and backward (Filter), the magnitude response is |H|^2: -6 dB at the
+/// cutoffs, slope 2 * 20 N dB/decade, no phase shift.
+struct FilterSpec {
+  static constexpr int kDefaultOrder = 5;
+
+  FilterKind kind = FilterKind::kLowpass;
+  /// Band-pass: lower edge F1 in Hz, 0 < F1 < F2. Unused for a low-pass.
+  double low_hz = 0.0;
+  /// Low-pass: cutoff F in Hz (> 0). Band-pass: upper edge F2 in Hz.
+  double high_hz = 0.0;
+  /// Butterworth order, 1..10.
+  int order = kDefaultOrder;
+
+  /// True when the frequencies and the order are usable (independent of the
+  /// data; Filter also checks them against the data's Nyquist frequency).
+  bool IsValid(std::string* error) const;
+  /// "lowpass:10" / "bandpass:0.5,20", with ",order=N" when not the default;
+  /// Parse(ToString()) gives the same spec.
+  std::string ToString() const;
+  /// Parses the syntax above.
+  /// @throws InvalidArgument with a message starting "filter 'TEXT': ", e.g.
+  ///         "filter 'bandpass:20,5': need F1 < F2, got F1 = 20 Hz, F2 = 5 Hz".
+  static FilterSpec Parse(const std::string& text);
+};
+
+/// Filters the selected channels with the zero-phase Butterworth filter of
+/// `spec`: the digital filter of butter(order, f / (fs / 2)) [2] run forward
+/// and backward with odd extension of 3 * (2 * sections + 1) samples at each
+/// end (fewer for a low-pass of odd order, whose first-order section has no
+/// z^-2 term) and steady-state initial conditions [3]; identical to
+/// scipy.signal.sosfiltfilt(butter(order, Wn, btype, output='sos'), x). The
+/// samples keep their times and file lines.
+/// @throws InvalidArgument when spec is invalid.
+/// @throws DataError when the sampling is not uniform, a frequency is not below
+///         the Nyquist frequency of the data ("filter cutoff 60 Hz is above the
+///         Nyquist frequency 50 Hz of data.csv"), or the data is not longer
+///         than the edge padding.
+Dataset Filter(const Dataset& data, const FilterSpec& spec, ChannelSet which = ChannelSet::kBoth);
+
+/// A time window [start, end] in seconds, written "T0:T1"; either side may be
+/// left empty ("5:" from 5 s to the end, ":9" up to 9 s).
+struct TimeWindow {
+  double start = -std::numeric_limits<double>::infinity();
+  double end = std::numeric_limits<double>::infinity();
+
+  /// True when at least one side is bounded.
+  bool IsSet() const;
+  bool IsValid(std::string* error) const;  ///< start <= end, neither NaN
+  std::string ToString() const;            ///< "5:9", "5:", ":9"
+  /// @throws InvalidArgument "window '9:5': start 9 s is after end 5 s" and the like.
+  static TimeWindow Parse(const std::string& text);
+};
+
+/// How Preprocess removes offsets or trends.
+enum class DetrendKind {
+  kNone,      ///< leave levels alone
+  kConstant,  ///< subtract the mean of each channel (numpy: x - x.mean())
+  kLinear,    ///< subtract the least-squares line (scipy.signal.detrend(x, 'linear'))
+};
+std::string ToString(DetrendKind k);  ///< "none", "constant", "linear"
+/// Parses "none", "constant" (alias "mean"), "linear"; @throws InvalidArgument.
+DetrendKind DetrendKindFromString(const std::string& s);
+
+/// Options of Preprocess. The steps run in this fixed order:
+///   1. window          keep the samples in [window.start, window.end]
+///   2. resample        linear interpolation onto a uniform grid of resample_ts
+///   3. offsets         remove_initial (level before the step, or of the first
+///                      initial_samples samples) or detrend (mean or line)
+///   4. filter          zero-phase Butterworth (FilterSpec)
+///   5. decimate        keep every decimate-th sample after an anti-alias filter
+/// Window first so that everything else sees only the selected part;
+/// resampling before anything that assumes uniform sampling; offsets from the
+/// unfiltered samples so that the operating point is in the units and levels
+/// of the raw data; decimation last, after the filter, at the rate the filter
+/// spec was written for.
+struct PreprocessOptions {
+  TimeWindow window;                ///< default: all samples
+  double resample_ts = 0.0;         ///< seconds; 0: keep the time base
+  bool remove_initial = false;      ///< subtract the initial steady state
+  /// With remove_initial: 0 averages the samples before the step found by
+  /// DetectStep(step); n > 0 averages the first n samples.
+  Eigen::Index initial_samples = 0;
+  StepDetectOptions step;           ///< step search for remove_initial
+  DetrendKind detrend = DetrendKind::kNone;  ///< not together with remove_initial
+  std::optional<FilterSpec> filter;  ///< none by default
+  int decimate = 1;                 ///< factor >= 1; 1: keep all samples
+  DecimateOptions decimate_options;
+  /// Channels the offsets, trends and the filter apply to.
+  ChannelSet channels = ChannelSet::kBoth;
+
+  /// False for a negative resample_ts, decimate < 1, remove_initial together
+  /// with detrend, invalid window, filter or step/decimate options.
+  bool IsValid(std::string* error) const;
+  /// True when no step would change the data.
+  bool IsIdentity() const;
+};
+
+/// What Preprocess did, enough to re-apply the same steps to other data
+/// (ApplyRecorded) and to restore the original levels of a model's simulated
+/// output: y_original(t) = y(t) + OutputOffsetAt(t).
+///
+/// The removed offset of channel i at time t is
+///   offset_i(t) = level_i + slope_i * (t - trend_time)
+/// with slope 0 for remove_initial and constant detrend.
+struct PreprocessRecord {
+  TimeWindow window;          ///< as applied (unbounded when none)
+  double resample_ts = 0.0;   ///< 0: not resampled
+  /// "none", "initial" (remove_initial) or ToString(DetrendKind).
+  std::string offsets = "none";
+  OperatingPoint level;       ///< level_i, one value per channel (0 where untouched)
+  OperatingPoint slope;       ///< slope_i per second (zero unless linear detrend)
+  double trend_time = 0.0;    ///< time origin of the slope, s (mean time of the data)
+  std::optional<FilterSpec> filter;
+  ChannelSet channels = ChannelSet::kBoth;
+  int decimate = 1;
+  DecimateOptions decimate_options;
+  /// One line per step applied, for reports and model notes, e.g.
+  /// "remove initial offset: mean of the 120 samples before the step at t = 1.2 s".
+  std::vector<std::string> steps;
+
+  /// Offsets removed from the inputs / outputs at time t (level + slope term).
+  Eigen::VectorXd InputOffsetAt(double t) const;
+  Eigen::VectorXd OutputOffsetAt(double t) const;
+  /// True when nothing was done.
+  bool IsIdentity() const;
+};
+
+/// Applies the steps of `options` in the order documented at PreprocessOptions
+/// and returns the result; *record (if not null) receives what was done.
+/// @throws InvalidArgument when options are invalid ("decimation factor must be
+///         >= 1, got 0").
+/// @throws DataError naming the source when a step does not fit the data: the
+///         window lies outside it ("window 5:9 s lies outside the data 0..4 s
+///         of data.csv"), a filter frequency is at or above its Nyquist
+///         frequency, no step is found for remove_initial, too few samples.
+Dataset Preprocess(const Dataset& data, const PreprocessOptions& options,
+                   PreprocessRecord* record = nullptr);
+
+/// Applies a recorded preprocessing to other data (validation data, data to
+/// simulate against): resampling, the recorded offsets and trends (not
+/// re-estimated from `data`), the filter and decimation. The window is not
+/// applied: it selected a part of the estimation data, whose times need not
+/// mean anything in `data`.
+/// @throws DataError as Preprocess, and when `data` has a different number of
+///         inputs or outputs than the record.
+Dataset ApplyRecorded(const Dataset& data, const PreprocessRecord& record);
 
 }  // namespace pneumid
