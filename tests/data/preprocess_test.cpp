@@ -8,6 +8,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/load.hpp"
+#include "pneumid/data/preprocess_io.hpp"
 
 namespace pneumid {
 namespace {
@@ -292,6 +293,320 @@ TEST(PreprocessTest, ExampleStepTestGivesThePapersStaticGain) {
   const Dataset r = RemoveInitialOffset(d, e);
   const double y_final = r.y().tail(100).mean();
   EXPECT_NEAR(y_final / e.size, 1.59796, 0.005 * 1.59796);
+}
+
+/// `d` with every input and output value raised by 5.
+Dataset Rebuild5(const Dataset& d) {
+  return Dataset(d.time(), d.inputs().array() + 5.0, d.outputs().array() + 5.0);
+}
+
+// Reference: tests/data/gen_filter.py writes preprocess_golden.csv, a recorded
+// signal pair (u, y) at 100 Hz and what numpy / scipy 1.10.1 make of it.
+Dataset Golden(const std::vector<std::string>& columns) {
+  CsvReadOptions o;
+  o.input_columns = {columns[0]};
+  o.output_columns = {columns[1]};
+  return ReadCsv(std::string(PNEUMID_SOURCE_DIR) + "/tests/data/preprocess_golden.csv", o);
+}
+
+Dataset GoldenInput() { return Golden({"u", "y"}); }
+
+/// Largest deviation of the channels of `got` from the golden columns `u_KEY`, `y_KEY`.
+double GoldenError(const Dataset& got, const std::string& key) {
+  const Dataset want = Golden({"u_" + key, "y_" + key});
+  EXPECT_EQ(got.size(), want.size());
+  if (got.size() != want.size()) return INFINITY;
+  return std::max((got.u() - want.u()).cwiseAbs().maxCoeff(),
+                  (got.y() - want.y()).cwiseAbs().maxCoeff());
+}
+
+TEST(PreprocessTest, RemoveMeansReproducesNumpy) {
+  // numpy: x - x.mean(), values of 40..140 to 1e-12.
+  const Dataset d = GoldenInput();
+  OperatingPoint op;
+  const Dataset r = RemoveMeans(d, ChannelSet::kBoth, &op);
+  EXPECT_LT(GoldenError(r, "mean"), 1e-12);
+  EXPECT_NEAR(op.u0[0], d.u().mean(), 1e-12);
+  EXPECT_EQ(r.source(), d.source());
+}
+
+TEST(PreprocessTest, DetrendReproducesScipyLinearDetrend) {
+  // scipy.signal.detrend(x, type='linear') to 1e-12; the removed line is
+  // level + slope (t - time), with the mean as level.
+  const Dataset d = GoldenInput();
+  LinearTrend trend;
+  const Dataset r = Detrend(d, ChannelSet::kBoth, &trend);
+  EXPECT_LT(GoldenError(r, "linear"), 1e-12);
+  EXPECT_NEAR(trend.time, d.time().mean(), 1e-15);
+  EXPECT_NEAR(trend.level.y0[0], d.y().mean(), 1e-12);
+  EXPECT_GT(trend.slope.y0[0], 3.0);  // the output drifts by 3.5 N/s plus the step
+  for (Eigen::Index i : {0, 123, 399}) {
+    const double line = trend.level.y0[0] + trend.slope.y0[0] * (d.time()[i] - trend.time);
+    EXPECT_NEAR(r.y()[i], d.y()[i] - line, 1e-12);
+  }
+}
+
+TEST(PreprocessTest, FilterMatchesScipySosfiltfilt) {
+  // sosfiltfilt(butter(N, Wn, btype, fs=100, output='sos'), x) to 1e-10.
+  const Dataset d = GoldenInput();
+  EXPECT_LT(GoldenError(Filter(d, FilterSpec::Parse("lowpass:10")), "lp10"), 1e-10);
+  EXPECT_LT(GoldenError(Filter(d, FilterSpec::Parse("lowpass:20,order=2")), "lp20o2"), 1e-10);
+  EXPECT_LT(GoldenError(Filter(d, FilterSpec::Parse("bandpass:2,15")), "bp2_15"), 1e-10);
+  EXPECT_LT(GoldenError(Filter(d, FilterSpec::Parse("bandpass:1,30,order=4")), "bp1_30o4"),
+            1e-10);
+}
+
+TEST(PreprocessTest, FilterSelectedChannelsKeepTimesAndLines) {
+  const Dataset d = GoldenInput();
+  const Dataset r = Filter(d, FilterSpec::Parse("lowpass:10"), ChannelSet::kOutputs);
+  EXPECT_EQ(r.u(), d.u());
+  EXPECT_EQ(r.time(), d.time());
+  EXPECT_EQ(r.SourceLine(0), d.SourceLine(0));
+  EXPECT_EQ(r.Where(5), d.Where(5));
+  // Zero phase and unit DC gain: a constant passes unchanged.
+  const Dataset c = Uniform(Eigen::VectorXd::Constant(200, 3.5), Eigen::VectorXd::Zero(200));
+  EXPECT_LT((Filter(c, FilterSpec::Parse("lowpass:5")).u().array() - 3.5).abs().maxCoeff(), 1e-12);
+  // A band-pass removes the constant.
+  EXPECT_LT(Filter(c, FilterSpec::Parse("bandpass:1,5")).u().cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(PreprocessTest, FilterSpecParsesAndPrints) {
+  const FilterSpec lp = FilterSpec::Parse("lowpass:10");
+  EXPECT_EQ(lp.kind, FilterKind::kLowpass);
+  EXPECT_EQ(lp.high_hz, 10.0);
+  EXPECT_EQ(lp.order, FilterSpec::kDefaultOrder);
+  EXPECT_EQ(lp.ToString(), "lowpass:10");
+  const FilterSpec bp = FilterSpec::Parse(" BandPass: 0.5 , 20 ,order=3");
+  EXPECT_EQ(bp.kind, FilterKind::kBandpass);
+  EXPECT_EQ(bp.low_hz, 0.5);
+  EXPECT_EQ(bp.high_hz, 20.0);
+  EXPECT_EQ(bp.order, 3);
+  EXPECT_EQ(bp.ToString(), "bandpass:0.5,20,order=3");
+  EXPECT_EQ(FilterSpec::Parse(bp.ToString()).ToString(), bp.ToString());
+  EXPECT_EQ(FilterKindFromString(ToString(FilterKind::kBandpass)), FilterKind::kBandpass);
+  auto fails = [](const std::string& text, const std::string& message) {
+    EXPECT_THAT([&] { FilterSpec::Parse(text); },
+                ThrowsMessage<InvalidArgument>(
+                    AllOf(HasSubstr("filter '" + text + "'"), HasSubstr(message))))
+        << text;
+  };
+  fails("10", "expected lowpass:F or bandpass:F1,F2");
+  fails("highpass:10", "unknown filter kind 'highpass'");
+  fails("lowpass:abc", "'abc' is not a frequency in Hz");
+  fails("lowpass:10,20", "one cutoff frequency F");
+  fails("bandpass:10", "two band edges F1,F2");
+  fails("bandpass:20,5", "need F1 < F2, got F1 = 20 Hz, F2 = 5 Hz");
+  fails("lowpass:-3", "cutoff must be > 0 Hz");
+  fails("lowpass:10,order=0", "order must be in [1, 10]");
+  fails("lowpass:10,order=2.5", "order must be an integer");
+  fails("lowpass:10,gain=2", "unknown key 'gain'");
+}
+
+TEST(PreprocessTest, FilterAboveNyquistNamesTheFile) {
+  Dataset d = Uniform(Eigen::VectorXd::Zero(100), Eigen::VectorXd::Zero(100));
+  d.set_source("data.csv");
+  EXPECT_THAT([&] { Filter(d, FilterSpec::Parse("lowpass:60")); },
+              ThrowsMessage<DataError>(HasSubstr(
+                  "filter cutoff 60 Hz is above the Nyquist frequency 50 Hz of data.csv")));
+  EXPECT_THAT([&] { Filter(d, FilterSpec::Parse("bandpass:10,50")); },
+              ThrowsMessage<DataError>(HasSubstr(
+                  "filter upper edge F2 = 50 Hz is at the Nyquist frequency 50 Hz of data.csv")));
+  const Dataset shortd = Uniform(Eigen::VectorXd::Zero(18), Eigen::VectorXd::Zero(18));
+  EXPECT_THAT([&] { Filter(shortd, FilterSpec::Parse("lowpass:10")); },
+              ThrowsMessage<DataError>(HasSubstr("needs more than 18 samples")));
+}
+
+TEST(PreprocessTest, TimeWindowParses) {
+  const TimeWindow w = TimeWindow::Parse("5:9");
+  EXPECT_EQ(w.start, 5.0);
+  EXPECT_EQ(w.end, 9.0);
+  EXPECT_EQ(w.ToString(), "5:9");
+  EXPECT_EQ(TimeWindow::Parse("2.5:").ToString(), "2.5:");
+  EXPECT_EQ(TimeWindow::Parse(":9").ToString(), ":9");
+  EXPECT_TRUE(TimeWindow::Parse(":9").IsSet());
+  EXPECT_FALSE(TimeWindow().IsSet());
+  EXPECT_THAT([] { TimeWindow::Parse("9:5"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("window '9:5': start 9 s is after end 5 s")));
+  EXPECT_THAT([] { TimeWindow::Parse("5"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("expected T0:T1")));
+  EXPECT_THAT([] { TimeWindow::Parse("a:5"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("start 'a' is not a time")));
+}
+
+TEST(PreprocessTest, DetrendKindStrings) {
+  for (auto k : {DetrendKind::kNone, DetrendKind::kConstant, DetrendKind::kLinear}) {
+    EXPECT_EQ(DetrendKindFromString(ToString(k)), k);
+  }
+  EXPECT_EQ(DetrendKindFromString("mean"), DetrendKind::kConstant);
+  EXPECT_THROW(DetrendKindFromString("quadratic"), InvalidArgument);
+}
+
+TEST(PreprocessTest, PreprocessOptionsValidation) {
+  auto invalid = [](const PreprocessOptions& o, const std::string& message) {
+    std::string error;
+    EXPECT_FALSE(o.IsValid(&error));
+    EXPECT_THAT(error, HasSubstr(message));
+    const Dataset d = Uniform(Eigen::VectorXd::Zero(100), Eigen::VectorXd::Zero(100));
+    EXPECT_THAT([&] { Preprocess(d, o); }, ThrowsMessage<InvalidArgument>(HasSubstr(message)));
+  };
+  PreprocessOptions o;
+  EXPECT_TRUE(o.IsValid(nullptr));
+  EXPECT_TRUE(o.IsIdentity());
+  o.decimate = 0;
+  invalid(o, "decimation factor must be >= 1, got 0");
+  o = {};
+  o.remove_initial = true;
+  o.detrend = DetrendKind::kLinear;
+  invalid(o, "remove-initial and detrend linear are alternatives");
+  o = {};
+  o.resample_ts = -0.1;
+  invalid(o, "resample sample time must be > 0 s");
+  o = {};
+  o.filter = FilterSpec{FilterKind::kBandpass, 5.0, 2.0, 5};
+  invalid(o, "need F1 < F2");
+}
+
+TEST(PreprocessTest, PreprocessWithoutStepsReturnsTheData) {
+  const Dataset d = GoldenInput();
+  PreprocessRecord r;
+  const Dataset out = Preprocess(d, {}, &r);
+  EXPECT_EQ(out.u(), d.u());
+  EXPECT_EQ(out.Where(3), d.Where(3));
+  EXPECT_TRUE(r.IsIdentity());
+  EXPECT_TRUE(r.steps.empty());
+  EXPECT_EQ(r.OutputOffsetAt(1.0), Eigen::VectorXd::Zero(1));
+}
+
+TEST(PreprocessTest, PreprocessRunsTheStepsInOrder) {
+  // window -> resample -> detrend -> filter -> decimate, each equal to the
+  // function applied alone in that order.
+  const Dataset d = GoldenInput();
+  PreprocessOptions o;
+  o.window = TimeWindow::Parse("0.5:3.5");
+  o.resample_ts = 0.005;
+  o.detrend = DetrendKind::kLinear;
+  o.filter = FilterSpec::Parse("lowpass:20");
+  o.decimate = 2;
+  PreprocessRecord r;
+  const Dataset out = Preprocess(d, o, &r);
+  LinearTrend trend;
+  const Dataset expected = Decimate(
+      Filter(Detrend(Resample(SelectWindow(d, 0.5, 3.5), 0.005), ChannelSet::kBoth, &trend),
+             *o.filter),
+      2);
+  ASSERT_EQ(out.size(), expected.size());
+  EXPECT_EQ(out.u(), expected.u());
+  EXPECT_EQ(out.y(), expected.y());
+  EXPECT_EQ(out.time(), expected.time());
+  EXPECT_EQ(r.window.ToString(), "0.5:3.5");
+  EXPECT_EQ(r.resample_ts, 0.005);
+  EXPECT_EQ(r.offsets, "linear");
+  EXPECT_EQ(r.level.y0, trend.level.y0);
+  EXPECT_EQ(r.slope.y0, trend.slope.y0);
+  EXPECT_EQ(r.trend_time, trend.time);
+  ASSERT_TRUE(r.filter.has_value());
+  EXPECT_EQ(r.filter->ToString(), "lowpass:20");
+  EXPECT_EQ(r.decimate, 2);
+  ASSERT_EQ(r.steps.size(), 5u);
+  EXPECT_THAT(r.steps[0], HasSubstr("window 0.5:3.5 s"));
+  EXPECT_THAT(r.steps[2], HasSubstr("detrend linear"));
+  EXPECT_THAT(r.steps[4], HasSubstr("decimate by 2"));
+  EXPECT_NEAR(r.OutputOffsetAt(r.trend_time + 1.0)[0], trend.level.y0[0] + trend.slope.y0[0],
+              1e-12);
+}
+
+TEST(PreprocessTest, PreprocessRemovesInitialLevelBeforeTheStep) {
+  // The golden input steps from about 40 to 65 at t = 1 s (sample 100).
+  const Dataset d = GoldenInput();
+  PreprocessOptions o;
+  o.remove_initial = true;
+  PreprocessRecord r;
+  const Dataset out = Preprocess(d, o, &r);
+  EXPECT_EQ(r.offsets, "initial");
+  EXPECT_NEAR(r.level.u0[0], d.u().head(100).mean(), 1e-12);
+  EXPECT_NEAR(r.level.y0[0], d.y().head(100).mean(), 1e-12);
+  EXPECT_NEAR(out.y()[7], d.y()[7] - r.level.y0[0], 1e-12);
+  EXPECT_THAT(r.steps[0], HasSubstr("100 samples before the step at t = 1 s"));
+  o.initial_samples = 20;
+  Preprocess(d, o, &r);
+  EXPECT_NEAR(r.level.u0[0], d.u().head(20).mean(), 1e-12);
+  EXPECT_EQ(r.slope.u0, Eigen::VectorXd::Zero(1));
+}
+
+TEST(PreprocessTest, PreprocessErrorsNameTheData) {
+  Dataset d = Uniform(Eigen::VectorXd::Zero(401), Eigen::VectorXd::Zero(401));
+  d.set_source("FILE.csv");
+  PreprocessOptions o;
+  o.window = TimeWindow::Parse("5:9");
+  EXPECT_THAT([&] { Preprocess(d, o); },
+              ThrowsMessage<DataError>(
+                  HasSubstr("window 5:9 s lies outside the data 0..4 s of FILE.csv")));
+  o = {};
+  o.filter = FilterSpec::Parse("lowpass:60");
+  EXPECT_THAT([&] { Preprocess(d, o); },
+              ThrowsMessage<DataError>(HasSubstr(
+                  "filter cutoff 60 Hz is above the Nyquist frequency 50 Hz of FILE.csv")));
+  o = {};
+  o.remove_initial = true;
+  EXPECT_THAT([&] { Preprocess(d, o); },
+              ThrowsMessage<DataError>(HasSubstr("FILE.csv: input 'u' is constant")));
+}
+
+TEST(PreprocessTest, ApplyRecordedUsesTheRecordedOffsets) {
+  const Dataset d = GoldenInput();
+  PreprocessOptions o;
+  o.detrend = DetrendKind::kConstant;
+  o.filter = FilterSpec::Parse("lowpass:15");
+  PreprocessRecord r;
+  const Dataset out = Preprocess(d, o, &r);
+  // The same data: the same result.
+  const Dataset again = ApplyRecorded(d, r);
+  EXPECT_LT((again.y() - out.y()).cwiseAbs().maxCoeff(), 1e-12);
+  // Other data (the same signals shifted by +5): the estimation offsets are
+  // removed, not the new means, so the shift survives.
+  const Dataset shifted = Rebuild5(d);
+  const Dataset v = ApplyRecorded(shifted, r);
+  EXPECT_LT((v.y().array() - out.y().array() - 5.0).abs().maxCoeff(), 1e-9);
+  EXPECT_LT((v.u().array() - out.u().array() - 5.0).abs().maxCoeff(), 1e-9);
+  // A linear trend is re-applied as the recorded line.
+  o.detrend = DetrendKind::kLinear;
+  o.filter.reset();
+  Preprocess(d, o, &r);
+  EXPECT_LT((ApplyRecorded(shifted, r).y().array() - Detrend(d).y().array() - 5.0)
+                .abs()
+                .maxCoeff(),
+            1e-9);
+  // Channel counts must match the record.
+  const Dataset two(d.time(), Eigen::MatrixXd::Zero(d.size(), 2), d.outputs());
+  EXPECT_THAT([&] { ApplyRecorded(two, r); },
+              ThrowsMessage<DataError>(HasSubstr("has 2 inputs, the recorded preprocessing")));
+}
+
+TEST(PreprocessTest, PreprocessRecordJsonRoundTrip) {
+  const Dataset d = GoldenInput();
+  PreprocessOptions o;
+  o.window = TimeWindow::Parse("0.5:");
+  o.detrend = DetrendKind::kLinear;
+  o.filter = FilterSpec::Parse("bandpass:1,20,order=3");
+  o.decimate = 2;
+  o.channels = ChannelSet::kOutputs;
+  PreprocessRecord r;
+  Preprocess(d, o, &r);
+  const nlohmann::json j = ToJson(r);
+  EXPECT_EQ(j.at("window"), "0.5:");
+  EXPECT_EQ(j.at("filter"), "bandpass:1,20,order=3");
+  EXPECT_EQ(j.at("channels"), "outputs");
+  const PreprocessRecord back = PreprocessRecordFromJson(nlohmann::json::parse(j.dump()));
+  EXPECT_EQ(ToJson(back), j);
+  EXPECT_EQ(back.slope.y0, r.slope.y0);
+  EXPECT_EQ(back.trend_time, r.trend_time);
+  EXPECT_EQ(ApplyRecorded(d, back).y(), ApplyRecorded(d, r).y());
+  EXPECT_TRUE(PreprocessRecordFromJson(nlohmann::json::object()).IsIdentity());
+  EXPECT_THAT([] { PreprocessRecordFromJson(nlohmann::json{{"filter", "lowpass:x"}}); },
+              ThrowsMessage<InvalidArgument>(
+                  AllOf(HasSubstr("preprocessing: key 'filter'"), HasSubstr("not a frequency"))));
+  EXPECT_THAT([] { PreprocessRecordFromJson(nlohmann::json{{"decimate", "4"}}); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("preprocessing: key 'decimate'")));
 }
 
 }  // namespace

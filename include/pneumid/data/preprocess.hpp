@@ -55,10 +55,20 @@ Dataset RemoveInitialOffset(const Dataset& data, Eigen::Index n,
                             ChannelSet which = ChannelSet::kBoth,
                             OperatingPoint* removed = nullptr);
 
+/// A straight line per channel: value_i(t) = level_i + slope_i * (t - time).
+struct LinearTrend {
+  OperatingPoint level;  ///< value at `time` (the channel mean), one per channel
+  OperatingPoint slope;  ///< per second (0 for channels left alone)
+  double time = 0.0;     ///< time origin in seconds (the mean time of the data)
+};
+
 /// Removes a least-squares straight line a + b t (t in seconds) from each
-/// selected channel; the result has zero mean and no linear trend [1].
+/// selected channel; the result has zero mean and no linear trend [1]. For
+/// uniform sampling this is scipy.signal.detrend(x, type='linear').
+/// @param removed  if not null, receives the lines that were subtracted.
 /// @throws DataError when the dataset has fewer than 2 samples.
-Dataset Detrend(const Dataset& data, ChannelSet which = ChannelSet::kBoth);
+Dataset Detrend(const Dataset& data, ChannelSet which = ChannelSet::kBoth,
+                LinearTrend* removed = nullptr);
 
 struct StepDetectOptions {
   /// Input channel searched for the step. Default 0.
