@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Dense>
 #include <Eigen/SVD>
@@ -36,6 +37,11 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void ReduceKernel(do
     const double sigma = (s0 + s1) + (s2 + s3);
     if (sigma == 0.0) continue;
     const double x0 = R[j + j * p];
+    // A column that is zero up to rounding (exactly collinear columns, e.g. a
+    // constant input in many Hankel columns) leaves residuals that shrink by
+    // ~eps per column; once x0^2 + sigma is subnormal, beta = 2 / (v0^2 + sigma)
+    // overflows and 0 * inf spreads NaN through R. Such a column is zero.
+    if (x0 * x0 + sigma < std::numeric_limits<double>::min()) continue;
     const double alpha = -std::copysign(std::sqrt(x0 * x0 + sigma), x0);
     const double v0 = x0 - alpha;
     const double beta = 2.0 / (v0 * v0 + sigma);

@@ -1,14 +1,68 @@
 #include "pneumid/identify/subspace.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Dense>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/arx.hpp"
 #include "tall_skinny_qr.hpp"
 
 namespace pneumid {
+
+namespace {
+constexpr EnumName<SubspaceWeighting> kSubspaceWeightingNames[] = {
+    {SubspaceWeighting::kMoesp, "moesp"},
+    {SubspaceWeighting::kN4sid, "n4sid"},
+    {SubspaceWeighting::kCva, "cva"},
+};
+
+// The weighted matrix M of the unifying theorem (subspace.hpp) and W1^(-1),
+// from the LQ factor L of [U_f; U_p; Y_p; Y_f] with horizon s.
+void WeightedProjection(const Eigen::MatrixXd& L, int s, SubspaceWeighting w, Eigen::MatrixXd* M,
+                        Eigen::MatrixXd* w1_inverse) {
+  const Eigen::MatrixXd L32 = L.block(3 * s, s, s, 2 * s);
+  *w1_inverse = Eigen::MatrixXd::Identity(s, s);
+  switch (w) {
+    case SubspaceWeighting::kMoesp:
+      *M = L32;
+      return;
+    case SubspaceWeighting::kN4sid: {
+      // O = L32 L22^+ [L21 L22]: L22 is singular when the input is constant
+      // over the whole record or most of it, hence the pseudo-inverse
+      // (minimum-norm least squares of L22' X' = L32').
+      const Eigen::MatrixXd L2 = L.block(s, 0, 2 * s, 3 * s);  // [L21 L22]
+      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(
+          L.block(s, s, 2 * s, 2 * s).transpose());
+      const Eigen::MatrixXd X = cod.solve(L32.transpose()).transpose();
+      *M = X * L2;
+      return;
+    }
+    case SubspaceWeighting::kCva: {
+      const Eigen::MatrixXd L33 = L.block(3 * s, 3 * s, s, s);
+      const Eigen::MatrixXd sigma = L32 * L32.transpose() + L33 * L33.transpose();
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(sigma);
+      // Noise-free data make sigma singular: eigenvalues are floored.
+      const Eigen::VectorXd lambda = eig.eigenvalues().cwiseMax(
+          std::max(eig.eigenvalues().maxCoeff(), 0.0) * 1e-12 + std::numeric_limits<double>::min());
+      const Eigen::MatrixXd& V = eig.eigenvectors();
+      *w1_inverse = V * lambda.cwiseSqrt().asDiagonal() * V.transpose();
+      *M = V * lambda.cwiseSqrt().cwiseInverse().asDiagonal() * V.transpose() * L32;
+      return;
+    }
+  }
+}
+}  // namespace
+
+std::string ToString(SubspaceWeighting w) {
+  return std::string(EnumToString(kSubspaceWeightingNames, w));
+}
+
+SubspaceWeighting SubspaceWeightingFromString(const std::string& name) {
+  return EnumFromString(kSubspaceWeightingNames, name, "subspace weighting", true);
+}
 
 bool SubspaceOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& m) {
@@ -54,8 +108,9 @@ SubspaceResult EstimateSubspace(const Eigen::VectorXd& y, const Eigen::VectorXd&
     qr.AddRows(rows.topRows(m));
   }
   const Eigen::MatrixXd L = qr.R().transpose();  // H = L Q'
-  const Eigen::MatrixXd L42 = L.block(3 * s, s, s, 2 * s);
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(L42, Eigen::ComputeThinU);
+  Eigen::MatrixXd M, w1_inverse;
+  WeightedProjection(L, s, o.weighting, &M, &w1_inverse);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
   SubspaceResult r;
   r.singular_values = svd.singularValues();
   const Eigen::VectorXd& sv = r.singular_values;
@@ -76,7 +131,8 @@ SubspaceResult EstimateSubspace(const Eigen::VectorXd& y, const Eigen::VectorXd&
     }
   }
   r.order = n;
-  const Eigen::MatrixXd gamma = svd.matrixU().leftCols(n) * sv.head(n).cwiseSqrt().asDiagonal();
+  const Eigen::MatrixXd gamma =
+      w1_inverse * svd.matrixU().leftCols(n) * sv.head(n).cwiseSqrt().asDiagonal();
   const Eigen::MatrixXd C = gamma.topRows(1);
   const Eigen::MatrixXd A =
       gamma.topRows(s - 1).colPivHouseholderQr().solve(gamma.bottomRows(s - 1));
@@ -104,19 +160,24 @@ SubspaceResult EstimateSubspace(const Eigen::VectorXd& y, const Eigen::VectorXd&
   }
   const Eigen::MatrixXd R2 = qr2.R();
   const Eigen::MatrixXd R11 = R2.topLeftCorner(p, p);
-  const Eigen::VectorXd theta = R11.triangularView<Eigen::Upper>().solve(R2.col(p).head(p));
+  Eigen::VectorXd theta = R11.triangularView<Eigen::Upper>().solve(R2.col(p).head(p));
+  const bool finite = A.allFinite() && C.allFinite() && theta.allFinite();
+  if (!finite) theta.setZero();
   r.x0 = theta.head(n);
   const Eigen::MatrixXd B = theta.segment(n, n);
   Eigen::MatrixXd D = Eigen::MatrixXd::Zero(1, 1);
   if (nd) D(0, 0) = theta[2 * n];
-  r.model = StateSpace(A, B, C, D, Ts);
+  r.model = finite ? StateSpace(A, B, C, D, Ts)
+                   : StateSpace(Eigen::MatrixXd::Zero(n, n), B, Eigen::MatrixXd::Zero(1, n), D, Ts);
   EstimationSummary& sum = r.summary;
   sum.num_rows = N;
   sum.num_parameters = n * n + 2 * n + nd;
   sum.loss = R2(p, p) * R2(p, p) / static_cast<double>(N);
-  sum.termination =
-      theta.allFinite() ? EstimationTermination::kConvergence : EstimationTermination::kFailure;
-  sum.message = fmt::format("PO-MOESP, order {}, horizon {}", n, s);
+  sum.termination = finite ? EstimationTermination::kConvergence : EstimationTermination::kFailure;
+  static constexpr const char* kLabel[] = {"PO-MOESP", "N4SID", "CVA"};
+  sum.message = fmt::format("{}, order {}, horizon {}{}", kLabel[static_cast<int>(o.weighting)], n,
+                            s, finite ? "" : ": non-finite A, C or B, D, x0 (unstable A?)");
+  if (!finite) return r;
   if (!r.model.IsStable()) sum.warnings.push_back("the identified model is unstable");
   return r;
 }
