@@ -204,6 +204,22 @@ static Registrar reg(
       app.add_option("--nc", args->request.nc, "C order (armax, bj)")->capture_default_str();
       app.add_option("--nd", args->request.nd, "D order (bj)")->capture_default_str();
       app.add_option("--nf", args->request.nf, "F order (oe, bj)")->capture_default_str();
+      app.add_flag("--feedthrough", args->request.feedthrough,
+                   "n4sid: estimate the direct term D (default D = 0)");
+      app.add_option_function<std::string>(
+             "--n4sid-weight",
+             [args](const std::string& s) {
+               args->request.n4sid_weight = SubspaceWeightingFromString(s);
+             },
+             "n4sid weighting (MATLAB N4Weight): moesp (default), n4sid, cva")
+          ->check([](const std::string& s) {
+            try {
+              SubspaceWeightingFromString(s);
+              return std::string();
+            } catch (const InvalidArgument& e) {
+              return std::string(e.what());
+            }
+          });
       app.add_option("--loss", args->loss, "Loss of the fit-* methods: none, huber, cauchy")
           ->capture_default_str();
       app.add_flag("--json", args->json,

@@ -73,8 +73,10 @@ void BindIdentify(py::module_& m) {
   m.def(
       "identify",
       [](const std::string& method, const Dataset& data, int input, int output, int order, int na,
-         int nb, int nk, int nc, int nd, int nf) {
+         int nb, int nk, int nc, int nd, int nf, bool feedthrough, const std::string& n4sid_weight) {
         IdentifyRequest r;
+        r.feedthrough = feedthrough;
+        r.n4sid_weight = SubspaceWeightingFromString(n4sid_weight);
         r.input = input;
         r.output = output;
         r.order = order;
@@ -88,10 +90,13 @@ void BindIdentify(py::module_& m) {
         return Identify(method, data, r);
       },
       "method"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3, "nb"_a = 3,
-      "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3,
+      "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3, "feedthrough"_a = false,
+      "n4sid_weight"_a = "moesp",
       "Identifies a model of data with a method of identify_methods(): e.g. "
       "'reaction-curve' (FOPDT, paper Eq. 2), 'ptn' (PTn of order `order`, Eq. 3), 'arx' "
-      "(ARX(na, nb, nk), Eq. 4). Raises DataError when the data do not suit the method.");
+      "(ARX(na, nb, nk), Eq. 4); 'n4sid' (order na, D term when `feedthrough`, weighting "
+      "`n4sid_weight` 'moesp', 'n4sid' or 'cva'). Raises DataError when the data do not suit the "
+      "method.");
   m.def(
       "simulate_on_data",
       [](const TransferFunction& g, const Dataset& data, int input, int output, double y0) {

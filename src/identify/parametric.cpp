@@ -182,6 +182,8 @@ IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& dat
   if (method == "n4sid") {
     SubspaceOptions o;
     o.order = request.na;
+    o.feedthrough = request.feedthrough;
+    o.weighting = request.n4sid_weight;
     const SubspaceResult r = EstimateSubspace(d, o);
     PNEUMID_CHECK(r.summary.IsSolutionUsable(), "subspace estimation failed: {}",
                   r.summary.message);

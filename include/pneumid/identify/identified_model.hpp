@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "pneumid/data/dataset.hpp"
+#include "pneumid/identify/subspace.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
@@ -76,6 +77,8 @@ struct IdentifyRequest {
   int order = 2;   ///< PTn / Strejc order n
   int na = 3, nb = 3, nk = 1;  ///< polynomial orders
   int nc = 1, nd = 1, nf = 3;  ///< ARMAX/BJ/OE orders
+  bool feedthrough = false;    ///< n4sid: estimate the D term (subspace.hpp)
+  SubspaceWeighting n4sid_weight = SubspaceWeighting::kMoesp;  ///< n4sid: W1/W2 weighting
   bool IsValid(std::string* error) const;
 };
 
