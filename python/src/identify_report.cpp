@@ -7,6 +7,7 @@
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/initial_state.hpp"
 #include "pneumid/identify/identify.hpp"
 #include "pneumid/identify/step_analysis.hpp"
 #include "pneumid/identify/step_methods.hpp"
@@ -107,6 +108,11 @@ void BindIdentify(py::module_& m) {
       "y0"_a = std::numeric_limits<double>::quiet_NaN(),
       "Model output on the data's input in deviation variables: y0 + lsim(g, u - u0).");
   m.def("nrmse_fit", &NrmseFit, "y"_a, "yhat"_a, "NRMSE fit [%] (MATLAB compare).");
+  m.def("estimate_initial_state", &EstimateInitialState, "sys"_a, "u"_a, "y"_a,
+        "Least-squares initial state of the discrete StateSpace sys for input u (N x nu) and "
+        "output y (N x ny) (MATLAB findstates).");
+  m.def("simulate_from_state", &SimulateFromState, "sys"_a, "u"_a, "x0"_a,
+        "Output (N x ny) of the discrete StateSpace sys from initial state x0 for input u.");
   m.def("rmse", &Rmse, "y"_a, "yhat"_a);
   m.def(
       "analyze_step",
