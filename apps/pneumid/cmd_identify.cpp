@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <iostream>
 #include <type_traits>
 #include <variant>
@@ -18,6 +19,7 @@
 #include "command.hpp"
 #include "data_options.hpp"
 #include "output_options.hpp"
+#include "progress.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
@@ -34,6 +36,9 @@ struct IdentifyArgs {
   bool json = false;
   std::string plot;
   std::string output;
+  std::string validation;  ///< held-out data file (same column options)
+  double split = 0.0;
+  bool progress = false;
 };
 
 // "K=1.6 a=[1 -0.6 0.2] A=[[0.9] [0.1]] t=[200 values]": numbers with 4
@@ -65,16 +70,6 @@ std::string FormatParams(const ModelParams& params) {
   return fmt::format("{}", fmt::join(parts, " "));
 }
 
-void Progress(std::size_t i, std::size_t n, const std::string& method) {
-  if (!StderrIsTerminal() || n < 2) return;
-  const int width = 30;
-  const int filled = static_cast<int>(width * i / n);
-  std::cerr << fmt::format("\ridentify [{}{}] {}/{} {:<16}", std::string(filled, '#'),
-                           std::string(width - filled, '.'), i, n, method)
-            << std::flush;
-  if (i == n) std::cerr << "\r" << std::string(width + 40, ' ') << "\r" << std::flush;
-}
-
 void WritePlot(const std::string& path, const Dataset& data, const IdentifyRequest& request,
                const std::vector<IdentifiedModel>& models) {
   Figure fig(2);
@@ -101,10 +96,8 @@ void WritePlot(const std::string& path, const Dataset& data, const IdentifyReque
   for (const IdentifiedModel& m : models) {
     if (drawn >= 8 || !(m.fit_percent > 0.0)) break;
     ++drawn;
-    const double y0 = m.params.FindScalar("y0").value_or(std::numeric_limits<double>::quiet_NaN());
     try {
-      const Eigen::VectorXd yhat =
-          SimulateOnData(m.discrete ? *m.discrete : m.tf, data, request.input, request.output, y0);
+      const Eigen::VectorXd yhat = SimulateModel(m, data, request.input);
       if (yhat.allFinite()) {
         top.AddLine(data.time(), yhat, fmt::format("{} ({:.1f} %)", m.method, m.fit_percent));
       }
@@ -120,38 +113,59 @@ void WritePlot(const std::string& path, const Dataset& data, const IdentifyReque
   fig.Save(path);
 }
 
+std::string FlagNames(const IdentifiedModel& m) {
+  std::vector<std::string> names;
+  for (const ModelFlagNote& f : m.flags) names.push_back(ToString(f.flag));
+  return names.empty() ? "-" : fmt::format("{}", fmt::join(names, ","));
+}
+
 void Run(const IdentifyArgs& args) {
   std::string why;
   PNEUMID_CHECK(args.request.IsValid(&why), "{}", why);
+  PNEUMID_CHECK(args.validation.empty() || args.split == 0.0,
+                "--validation and --split exclude each other: give held-out data as a file or "
+                "as a fraction of DATA");
+  PNEUMID_CHECK(args.split == 0.0 || (args.split > 0.0 && args.split < 1.0),
+                "--split must be a fraction in (0, 1), e.g. 0.7, got {}", args.split);
   const std::vector<std::string> methods = ParseMethodList(args.methods);
-  const bool all_requested = args.methods.find("all") != std::string::npos;
   const Dataset data = LoadFromOptions(args.data);
+  std::optional<Dataset> validation;
+  if (!args.validation.empty()) {
+    DataOptions v = args.data;
+    v.path = args.validation;
+    validation.emplace(LoadFromOptions(v));
+  }
   IdentifyOptions options;
   options.step.fit.loss = RobustLossFromString(args.loss);
+  options.split = args.split;
 
-  std::vector<IdentifiedModel> models;
-  for (std::size_t i = 0; i < methods.size(); ++i) {
-    Progress(i, methods.size(), methods[i]);
-    const std::string& m = methods[i];
-    try {
-      models.push_back(Identify(m, data, args.request, options));
-    } catch (const std::exception& e) {
-      // With "all", a method that does not suit the data is skipped with a
-      // warning; a method asked for by name fails the command.
-      if (!all_requested) {
-        throw DataError(fmt::format("{}: {}", m, e.what()));
-      }
-      std::cerr << fmt::format("pneumid identify: warning: {} skipped: {}\n", m, e.what());
-    }
+  IdentificationSummary summary;
+  {
+    ProgressBar bar("identify", args.progress || StderrIsTerminal());
+    summary = IdentifyModels(
+        methods, data, args.request, options, validation ? &*validation : nullptr,
+        [&bar](std::size_t done, std::size_t total, const std::string& method) {
+          bar(static_cast<double>(done) / static_cast<double>(total), method);
+        });
   }
-  Progress(methods.size(), methods.size(), "");
-  if (models.empty()) throw DataError("no method produced a model for these data");
-  std::stable_sort(models.begin(), models.end(),
-                   [](const auto& a, const auto& b) { return a.fit_percent > b.fit_percent; });
+  for (const auto& [method, reason] : summary.failures)
+    std::cerr << fmt::format("pneumid identify: {} failed: {}\n", method, reason);
+  if (summary.models.empty()) throw DataError(summary.message);
+  const std::vector<IdentifiedModel>& models = summary.models;
+  const bool held_out = summary.validation_samples > 0;
 
   nlohmann::json j;
   j["models"] = nlohmann::json::array();
   for (const IdentifiedModel& m : models) j["models"].push_back(ToJson(m));
+  j["best"] = models.front().method;
+  j["ranked_by"] = held_out ? "validation_fit_percent" : "fit_percent";
+  j["estimation_samples"] = summary.estimation_samples;
+  j["validation_samples"] = summary.validation_samples;
+  j["failures"] = nlohmann::json::array();
+  for (const auto& [method, reason] : summary.failures)
+    j["failures"].push_back({{"method", method}, {"reason", reason}});
+  j["termination"] = ToString(summary.termination);
+  j["message"] = summary.message;
   if (!args.output.empty()) WriteJsonFile(j, args.output);
   if (!args.plot.empty()) WritePlot(args.plot, data, args.request, models);
 
@@ -160,9 +174,17 @@ void Run(const IdentifyArgs& args) {
     nlohmann::ordered_json brief;
     brief["output"] = args.output;
     brief["models"] = nlohmann::json::array();
-    for (const IdentifiedModel& m : models)
-      brief["models"].push_back(
-          {{"method", m.method}, {"structure", m.structure}, {"fit_percent", m.fit_percent}});
+    for (const IdentifiedModel& m : models) {
+      nlohmann::ordered_json b = {
+          {"method", m.method}, {"structure", m.structure}, {"fit_percent", m.fit_percent}};
+      if (held_out) b["validation_fit_percent"] = JsonNumber(m.validation_fit_percent);
+      b["flags"] = nlohmann::json::array();
+      for (const ModelFlagNote& f : m.flags) b["flags"].push_back(ToString(f.flag));
+      brief["models"].push_back(b);
+    }
+    brief["best"] = models.front().method;
+    brief["failures"] = j["failures"];
+    brief["termination"] = j["termination"];
     if (!args.plot.empty()) brief["plot"] = args.plot;
     std::cout << brief.dump(2) << "\n";
     return;
@@ -173,13 +195,35 @@ void Run(const IdentifyArgs& args) {
   }
   std::cout << fmt::format("{} samples, Ts = {:g} s{}\n", data.size(), data.SampleTime(),
                            data.source().empty() ? "" : ", from " + data.source());
-  std::cout << fmt::format("{:<16} {:<10} {:>9} {:>11}  {}\n", "method", "structure", "fit %",
-                           "IAE", "parameters");
+  if (held_out)
+    std::cout << fmt::format("estimated on {} samples, validated on {} held-out samples{}\n",
+                             summary.estimation_samples, summary.validation_samples,
+                             validation ? " of " + validation->source() : "");
+  std::cout << fmt::format("{:<16} {:<10} {:>9}{} {:>11}  {:<20} {}\n", "method", "structure",
+                           "fit %", held_out ? fmt::format(" {:>9}", "val fit %") : "", "IAE",
+                           "flags", "parameters");
   for (const IdentifiedModel& m : models) {
-    std::cout << fmt::format("{:<16} {:<10} {:>9.2f} {:>11.4g}  {}\n", m.method, m.structure,
-                             m.fit_percent, m.iae, FormatParams(m.params));
+    std::cout << fmt::format("{:<16} {:<10} {:>9.2f}{} {:>11.4g}  {:<20} {}\n", m.method,
+                             m.structure, m.fit_percent,
+                             held_out ? fmt::format(" {:>9.2f}", m.validation_fit_percent) : "",
+                             m.iae, FlagNames(m), FormatParams(m.params));
+    for (const ModelFlagNote& f : m.flags)
+      std::cout << fmt::format("{:<16} flag {}: {}\n", "", ToString(f.flag), f.reason);
     for (const std::string& note : m.notes) std::cout << fmt::format("{:<16} note: {}\n", "", note);
   }
+  const IdentifiedModel& best = models.front();
+  std::cout << fmt::format("best: {} ({:.2f} % {}fit){}\n", best.method, RankScore(best),
+                           held_out ? "validation " : "",
+                           best.flags.empty()
+                               ? ""
+                               : fmt::format("; every model is flagged, {} least severely",
+                                             best.method));
+  if (!summary.failures.empty())
+    std::cout << fmt::format("failed: {}\n", [&] {
+      std::vector<std::string> f;
+      for (const auto& [method, reason] : summary.failures) f.push_back(method);
+      return fmt::format("{}", fmt::join(f, ", "));
+    }());
   if (!args.plot.empty()) std::cout << "plot written to " << args.plot << "\n";
   if (!args.output.empty()) std::cout << "models written to " << args.output << "\n";
 }
@@ -229,6 +273,16 @@ static Registrar reg(
                     "the data and the responses of the (up to 8) best models with a positive fit");
       app.add_option("-o,--output", args->output,
                      "Write the models as JSON ({\"models\": [...]}) to this file");
+      app.add_option("--validation", args->validation,
+                     "Held-out data file (same columns as DATA): models are ranked by their "
+                     "simulation fit on it")
+          ->check(CLI::ExistingFile);
+      app.add_option("--split", args->split,
+                     "Estimate on the first fraction of DATA (e.g. 0.7) and rank by the fit on "
+                     "the rest")
+          ->check(CLI::Range(0.0, 1.0));
+      app.add_flag("--progress", args->progress,
+                   "Draw the progress bar even when stderr is not a terminal");
       app.callback([args] { Run(*args); });
     });
 

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "progress.hpp"
 #include "validators.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/csv.hpp"
@@ -36,34 +37,6 @@ struct SimulateOptions {
   bool progress = false;
 };
 
-/// Progress bar on stderr, drawn only on a terminal (or when forced) and only
-/// once the run has taken more than a second.
-class ProgressBar {
- public:
-  explicit ProgressBar(bool enabled) : enabled_(enabled), start_(Clock::now()) {}
-  void operator()(double fraction) {
-    if (!enabled_) return;
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
-    if (elapsed < 1.0 && fraction < 1.0) return;
-    if (elapsed < 1.0 && !drawn_) return;
-    const int width = 40;
-    const int filled = static_cast<int>(fraction * width);
-    std::fprintf(stderr, "\rsimulating [%s%s] %3.0f%% %.1f s", std::string(filled, '#').c_str(),
-                 std::string(width - filled, ' ').c_str(), 100.0 * fraction, elapsed);
-    std::fflush(stderr);
-    drawn_ = true;
-  }
-  ~ProgressBar() {
-    if (drawn_) std::fprintf(stderr, "\n");
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  bool enabled_;
-  bool drawn_ = false;
-  Clock::time_point start_;
-};
-
 void Run(const SimulateOptions& o) {
   PNEUMID_CHECK(o.Ts > 0.0 && std::isfinite(o.Ts), "--Ts must be positive, got {}", o.Ts);
   PNEUMID_CHECK(std::isfinite(o.duration) && o.duration >= o.Ts,
@@ -84,7 +57,7 @@ void Run(const SimulateOptions& o) {
   ExperimentOptions options;
   options.input_channel = PlantInputChannel(*plant);
   options.output_channel = PlantOutputChannel(*plant);
-  ProgressBar bar(o.progress || StderrIsTerminal());
+  ProgressBar bar("simulating", o.progress || StderrIsTerminal());
   options.progress = [&bar](double f) { bar(f); };
   const auto start = std::chrono::steady_clock::now();
   const Experiment e = RunExperiment(*plant, *input, o.duration, options);

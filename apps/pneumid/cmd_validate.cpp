@@ -2,6 +2,7 @@
 // residual tests of MATLAB compare and resid, with an optional plot.
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 
 #include <fmt/format.h>
@@ -12,6 +13,9 @@
 #include "data_options.hpp"
 #include "output_options.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/model_evaluation.hpp"
 #include "pneumid/identify/parametric_model.hpp"
 #include "pneumid/identify/residual_analysis.hpp"
 #include "pneumid/identify/validation.hpp"
@@ -31,9 +35,10 @@ struct ValidateArgs {
   bool json = false;
 };
 
-// The polynomial model inside a JSON file written by `pneumid identify --json`
-// (first model, or FILE.json#method), or nothing when the file holds another kind of model.
-std::optional<PolynomialModel> ReadPolynomial(const std::string& spec, std::string* label) {
+// The identified model inside a JSON file written by `pneumid identify --json`
+// or `-o` (first model, or FILE.json#method), or nothing when `spec` is not a
+// JSON file (a model spec such as arx-paper or tf:...).
+std::optional<IdentifiedModel> ReadIdentified(const std::string& spec) {
   std::string path = spec, method;
   const auto hash = spec.rfind('#');
   if (hash != std::string::npos) {
@@ -56,7 +61,7 @@ std::optional<PolynomialModel> ReadPolynomial(const std::string& spec, std::stri
     if (!method.empty()) {
       bool found = false;
       for (const auto& x : j["models"])
-        if (x.value("method", "") == method) {
+        if (x.is_object() && x.value("method", "") == method) {
           m = x;
           found = true;
           break;
@@ -64,18 +69,51 @@ std::optional<PolynomialModel> ReadPolynomial(const std::string& spec, std::stri
       PNEUMID_CHECK(found, "{}: no model with method '{}'", path, method);
     }
   }
-  if (!m.is_object() || !m.contains("params") || !m["params"].is_object() ||
-      !m["params"].contains("b") || !m["params"].contains("Ts"))
+  if (!m.is_object() || !m.contains("params") || !m.contains("tf")) return std::nullopt;
+  try {
+    return IdentifiedModelFromJson(m);
+  } catch (const InvalidArgument& e) {
+    throw DataError(fmt::format("{}: {}", path, e.what()));
+  }
+}
+
+// The polynomial form of an identified ARX/ARMAX/OE/BJ model (k-step prediction
+// and prediction-error residuals need its noise model).
+std::optional<PolynomialModel> PolynomialOf(const IdentifiedModel& m) {
+  if (!m.params.contains("a") || !m.params.contains("b") || !m.params.contains("Ts"))
     return std::nullopt;
-  *label = fmt::format("{} {}", m.value("method", "model"), m.value("structure", ""));
-  return PolynomialModel::FromParamsJson(m["params"], m.value("structure", "ARX"));
+  return PolynomialModel::FromParamsJson(ToJson(m.params), m.structure);
+}
+
+// Simulation fit of an identified model (its operating point applied).
+CompareResult SimulateIdentified(const IdentifiedModel& m, const Dataset& data, int skip) {
+  PNEUMID_CHECK(skip + 2 <= data.size(), "--skip {} leaves fewer than 2 of the {} samples", skip,
+                data.size());
+  CompareResult r;
+  r.t = data.time();
+  r.y = data.y(0);
+  r.yhat = SimulateModel(m, data, 0);
+  const Eigen::Index n = data.size() - skip;
+  if (r.yhat.tail(n).allFinite()) {
+    r.fit_percent = NrmseFit(r.y.tail(n), r.yhat.tail(n));
+    r.rmse = Rmse(r.y.tail(n), r.yhat.tail(n));
+  } else {
+    r.fit_percent = -std::numeric_limits<double>::infinity();
+    r.rmse = std::numeric_limits<double>::infinity();
+  }
+  return r;
 }
 
 void Run(const ValidateArgs& a) {
   PNEUMID_CHECK(a.horizon >= 0, "--horizon must be >= 0 (0 = simulation), got {}", a.horizon);
   const Dataset data = LoadFromOptions(a.data);
   std::string label = a.model;
-  const std::optional<PolynomialModel> poly = ReadPolynomial(a.model, &label);
+  const std::optional<IdentifiedModel> identified = ReadIdentified(a.model);
+  std::optional<PolynomialModel> poly;
+  if (identified) {
+    label = fmt::format("{} {}", identified->method, identified->structure);
+    poly = PolynomialOf(*identified);
+  }
   CompareOptions co;
   co.skip = a.skip;
   ResidualAnalysisOptions ro;
@@ -83,14 +121,19 @@ void Run(const ValidateArgs& a) {
   CompareResult sim, pred;
   ResidualAnalysis res;
   bool have_pred = false;
-  if (poly) {
-    sim = Compare(*poly, data, co);
+  if (identified) {
+    sim = SimulateIdentified(*identified, data, a.skip);
+    PNEUMID_CHECK(a.horizon == 0 || poly,
+                  "--horizon needs a polynomial model with a noise model; '{}' is a {} model "
+                  "(simulation only)",
+                  a.model, identified->structure);
     if (a.horizon > 0) {
       co.horizon = a.horizon;
       pred = Compare(*poly, data, co);
       have_pred = true;
     }
-    res = AnalyzeResiduals(*poly, data, ro);
+    res = poly ? AnalyzeResiduals(*poly, data, ro)
+               : AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro);
   } else {
     PNEUMID_CHECK(a.horizon == 0,
                   "--horizon needs a polynomial model with a noise model; '{}' is a transfer "

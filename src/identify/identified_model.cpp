@@ -1,10 +1,27 @@
 #include "pneumid/identify/identified_model.hpp"
 
+#include "pneumid/common/enum_names.hpp"
+
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
 
 namespace pneumid {
+
+namespace {
+inline constexpr EnumName<ModelFlag> kModelFlagNames[] = {
+    {ModelFlag::kNotFinite, "not_finite"},
+    {ModelFlag::kUnstable, "unstable"},
+    {ModelFlag::kNyquistPole, "nyquist_pole"},
+    {ModelFlag::kNoConvergence, "no_convergence"},
+    {ModelFlag::kResidualsNotWhite, "residuals_not_white"}};
+}  // namespace
+
+std::string ToString(ModelFlag f) { return std::string(EnumToString(kModelFlagNames, f)); }
+
+ModelFlag ModelFlagFromString(const std::string& name) {
+  return EnumFromString(kModelFlagNames, name, "model flag");
+}
 
 namespace {
 

@@ -1,5 +1,6 @@
 #include "pneumid/identify/identified_model_io.hpp"
 
+#include <cmath>
 #include <limits>
 
 #include "pneumid/common/check.hpp"
@@ -68,6 +69,13 @@ nlohmann::json ToJson(const IdentifiedModel& model) {
   j["fit_percent"] = model.fit_percent;
   j["iae"] = model.iae;
   if (!model.notes.empty()) j["notes"] = model.notes;
+  j["operating_point"] = {{"u0", model.u0}, {"y0", model.y0}};
+  j["termination"] = ToString(model.termination);
+  if (std::isfinite(model.validation_fit_percent))
+    j["validation_fit_percent"] = model.validation_fit_percent;
+  j["flags"] = nlohmann::json::array();
+  for (const ModelFlagNote& f : model.flags)
+    j["flags"].push_back({{"flag", ToString(f.flag)}, {"reason", f.reason}});
   return j;
 }
 
@@ -92,6 +100,37 @@ IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
   m.fit_percent = number("fit_percent", -std::numeric_limits<double>::infinity());
   m.iae = number("iae", std::numeric_limits<double>::infinity());
   if (j.contains("notes")) m.notes = j.at("notes").get<std::vector<std::string>>();
+  if (j.contains("operating_point")) {
+    const nlohmann::json& op = j.at("operating_point");
+    PNEUMID_CHECK(op.is_object(), "'operating_point' must be an object with u0 and y0, got {}",
+                  Excerpt(op.dump()));
+    for (const char* key : {"u0", "y0"}) {
+      PNEUMID_CHECK(!op.contains(key) || op.at(key).is_number(),
+                    "'operating_point.{}' must be a number, got {}", key,
+                    Excerpt(op.at(key).dump()));
+    }
+    m.u0 = op.value("u0", 0.0);
+    m.y0 = op.value("y0", 0.0);
+  } else if (const std::optional<double> y0 = m.params.FindScalar("y0")) {
+    m.y0 = *y0;  // files written before the operating point was stored
+  }
+  if (j.contains("termination")) {
+    PNEUMID_CHECK(j.at("termination").is_string(), "'termination' must be a string, got {}",
+                  Excerpt(j.at("termination").dump()));
+    m.termination = TerminationFromString(j.at("termination").get<std::string>());
+  }
+  m.validation_fit_percent = number("validation_fit_percent",
+                                    std::numeric_limits<double>::quiet_NaN());
+  if (j.contains("flags")) {
+    PNEUMID_CHECK(j.at("flags").is_array(), "'flags' must be an array, got {}",
+                  Excerpt(j.at("flags").dump()));
+    for (const nlohmann::json& f : j.at("flags")) {
+      PNEUMID_CHECK(f.is_object() && f.contains("flag") && f.at("flag").is_string(),
+                    "each element of 'flags' needs a string 'flag', got {}", Excerpt(f.dump()));
+      m.flags.push_back({ModelFlagFromString(f.at("flag").get<std::string>()),
+                         f.value("reason", std::string())});
+    }
+  }
   return m;
 }
 

@@ -1,16 +1,34 @@
 #include "pneumid/identify/identify.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <optional>
+#include <thread>
 
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
 #include "pneumid/identify/parametric.hpp"
+#include "pneumid/identify/validation.hpp"
 
 namespace pneumid {
 
-bool IdentifyOptions::IsValid(std::string* error) const { return step.IsValid(error); }
+bool IdentifyOptions::IsValid(std::string* error) const {
+  if (!step.IsValid(error) || !quality.IsValid(error)) return false;
+  if (!(split == 0.0 || (split > 0.0 && split < 1.0))) {
+    if (error) *error = fmt::format("IdentifyOptions::split must be 0 (none) or in (0, 1), got {}", split);
+    return false;
+  }
+  if (num_threads < 0) {
+    if (error) *error = fmt::format("IdentifyOptions::num_threads must be >= 0, got {}", num_threads);
+    return false;
+  }
+  return true;
+}
 
 const std::vector<std::string>& IdentifyMethodNames() {
   static const std::vector<std::string> names = [] {
@@ -53,6 +71,145 @@ IdentifiedModel Identify(const std::string& method, const Dataset& data,
   PNEUMID_CHECK(false, "unknown method '{}' (valid: {})", method,
                 fmt::join(IdentifyMethodNames(), ", "));
   return {};
+}
+
+std::string IdentificationSummary::BriefReport() const {
+  std::string best;
+  if (!models.empty()) {
+    const IdentifiedModel& m = models.front();
+    best = fmt::format(", best {} ({:.2f} % {}fit{})", m.method, RankScore(m),
+                       std::isfinite(m.validation_fit_percent) ? "validation " : "",
+                       m.flags.empty() ? "" : ", flagged");
+  }
+  return fmt::format("identify {}: {} model(s), {} failed{}", ToString(termination), models.size(),
+                     failures.size(), best);
+}
+
+namespace {
+
+bool SameChannels(const std::vector<Channel>& a, const std::vector<Channel>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].name != b[i].name) return false;
+  return true;
+}
+
+std::string ChannelNames(const std::vector<Channel>& c) {
+  std::vector<std::string> names;
+  for (const Channel& x : c) names.push_back(x.name);
+  return fmt::format("[{}]", fmt::join(names, ", "));
+}
+
+}  // namespace
+
+IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, const Dataset& data,
+                                     const IdentifyRequest& request, const IdentifyOptions& options,
+                                     const Dataset* validation, const IdentifyProgress& progress) {
+  std::string why;
+  PNEUMID_CHECK(!methods.empty(), "IdentifyModels needs at least one method");
+  for (const std::string& m : methods)
+    PNEUMID_CHECK(IsIdentifyMethod(m), "unknown method '{}' (valid: {})", m,
+                  fmt::join(IdentifyMethodNames(), ", "));
+  PNEUMID_CHECK(request.IsValid(&why), "invalid identify request: {}", why);
+  PNEUMID_CHECK(options.IsValid(&why), "{}", why);
+  PNEUMID_CHECK(request.input < data.num_inputs() && request.output < data.num_outputs(),
+                "input column {} / output column {} do not exist (the data{} have {} input(s) "
+                "and {} output(s))",
+                request.input, request.output,
+                data.source().empty() ? "" : " of " + data.source(), data.num_inputs(),
+                data.num_outputs());
+  PNEUMID_CHECK(validation == nullptr || options.split == 0.0,
+                "give either held-out validation data or a split fraction ({}), not both",
+                options.split);
+  if (validation != nullptr) {
+    const std::string vsrc = validation->source().empty() ? "the validation data"
+                                                          : validation->source();
+    PNEUMID_CHECK(SameChannels(validation->input_channels(), data.input_channels()) &&
+                      SameChannels(validation->output_channels(), data.output_channels()),
+                  "{} have the channels inputs {} outputs {}, the estimation data inputs {} "
+                  "outputs {}",
+                  vsrc, ChannelNames(validation->input_channels()),
+                  ChannelNames(validation->output_channels()), ChannelNames(data.input_channels()),
+                  ChannelNames(data.output_channels()));
+    validation->RequireUniform();
+    PNEUMID_CHECK(std::abs(validation->SampleTime() - data.SampleTime()) <=
+                      1e-6 * data.SampleTime(),
+                  "{} are sampled at {} s, the estimation data at {} s", vsrc,
+                  validation->SampleTime(), data.SampleTime());
+  }
+
+  // The estimation part, and the held-out samples [score_from, N) of `scored`.
+  std::optional<Dataset> head;
+  const Dataset* scored = validation;
+  Eigen::Index score_from = 0;
+  if (options.split > 0.0) {
+    auto parts = SplitDataset(data, options.split);
+    head.emplace(std::move(parts.first));
+    scored = &data;
+    score_from = head->size();
+  }
+  const Dataset& estimation = head ? *head : data;
+
+  const std::size_t n = methods.size();
+  std::vector<std::optional<IdentifiedModel>> results(n);
+  std::vector<std::string> errors(n);
+  std::mutex progress_mutex;
+  std::size_t started = 0;
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t i = next++; i < n; i = next++) {
+      if (progress) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        progress(started++, n, methods[i]);
+      }
+      try {
+        IdentifiedModel m = Identify(methods[i], estimation, request, options);
+        m.flags = AssessModel(m, estimation, request.input, request.output, options.quality);
+        if (scored != nullptr) {
+          const FitMetrics f =
+              EvaluateModel(m, *scored, request.input, request.output, score_from);
+          m.validation_fit_percent = f.fit_percent;
+        }
+        results[i] = std::move(m);
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+      }
+    }
+  };
+  unsigned threads = options.num_threads > 0 ? static_cast<unsigned>(options.num_threads)
+                                             : std::max(1u, std::thread::hardware_concurrency());
+  threads = static_cast<unsigned>(std::min<std::size_t>(threads, n));
+  if (threads <= 1) {
+    work();
+  } else {
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work);
+    for (std::thread& t : pool) t.join();
+  }
+  if (progress) progress(n, n, "");
+
+  IdentificationSummary s;
+  s.estimation_samples = estimation.size();
+  s.validation_samples = scored == nullptr ? 0 : scored->size() - score_from;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (results[i]) {
+      s.models.push_back(std::move(*results[i]));
+    } else {
+      s.failures.emplace_back(methods[i], errors[i]);
+    }
+  }
+  RankModels(&s.models);
+  if (s.models.empty()) {
+    s.termination = Termination::kFailure;
+    s.message = fmt::format("no method produced a model ({} failed)", n);
+  } else if (!s.failures.empty()) {
+    s.termination = Termination::kPartial;
+    s.message = fmt::format("{} of {} methods failed", s.failures.size(), n);
+  } else {
+    s.termination = Termination::kSuccess;
+    s.message = fmt::format("all {} methods produced a model", n);
+  }
+  return s;
 }
 
 }  // namespace pneumid

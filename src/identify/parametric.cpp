@@ -9,6 +9,7 @@
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/iv.hpp"
+#include "pneumid/identify/model_evaluation.hpp"
 #include "pneumid/identify/nonparametric_freq.hpp"
 #include "pneumid/identify/pem.hpp"
 #include "pneumid/identify/subspace.hpp"
@@ -67,21 +68,20 @@ IdentifiedModel ToIdentifiedModel(const std::string& method, const PolynomialMod
   }
   r.discrete = model.ToTransferFunction(0);
   r.tf = ContinuousForm(*r.discrete, &r.notes);
-  Eigen::MatrixXd u(data.size(), model.num_inputs());
+  r.termination = summary.termination;
   if (model.num_inputs() == 1) {
-    u.col(0) = data.u(input);
+    ScoreModel(data, input, output, &r);
   } else {
-    u = data.inputs();
-  }
-  const Eigen::VectorXd y = data.y(output);
-  const Eigen::VectorXd yhat = Simulate(model, u);
-  if (yhat.allFinite()) {
-    r.fit_percent = NrmseFit(y, yhat);
-    r.iae = Iae(data.time(), y, yhat);
-  } else {
-    r.fit_percent = -std::numeric_limits<double>::infinity();
-    r.iae = std::numeric_limits<double>::infinity();
-    r.notes.push_back("the simulated model output diverges (unstable model)");
+    const Eigen::VectorXd y = data.y(output);
+    const Eigen::VectorXd yhat = Simulate(model, data.inputs());
+    if (yhat.allFinite()) {
+      r.fit_percent = NrmseFit(y, yhat);
+      r.iae = Iae(data.time(), y, yhat);
+    } else {
+      r.fit_percent = -std::numeric_limits<double>::infinity();
+      r.iae = std::numeric_limits<double>::infinity();
+      r.notes.push_back("the simulated model output diverges (unstable model)");
+    }
   }
   r.notes.push_back(summary.BriefReport());
   for (const auto& w : summary.warnings) r.notes.push_back(w);
@@ -117,25 +117,15 @@ IdentifiedModel FinishTransferFunctionModel(IdentifiedModel m, const TransferFun
   m.discrete = g;
   m.tf = g;
   if (try_d2c) m.tf = ContinuousForm(g, &m.notes);
-  const Eigen::VectorXd y = d.y(0);
-  Eigen::VectorXd yhat;
-  if (try_d2c) {
-    yhat = Lsim(g, d.u(0), g.Ts());
-  } else {
+  m.termination = summary.termination;
+  if (!try_d2c) {
     // Non-parametric estimates describe deviations from the mean operating
-    // point (they are computed from mean-removed signals): simulate those.
-    const Eigen::VectorXd du = d.u(0).array() - d.u(0).mean();
-    yhat = (Lsim(g, du, g.Ts()).array() + y.mean()).matrix();
+    // point (they are computed from mean-removed signals).
+    m.u0 = d.u(0).mean();
+    m.y0 = d.y(0).mean();
     m.notes.push_back("fit of the deviations from the mean input and output");
   }
-  if (yhat.allFinite()) {
-    m.fit_percent = NrmseFit(y, yhat);
-    m.iae = Iae(d.time(), y, yhat);
-  } else {
-    m.fit_percent = -std::numeric_limits<double>::infinity();
-    m.iae = std::numeric_limits<double>::infinity();
-    m.notes.push_back("the simulated model output diverges (unstable model)");
-  }
+  ScoreModel(d, 0, 0, &m);
   m.notes.push_back(summary.BriefReport());
   for (const auto& w : summary.warnings) m.notes.push_back(w);
   return m;
@@ -232,17 +222,37 @@ IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& dat
   m.structure = "FRD";
   m.params = ModelParamsFromJson(r.ToJson());
   const int K = static_cast<int>(r.response.size());
+  // Where the windowed input spectrum estimate is not positive (a step input
+  // has almost no power at high frequencies, and the Hann lag window's
+  // spectral window has negative side lobes, so the estimate can dip below
+  // zero there on long records) the frequency function is undefined (NaN in
+  // the FRD). The FIR model takes the nearest defined value at those
+  // frequencies instead of turning every tap into NaN.
+  Eigen::VectorXcd G = r.response;
+  int undefined = 0;
+  for (int k = 0; k < K; ++k) undefined += std::isfinite(G[k].real()) ? 0 : 1;
+  PNEUMID_CHECK(undefined < K, "spa: the input has no estimated power at any of the {} frequencies",
+                K);
+  for (int k = 1; k < K; ++k)
+    if (!std::isfinite(G[k].real()) && std::isfinite(G[k - 1].real())) G[k] = G[k - 1];
+  for (int k = K - 2; k >= 0; --k)
+    if (!std::isfinite(G[k].real())) G[k] = G[k + 1];
   const int taps = 2 * K;
   std::vector<double> g(taps, 0.0);
   // G(e^{i w}) on w_k = k pi / K, k = 1..K; k = 0 taken equal to k = 1 (real part).
   for (int n = 0; n < taps; ++n) {
-    double acc = r.response[0].real();
+    double acc = G[0].real();
     for (int k = 1; k < K; ++k)
-      acc += 2.0 * std::real(r.response[k - 1] * std::polar(1.0, M_PI * k * n / K));
-    acc += std::real(r.response[K - 1] * std::polar(1.0, M_PI * n));
+      acc += 2.0 * std::real(G[k - 1] * std::polar(1.0, M_PI * k * n / K));
+    acc += std::real(G[K - 1] * std::polar(1.0, M_PI * n));
     g[n] = acc / taps;
   }
   EstimationSummary s;
+  if (undefined > 0)
+    s.warnings.push_back(fmt::format(
+        "{} of {} frequencies have a non-positive input spectrum estimate (no excitation): the "
+        "FIR model holds the nearest estimated value there",
+        undefined, K));
   s.termination = EstimationTermination::kConvergence;
   s.message = fmt::format("Blackman-Tukey spectral analysis, Hann window, {} frequencies", K);
   return FinishTransferFunctionModel(

@@ -8,6 +8,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/areas.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/model_evaluation.hpp"
 #include "pneumid/identify/ptn.hpp"
 #include "pneumid/identify/reaction_curve.hpp"
 #include "pneumid/identify/sopdt.hpp"
@@ -70,22 +71,18 @@ Eigen::VectorXd SimulateOnData(const TransferFunction& g, const Dataset& data, i
       .matrix();
 }
 
-void ScoreModel(const Dataset& data, int input, int output, IdentifiedModel* model) {
-  PNEUMID_CHECK(model != nullptr, "ScoreModel: model must not be null");
-  const double y0 =
-      model->params.FindScalar("y0").value_or(std::numeric_limits<double>::quiet_NaN());
-  const TransferFunction& g = model->discrete ? *model->discrete : model->tf;
-  const Eigen::VectorXd yhat = SimulateOnData(g, data, input, output, y0);
-  const Eigen::VectorXd y = data.y(output);
-  if (!yhat.allFinite()) {
-    model->fit_percent = -std::numeric_limits<double>::infinity();
-    model->iae = std::numeric_limits<double>::infinity();
-    model->notes.push_back("the simulated response is not finite (unstable model?)");
-    return;
-  }
-  model->fit_percent = NrmseFit(y, yhat);
-  model->iae = Iae(data.time(), y, yhat);
+namespace {
+
+// The operating point of a step-response model: the input before its first
+// change and the output's mean there (or the offset a process fit estimated).
+void SetOperatingPoint(const Dataset& data, int input, int output, IdentifiedModel* m) {
+  const Eigen::VectorXd u = data.u(input), y = data.y(output);
+  const auto [u0, k0] = InitialInput(u);
+  m->u0 = u0;
+  m->y0 = m->params.FindScalar("y0").value_or(k0 > 0 ? y.head(k0).mean() : y[0]);
 }
+
+}  // namespace
 
 IdentifiedModel IdentifyStepMethod(const std::string& method, const Dataset& data,
                                    const IdentifyRequest& request,
@@ -116,6 +113,8 @@ IdentifiedModel IdentifyStepMethod(const std::string& method, const Dataset& dat
     if (!r.summary.covariance_ok) {
       m.notes.push_back("parameter standard deviations unavailable (singular Jacobian)");
     }
+    m.termination = r.summary.termination;
+    SetOperatingPoint(data, in, out, &m);
     ScoreModel(data, in, out, &m);
     return m;
   }
@@ -189,6 +188,7 @@ IdentifiedModel IdentifyStepMethod(const std::string& method, const Dataset& dat
     m.params["A2"] = a.A2;
     m.params["A3"] = a.A3;
   }
+  SetOperatingPoint(data, in, out, &m);
   ScoreModel(data, in, out, &m);
   return m;
 }

@@ -8,6 +8,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/model_evaluation.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {
@@ -129,7 +130,16 @@ Figure ModelComparisonFigure(const Dataset& data, const std::vector<NamedModel>&
   int k = 0;
   const bool fit_defined = (y.array() != y[0]).any();
   for (const auto& m : models) {
-    const Eigen::VectorXd yhat = SimulateOnData(m.model, data, options.input, options.output);
+    Eigen::VectorXd yhat;
+    if (std::isfinite(m.u0) && std::isfinite(m.y0)) {
+      IdentifiedModel im;
+      im.tf = m.model;
+      im.u0 = m.u0;
+      im.y0 = m.y0;
+      yhat = SimulateModel(im, data, options.input);
+    } else {
+      yhat = SimulateOnData(m.model, data, options.input, options.output);
+    }
     std::string label = m.label;
     if (options.show_fit && fit_defined) label += fmt::format(" (fit {:.1f} %)", NrmseFit(y, yhat));
     Curve& s = ax.AddLine(t, yhat, label, k % 2 == 0 ? LineStyle::kSolid : LineStyle::kDashed);

@@ -90,14 +90,10 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
   if (ec) throw DataError(dir + ": cannot create the directory: " + ec.message());
 
   ReportSummary summary;
-  for (const auto& method : options.methods) {
-    try {
-      summary.models.push_back(Identify(method, data, options.request));
-    } catch (const InvalidArgument& e) {
-      summary.failures.emplace_back(method, e.what());
-    } catch (const DataError& e) {
-      summary.failures.emplace_back(method, e.what());
-    }
+  {
+    const IdentificationSummary ids = IdentifyModels(options.methods, data, options.request);
+    summary.models = ids.models;
+    summary.failures = ids.failures;
   }
 
   const std::string source = data.source().empty() ? "(in-memory data)" : data.source();
@@ -154,22 +150,22 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
     Table mt;
     mt.caption = "Fit to the data (model simulated on the measured input)";
     mt.header = {"method", "NRMSE fit [%]", "IAE [" + (yc.unit.empty() ? "" : yc.unit + " ") + "s]",
-                 "RMSE",   "max |error|",   "notes"};
+                 "RMSE",   "max |error|",   "flags", "notes"};
     for (const auto& m : summary.models) {
       FitMetrics fm;
       fm.fit_percent = m.fit_percent;
       fm.iae = m.iae;
       fm.rmse = fm.max_abs_error = std::numeric_limits<double>::quiet_NaN();
       try {
-        const TransferFunction& g = m.discrete ? *m.discrete : m.tf;
-        const Eigen::VectorXd yhat = SimulateOnData(g, data, in, out);
-        if (yhat.allFinite()) fm = ComputeFitMetrics(data.time(), data.y(out), yhat);
+        fm = EvaluateModel(m, data, in, out);
       } catch (const InvalidArgument&) {
       }
-      std::string notes;
+      std::string flags, notes;
+      for (const auto& f : m.flags)
+        flags += (flags.empty() ? "" : "; ") + ToString(f.flag) + ": " + f.reason;
       for (const auto& n : m.notes) notes += (notes.empty() ? "" : "; ") + n;
-      mt.rows.push_back(
-          {m.method, Num(fm.fit_percent), Num(fm.iae), Num(fm.rmse), Num(fm.max_abs_error), notes});
+      mt.rows.push_back({m.method, Num(fm.fit_percent), Num(fm.iae), Num(fm.rmse),
+                         Num(fm.max_abs_error), flags.empty() ? "-" : flags, notes});
     }
     doc.AddTable(mt);
   }
@@ -182,10 +178,25 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
 
   // Figures.
   if (!summary.models.empty()) {
-    std::vector<NamedModel> named;
+    // Every model is compared with the data; the step and frequency responses
+    // leave out models flagged unstable, not finite or with a Nyquist pole,
+    // whose responses are not the plant's (and would set the axes).
+    std::vector<NamedModel> named, trusted;
+    std::vector<std::string> left_out;
     for (const auto& m : summary.models) {
-      named.push_back({m.method + " (" + m.structure + ")", m.discrete ? *m.discrete : m.tf});
+      NamedModel nm{m.method + " (" + m.structure + ")", m.discrete ? *m.discrete : m.tf, m.u0,
+                    m.y0};
+      named.push_back(nm);
+      if (RankGroup(m) < 2) {
+        trusted.push_back(nm);
+      } else {
+        left_out.push_back(m.method);
+      }
     }
+    const std::string left_out_text =
+        left_out.empty() ? ""
+                         : fmt::format(" Left out (flagged, see the fit table): {}.",
+                                       fmt::join(left_out, ", "));
     doc.AddHeading("Figures");
     ComparisonFigureOptions co;
     co.labels = labels;
@@ -206,25 +217,22 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
     }
     so.amplitude = du;
     so.t_final = data.time()[data.size() - 1] - data.time()[0];
-    doc.AddFigure(
-        StepResponseFigure(named, so),
-        fmt::format("Responses of the models to an input step of {} (input units).", Num(du)));
+    if (!trusted.empty()) {
+      doc.AddFigure(StepResponseFigure(trusted, so),
+                    fmt::format("Responses of the models to an input step of {} (input units).{}",
+                                Num(du), left_out_text));
+      doc.AddFigure(BodeFigure(trusted), "Frequency responses of the models." + left_out_text);
+    }
 
-    doc.AddFigure(BodeFigure(named), "Frequency responses of the models.");
-
-    // Residuals of the best model.
-    const auto best = std::max_element(summary.models.begin(), summary.models.end(),
-                                       [](const IdentifiedModel& a, const IdentifiedModel& b) {
-                                         return a.fit_percent < b.fit_percent;
-                                       });
+    // Residuals of the best model (the first of the ranking).
+    const auto best = summary.models.begin();
     try {
-      const TransferFunction& g = best->discrete ? *best->discrete : best->tf;
-      const Eigen::VectorXd e = data.y(out) - SimulateOnData(g, data, in, out);
+      const Eigen::VectorXd e = data.y(out) - SimulateModel(*best, data, in);
       const int lag = std::min<int>(options.residual_max_lag, static_cast<int>(data.size()) - 2);
       const ResidualCorrelation rc =
           ComputeResidualCorrelation(e, data.u(in), lag, options.residual_confidence);
       doc.AddFigure(ResidualFigure(rc, "Residuals of " + best->method),
-                    fmt::format("Residual analysis of the best model ({}): {:.0f} % of the "
+                    fmt::format("Residual analysis of the best-ranked model ({}): {:.0f} % of the "
                                 "autocorrelation lags and {:.0f} % of the cross-correlation "
                                 "lags lie outside the {:g} % band.",
                                 best->method, 100.0 * rc.auto_outside, 100.0 * rc.cross_outside,

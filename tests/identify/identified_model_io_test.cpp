@@ -44,9 +44,47 @@ TEST(IdentifiedModelIoTest, ReadsAndWritesTheModelFileForm) {
   EXPECT_DOUBLE_EQ(m.param_std.Scalar("K"), 0.01);
   ASSERT_TRUE(m.discrete.has_value());
   EXPECT_EQ(m.notes, std::vector<std::string>{"a note"});
-  // Written back: the same keys and values (integers stay integers).
-  EXPECT_EQ(ToJson(m), written);
+  // Written back: the same keys and values (integers stay integers), plus the
+  // keys added since: operating point, termination and flags, with the values
+  // an older file implies.
+  nlohmann::json expected = written;
+  expected["operating_point"] = {{"u0", 0.0}, {"y0", 0.0}};
+  expected["termination"] = "convergence";
+  expected["flags"] = nlohmann::json::array();
+  EXPECT_EQ(ToJson(m), expected);
   EXPECT_EQ(ToJson(m)["params"]["nk"].dump(), "1");
+}
+
+TEST(IdentifiedModelIoTest, RoundTripsOperatingPointFlagsAndValidationFit) {
+  IdentifiedModel m;
+  m.method = "fit-p1d";
+  m.structure = "P1D";
+  m.params = {{"K", 1.5}, {"y0", 0.25}};
+  m.tf = TransferFunction::Fopdt(1.5, 0.2, 0.01);
+  m.u0 = 0.61;
+  m.y0 = 0.25;
+  m.termination = Termination::kNoConvergence;
+  m.validation_fit_percent = 88.5;
+  m.flags = {{ModelFlag::kNyquistPole, "pole at z = -0.97"},
+             {ModelFlag::kResidualsNotWhite, "Q = 80 > 44"}};
+  const IdentifiedModel back = IdentifiedModelFromJson(ToJson(m));
+  EXPECT_EQ(back.u0, 0.61);
+  EXPECT_EQ(back.y0, 0.25);
+  EXPECT_EQ(back.termination, Termination::kNoConvergence);
+  EXPECT_EQ(back.validation_fit_percent, 88.5);
+  EXPECT_EQ(back.flags, m.flags);
+  // A file without an operating point takes y0 from a process model's offset.
+  nlohmann::json old = ToJson(m);
+  old.erase("operating_point");
+  EXPECT_EQ(IdentifiedModelFromJson(old).y0, 0.25);
+  EXPECT_EQ(IdentifiedModelFromJson(old).u0, 0.0);
+  old["flags"] = {{{"flag", "bogus"}}};
+  EXPECT_THAT([&] { IdentifiedModelFromJson(old); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("unknown model flag 'bogus'")));
+  old["flags"] = nlohmann::json::array();
+  old["operating_point"] = {{"u0", "x"}};
+  EXPECT_THAT([&] { IdentifiedModelFromJson(old); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("operating_point.u0")));
 }
 
 TEST(IdentifiedModelIoTest, ModelFilesOfIdentifyStayReadableAsModelSpecs) {

@@ -9,12 +9,14 @@
 #pragma once
 
 #include <initializer_list>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/subspace.hpp"
 #include "pneumid/lti/transfer_function.hpp"
@@ -58,6 +60,26 @@ class ModelParams {
   Map values_;
 };
 
+/// Why a model should not be trusted (model_evaluation.hpp decides and ranks
+/// flagged models after unflagged ones).
+enum class ModelFlag {
+  kNotFinite,         ///< "not_finite": the simulated output is not finite
+  kUnstable,          ///< "unstable": a pole outside the stability region
+  kNyquistPole,       ///< "nyquist_pole": a discrete pole near z = -1 (ripple aliased to Nyquist)
+  kNoConvergence,     ///< "no_convergence": the iterative estimator did not converge
+  kResidualsNotWhite  ///< "residuals_not_white": residual whiteness test failed
+};
+std::string ToString(ModelFlag f);
+/// Inverse of ToString. @throws InvalidArgument listing the valid names.
+ModelFlag ModelFlagFromString(const std::string& name);
+
+/// A flag and the measured reason ("pole at z = -0.962, 0.038 from -1").
+struct ModelFlagNote {
+  ModelFlag flag = ModelFlag::kNotFinite;
+  std::string reason;
+  bool operator==(const ModelFlagNote&) const = default;
+};
+
 struct IdentifiedModel {
   std::string method;     ///< e.g. "reaction-curve", "fit-p1d", "arx"
   std::string structure;  ///< e.g. "FOPDT", "PTn", "P2D", "ARX"
@@ -68,6 +90,20 @@ struct IdentifiedModel {
   double fit_percent = 0.0;  ///< NRMSE fit, MATLAB compare: 100 (1 - |y - yhat| / |y - mean y|)
   double iae = 0.0;          ///< integral of |y - yhat| dt over the data (output units * s)
   std::vector<std::string> notes;  ///< warnings (poor excitation, not converged, ...)
+  /// Operating point of the model: on data it predicts y0 + G (u - u0) from a
+  /// state at rest (model_evaluation.hpp, SimulateModel). Step-response
+  /// methods take u0 and y0 from the level before the step (process fits
+  /// estimate y0), the polynomial and state-space methods model the signals
+  /// as they are (0, 0), the correlation methods their means.
+  double u0 = 0.0;
+  double y0 = 0.0;
+  /// How the estimator ended (kNoConvergence: the last iterate is returned).
+  Termination termination = Termination::kConvergence;
+  /// NRMSE fit on held-out validation data (NaN when none were given); the
+  /// ranking uses it instead of fit_percent when present.
+  double validation_fit_percent = std::numeric_limits<double>::quiet_NaN();
+  /// Reasons not to trust the model (empty: none found).
+  std::vector<ModelFlagNote> flags;
 };
 
 /// Options shared by every method of `pneumid identify`.

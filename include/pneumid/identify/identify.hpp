@@ -13,11 +13,16 @@
 // data it was identified from (fit_percent, iae).
 #pragma once
 
+#include <cstddef>
+#include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/identified_model.hpp"
+#include "pneumid/identify/model_evaluation.hpp"
 #include "pneumid/identify/step_methods.hpp"
 
 namespace pneumid {
@@ -27,6 +32,15 @@ struct IdentifyOptions {
   /// Step analysis, tangent and fit-* settings of the step-response methods
   /// (the parametric methods take their orders from the request only).
   StepMethodOptions step;
+  /// Flags that rank a model after the trusted ones (IdentifyModels).
+  ModelQualityOptions quality;
+  /// Held-out split for IdentifyModels: the first `split` fraction of the
+  /// samples estimates, the rest validates (models simulated over the whole
+  /// record, scored on the rest). 0 (default) = no split; else in (0, 1).
+  double split = 0.0;
+  /// Worker threads of IdentifyModels (methods run side by side); 0 = one per
+  /// hardware thread. Results do not depend on it.
+  int num_threads = 0;
   bool IsValid(std::string* error) const;
 };
 
@@ -51,5 +65,40 @@ std::vector<std::string> ParseMethodList(const std::string& list);
 ///         not uniformly sampled, ...).
 IdentifiedModel Identify(const std::string& method, const Dataset& data,
                          const IdentifyRequest& request = {}, const IdentifyOptions& options = {});
+
+/// Result of IdentifyModels (after Ceres' Solver::Summary).
+struct IdentificationSummary {
+  /// The models, ranked best first (RankModels): unflagged models by their
+  /// validation fit (held-out data) or else estimation fit, then flagged ones.
+  std::vector<IdentifiedModel> models;
+  /// Methods that gave no model: (method, reason).
+  std::vector<std::pair<std::string, std::string>> failures;
+  Eigen::Index estimation_samples = 0;  ///< samples the models were estimated on
+  Eigen::Index validation_samples = 0;  ///< held-out samples scored (0: none)
+  /// kSuccess: every method gave a model; kPartial: some failed; kFailure: none gave one.
+  Termination termination = Termination::kFailure;
+  std::string message;
+  /// One line: "identify success: 22 model(s), 0 failed, best fit-p2d (99.1 %)".
+  std::string BriefReport() const;
+};
+
+/// Called before each method starts and once at the end (done == total).
+using IdentifyProgress =
+    std::function<void(std::size_t done, std::size_t total, const std::string& method)>;
+
+/// Runs each method on `data` (the first options.split of it when splitting);
+/// a method that fails is listed in failures with its reason and the others
+/// still run. Each model is flagged (AssessModel on the estimation data),
+/// scored on the held-out data when given (`validation`, scored from its first
+/// sample with the model at rest at its operating point; or the split's rest),
+/// and the list is ranked.
+/// @throws InvalidArgument for an empty method list, an unknown method, invalid
+///         request/options, a split together with a validation dataset, or a
+///         validation dataset whose channels differ from the data's.
+IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, const Dataset& data,
+                                     const IdentifyRequest& request = {},
+                                     const IdentifyOptions& options = {},
+                                     const Dataset* validation = nullptr,
+                                     const IdentifyProgress& progress = {});
 
 }  // namespace pneumid

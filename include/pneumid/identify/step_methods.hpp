@@ -64,8 +64,5 @@ Eigen::VectorXd SimulateOnData(const TransferFunction& g, const Dataset& data, i
                                int output = 0,
                                double y0 = std::numeric_limits<double>::quiet_NaN());
 
-/// Sets model->fit_percent and model->iae from its simulation on the data
-/// (uses model->discrete when set, model->tf otherwise).
-void ScoreModel(const Dataset& data, int input, int output, IdentifiedModel* model);
 
 }  // namespace pneumid

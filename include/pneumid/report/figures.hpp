@@ -40,6 +40,10 @@ namespace pneumid {
 struct NamedModel {
   std::string label;
   TransferFunction model;
+  /// Operating point for simulations on data (IdentifiedModel::u0, y0):
+  /// y0 + G (u - u0). NaN (default): the levels before the first input change.
+  double u0 = std::numeric_limits<double>::quiet_NaN();
+  double y0 = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Labels shared by the figures (with units).

@@ -1,0 +1,191 @@
+#include "pneumid/identify/model_evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/parametric_model.hpp"
+#include "pneumid/identify/residual_analysis.hpp"
+#include "pneumid/lti/response.hpp"
+
+namespace pneumid {
+
+namespace {
+
+const TransferFunction& SimulatedForm(const IdentifiedModel& m) {
+  return m.discrete ? *m.discrete : m.tf;
+}
+
+std::string Complex(std::complex<double> z) {
+  if (std::abs(z.imag()) < 1e-12 * std::max(1.0, std::abs(z.real())))
+    return fmt::format("{:.4g}", z.real());
+  return fmt::format("{:.4g}{:+.4g}i", z.real(), z.imag());
+}
+
+bool IsPolynomial(const IdentifiedModel& m) {
+  return m.params.contains("a") && m.params.contains("b") && m.params.contains("Ts");
+}
+
+}  // namespace
+
+Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input) {
+  PNEUMID_CHECK(input >= 0 && input < data.num_inputs(),
+                "input column {} does not exist (the data have {} input(s))", input,
+                data.num_inputs());
+  const TransferFunction& g = SimulatedForm(model);
+  const double Ts = data.SampleTime();
+  if (g.IsDiscrete()) {
+    PNEUMID_CHECK(std::abs(g.Ts() - Ts) <= 1e-6 * Ts,
+                  "the model '{}' has sample time {} s, the data{} {} s", model.method, g.Ts(),
+                  data.source().empty() ? "" : " of " + data.source(), Ts);
+  }
+  const Eigen::VectorXd du = (data.u(input).array() - model.u0).matrix();
+  const Eigen::VectorXd y = g.IsDiscrete()
+                                ? Lsim(TransferFunction(g.num(), g.den(), Ts, g.delay()), du, Ts)
+                                : Lsim(g, du, Ts);
+  return (y.array() + model.y0).matrix();
+}
+
+FitMetrics EvaluateModel(const IdentifiedModel& model, const Dataset& data, int input, int output,
+                         Eigen::Index score_from) {
+  PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
+                "output column {} does not exist (the data have {} output(s))", output,
+                data.num_outputs());
+  PNEUMID_CHECK(score_from >= 0 && score_from + 2 <= data.size(),
+                "the scored samples must start in [0, {}], got {}", data.size() - 2, score_from);
+  const Eigen::VectorXd yhat = SimulateModel(model, data, input);
+  const Eigen::Index n = data.size() - score_from;
+  if (!yhat.tail(n).allFinite()) {
+    const double inf = std::numeric_limits<double>::infinity();
+    return FitMetrics{-inf, inf, inf, inf};
+  }
+  return ComputeFitMetrics(data.time().tail(n), data.y(output).tail(n), yhat.tail(n));
+}
+
+void ScoreModel(const Dataset& data, int input, int output, IdentifiedModel* model) {
+  PNEUMID_CHECK(model != nullptr, "ScoreModel: model must not be null");
+  const FitMetrics f = EvaluateModel(*model, data, input, output);
+  model->fit_percent = f.fit_percent;
+  model->iae = f.iae;
+  if (!std::isfinite(f.fit_percent))
+    model->notes.push_back("the simulated response is not finite (unstable model?)");
+}
+
+bool ModelQualityOptions::IsValid(std::string* error) const {
+  auto fail = [error](std::string m) {
+    if (error) *error = std::move(m);
+    return false;
+  };
+  if (!(nyquist_distance >= 0.0 && nyquist_distance < 1.0))
+    return fail(fmt::format("ModelQualityOptions::nyquist_distance must be in [0, 1), got {}",
+                            nyquist_distance));
+  if (!(confidence > 0.0 && confidence < 1.0))
+    return fail(
+        fmt::format("ModelQualityOptions::confidence must be in (0, 1), got {}", confidence));
+  if (max_lag < 1)
+    return fail(fmt::format("ModelQualityOptions::max_lag must be >= 1, got {}", max_lag));
+  return true;
+}
+
+std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Dataset& data,
+                                       int input, int output, const ModelQualityOptions& options) {
+  std::string why;
+  PNEUMID_CHECK(options.IsValid(&why), "{}", why);
+  std::vector<ModelFlagNote> flags;
+  const TransferFunction& g = SimulatedForm(model);
+  const Eigen::VectorXcd poles = g.Poles();
+  const double tol = 1e-9;
+  for (Eigen::Index i = 0; i < poles.size(); ++i) {
+    const std::complex<double> p = poles[i];
+    const bool unstable = g.IsDiscrete() ? std::abs(p) > 1.0 + tol : p.real() > tol;
+    if (unstable) {
+      flags.push_back({ModelFlag::kUnstable, fmt::format("pole at {} = {}{}",
+                                                         g.IsDiscrete() ? "z" : "s", Complex(p),
+                                                         g.IsDiscrete() ? fmt::format(
+                                                                              " (|z| = {:.4g})",
+                                                                              std::abs(p))
+                                                                        : "")});
+      break;
+    }
+  }
+  if (g.IsDiscrete() && options.nyquist_distance > 0.0) {
+    for (Eigen::Index i = 0; i < poles.size(); ++i) {
+      const double d = std::abs(poles[i] + 1.0);
+      if (d <= options.nyquist_distance) {
+        flags.push_back({ModelFlag::kNyquistPole,
+                         fmt::format("pole at z = {}, {:.3g} from z = -1 (a ripple at the "
+                                     "Nyquist frequency {:g} Hz, not plant dynamics)",
+                                     Complex(poles[i]), d, 0.5 / g.Ts())});
+        break;
+      }
+    }
+  }
+  if (model.termination == Termination::kNoConvergence ||
+      model.termination == Termination::kFailure) {
+    flags.push_back({ModelFlag::kNoConvergence,
+                     fmt::format("the estimator ended with '{}'", ToString(model.termination))});
+  }
+  const Eigen::VectorXd yhat = SimulateModel(model, data, input);
+  if (!yhat.allFinite()) {
+    flags.push_back({ModelFlag::kNotFinite, "the simulated output is not finite"});
+    return flags;
+  }
+  ResidualAnalysisOptions ro;
+  ro.max_lag = std::min<int>(options.max_lag, static_cast<int>(data.size() / 2) - 1);
+  ro.confidence = options.confidence;
+  if (ro.max_lag < 1) return flags;
+  try {
+    ResidualAnalysis r;
+    const bool noise_model = IsPolynomial(model) && model.structure != "OE";
+    if (noise_model) {
+      const PolynomialModel poly =
+          PolynomialModel::FromParamsJson(ToJson(model.params), model.structure);
+      r = AnalyzeResiduals(poly, data, ro, input, output);
+    } else {
+      r = AnalyzeResiduals(data.y(output) - yhat, data.u(input), ro);
+    }
+    if (!r.whiteness_passed) {
+      flags.push_back(
+          {ModelFlag::kResidualsNotWhite,
+           fmt::format("{} errors not white: Q = {:.4g} > {:.4g} ({:g} % level), {} of {} lags "
+                       "outside the band",
+                       noise_model ? "one-step prediction" : "simulation", r.whiteness_statistic,
+                       r.whiteness_threshold, 100.0 * options.confidence, r.auto_outside,
+                       r.autocorr.size() - 1)});
+    }
+  } catch (const InvalidArgument&) {
+    // constant residuals or input: the test is undefined, nothing to flag
+  }
+  return flags;
+}
+
+int RankGroup(const IdentifiedModel& model) {
+  if (model.flags.empty()) return 0;
+  const bool only_residuals =
+      std::all_of(model.flags.begin(), model.flags.end(),
+                  [](const ModelFlagNote& f) { return f.flag == ModelFlag::kResidualsNotWhite; });
+  return only_residuals ? 1 : 2;
+}
+
+double RankScore(const IdentifiedModel& model) {
+  const double s =
+      std::isfinite(model.validation_fit_percent) ? model.validation_fit_percent : model.fit_percent;
+  return std::isnan(s) ? -std::numeric_limits<double>::infinity() : s;
+}
+
+void RankModels(std::vector<IdentifiedModel>* models) {
+  PNEUMID_CHECK(models != nullptr, "RankModels: models must not be null");
+  std::stable_sort(models->begin(), models->end(),
+                   [](const IdentifiedModel& a, const IdentifiedModel& b) {
+                     const int ga = RankGroup(a), gb = RankGroup(b);
+                     if (ga != gb) return ga < gb;
+                     return RankScore(a) > RankScore(b);
+                   });
+}
+
+}  // namespace pneumid

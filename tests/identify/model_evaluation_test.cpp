@@ -1,0 +1,225 @@
+// Simulation around the operating point, the fit on held-out samples, the
+// quality flags and the ranking (model_evaluation.hpp).
+#include "pneumid/identify/model_evaluation.hpp"
+
+#include <cmath>
+#include <random>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/identify.hpp"
+#include "pneumid/identify/validation.hpp"
+#include "step_test_util.hpp"
+
+namespace pneumid {
+namespace {
+
+using ::testing::HasSubstr;
+
+IdentifiedModel Discrete(const Eigen::VectorXd& num, const Eigen::VectorXd& den, double Ts) {
+  IdentifiedModel m;
+  m.method = "test";
+  m.tf = TransferFunction(num, den, Ts);
+  m.discrete = m.tf;
+  return m;
+}
+
+bool HasFlag(const std::vector<ModelFlagNote>& flags, ModelFlag f) {
+  for (const auto& x : flags)
+    if (x.flag == f) return true;
+  return false;
+}
+
+TEST(ModelEvaluationTest, SimulatesAroundTheOperatingPoint) {
+  // y = y0 + K (1 - exp(-t / tau)) (u1 - u0) after a step at t = 0 (ZOH is exact
+  // for a piecewise-constant input at the sample instants).
+  const double K = 2.0, tau = 0.5, Ts = 0.01, u0 = 10.0, u1 = 30.0, y0 = 5.0;
+  const int N = 300;
+  Eigen::VectorXd u = Eigen::VectorXd::Constant(N, u1);
+  const Dataset d = Dataset::FromUniform(Ts, u, Eigen::VectorXd::Zero(N));
+  IdentifiedModel m;
+  m.tf = TransferFunction::Fopdt(K, tau, 0.0);
+  m.u0 = u0;
+  m.y0 = y0;
+  const Eigen::VectorXd yhat = SimulateModel(m, d);
+  for (int k = 0; k < N; ++k) {
+    const double expected = y0 + K * (u1 - u0) * (1.0 - std::exp(-k * Ts / tau));
+    ASSERT_NEAR(yhat[k], expected, 1e-9) << k;
+  }
+}
+
+TEST(ModelEvaluationTest, ScoresOnlyTheHeldOutSamples) {
+  const TransferFunction g = TransferFunction::Fopdt(1.5, 0.3, 0.05);
+  Dataset d = testing::MakeStepData(g, 0.01, 50, 400, 2.0, 7.0, 0.05, 3, 1.0);
+  IdentifiedModel m;
+  m.tf = g;
+  m.u0 = 2.0;
+  m.y0 = 1.0;
+  const Eigen::VectorXd yhat = SimulateModel(m, d);
+  const FitMetrics f = EvaluateModel(m, d, 0, 0, 100);
+  EXPECT_DOUBLE_EQ(f.fit_percent, NrmseFit(d.y(0).tail(300), yhat.tail(300)));
+  EXPECT_DOUBLE_EQ(f.rmse, Rmse(d.y(0).tail(300), yhat.tail(300)));
+  EXPECT_THROW(EvaluateModel(m, d, 0, 0, 399), InvalidArgument);
+  EXPECT_THROW(EvaluateModel(m, d, 1, 0), InvalidArgument);
+}
+
+TEST(ModelEvaluationTest, DiscreteModelNeedsTheDataSampleTime) {
+  const Dataset d = Dataset::FromUniform(0.01, Eigen::VectorXd::Ones(10), Eigen::VectorXd::Ones(10));
+  const IdentifiedModel m = Discrete(Eigen::Vector2d(0, 0.1), Eigen::Vector2d(1, -0.9), 0.02);
+  EXPECT_THAT([&] { SimulateModel(m, d); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("sample time 0.02 s")));
+}
+
+// y(t) = 0.9 y(t-1) + 0.5 u(t-1) + e(t): an ARX model whose prediction errors are white.
+Dataset ArxData(int N, double noise, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::VectorXd u(N), y(N);
+  double prev_y = 0.0, prev_u = 0.0;
+  for (int k = 0; k < N; ++k) {
+    u[k] = n(gen) > 0 ? 1.0 : -1.0;
+    y[k] = 0.9 * prev_y + 0.5 * prev_u + noise * n(gen);
+    prev_y = y[k];
+    prev_u = u[k];
+  }
+  return Dataset::FromUniform(0.1, u, y);
+}
+
+TEST(ModelEvaluationTest, FlagsPolesNearMinusOneAndOutsideTheUnitCircle) {
+  const Dataset d = ArxData(500, 0.1, 1);
+  const IdentifiedModel nyq = Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, 0.96), 0.1);
+  auto flags = AssessModel(nyq, d);
+  ASSERT_TRUE(HasFlag(flags, ModelFlag::kNyquistPole));
+  EXPECT_FALSE(HasFlag(flags, ModelFlag::kUnstable));
+  // 0.04 from -1 is inside the default 0.05, outside a distance of 0.03.
+  ModelQualityOptions o;
+  o.nyquist_distance = 0.03;
+  EXPECT_FALSE(HasFlag(AssessModel(nyq, d, 0, 0, o), ModelFlag::kNyquistPole));
+
+  const IdentifiedModel unstable = Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -1.05), 0.1);
+  flags = AssessModel(unstable, d);
+  EXPECT_TRUE(HasFlag(flags, ModelFlag::kUnstable));
+  // An integrator (pole at z = 1) is not unstable in this sense.
+  const IdentifiedModel integrator = Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -1.0), 0.1);
+  EXPECT_FALSE(HasFlag(AssessModel(integrator, d), ModelFlag::kUnstable));
+}
+
+TEST(ModelEvaluationTest, ResidualWhitenessSeparatesTheTrueModelFromAWrongOne) {
+  const Dataset d = ArxData(2000, 0.2, 7);
+  IdentifiedModel truth = Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -0.9), 0.1);
+  truth.structure = "ARX";
+  truth.params = {{"a", std::vector<double>{1, -0.9}}, {"b", std::vector<double>{0, 0.5}},
+                  {"nk", 1}, {"Ts", 0.1}};
+  EXPECT_FALSE(HasFlag(AssessModel(truth, d), ModelFlag::kResidualsNotWhite));
+  IdentifiedModel wrong = truth;
+  wrong.params = {{"a", std::vector<double>{1, -0.5}}, {"b", std::vector<double>{0, 0.5}},
+                  {"nk", 1}, {"Ts", 0.1}};
+  wrong.tf = TransferFunction(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -0.5), 0.1);
+  wrong.discrete = wrong.tf;
+  const auto flags = AssessModel(wrong, d);
+  ASSERT_TRUE(HasFlag(flags, ModelFlag::kResidualsNotWhite));
+  EXPECT_THAT(flags.back().reason, HasSubstr("one-step prediction errors not white"));
+}
+
+TEST(ModelEvaluationTest, FlagsAnEstimatorThatDidNotConverge) {
+  const Dataset d = ArxData(300, 0.1, 2);
+  IdentifiedModel m = Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -0.9), 0.1);
+  m.termination = Termination::kNoConvergence;
+  EXPECT_TRUE(HasFlag(AssessModel(m, d), ModelFlag::kNoConvergence));
+  ModelQualityOptions bad;
+  bad.confidence = 1.0;
+  EXPECT_THROW(AssessModel(m, d, 0, 0, bad), InvalidArgument);
+}
+
+TEST(ModelEvaluationTest, RanksUnflaggedModelsFirstThenByValidationFit) {
+  auto make = [](std::string name, double fit, double val, std::vector<ModelFlag> flags) {
+    IdentifiedModel m;
+    m.method = std::move(name);
+    m.fit_percent = fit;
+    m.validation_fit_percent = val;
+    for (ModelFlag f : flags) m.flags.push_back({f, ""});
+    return m;
+  };
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  std::vector<IdentifiedModel> ms = {
+      make("nyquist", 99.0, none, {ModelFlag::kNyquistPole}),
+      make("colored", 97.0, none, {ModelFlag::kResidualsNotWhite}),
+      make("clean-low", 60.0, none, {}),
+      make("clean-high", 90.0, none, {}),
+  };
+  RankModels(&ms);
+  std::vector<std::string> order;
+  for (const auto& m : ms) order.push_back(m.method);
+  EXPECT_THAT(order, ::testing::ElementsAre("clean-high", "clean-low", "colored", "nyquist"));
+
+  std::vector<IdentifiedModel> v = {make("a", 99.0, 50.0, {}), make("b", 80.0, 70.0, {})};
+  RankModels(&v);
+  EXPECT_EQ(v.front().method, "b");  // the validation fit decides, not the estimation fit
+}
+
+TEST(IdentifyModelsTest, AFailingMethodDoesNotStopTheOthers) {
+  // A PRBS record has no single step: the step-response methods fail, ARX works.
+  const Dataset d = ArxData(400, 0.05, 3);
+  const IdentificationSummary s = IdentifyModels({"reaction-curve", "arx", "tangent"}, d);
+  ASSERT_EQ(s.models.size(), 1u);
+  EXPECT_EQ(s.models.front().method, "arx");
+  ASSERT_EQ(s.failures.size(), 2u);
+  EXPECT_EQ(s.failures[0].first, "reaction-curve");
+  EXPECT_FALSE(s.failures[0].second.empty());
+  EXPECT_EQ(s.termination, Termination::kPartial);
+
+  const IdentificationSummary none = IdentifyModels({"reaction-curve"}, d);
+  EXPECT_TRUE(none.models.empty());
+  EXPECT_EQ(none.termination, Termination::kFailure);
+}
+
+TEST(IdentifyModelsTest, SplitScoresTheTailOfOneSimulation) {
+  const Dataset d = ArxData(1000, 0.1, 4);
+  IdentifyOptions o;
+  o.split = 0.7;
+  o.num_threads = 1;
+  const IdentificationSummary s = IdentifyModels({"arx"}, d, {}, o);
+  ASSERT_EQ(s.models.size(), 1u);
+  EXPECT_EQ(s.estimation_samples, 700);
+  EXPECT_EQ(s.validation_samples, 300);
+  const IdentifiedModel& m = s.models.front();
+  EXPECT_DOUBLE_EQ(m.validation_fit_percent, EvaluateModel(m, d, 0, 0, 700).fit_percent);
+  // Estimated on the first 70 % only.
+  EXPECT_DOUBLE_EQ(m.fit_percent,
+                   Identify("arx", SliceDataset(d, 0, 700)).fit_percent);
+}
+
+TEST(IdentifyModelsTest, ThreadsDoNotChangeTheResult) {
+  const Dataset d = ArxData(600, 0.1, 5);
+  IdentifyOptions one, two;
+  one.num_threads = 1;
+  two.num_threads = 2;
+  const auto a = IdentifyModels({"arx", "oe", "iv4", "cra"}, d, {}, one);
+  const auto b = IdentifyModels({"arx", "oe", "iv4", "cra"}, d, {}, two);
+  ASSERT_EQ(a.models.size(), b.models.size());
+  for (std::size_t i = 0; i < a.models.size(); ++i) {
+    EXPECT_EQ(a.models[i].method, b.models[i].method);
+    EXPECT_EQ(a.models[i].fit_percent, b.models[i].fit_percent);
+  }
+}
+
+TEST(IdentifyModelsTest, ValidationDataMustHaveTheSameChannels) {
+  const Dataset d = ArxData(300, 0.1, 6);
+  Dataset other = Dataset::FromUniform(0.1, d.u(0), d.y(0));
+  other = Dataset(other.time(), other.inputs(), other.outputs(), {Channel{"valve", "%"}},
+                  {Channel{"y", ""}});
+  EXPECT_THAT([&] { IdentifyModels({"arx"}, d, {}, {}, &other); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("inputs [valve]")));
+  const Dataset slow = Dataset::FromUniform(0.2, d.u(0), d.y(0));
+  EXPECT_THAT([&] { IdentifyModels({"arx"}, d, {}, {}, &slow); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("sampled at 0.2 s")));
+  IdentifyOptions o;
+  o.split = 0.5;
+  EXPECT_THROW(IdentifyModels({"arx"}, d, {}, o, &d), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pneumid
