@@ -37,6 +37,22 @@ inline std::string_view LineContent(std::string_view line, char comment) {
   return Trim(line);
 }
 
+/// Number of lines in [p, end): newlines, plus one for a last line without.
+Eigen::Index CountLines(const char* p, const char* end) {
+  // Counted in chunks of 255 bytes into a byte counter, a loop the compiler
+  // vectorizes.
+  const bool unterminated = p < end && end[-1] != '\n';
+  std::size_t lines = 0;
+  while (end - p >= 255) {
+    unsigned char chunk = 0;
+    for (int i = 0; i < 255; ++i) chunk += static_cast<unsigned char>(p[i] == '\n');
+    lines += chunk;
+    p += 255;
+  }
+  for (; p < end; ++p) lines += (*p == '\n');
+  return static_cast<Eigen::Index>(lines + (unterminated ? 1 : 0));
+}
+
 char DetectDelimiter(std::string_view header) {
   std::size_t best_count = 0;
   char best = ' ';
@@ -255,56 +271,64 @@ Eigen::Index ReadCsvRows(const std::string& path, const CsvReadOptions& options,
   std::vector<int> column_slot(num_columns, -1);
   for (std::size_t s = num_slots; s-- > 0;) column_slot[slot_column[s]] = static_cast<int>(s);
 
-  // Estimate the number of rows from the size of the first data line.
-  std::vector<std::vector<double>> values(num_slots);
-  {
-    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
-    const std::size_t first_len =
-        std::max<std::size_t>(4, (nl == nullptr ? end : static_cast<const char*>(nl)) - p + 1);
-    const std::size_t estimate = static_cast<std::size_t>(end - p) / first_len + 16;
-    for (auto& v : values) v.reserve(on_block ? block_rows : estimate + estimate / 8);
+  // The samples are parsed straight into the columns of the result: time
+  // (when read), inputs and outputs, with room for `capacity` rows. Reading
+  // the whole file, the capacity is the number of lines left, so the columns
+  // are allocated once and handed to the Dataset without a copy; reading
+  // blocks, it is the block size and the storage is reused.
+  const auto num_inputs = static_cast<Eigen::Index>(options.input_columns.size());
+  const auto num_outputs = static_cast<Eigen::Index>(options.output_columns.size());
+  Eigen::VectorXd time_store;
+  Eigen::MatrixXd input_store, output_store;
+  std::vector<double*> dest(num_slots);
+  Eigen::Index capacity = 0;
+  auto reserve = [&](Eigen::Index rows) {
+    if (has_time) time_store.conservativeResize(rows);
+    input_store.conservativeResize(rows, num_inputs);
+    output_store.conservativeResize(rows, num_outputs);
+    capacity = rows;
+    std::size_t s = 0;
+    if (has_time) dest[s++] = time_store.data();
+    for (Eigen::Index c = 0; c < num_inputs; ++c) dest[s++] = input_store.col(c).data();
+    for (Eigen::Index c = 0; c < num_outputs; ++c) dest[s++] = output_store.col(c).data();
+    // One system call maps the pages of large columns, not a fault per page.
+    const auto bytes = static_cast<std::size_t>(rows) * sizeof(double);
+    if (bytes >= (1u << 20)) {
+      for (double* column : dest) internal::PopulatePages(column, bytes, /*write=*/true);
+    }
+  };
+  reserve(on_block ? static_cast<Eigen::Index>(block_rows) : CountLines(p, end));
+  // slot -> the slot whose cell it copies (a column may feed several slots).
+  std::vector<std::size_t> slot_source(num_slots);
+  for (std::size_t s = 0; s < num_slots; ++s) {
+    slot_source[s] = static_cast<std::size_t>(column_slot[slot_column[s]]);
   }
   std::vector<double> row(num_slots);
   std::vector<Eigen::Index> break_samples;
   std::vector<long> break_lines;
   long previous_line = -1;
-  Eigen::Index n = 0;
+  Eigen::Index n = 0;      // samples read
+  Eigen::Index stored = 0;  // samples in the storage (the current block)
   double previous_time = 0.0;
 
-  // The samples gathered in `values`, from sample index `first` on, as time,
-  // inputs and outputs; `values` is emptied (its memory kept for the next
-  // block when reading blocks).
+  // The `stored` samples of the storage, the first of which is sample `first`.
   auto take_block = [&](Eigen::Index first) {
-    const Eigen::Index rows = static_cast<Eigen::Index>(values[0].size());
+    const Eigen::Index rows = stored;
     CsvBlock b;
     b.first_sample = first;
-    std::size_t s = 0;
-    auto take = [&](Eigen::VectorXd column) {
-      if (on_block) {
-        values[s++].clear();
-      } else {
-        std::vector<double>().swap(values[s++]);
-      }
-      return column;
-    };
     if (has_time) {
-      b.time = take(Eigen::Map<const Eigen::VectorXd>(values[s].data(), rows));
+      b.time = time_store.head(rows);
     } else {
       b.time.resize(rows);
       for (Eigen::Index i = 0; i < rows; ++i) {
         b.time[i] = options.start_time + static_cast<double>(first + i) * options.sample_time;
       }
     }
-    b.inputs.resize(rows, static_cast<Eigen::Index>(options.input_columns.size()));
-    for (Eigen::Index c = 0; c < b.inputs.cols(); ++c) {
-      b.inputs.col(c) = take(Eigen::Map<const Eigen::VectorXd>(values[s].data(), rows));
-    }
-    b.outputs.resize(rows, static_cast<Eigen::Index>(options.output_columns.size()));
-    for (Eigen::Index c = 0; c < b.outputs.cols(); ++c) {
-      b.outputs.col(c) = take(Eigen::Map<const Eigen::VectorXd>(values[s].data(), rows));
-    }
+    b.inputs = input_store.topRows(rows);
+    b.outputs = output_store.topRows(rows);
     b.fraction_read =
         text.empty() ? 1.0 : static_cast<double>(p - text.data()) / static_cast<double>(text.size());
+    stored = 0;
     return b;
   };
 
@@ -313,9 +337,12 @@ Eigen::Index ReadCsvRows(const std::string& path, const CsvReadOptions& options,
         fmt::format("{}:{}: column '{}': {}", path, line, Excerpt(columns[column].label), what));
   };
 
-  while (p < end) {
-    const std::string_view content = LineContent(next_line(), options.comment);
-    if (content.empty()) continue;
+  // The general row parser: comments, blanks, quotes, '+' signs, runs of
+  // blanks as delimiter, and every error message. Returns false for a line
+  // without content.
+  auto parse_row = [&](std::string_view raw) {
+    const std::string_view content = LineContent(raw, options.comment);
+    if (content.empty()) return false;
     const std::size_t cells =
         ForEachCell(content, delimiter, [&](std::size_t c, std::string_view cell) {
           if (c >= num_columns) return;
@@ -347,9 +374,53 @@ Eigen::Index ReadCsvRows(const std::string& path, const CsvReadOptions& options,
           "missing cells; delimiter {})",
           path, line, cells, header_line, num_columns, DelimiterName(delimiter)));
     }
-    for (std::size_t s = 0; s < num_slots; ++s) {
-      const int source_slot = column_slot[slot_column[s]];
-      values[s].push_back(row[static_cast<std::size_t>(source_slot)]);
+    return true;
+  };
+
+  // The fast row parser for the common plain row "1.5,2,3e-2": every cell
+  // read is a number that std::from_chars reads up to the next delimiter,
+  // finite, with the right number of cells. It returns false for anything
+  // else (blank line, comment, blanks, quotes, '+', bad cells), and the
+  // general parser then reads the line and reports what is wrong: both give
+  // the same values, only the general one throws.
+  const bool fast = delimiter != ' ';
+  const char comment = options.comment;
+  auto parse_row_fast = [&](const char* q, const char* e) {
+    if (e > q && e[-1] == '\r') --e;
+    if (q == e) return false;
+    for (std::size_t c = 0; c < num_columns; ++c) {
+      const int slot = column_slot[c];
+      if (slot >= 0) {
+        double v;
+        const auto [ptr, ec] = std::from_chars(q, e, v);
+        if (ec != std::errc() || !std::isfinite(v)) return false;
+        row[static_cast<std::size_t>(slot)] = v;
+        q = ptr;
+      } else {
+        while (q < e && *q != delimiter) {
+          if (*q == comment) return false;
+          ++q;
+        }
+      }
+      if (c + 1 < num_columns) {
+        if (q == e || *q != delimiter) return false;
+        ++q;
+      } else if (q != e) {
+        return false;
+      }
+    }
+    return true;
+  };
+
+  while (p < end) {
+    const char* const line_start = p;
+    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
+    const char* const line_end = nl == nullptr ? end : static_cast<const char*>(nl);
+    p = nl == nullptr ? end : line_end + 1;
+    ++line;
+    if (!(fast && parse_row_fast(line_start, line_end)) &&
+        !parse_row(std::string_view(line_start, static_cast<std::size_t>(line_end - line_start)))) {
+      continue;
     }
     if (has_time) {
       const double t = row[0];
@@ -360,26 +431,34 @@ Eigen::Index ReadCsvRows(const std::string& path, const CsvReadOptions& options,
       }
       previous_time = t;
     }
+    if (stored == capacity) reserve(capacity + capacity / 2 + 16);
+    for (std::size_t s = 0; s < num_slots; ++s) dest[s][stored] = row[slot_source[s]];
+    ++stored;
     if (line != previous_line + 1) {
       break_samples.push_back(n);
       break_lines.push_back(line);
     }
     previous_line = line;
     ++n;
-    if (on_block && values[0].size() == block_rows) (*on_block)(take_block(n - static_cast<Eigen::Index>(block_rows)));
+    if (on_block && stored == capacity) (*on_block)(take_block(n - stored));
   }
   if (n == 0) {
     throw DataError(
         fmt::format("{}:{}: header row only, the file has no data rows", path, header_line));
   }
   if (on_block) {
-    if (!values[0].empty()) {
-      (*on_block)(take_block(n - static_cast<Eigen::Index>(values[0].size())));
-    }
+    if (stored > 0) (*on_block)(take_block(n - stored));
     return n;
   }
 
-  CsvBlock all = take_block(0);
+  // Blank and comment lines leave unused rows (a copy; none for plain files).
+  if (n < capacity) reserve(n);
+  if (!has_time) {
+    time_store.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      time_store[i] = options.start_time + static_cast<double>(i) * options.sample_time;
+    }
+  }
   auto channels = [&](std::size_t first_slot, std::size_t count) {
     std::vector<Channel> out;
     for (std::size_t s = first_slot; s < first_slot + count; ++s) {
@@ -394,7 +473,7 @@ Eigen::Index ReadCsvRows(const std::string& path, const CsvReadOptions& options,
     time_channel = {col.name, col.unit.empty() ? "s" : col.unit};
   }
   const std::size_t first_input = has_time ? 1 : 0;
-  *data = Dataset(std::move(all.time), std::move(all.inputs), std::move(all.outputs),
+  *data = Dataset(std::move(time_store), std::move(input_store), std::move(output_store),
                   channels(first_input, options.input_columns.size()),
                   channels(first_input + options.input_columns.size(),
                            options.output_columns.size()));

@@ -18,7 +18,8 @@ std::vector<Channel> DefaultChannels(const std::string& prefix, Eigen::Index n) 
   return channels;
 }
 
-void CheckFinite(const Eigen::MatrixXd& m, const char* what) {
+void CheckFinite(const Eigen::Ref<const Eigen::MatrixXd>& m, const char* what) {
+  if (m.allFinite()) return;
   for (Eigen::Index c = 0; c < m.cols(); ++c) {
     for (Eigen::Index r = 0; r < m.rows(); ++r) {
       PNEUMID_CHECK(std::isfinite(m(r, c)), "Dataset: {} ({}, {}) is not finite: {}", what, r, c,
@@ -41,41 +42,55 @@ double MedianInterval(const Eigen::VectorXd& t) {
   return *mid;
 }
 
+/// True when max(dt) - min(dt) <= rel_tol * min(dt): then every interval is
+/// within rel_tol times the median interval of it (the median lies between
+/// min and max), without sorting. One pass; false leaves the decision to the
+/// median test.
+bool IntervalsWithin(const Eigen::VectorXd& t, double rel_tol) {
+  const Eigen::Index n = t.size();
+  if (n < 2) return true;
+  const auto dt = t.tail(n - 1) - t.head(n - 1);
+  return dt.maxCoeff() - dt.minCoeff() <= rel_tol * dt.minCoeff();
+}
+
 }  // namespace
 
 Dataset::Dataset(Eigen::VectorXd time, Eigen::MatrixXd inputs, Eigen::MatrixXd outputs,
                  std::vector<Channel> input_channels, std::vector<Channel> output_channels)
-    : time_(std::move(time)),
-      inputs_(std::move(inputs)),
-      outputs_(std::move(outputs)),
-      input_channels_(std::move(input_channels)),
-      output_channels_(std::move(output_channels)) {
-  const Eigen::Index n = time_.size();
+    : input_channels_(std::move(input_channels)), output_channels_(std::move(output_channels)) {
+  const Eigen::Index n = time.size();
   // A matrix without columns carries no samples; give it the right shape.
-  if (inputs_.cols() == 0) inputs_.resize(n, 0);
-  if (outputs_.cols() == 0) outputs_.resize(n, 0);
-  PNEUMID_CHECK(inputs_.rows() == n,
+  if (inputs.cols() == 0) inputs.resize(n, 0);
+  if (outputs.cols() == 0) outputs.resize(n, 0);
+  PNEUMID_CHECK(inputs.rows() == n,
                 "Dataset: inputs have {} rows but time has {} samples (length mismatch)",
-                inputs_.rows(), n);
-  PNEUMID_CHECK(outputs_.rows() == n,
+                inputs.rows(), n);
+  PNEUMID_CHECK(outputs.rows() == n,
                 "Dataset: outputs have {} rows but time has {} samples (length mismatch)",
-                outputs_.rows(), n);
-  if (input_channels_.empty()) input_channels_ = DefaultChannels("u", inputs_.cols());
-  if (output_channels_.empty()) output_channels_ = DefaultChannels("y", outputs_.cols());
-  PNEUMID_CHECK(static_cast<Eigen::Index>(input_channels_.size()) == inputs_.cols(),
+                outputs.rows(), n);
+  if (input_channels_.empty()) input_channels_ = DefaultChannels("u", inputs.cols());
+  if (output_channels_.empty()) output_channels_ = DefaultChannels("y", outputs.cols());
+  PNEUMID_CHECK(static_cast<Eigen::Index>(input_channels_.size()) == inputs.cols(),
                 "Dataset: {} input channel names for {} input columns", input_channels_.size(),
-                inputs_.cols());
-  PNEUMID_CHECK(static_cast<Eigen::Index>(output_channels_.size()) == outputs_.cols(),
+                inputs.cols());
+  PNEUMID_CHECK(static_cast<Eigen::Index>(output_channels_.size()) == outputs.cols(),
                 "Dataset: {} output channel names for {} output columns", output_channels_.size(),
-                outputs_.cols());
-  CheckFinite(time_, "time");
-  CheckFinite(inputs_, "input");
-  CheckFinite(outputs_, "output");
+                outputs.cols());
+  CheckFinite(time, "time");
+  CheckFinite(inputs, "input");
+  CheckFinite(outputs, "output");
   for (Eigen::Index i = 1; i < n; ++i) {
-    PNEUMID_CHECK(time_[i] > time_[i - 1],
+    PNEUMID_CHECK(time[i] > time[i - 1],
                   "Dataset: time is not strictly increasing at sample {}: t[{}] = {} <= t[{}] = {}",
-                  i, i, time_[i], i - 1, time_[i - 1]);
+                  i, i, time[i], i - 1, time[i - 1]);
   }
+  samples_ = std::make_shared<const Samples>(
+      Samples{std::move(time), std::move(inputs), std::move(outputs)});
+}
+
+const Dataset::Samples& Dataset::Empty() {
+  static const Samples empty;
+  return empty;
 }
 
 Dataset Dataset::FromUniform(double Ts, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
@@ -94,33 +109,71 @@ Dataset Dataset::FromUniform(double Ts, const Eigen::VectorXd& u, const Eigen::V
 Eigen::VectorXd Dataset::u(int i) const {
   PNEUMID_CHECK(i >= 0 && i < num_inputs(), "Dataset::u: input {} out of range [0, {})", i,
                 num_inputs());
-  return inputs_.col(i);
+  return inputs().col(i);
 }
 
 Eigen::VectorXd Dataset::y(int i) const {
   PNEUMID_CHECK(i >= 0 && i < num_outputs(), "Dataset::y: output {} out of range [0, {})", i,
                 num_outputs());
-  return outputs_.col(i);
+  return outputs().col(i);
+}
+
+Dataset Dataset::SelectChannels(const std::vector<int>& inputs,
+                                const std::vector<int>& outputs) const {
+  auto identity = [](const std::vector<int>& v, int n) {
+    if (static_cast<int>(v.size()) != n) return false;
+    for (int i = 0; i < n; ++i) {
+      if (v[static_cast<std::size_t>(i)] != i) return false;
+    }
+    return true;
+  };
+  auto pick = [](const Eigen::MatrixXd& m, const std::vector<int>& v,
+                 const std::vector<Channel>& channels, const char* what,
+                 std::vector<Channel>* picked) {
+    Eigen::MatrixXd out(m.rows(), static_cast<Eigen::Index>(v.size()));
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      PNEUMID_CHECK(v[k] >= 0 && v[k] < m.cols(),
+                    "Dataset::SelectChannels: {} {} out of range [0, {})", what, v[k], m.cols());
+      out.col(static_cast<Eigen::Index>(k)) = m.col(v[k]);
+      picked->push_back(channels[static_cast<std::size_t>(v[k])]);
+    }
+    return out;
+  };
+  Dataset out;
+  if (identity(inputs, num_inputs()) && identity(outputs, num_outputs())) {
+    out = *this;
+    return out;
+  }
+  std::vector<Channel> ic, oc;
+  Eigen::MatrixXd u = pick(this->inputs(), inputs, input_channels_, "input", &ic);
+  Eigen::MatrixXd y = pick(this->outputs(), outputs, output_channels_, "output", &oc);
+  out = Dataset(time(), std::move(u), std::move(y), std::move(ic), std::move(oc));
+  out.time_channel_ = time_channel_;
+  out.source_ = source_;
+  out.line_samples_ = line_samples_;
+  out.line_numbers_ = line_numbers_;
+  return out;
 }
 
 double Dataset::SampleTime() const {
   PNEUMID_CHECK(size() >= 2, "Dataset::SampleTime: needs at least 2 samples, {} has {}",
                 SourcePrefix(source_), size());
-  return (time_[size() - 1] - time_[0]) / static_cast<double>(size() - 1);
+  return (time()[size() - 1] - time()[0]) / static_cast<double>(size() - 1);
 }
 
 double Dataset::MedianSampleInterval() const {
   PNEUMID_CHECK(size() >= 2, "Dataset::MedianSampleInterval: needs at least 2 samples, {} has {}",
                 SourcePrefix(source_), size());
-  return MedianInterval(time_);
+  return MedianInterval(time());
 }
 
 bool Dataset::IsUniform(double rel_tol) const {
   PNEUMID_CHECK(rel_tol >= 0, "Dataset::IsUniform: tolerance must be >= 0, got {}", rel_tol);
   if (size() < 3) return true;
-  const double Ts = MedianInterval(time_);
+  if (IntervalsWithin(time(), rel_tol)) return true;
+  const double Ts = MedianInterval(time());
   for (Eigen::Index i = 1; i < size(); ++i) {
-    if (std::abs((time_[i] - time_[i - 1]) - Ts) > rel_tol * Ts) return false;
+    if (std::abs((time()[i] - time()[i - 1]) - Ts) > rel_tol * Ts) return false;
   }
   return true;
 }
@@ -128,9 +181,10 @@ bool Dataset::IsUniform(double rel_tol) const {
 void Dataset::RequireUniform(double rel_tol) const {
   PNEUMID_CHECK(rel_tol >= 0, "Dataset::RequireUniform: tolerance must be >= 0, got {}", rel_tol);
   if (size() < 3) return;
-  const double Ts = MedianInterval(time_);
+  if (IntervalsWithin(time(), rel_tol)) return;
+  const double Ts = MedianInterval(time());
   for (Eigen::Index i = 1; i < size(); ++i) {
-    const double dt = time_[i] - time_[i - 1];
+    const double dt = time()[i] - time()[i - 1];
     if (std::abs(dt - Ts) > rel_tol * Ts) {
       throw DataError(fmt::format(
           "{}: column '{}': sampling is not uniform: interval {:g} s between t = {:g} and t = {:g} "
@@ -138,7 +192,7 @@ void Dataset::RequireUniform(double rel_tol) const {
           "resample the data "
           "to a uniform grid first (pneumid::Resample, or `pneumid info {} --resample {:g} --save "
           "FILE`)",
-          Where(i), time_channel_.name, dt, time_[i - 1], time_[i], Ts,
+          Where(i), time_channel_.name, dt, time()[i - 1], time()[i], Ts,
           100.0 * std::abs(dt - Ts) / Ts, 100.0 * rel_tol,
           source_.empty() ? std::string("DATA") : source_, Ts));
     }
@@ -153,7 +207,8 @@ void Dataset::RequireSamples(Eigen::Index n, const std::string& what) const {
 }
 
 void Dataset::RequireNumericScale() const {
-  auto check = [&](const Eigen::VectorXd& v, const std::string& kind, const Channel& channel) {
+  auto check = [&](const Eigen::Ref<const Eigen::VectorXd>& v, const std::string& kind,
+                   const Channel& channel) {
     if (v.size() == 0) return;
     const double lo = v.minCoeff();
     const double hi = v.maxCoeff();
@@ -176,12 +231,12 @@ void Dataset::RequireNumericScale() const {
           column, lo, hi, spread, kMinSpread));
     }
   };
-  check(time_, "time", time_channel_);
+  check(time(), "time", time_channel_);
   for (int i = 0; i < num_inputs(); ++i) {
-    check(inputs_.col(i), "input", input_channels_[static_cast<std::size_t>(i)]);
+    check(inputs().col(i), "input", input_channels_[static_cast<std::size_t>(i)]);
   }
   for (int i = 0; i < num_outputs(); ++i) {
-    check(outputs_.col(i), "output", output_channels_[static_cast<std::size_t>(i)]);
+    check(outputs().col(i), "output", output_channels_[static_cast<std::size_t>(i)]);
   }
 }
 

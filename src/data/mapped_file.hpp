@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <string_view>
@@ -16,6 +17,24 @@
 #include "pneumid/common/check.hpp"
 
 namespace pneumid::internal {
+
+/// Maps the pages of [p, p + bytes) in one system call (MADV_POPULATE_READ /
+/// _WRITE, Linux 5.14) instead of one page fault per 4 KiB page on first
+/// access, and asks for transparent huge pages for memory to be written. On
+/// kernels without these calls nothing happens and the pages fault in as usual.
+inline void PopulatePages(void* p, std::size_t bytes, bool write) {
+  const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+  const auto begin = (reinterpret_cast<std::uintptr_t>(p) + page - 1) / page * page;
+  const auto end = (reinterpret_cast<std::uintptr_t>(p) + bytes) / page * page;
+  if (end <= begin) return;
+  void* const first = reinterpret_cast<void*>(begin);
+#ifdef MADV_HUGEPAGE
+  if (write) ::madvise(first, end - begin, MADV_HUGEPAGE);
+#endif
+#if defined(MADV_POPULATE_READ) && defined(MADV_POPULATE_WRITE)
+  ::madvise(first, end - begin, write ? MADV_POPULATE_WRITE : MADV_POPULATE_READ);
+#endif
+}
 
 /// Read-only view of a whole file, memory-mapped (or empty for an empty file).
 class MappedFile {
@@ -44,6 +63,7 @@ class MappedFile {
         throw DataError(fmt::format("{}: cannot map: {}", path, std::strerror(e)));
       }
       ::madvise(p, size_, MADV_SEQUENTIAL);
+      PopulatePages(p, size_, /*write=*/false);
       data_ = static_cast<const char*>(p);
     }
   }

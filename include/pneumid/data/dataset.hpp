@@ -6,8 +6,14 @@
 //   outputs  N x ny   one column per output channel
 // Names and units describe each channel; `source` names the file the data came
 // from so that later errors can point at it.
+//
+// The samples are immutable and shared: copying a Dataset (passing it by value,
+// storing it in a vector, SelectChannels of all channels) copies no sample, so
+// a million-row record goes from the reader to an estimator without copies.
+// Only the metadata (names, source, line map) is per object.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,16 +41,22 @@ class Dataset {
                              double t0 = 0.0, Channel input = {"u", ""},
                              Channel output = {"y", ""});
 
-  Eigen::Index size() const { return time_.size(); }
-  int num_inputs() const { return static_cast<int>(inputs_.cols()); }
-  int num_outputs() const { return static_cast<int>(outputs_.cols()); }
+  Eigen::Index size() const { return time().size(); }
+  int num_inputs() const { return static_cast<int>(inputs().cols()); }
+  int num_outputs() const { return static_cast<int>(outputs().cols()); }
 
-  const Eigen::VectorXd& time() const { return time_; }
-  const Eigen::MatrixXd& inputs() const { return inputs_; }
-  const Eigen::MatrixXd& outputs() const { return outputs_; }
+  const Eigen::VectorXd& time() const { return samples().time; }
+  const Eigen::MatrixXd& inputs() const { return samples().inputs; }
+  const Eigen::MatrixXd& outputs() const { return samples().outputs; }
   /// Column i of the inputs / outputs (throws InvalidArgument when out of range).
   Eigen::VectorXd u(int i = 0) const;
   Eigen::VectorXd y(int i = 0) const;
+
+  /// The dataset restricted to the given input and output channels (in that
+  /// order), with their names, the time channel, source and line map. Selecting
+  /// all channels in their order shares the samples (no copy).
+  /// @throws InvalidArgument when a channel index is out of range.
+  Dataset SelectChannels(const std::vector<int>& inputs, const std::vector<int>& outputs) const;
 
   const std::vector<Channel>& input_channels() const { return input_channels_; }
   const std::vector<Channel>& output_channels() const { return output_channels_; }
@@ -99,9 +111,15 @@ class Dataset {
   void set_source_lines(std::vector<Eigen::Index> first_samples, std::vector<long> first_lines);
 
  private:
-  Eigen::VectorXd time_;
-  Eigen::MatrixXd inputs_;
-  Eigen::MatrixXd outputs_;
+  struct Samples {
+    Eigen::VectorXd time;
+    Eigen::MatrixXd inputs;
+    Eigen::MatrixXd outputs;
+  };
+  const Samples& samples() const { return samples_ ? *samples_ : Empty(); }
+  static const Samples& Empty();
+
+  std::shared_ptr<const Samples> samples_;
   std::vector<Channel> input_channels_;
   std::vector<Channel> output_channels_;
   Channel time_channel_{"t", "s"};
