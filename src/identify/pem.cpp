@@ -6,6 +6,7 @@
 #include <ceres/ceres.h>
 #include <Eigen/Dense>
 
+#include "ceres_logging.hpp"
 #include "parametric_filter.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/enum_names.hpp"
@@ -52,12 +53,6 @@ bool PemOptions::IsValid(std::string* error) const {
 
 namespace {
 
-inline double ScalarPart(double x) { return x; }
-template <typename T, int N>
-double ScalarPart(const ceres::Jet<T, N>& x) {
-  return x.a;
-}
-
 // True when all roots of the monic polynomial p (given as scalars) are strictly
 // inside the unit circle.
 bool IsStablePoly(const std::vector<double>& p) {
@@ -79,45 +74,88 @@ Layout LayoutOf(const PolynomialModel& m) {
   return {m.na(), m.nb(0), m.nk[0], m.nc(), m.nd(), m.nf(0)};
 }
 
-class PredictionErrorCost {
+// Prediction errors of the general polynomial model
+//   e(t) = D(q)/C(q) [A(q) y(t) - B(q)/F(q) u(t)]
+// with zero initial conditions, and their analytic gradient, obtained by
+// filtering the data once per polynomial ([1] Ljung, System Identification,
+// 2nd ed., 1999, sec. 10.3, eqs. 10.54-10.56):
+//   de/da_i =  D/C         y(t - i)
+//   de/db_j = -D/(C F)     u(t - nk - j)
+//   de/dc_i = -1/C         e(t - i)
+//   de/dd_i =  1/C         v(t - i),  v = A y - w
+//   de/df_i =  D/(C F)     w(t - i),  w = B/F u
+// Each column is a delayed copy of one of five filtered signals, so an
+// evaluation costs a few O(N) recursions instead of a forward-mode pass per
+// parameter; the values equal those of automatic differentiation of the
+// recursion (zero initial conditions commute with the delays).
+class PredictionErrorCost final : public ceres::CostFunction {
  public:
   PredictionErrorCost(const Eigen::VectorXd& y, const Eigen::VectorXd& u, Layout l)
-      : y_(y.data(), y.data() + y.size()), u_(u.data(), u.data() + u.size()), l_(l) {}
+      : y_(y), u_(u), l_(l) {
+    set_num_residuals(static_cast<int>(y.size()));
+    mutable_parameter_block_sizes()->push_back(l.size());
+  }
 
-  template <typename T>
-  bool operator()(T const* const* params, T* residuals) const {
-    const T* p = params[0];
-    std::vector<T> A(l_.na + 1), B(l_.nk + l_.nb, T(0.0)), C(l_.nc + 1), D(l_.nd + 1), F(l_.nf + 1);
-    A[0] = C[0] = D[0] = F[0] = T(1.0);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* p = parameters[0];
+    Eigen::VectorXd A = Eigen::VectorXd::Zero(l_.na + 1), B = Eigen::VectorXd::Zero(l_.nk + l_.nb),
+                    C = Eigen::VectorXd::Zero(l_.nc + 1), D = Eigen::VectorXd::Zero(l_.nd + 1),
+                    F = Eigen::VectorXd::Zero(l_.nf + 1);
+    A[0] = C[0] = D[0] = F[0] = 1.0;
     int k = 0;
     for (int i = 1; i <= l_.na; ++i) A[i] = p[k++];
     for (int i = 0; i < l_.nb; ++i) B[l_.nk + i] = p[k++];
     for (int i = 1; i <= l_.nc; ++i) C[i] = p[k++];
     for (int i = 1; i <= l_.nd; ++i) D[i] = p[k++];
     for (int i = 1; i <= l_.nf; ++i) F[i] = p[k++];
-    auto scalars = [](const std::vector<T>& v) {
-      std::vector<double> s(v.size());
-      for (std::size_t i = 0; i < v.size(); ++i) s[i] = ScalarPart(v[i]);
-      return s;
+    if (!A.allFinite() || !B.allFinite() || !C.allFinite() || !D.allFinite() || !F.allFinite())
+      return false;
+    if (!IsStablePoly(std::vector<double>(C.data(), C.data() + C.size())) ||
+        !IsStablePoly(std::vector<double>(F.data(), F.data() + F.size())))
+      return false;
+    const Eigen::Index n = y_.size();
+    const Eigen::VectorXd one = Eigen::VectorXd::Ones(1);
+    const Eigen::VectorXd w = internal::Filter(B, F, u_);
+    const Eigen::VectorXd v = (l_.na > 0 ? internal::Filter(A, one, y_) : y_) - w;
+    const Eigen::VectorXd e = internal::Filter(D, C, v);
+    if (!e.allFinite()) return false;
+    Eigen::Map<Eigen::VectorXd>(residuals, n) = e;
+    if (jacobians == nullptr || jacobians[0] == nullptr) return true;
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    Eigen::Map<RowMajor> J(jacobians[0], n, l_.size());
+    // Column `col` = sign * s(t - delay), zero for t < delay.
+    auto delayed = [&](int col, const Eigen::VectorXd& s, int delay, double sign) {
+      const Eigen::Index d = std::min<Eigen::Index>(delay, n);
+      J.col(col).head(d).setZero();
+      J.col(col).tail(n - d) = sign * s.head(n - d);
     };
-    if (!IsStablePoly(scalars(C)) || !IsStablePoly(scalars(F))) return false;
-    const std::size_t n = y_.size();
-    std::vector<T> ut(n), yt(n);
-    for (std::size_t t = 0; t < n; ++t) {
-      ut[t] = T(u_[t]);
-      yt[t] = T(y_[t]);
+    const Eigen::VectorXd CF = internal::Convolve(C, F);
+    int col = 0;
+    if (l_.na > 0) {
+      const Eigen::VectorXd ya = internal::Filter(D, C, y_);
+      for (int i = 1; i <= l_.na; ++i) delayed(col++, ya, i, 1.0);
     }
-    const std::vector<T> one{T(1.0)};
-    const std::vector<T> w = internal::Filter<T>(B, static_cast<int>(B.size()), F, l_.nf + 1, ut);
-    std::vector<T> v = internal::Filter<T>(A, l_.na + 1, one, 1, yt);
-    for (std::size_t t = 0; t < n; ++t) v[t] -= w[t];
-    const std::vector<T> e = internal::Filter<T>(D, l_.nd + 1, C, l_.nc + 1, v);
-    for (std::size_t t = 0; t < n; ++t) residuals[t] = e[t];
-    return true;
+    const Eigen::VectorXd ub = internal::Filter(D, CF, u_);
+    for (int j = 0; j < l_.nb; ++j) delayed(col++, ub, l_.nk + j, -1.0);
+    if (l_.nc > 0) {
+      const Eigen::VectorXd ec = internal::Filter(one, C, e);
+      for (int i = 1; i <= l_.nc; ++i) delayed(col++, ec, i, -1.0);
+    }
+    if (l_.nd > 0) {
+      const Eigen::VectorXd vc = internal::Filter(one, C, v);
+      for (int i = 1; i <= l_.nd; ++i) delayed(col++, vc, i, 1.0);
+    }
+    if (l_.nf > 0) {
+      const Eigen::VectorXd wf = internal::Filter(D, CF, w);
+      for (int i = 1; i <= l_.nf; ++i) delayed(col++, wf, i, 1.0);
+    }
+    return J.allFinite();
   }
 
  private:
-  std::vector<double> y_, u_;
+  const Eigen::VectorXd& y_;
+  const Eigen::VectorXd& u_;
   Layout l_;
 };
 
@@ -211,14 +249,11 @@ PemResult RefinePem(const PolynomialModel& initial, const Eigen::VectorXd& y,
     return result;
   }
   Eigen::VectorXd theta = start.Parameters();
-  auto* cost = new ceres::DynamicAutoDiffCostFunction<PredictionErrorCost, 4>(
-      new PredictionErrorCost(y, u, l));
-  cost->AddParameterBlock(l.size());
-  cost->SetNumResiduals(static_cast<int>(y.size()));
+  auto* cost = new PredictionErrorCost(y, u, l);
   ceres::Problem problem;
   problem.AddResidualBlock(cost, nullptr, theta.data());
   ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
+  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // J^T J: O(N np^2) once, N >> np
   so.max_num_iterations = options.max_iterations;
   so.function_tolerance = options.function_tolerance;
   so.gradient_tolerance = options.gradient_tolerance;
@@ -226,6 +261,7 @@ PemResult RefinePem(const PolynomialModel& initial, const Eigen::VectorXd& y,
   so.num_threads = 1;
   so.logging_type = ceres::SILENT;
   ceres::Solver::Summary cs;
+  internal::SilenceCeresLogging();
   ceres::Solve(so, &problem, &cs);
   const double N = static_cast<double>(y.size());
   s.iterations = static_cast<int>(cs.iterations.size()) - 1;

@@ -9,6 +9,7 @@
 #include <ceres/ceres.h>
 #include <fmt/format.h>
 
+#include "ceres_logging.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/reaction_curve.hpp"
@@ -144,21 +145,31 @@ class Simulator {
     return p;
   }
 
-  // Residuals y - yhat for scaled parameters x; false when the model is invalid.
-  bool Residuals(const double* x, Eigen::VectorXd* r) const {
-    const ProcessParams p = ToParams(x);
+  // Response of the model with unit gain and no offset to the input steps du
+  // (the output is linear in K and y0: yhat = K h + y0); false when invalid.
+  bool UnitResponse(const double* x, Eigen::VectorXd* h) const {
+    ProcessParams p = ToParams(x);
+    p.K = 1.0;
     try {
-      const TransferFunction g = ProcessTransferFunction(structure_, zero_, p);
-      const Eigen::VectorXd yhat = Lsim(g, du_, Ts_);
-      if (!yhat.allFinite()) return false;
-      *r = y_ - (yhat.array() + p.y0).matrix();
-      return true;
+      *h = Lsim(ProcessTransferFunction(structure_, zero_, p), du_, Ts_);
+      return h->allFinite();
     } catch (const std::exception&) {
       return false;
     }
   }
 
+  // Residuals y - yhat for scaled parameters x; false when the model is invalid.
+  bool Residuals(const double* x, Eigen::VectorXd* r) const {
+    Eigen::VectorXd h;
+    if (!UnitResponse(x, &h)) return false;
+    const ProcessParams p = ToParams(x);
+    *r = y_ - (p.K * h.array() + p.y0).matrix();
+    return r->allFinite();
+  }
+
   // Evaluates residuals (and the Jacobian when wanted) at x, caching the result.
+  // K and y0 enter linearly and have exact columns (-h scale_K, -scale_y0); the
+  // lags, zero and delay have central differences of K h (one-sided at a bound).
   bool Evaluate(const double* x, bool want_jacobian) {
     const int np = num_params();
     const bool same = valid_ && std::equal(x, x + np, x_.data());
@@ -166,30 +177,42 @@ class Simulator {
     x_ = Eigen::Map<const Eigen::VectorXd>(x, np);
     valid_ = true;
     jacobian_valid_ = false;
-    ok_ = Residuals(x, &r_);
+    ok_ = UnitResponse(x, &h_);
+    if (!ok_) return ok_;
+    const ProcessParams p = ToParams(x);
+    r_ = y_ - (p.K * h_.array() + p.y0).matrix();
+    ok_ = r_.allFinite();
     if (!ok_ || !want_jacobian) return ok_;
     J_.resize(r_.size(), np);
-    Eigen::VectorXd xp = x_, rp, rm;
+    Eigen::VectorXd xp = x_, hp, hm;
     for (int j = 0; j < np; ++j) {
-      const double h = 1e-6 * std::max(1.0, std::abs(x_[j]));
-      const bool can_up = x_[j] + h <= upper_[j];
-      const bool can_down = x_[j] - h >= lower_[j];
-      double hu = can_up ? h : 0.0, hd = can_down ? h : 0.0;
-      if (!can_up && !can_down) hu = h;  // degenerate bounds: step outside anyway
+      if (slots_[j] == kK) {
+        J_.col(j) = -scale_[j] * h_;
+        continue;
+      }
+      if (slots_[j] == kY0) {
+        J_.col(j).setConstant(-scale_[j]);
+        continue;
+      }
+      const double step = 1e-6 * std::max(1.0, std::abs(x_[j]));
+      const bool can_up = x_[j] + step <= upper_[j];
+      const bool can_down = x_[j] - step >= lower_[j];
+      double hu = can_up ? step : 0.0, hd = can_down ? step : 0.0;
+      if (!can_up && !can_down) hu = step;  // degenerate bounds: step outside anyway
       xp = x_;
       xp[j] = x_[j] + hu;
       if (hu > 0.0) {
-        if (!Residuals(xp.data(), &rp)) return ok_ = false;
+        if (!UnitResponse(xp.data(), &hp)) return ok_ = false;
       } else {
-        rp = r_;
+        hp = h_;
       }
       xp[j] = x_[j] - hd;
       if (hd > 0.0) {
-        if (!Residuals(xp.data(), &rm)) return ok_ = false;
+        if (!UnitResponse(xp.data(), &hm)) return ok_ = false;
       } else {
-        rm = r_;
+        hm = h_;
       }
-      J_.col(j) = (rp - rm) / (hu + hd);
+      J_.col(j) = (-p.K / (hu + hd)) * (hp - hm);
     }
     jacobian_valid_ = true;
     return ok_;
@@ -206,7 +229,7 @@ class Simulator {
   Eigen::VectorXd du_, y_;
   double Ts_;
   Eigen::VectorXd scale_, lower_, upper_;
-  Eigen::VectorXd x_, r_;
+  Eigen::VectorXd x_, r_, h_;
   Eigen::MatrixXd J_;
   bool valid_ = false, jacobian_valid_ = false, ok_ = false;
 };
@@ -232,6 +255,32 @@ class SampleResidual : public ceres::CostFunction {
  private:
   Simulator* sim_;
   Eigen::Index k_;
+};
+
+// All samples' residuals in one block (least squares without a robust loss):
+// one simulation per evaluation and a dense N x np Jacobian, without the
+// per-block overhead of N one-sample blocks.
+class RecordResidual : public ceres::CostFunction {
+ public:
+  explicit RecordResidual(Simulator* sim) : sim_(sim) {
+    set_num_residuals(static_cast<int>(sim->num_samples()));
+    mutable_parameter_block_sizes()->push_back(sim->num_params());
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const bool want_j = jacobians != nullptr && jacobians[0] != nullptr;
+    if (!sim_->Evaluate(parameters[0], want_j)) return false;
+    const Eigen::Index n = sim_->num_samples();
+    Eigen::Map<Eigen::VectorXd>(residuals, n) = sim_->residuals();
+    if (want_j) {
+      using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+      Eigen::Map<RowMajor>(jacobians[0], n, sim_->num_params()) = sim_->jacobian();
+    }
+    return true;
+  }
+
+ private:
+  Simulator* sim_;
 };
 
 }  // namespace
@@ -608,7 +657,10 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
   problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  for (Eigen::Index k = 0; k < data.size(); ++k) {
+  if (options.loss == RobustLoss::kNone) {
+    problem.AddResidualBlock(new RecordResidual(&sim), nullptr, x.data());
+  }
+  for (Eigen::Index k = 0; options.loss != RobustLoss::kNone && k < data.size(); ++k) {
     ceres::LossFunction* loss = nullptr;
     const double a = options.loss_scale > 0.0
                          ? options.loss_scale
@@ -623,7 +675,7 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
     if (std::isfinite(hi[i])) problem.SetParameterUpperBound(x.data(), i, hi[i]);
   }
   ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // J^T J: O(N np^2), N >> np
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.function_tolerance = options.function_tolerance;
   solver_options.parameter_tolerance = options.parameter_tolerance;
@@ -631,6 +683,7 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
   solver_options.num_threads = 1;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
+  internal::SilenceCeresLogging();
   ceres::Solve(solver_options, &problem, &summary);
 
   res.summary.iterations = static_cast<int>(summary.iterations.size());

@@ -61,6 +61,16 @@ VectorXd SimulateSiso(const StateSpace& g, const VectorXd& u, int d, const Vecto
   return y;
 }
 
+// The model Lsim runs: a discrete model as it is (at its own Ts), a
+// continuous one discretized by zoh at dt with its delay.
+StateSpace DiscretizeForLsim(const StateSpace& g, double dt) {
+  if (g.IsDiscrete()) {
+    CheckDiscreteStep(g.Ts(), dt);
+    return g;
+  }
+  return C2D(g, dt, DiscretizationMethod::kZoh);
+}
+
 // Time scales of a model in seconds: the slowest (1/|Re p|, largest) and the
 // fastest (1/|p|, smallest), with discrete poles mapped by s = ln(z) / Ts.
 void TimeScales(const TransferFunction& g, double* slow, double* fast) {
@@ -158,12 +168,7 @@ Eigen::MatrixXd Lsim(const StateSpace& g, const Eigen::MatrixXd& u, double dt,
   PNEUMID_CHECK(u.allFinite(), "lsim: the input contains NaN or Inf");
   PNEUMID_CHECK(x0.size() == 0 || x0.size() == g.num_states(),
                 "lsim: x0 must have nx = {} entries (or none), got {}", g.num_states(), x0.size());
-  StateSpace gd = g;
-  if (g.IsDiscrete()) {
-    CheckDiscreteStep(g.Ts(), dt);
-  } else {
-    gd = C2D(g, dt, DiscretizationMethod::kZoh);
-  }
+  const StateSpace gd = DiscretizeForLsim(g, dt);
   const int d = static_cast<int>(std::lround(gd.delay() / dt));
   const Eigen::Index n = gd.num_states();
   VectorXd x = VectorXd::Zero(n);
@@ -189,7 +194,35 @@ Eigen::MatrixXd Lsim(const StateSpace& g, const Eigen::MatrixXd& u, double dt,
 }
 
 Eigen::VectorXd Lsim(const TransferFunction& g, const Eigen::VectorXd& u, double dt) {
-  return Lsim(ToStateSpace(g), MatrixXd(u), dt).col(0);
+  // SISO directly on u: no copy of the input or output (long records).
+  PNEUMID_CHECK(std::isfinite(dt) && dt > 0.0, "lsim: dt must be > 0 s, got {}", dt);
+  PNEUMID_CHECK(u.allFinite(), "lsim: the input contains NaN or Inf");
+  const VectorXd den = poly::TrimLeading(g.den()), num = poly::TrimLeading(g.num());
+  if (g.IsDiscrete() && num.size() <= den.size()) {
+    // Difference equation den(q) y = num(q) u in q^-1 form, O(N (deg num +
+    // deg den)) instead of O(N n^2) for an order-n realization (a FIR model of
+    // a few hundred taps has as many states). Zero initial conditions equal
+    // the zero state of the realization.
+    CheckDiscreteStep(g.Ts(), dt);
+    const Eigen::Index n = den.size();
+    VectorXd b = VectorXd::Zero(n);
+    b.tail(num.size()) = num / den[0];
+    const VectorXd a = den / den[0];
+    const Eigen::Index d = std::lround(g.delay() / dt), N = u.size();
+    VectorXd y(N);
+    for (Eigen::Index k = 0; k < N; ++k) {
+      double acc = 0.0;
+      const Eigen::Index kb = std::min<Eigen::Index>(n - 1, k - d);
+      for (Eigen::Index i = 0; i <= kb; ++i) acc += b[i] * u[k - d - i];
+      const Eigen::Index ka = std::min<Eigen::Index>(n - 1, k);
+      for (Eigen::Index i = 1; i <= ka; ++i) acc -= a[i] * y[k - i];
+      y[k] = acc;
+    }
+    return y;
+  }
+  const StateSpace gd = DiscretizeForLsim(ToStateSpace(g), dt);
+  const int d = static_cast<int>(std::lround(gd.delay() / dt));
+  return SimulateSiso(gd, u, d, VectorXd::Zero(gd.num_states()));
 }
 
 TimeResponse Step(const TransferFunction& g, double t_final, double dt) {
