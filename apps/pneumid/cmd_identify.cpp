@@ -30,6 +30,7 @@ namespace {
 
 struct IdentifyArgs {
   DataOptions data;
+  PreprocessArgs preprocess;
   std::string methods = "reaction-curve";
   IdentifyRequest request;
   std::string loss = "none";
@@ -128,12 +129,16 @@ void Run(const IdentifyArgs& args) {
   PNEUMID_CHECK(args.split == 0.0 || (args.split > 0.0 && args.split < 1.0),
                 "--split must be a fraction in (0, 1), e.g. 0.7, got {}", args.split);
   const std::vector<std::string> methods = ParseMethodList(args.methods);
-  const Dataset data = LoadFromOptions(args.data);
+  const PreprocessOptions prep = ToPreprocessOptions(args.preprocess);
+  PreprocessRecord record;
+  const Dataset data = Preprocess(LoadFromOptions(args.data), prep, &record);
   std::optional<Dataset> validation;
   if (!args.validation.empty()) {
     DataOptions v = args.data;
     v.path = args.validation;
-    validation.emplace(LoadFromOptions(v));
+    // The validation data get the estimation data's preprocessing, with the
+    // offsets measured on the estimation data (not re-estimated).
+    validation.emplace(ApplyRecorded(LoadFromOptions(v), record));
   }
   IdentifyOptions options;
   options.step.fit.loss = RobustLossFromString(args.loss);
@@ -151,6 +156,8 @@ void Run(const IdentifyArgs& args) {
   for (const auto& [method, reason] : summary.failures)
     std::cerr << fmt::format("pneumid identify: {} failed: {}\n", method, reason);
   if (summary.models.empty()) throw DataError(summary.message);
+  if (!record.IsIdentity())
+    for (IdentifiedModel& m : summary.models) m.preprocessing = record;
   const std::vector<IdentifiedModel>& models = summary.models;
   const bool held_out = summary.validation_samples > 0;
 
@@ -195,6 +202,7 @@ void Run(const IdentifyArgs& args) {
   }
   std::cout << fmt::format("{} samples, Ts = {:g} s{}\n", data.size(), data.SampleTime(),
                            data.source().empty() ? "" : ", from " + data.source());
+  for (const std::string& step : record.steps) std::cout << "preprocessing: " << step << "\n";
   if (held_out)
     std::cout << fmt::format("estimated on {} samples, validated on {} held-out samples{}\n",
                              summary.estimation_samples, summary.validation_samples,
@@ -233,6 +241,7 @@ static Registrar reg(
     [](CLI::App& app) {
       auto args = std::make_shared<IdentifyArgs>();
       AddDataOptions(app, args->data);
+      AddPreprocessOptions(app, args->preprocess);
       app.add_option("-m,--method,--methods", args->methods,
                      "Comma-separated methods, or all: reaction-curve, tangent, smith, "
                      "sundaresan, broida, sopdt, ptn, strejc, areas, fit-p1d, fit-p2d, fit-p2du, "

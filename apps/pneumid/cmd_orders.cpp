@@ -17,6 +17,7 @@ namespace {
 
 struct OrdersArgs {
   DataOptions data;
+  PreprocessArgs preprocess;
   std::string na = "1:5", nb = "1:5", nk = "0:3";
   double split = 0.0;
   int top = 0;
@@ -33,7 +34,7 @@ void Run(const OrdersArgs& a) {
   PNEUMID_CHECK(a.split == 0.0 || (a.split > 0.0 && a.split < 1.0),
                 "--split must be in (0, 1), got {}", a.split);
   PNEUMID_CHECK(a.top >= 0, "--top must be >= 0, got {}", a.top);
-  const Dataset data = LoadFromOptions(a.data);
+  const Dataset data = Preprocess(LoadFromOptions(a.data), ToPreprocessOptions(a.preprocess));
   OrderSelection s;
   if (a.split > 0.0) {
     const auto [est, val] = SplitDataset(data, a.split);
@@ -78,6 +79,7 @@ static Registrar reg(
     [](CLI::App& app) {
       auto args = std::make_shared<OrdersArgs>();
       AddDataOptions(app, args->data);
+      AddPreprocessOptions(app, args->preprocess);
       app.add_option("--na-range", args->na, "A orders MIN:MAX (or N)")->capture_default_str();
       app.add_option("--nb-range", args->nb, "B orders MIN:MAX (or N)")->capture_default_str();
       app.add_option("--nk-range", args->nk, "input delays MIN:MAX in samples (or N)")

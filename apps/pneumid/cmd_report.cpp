@@ -36,6 +36,7 @@ std::vector<std::string> SplitComma(const std::string& s) {
 
 struct ReportArgs {
   pneumid::cli::DataOptions data;
+  pneumid::cli::PreprocessArgs preprocess;
   std::string methods = "reaction-curve,ptn,arx";
   std::string out_dir;
   std::string title;
@@ -66,6 +67,13 @@ void Run(const ReportArgs& a) {
   if (a.data.sample_time > 0) cmd += fmt::format(" --Ts {}", a.data.sample_time);
   if (!a.data.delimiter.empty()) cmd += " --delimiter " + ShellQuote(a.data.delimiter);
   if (a.data.format != defaults.format) cmd += " --format " + a.data.format;
+  const cli::PreprocessArgs& p = a.preprocess;
+  if (!p.window.empty()) cmd += " --window " + ShellQuote(p.window);
+  if (p.resample > 0) cmd += fmt::format(" --resample {}", p.resample);
+  if (p.remove_initial) cmd += " --remove-initial";
+  if (p.detrend != "none") cmd += " --detrend " + p.detrend;
+  if (!p.filter.empty()) cmd += " --filter " + ShellQuote(p.filter);
+  if (p.decimate != 1) cmd += fmt::format(" --decimate {}", p.decimate);
   cmd += " --method " + ShellQuote(a.methods);
   if (a.order != 2) cmd += fmt::format(" --order {}", a.order);
   if (a.na != 3 || a.nb != 3 || a.nk != 1)
@@ -75,7 +83,10 @@ void Run(const ReportArgs& a) {
   cmd += " --output-dir " + ShellQuote(a.out_dir);
   o.commands = {cmd};
 
-  const Dataset data = cli::LoadFromOptions(a.data);
+  PreprocessRecord record;
+  const Dataset data =
+      Preprocess(cli::LoadFromOptions(a.data), cli::ToPreprocessOptions(a.preprocess), &record);
+  if (!record.IsIdentity()) o.preprocessing = record;
   const ReportSummary s = WriteIdentificationReport(data, o, a.out_dir);
 
   if (a.json) {
@@ -111,6 +122,7 @@ const pneumid::cli::Registrar reg(
     [](CLI::App& app) {
       auto a = std::make_shared<ReportArgs>();
       pneumid::cli::AddDataOptions(app, a->data);
+      pneumid::cli::AddPreprocessOptions(app, a->preprocess);
       app.add_option("-m,--method,--methods", a->methods,
                      "Comma-separated identification methods (names of `pneumid identify "
                      "--method`)")

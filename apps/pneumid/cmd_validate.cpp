@@ -28,6 +28,7 @@ namespace {
 struct ValidateArgs {
   std::string model;
   DataOptions data;
+  PreprocessArgs preprocess;
   int horizon = 0;
   int max_lag = 25;
   int skip = 0;
@@ -106,9 +107,26 @@ CompareResult SimulateIdentified(const IdentifiedModel& m, const Dataset& data, 
 
 void Run(const ValidateArgs& a) {
   PNEUMID_CHECK(a.horizon >= 0, "--horizon must be >= 0 (0 = simulation), got {}", a.horizon);
-  const Dataset data = LoadFromOptions(a.data);
   std::string label = a.model;
   const std::optional<IdentifiedModel> identified = ReadIdentified(a.model);
+  // The data get the command's preprocessing, then the model's own (recorded
+  // when it was identified, with its offsets): together they would remove
+  // offsets twice, so only a window may be added to a model's preprocessing.
+  const PreprocessOptions prep = ToPreprocessOptions(a.preprocess);
+  Dataset data = Preprocess(LoadFromOptions(a.data), prep);
+  if (identified && identified->preprocessing) {
+    PreprocessOptions window_only;
+    window_only.window = prep.window;
+    PNEUMID_CHECK(prep.IsIdentity() || !window_only.IsIdentity() && [&] {
+      PreprocessOptions rest = prep;
+      rest.window = {};
+      return rest.IsIdentity();
+    }(),
+                  "{} carries the preprocessing it was identified with ({}); it is applied to "
+                  "the data, so give no other preprocessing flag than --window",
+                  a.model, fmt::join(identified->preprocessing->steps, "; "));
+    data = ApplyRecorded(data, *identified->preprocessing);
+  }
   std::optional<PolynomialModel> poly;
   if (identified) {
     label = fmt::format("{} {}", identified->method, identified->structure);
@@ -215,6 +233,7 @@ static Registrar reg(
                      "any model spec (arx-paper, tf:..., fopdt:...)")
           ->required();
       AddDataOptions(app, args->data);
+      AddPreprocessOptions(app, args->preprocess);
       app.add_option("--horizon", args->horizon,
                      "Also report the k-step-ahead prediction fit (polynomial models)")
           ->check(AtLeast(1));

@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
 #include "validators.hpp"
@@ -65,6 +67,61 @@ LoadOptions ToLoadOptions(const DataOptions& options) {
 
 Dataset LoadFromOptions(const DataOptions& options) {
   return LoadDataset(options.path, ToLoadOptions(options));
+}
+
+void AddPreprocessOptions(CLI::App& app, PreprocessArgs& args) {
+  const std::string group = "Preprocessing (in this order)";
+  app.add_option("--window", args.window,
+                 "Keep the samples with T0 <= t <= T1 seconds, written T0:T1 (5:, :9 for one side)")
+      ->group(group);
+  app.add_option("--resample", args.resample,
+                 "Resample onto a uniform grid of this sample time (s), linear interpolation")
+      ->check(NonNegative())
+      ->group(group);
+  app.add_flag("--remove-initial", args.remove_initial,
+               "Subtract each channel's level before the step (the operating point); the "
+               "model file records it")
+      ->group(group);
+  app.add_option("--detrend", args.detrend,
+                 "Subtract each channel's mean (constant) or least-squares line (linear)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "constant", "mean", "linear"}))
+      ->group(group);
+  app.add_option("--filter", args.filter,
+                 "Zero-phase Butterworth filter: lowpass:F or bandpass:F1,F2 (Hz), "
+                 "optionally ,order=N (default 5)")
+      ->group(group);
+  app.add_option("--decimate", args.decimate,
+                 "Keep every N-th sample after a zero-phase anti-alias low-pass (N >= 1)")
+      ->capture_default_str()
+      ->group(group);
+}
+
+PreprocessOptions ToPreprocessOptions(const PreprocessArgs& args) {
+  PreprocessOptions o;
+  auto flag = [](const char* name, auto&& parse) {
+    try {
+      return parse();
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(fmt::format("{}: {}", name, e.what()));
+    }
+  };
+  if (!args.window.empty())
+    o.window = flag("--window", [&] { return TimeWindow::Parse(args.window); });
+  o.resample_ts = args.resample;
+  o.remove_initial = args.remove_initial;
+  o.detrend = flag("--detrend", [&] { return DetrendKindFromString(args.detrend); });
+  PNEUMID_CHECK(!(o.remove_initial && o.detrend != DetrendKind::kNone),
+                "--remove-initial and --detrend {} both remove offsets: give one of them",
+                args.detrend);
+  if (!args.filter.empty())
+    o.filter = flag("--filter", [&] { return FilterSpec::Parse(args.filter); });
+  PNEUMID_CHECK(args.decimate >= 1, "--decimate must be an integer factor >= 1, got {}",
+                args.decimate);
+  o.decimate = args.decimate;
+  std::string why;
+  PNEUMID_CHECK(o.IsValid(&why), "{}", why);
+  return o;
 }
 
 }  // namespace pneumid::cli

@@ -20,6 +20,7 @@
 
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/data/load.hpp"
+#include "pneumid/data/preprocess.hpp"
 
 namespace pneumid::cli {
 
@@ -44,5 +45,29 @@ LoadOptions ToLoadOptions(const DataOptions& options);
 
 /// Loads the selected data. @throws DataError / InvalidArgument as LoadDataset.
 Dataset LoadFromOptions(const DataOptions& options);
+
+// Preprocessing of the loaded data (identify, validate, orders, report), in
+// the order of PreprocessOptions (data/preprocess.hpp):
+//   --window T0:T1       keep T0 <= t <= T1 (s; either side may be empty)
+//   --resample TS        linear interpolation onto a uniform grid of TS s
+//   --remove-initial     subtract the levels before the step (operating point)
+//   --detrend constant|linear   subtract the mean or the least-squares line
+//   --filter lowpass:F | bandpass:F1,F2   zero-phase Butterworth, Hz
+//   --decimate N         keep every N-th sample after an anti-alias filter
+struct PreprocessArgs {
+  std::string window;
+  double resample = 0.0;
+  bool remove_initial = false;
+  std::string detrend = "none";
+  std::string filter;
+  int decimate = 1;
+};
+
+/// Adds the flags above to `app`.
+void AddPreprocessOptions(CLI::App& app, PreprocessArgs& args);
+
+/// The library options of `args`.
+/// @throws InvalidArgument naming the flag for a malformed value.
+PreprocessOptions ToPreprocessOptions(const PreprocessArgs& args);
 
 }  // namespace pneumid::cli

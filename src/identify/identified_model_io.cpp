@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/data/preprocess_io.hpp"
 #include "pneumid/lti/model_io.hpp"
 
 namespace pneumid {
@@ -76,6 +77,7 @@ nlohmann::json ToJson(const IdentifiedModel& model) {
   j["flags"] = nlohmann::json::array();
   for (const ModelFlagNote& f : model.flags)
     j["flags"].push_back({{"flag", ToString(f.flag)}, {"reason", f.reason}});
+  if (model.preprocessing) j["preprocessing"] = ToJson(*model.preprocessing);
   return j;
 }
 
@@ -131,6 +133,7 @@ IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
                          f.value("reason", std::string())});
     }
   }
+  if (j.contains("preprocessing")) m.preprocessing = PreprocessRecordFromJson(j.at("preprocessing"));
   return m;
 }
 

@@ -94,6 +94,8 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
     const IdentificationSummary ids = IdentifyModels(options.methods, data, options.request);
     summary.models = ids.models;
     summary.failures = ids.failures;
+    if (options.preprocessing)
+      for (IdentifiedModel& m : summary.models) m.preprocessing = options.preprocessing;
   }
 
   const std::string source = data.source().empty() ? "(in-memory data)" : data.source();
@@ -122,6 +124,9 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
              {"duration [s]", Num(data.time()[data.size() - 1] - data.time()[0])},
              {"input", labels.input},
              {"output", labels.output}};
+  if (options.preprocessing)
+    for (const std::string& step : options.preprocessing->steps)
+      dt.rows.push_back({"preprocessing", step});
   try {
     const StepAnalysis s = AnalyzeStep(data, in, out);
     dt.rows.push_back({"step", s.BriefReport()});

@@ -18,6 +18,7 @@
 
 #include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
+#include "pneumid/data/preprocess.hpp"
 #include "pneumid/identify/subspace.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
@@ -104,6 +105,10 @@ struct IdentifiedModel {
   double validation_fit_percent = std::numeric_limits<double>::quiet_NaN();
   /// Reasons not to trust the model (empty: none found).
   std::vector<ModelFlagNote> flags;
+  /// The preprocessing of the data the model was identified from (window,
+  /// offsets, filter, decimation); u0/y0 above refer to the preprocessed
+  /// signals. `validate` re-applies it to new data (ApplyRecorded).
+  std::optional<PreprocessRecord> preprocessing;
 };
 
 /// Options shared by every method of `pneumid identify`.

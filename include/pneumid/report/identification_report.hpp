@@ -24,6 +24,7 @@
 //     (2015) 115-119.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct ReportOptions {
   double residual_confidence = 0.99;
   /// Command lines shown in the "Reproduce" section (empty = none given).
   std::vector<std::string> commands;
+  /// How the data were preprocessed before the report (listed in the data
+  /// table and stored with each model in models.json); none by default.
+  std::optional<PreprocessRecord> preprocessing;
   bool IsValid(std::string* error) const;
 };
 
