@@ -681,6 +681,11 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
   solver_options.parameter_tolerance = options.parameter_tolerance;
   solver_options.gradient_tolerance = 1e-14;
   solver_options.num_threads = 1;
+  // Trust-region steps are clamped to the bounds by Ceres; its projected line
+  // search on top of that evaluates the full Jacobian (2 simulations per lag
+  // or delay parameter) at every trial point, doubling the cost on long
+  // records for no gain in the fitted values.
+  solver_options.max_num_line_search_step_size_iterations = 0;
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   internal::SilenceCeresLogging();
@@ -718,9 +723,31 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
   cov_options.min_reciprocal_condition_number = 1e-14;
   ceres::Covariance covariance(cov_options);
   std::vector<std::pair<const double*, const double*>> blocks{{x.data(), x.data()}};
-  if (res.summary.termination != FitTermination::kFailure && covariance.Compute(blocks, &problem)) {
-    Eigen::MatrixXd C(np, np);
-    covariance.GetCovarianceBlock(x.data(), x.data(), C.data());
+  Eigen::MatrixXd C(np, np);
+  bool have_covariance = false;
+  if (res.summary.termination != FitTermination::kFailure) {
+    if (options.loss == RobustLoss::kNone) {
+      // The same pseudo-inverse as Ceres' DENSE_SVD covariance (eigenvalues of
+      // J^T J below 1e-14 of the largest dropped), from the np x np normal
+      // matrix instead of an SVD of the N x np Jacobian.
+      have_covariance = sim.Evaluate(x.data(), true);
+      if (have_covariance) {
+        const Eigen::MatrixXd JtJ = sim.jacobian().transpose() * sim.jacobian();
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(JtJ);
+        const Eigen::VectorXd lambda = eig.eigenvalues();
+        const double lmax = lambda.maxCoeff();
+        Eigen::VectorXd inv = Eigen::VectorXd::Zero(np);
+        for (int i = 0; i < np; ++i)
+          if (lmax > 0.0 && lambda[i] / lmax >= cov_options.min_reciprocal_condition_number)
+            inv[i] = 1.0 / lambda[i];
+        C = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+      }
+    } else {
+      have_covariance = covariance.Compute(blocks, &problem);
+      if (have_covariance) covariance.GetCovarianceBlock(x.data(), x.data(), C.data());
+    }
+  }
+  if (have_covariance) {
     const double s2 = 2.0 * summary.final_cost / static_cast<double>(data.size() - np);
     bool ok = true;
     for (int i = 0; i < np; ++i) {

@@ -33,8 +33,43 @@ void CheckDiscreteStep(double Ts, double dt) {
 
 // Runs x[k+1] = A x[k] + B u[k-d], y[k] = C x[k] + D u[k-d] for a SISO model.
 // Plain loops over preallocated buffers: O(N nx^2), no allocation per sample.
+// The loop of SimulateSiso for a compile-time order n (registers, unrolled):
+// process models (order 1-4 with a fractional-delay state) run several times
+// faster on long records than with run-time sizes.
+template <int n>
+VectorXd SimulateSisoFixed(const StateSpace& g, const VectorXd& u, int d, const VectorXd& x0) {
+  const Eigen::Index N = u.size();
+  VectorXd y(N);
+  const Eigen::Matrix<double, n, n> A = g.A();
+  const Eigen::Matrix<double, n, 1> b = g.B().col(0);
+  const Eigen::Matrix<double, 1, n> c = g.C().row(0);
+  const double dd = g.D()(0, 0);
+  Eigen::Matrix<double, n, 1> x = x0.size() == n ? Eigen::Matrix<double, n, 1>(x0)
+                                                 : Eigen::Matrix<double, n, 1>::Zero();
+  for (Eigen::Index k = 0; k < N; ++k) {
+    const double uk = k >= d ? u[k - d] : 0.0;
+    y[k] = dd * uk + c.dot(x);
+    x = (A * x + b * uk).eval();
+  }
+  return y;
+}
+
 VectorXd SimulateSiso(const StateSpace& g, const VectorXd& u, int d, const VectorXd& x0) {
   const Eigen::Index n = g.num_states();
+  switch (n) {
+    case 1:
+      return SimulateSisoFixed<1>(g, u, d, x0);
+    case 2:
+      return SimulateSisoFixed<2>(g, u, d, x0);
+    case 3:
+      return SimulateSisoFixed<3>(g, u, d, x0);
+    case 4:
+      return SimulateSisoFixed<4>(g, u, d, x0);
+    case 5:
+      return SimulateSisoFixed<5>(g, u, d, x0);
+    default:
+      break;
+  }
   const Eigen::Index N = u.size();
   VectorXd y(N);
   // Row-major copy of A for cache-friendly row dot products.
