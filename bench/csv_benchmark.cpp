@@ -2,14 +2,27 @@
 // 10 million rows) is generated once in a temporary directory; the benchmark
 // reports rows/s (items_per_second) and bytes/s.
 //
+// Whole process: BM_CliIdentifyArx runs `pneumid identify FILE -m arx` on the
+// 10^6-row file (start-up, reading, ARX, fit and output: what a user waits
+// for) and BM_CliHelp runs `pneumid --help` (start-up alone: dynamic loading
+// of the linked libraries). The CLI is BUILD/pneumid next to BUILD/bench/, or
+// $PNEUMID_CLI.
+//
 //   build/bench/csv_benchmark --benchmark_filter=ReadCsv
+//   build/bench/csv_benchmark --benchmark_filter=Cli
 #include <benchmark/benchmark.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -70,6 +83,56 @@ void BM_WriteCsv(benchmark::State& state) {
   std::remove(out.c_str());
 }
 BENCHMARK(BM_WriteCsv)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// The pneumid program: $PNEUMID_CLI, else ../pneumid relative to this program.
+std::string CliPath() {
+  if (const char* env = std::getenv("PNEUMID_CLI")) return env;
+  return (std::filesystem::read_symlink("/proc/self/exe").parent_path().parent_path() / "pneumid")
+      .string();
+}
+
+/// Runs the CLI with `args`, output to /dev/null; false when it fails.
+bool RunCli(const std::vector<std::string>& args) {
+  const std::string cli = CliPath();
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(cli.c_str()));
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, cli.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) return false;
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+void BM_CliIdentifyArx(benchmark::State& state) {
+  const long rows = state.range(0);
+  const std::string& path = CsvFile(rows);
+  for (auto _ : state) {
+    if (!RunCli({"identify", path, "-m", "arx"})) {
+      state.SkipWithError(("pneumid identify failed (CLI: " + CliPath() + ")").c_str());
+      break;
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * rows);
+}
+BENCHMARK(BM_CliIdentifyArx)->Arg(1'000'000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_CliHelp(benchmark::State& state) {
+  for (auto _ : state) {
+    if (!RunCli({"--help"})) {
+      state.SkipWithError(("pneumid --help failed (CLI: " + CliPath() + ")").c_str());
+      break;
+    }
+  }
+}
+BENCHMARK(BM_CliHelp)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

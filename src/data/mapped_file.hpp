@@ -63,7 +63,6 @@ class MappedFile {
         throw DataError(fmt::format("{}: cannot map: {}", path, std::strerror(e)));
       }
       ::madvise(p, size_, MADV_SEQUENTIAL);
-      PopulatePages(p, size_, /*write=*/false);
       data_ = static_cast<const char*>(p);
     }
   }

@@ -538,9 +538,8 @@ FilterSpec FilterSpec::Parse(const std::string& text) {
     order_given = true;
   }
   const std::size_t expected = spec.kind == FilterKind::kLowpass ? 1 : 2;
-  PNEUMID_CHECK(freqs.size() == expected, "{}: {} takes {} (in Hz), got {} value(s)", context,
-                kind, expected == 1 ? "one cutoff frequency F" : "two band edges F1,F2",
-                freqs.size());
+  PNEUMID_CHECK(freqs.size() == expected, "{}: {} takes {} (in Hz), got {} value(s)", context, kind,
+                expected == 1 ? "one cutoff frequency F" : "two band edges F1,F2", freqs.size());
   if (spec.kind == FilterKind::kLowpass) {
     spec.high_hz = freqs[0];
   } else {
@@ -578,9 +577,9 @@ Dataset Filter(const Dataset& data, const FilterSpec& spec, ChannelSet which) {
   const Eigen::Index pad = EdgePadding(sections);
   const Eigen::Index n = data.size();
   if (n <= pad) {
-    throw DataError(fmt::format(
-        "{}: filter {} needs more than {} samples (its edge padding), the data has {}",
-        Source(data), spec.ToString(), pad, n));
+    throw DataError(
+        fmt::format("{}: filter {} needs more than {} samples (its edge padding), the data has {}",
+                    Source(data), spec.ToString(), pad, n));
   }
   std::vector<double> ext;
   auto filter = [&](const Eigen::MatrixXd& x, bool active) {
@@ -703,14 +702,13 @@ bool PreprocessOptions::IsValid(std::string* error) const {
 }
 
 bool PreprocessOptions::IsIdentity() const {
-  return !window.IsSet() && resample_ts == 0 && !remove_initial &&
-         detrend == DetrendKind::kNone && !filter && decimate == 1;
+  return !window.IsSet() && resample_ts == 0 && !remove_initial && detrend == DetrendKind::kNone &&
+         !filter && decimate == 1;
 }
 
 namespace {
 
-Eigen::VectorXd OffsetAt(const Eigen::VectorXd& level, const Eigen::VectorXd& slope,
-                         double dt) {
+Eigen::VectorXd OffsetAt(const Eigen::VectorXd& level, const Eigen::VectorXd& slope, double dt) {
   if (slope.size() != level.size()) return level;
   return level + slope * dt;
 }
@@ -720,8 +718,8 @@ std::string Values(const Eigen::VectorXd& v) {
 }
 
 /// Subtracts level + slope (t - t0) from every channel.
-Dataset SubtractLines(const Dataset& data, const OperatingPoint& level,
-                      const OperatingPoint& slope, double t0) {
+Dataset SubtractLines(const Dataset& data, const OperatingPoint& level, const OperatingPoint& slope,
+                      double t0) {
   const Eigen::ArrayXd dt = data.time().array() - t0;
   auto apply = [&](const Eigen::MatrixXd& m, const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
     Eigen::MatrixXd out = m;
@@ -796,9 +794,9 @@ Dataset Preprocess(const Dataset& data, const PreprocessOptions& options,
     } else {
       const StepEvent step = DetectStep(*d, options.step);
       set(RemoveInitialOffset(*d, step, options.channels, &removed));
-      r.steps.push_back(fmt::format(
-          "remove initial offset: mean of the {} samples before the step at t = {:g} s",
-          step.index, step.time));
+      r.steps.push_back(
+          fmt::format("remove initial offset: mean of the {} samples before the step at t = {:g} s",
+                      step.index, step.time));
     }
     r.offsets = "initial";
     r.level = std::move(removed);
@@ -846,9 +844,9 @@ Dataset Preprocess(const Dataset& data, const PreprocessOptions& options,
 Dataset ApplyRecorded(const Dataset& data, const PreprocessRecord& record) {
   auto check_size = [&](const Eigen::VectorXd& v, int n, const char* what) {
     if (v.size() != 0 && v.size() != n) {
-      throw DataError(fmt::format(
-          "{} has {} {}, the recorded preprocessing (operating point) is for {}", Source(data), n,
-          what, v.size()));
+      throw DataError(
+          fmt::format("{} has {} {}, the recorded preprocessing (operating point) is for {}",
+                      Source(data), n, what, v.size()));
     }
   };
   check_size(record.level.u0, data.num_inputs(), "inputs");

@@ -84,14 +84,14 @@ PreprocessRecord PreprocessRecordFromJson(const nlohmann::json& j) {
   Get(j, "decimate_order", &r.decimate_options.order,
       [](const auto& v) { return v.template get<int>(); });
   Get(j, "decimate_cutoff", &r.decimate_options.cutoff, number);
-  Get(j, "steps", &r.steps, [](const auto& v) { return v.template get<std::vector<std::string>>(); });
+  Get(j, "steps", &r.steps,
+      [](const auto& v) { return v.template get<std::vector<std::string>>(); });
   PNEUMID_CHECK(r.slope.u0.size() == r.level.u0.size() && r.slope.y0.size() == r.level.y0.size(),
                 "preprocessing: u_slope/y_slope have {}/{} values, u0/y0 have {}/{}",
                 r.slope.u0.size(), r.slope.y0.size(), r.level.u0.size(), r.level.y0.size());
   PNEUMID_CHECK(r.resample_ts >= 0, "preprocessing: key 'resample_ts': must be >= 0, got {}",
                 r.resample_ts);
-  PNEUMID_CHECK(r.decimate >= 1, "preprocessing: key 'decimate': must be >= 1, got {}",
-                r.decimate);
+  PNEUMID_CHECK(r.decimate >= 1, "preprocessing: key 'decimate': must be >= 1, got {}", r.decimate);
   std::string error;
   PNEUMID_CHECK(r.decimate == 1 || r.decimate_options.IsValid(&error), "preprocessing: {}", error);
   return r;

@@ -111,5 +111,63 @@ TEST(DatasetTest, SourceLinesMap) {
   EXPECT_THROW(d.set_source_lines({0, 0}, {2, 3}), InvalidArgument);
 }
 
+TEST(DatasetTest, CopiesShareTheSamples) {
+  Dataset d(Eigen::VectorXd::LinSpaced(5, 0, 4), Eigen::MatrixXd::Random(5, 2),
+            Eigen::MatrixXd::Random(5, 1));
+  d.set_source("a.csv");
+  Dataset copy = d;
+  EXPECT_EQ(copy.time().data(), d.time().data());
+  EXPECT_EQ(copy.inputs().data(), d.inputs().data());
+  // Metadata stays per object.
+  copy.set_source("b.csv");
+  EXPECT_EQ(d.source(), "a.csv");
+  const std::vector<Dataset> several{d, d};
+  EXPECT_EQ(several[1].outputs().data(), d.outputs().data());
+  // A default dataset is empty, also after being moved from.
+  Dataset moved = std::move(copy);
+  EXPECT_EQ(moved.size(), 5);
+  EXPECT_EQ(Dataset().size(), 0);
+  EXPECT_EQ(Dataset().num_inputs(), 0);
+}
+
+TEST(DatasetTest, SelectChannels) {
+  Eigen::MatrixXd u(4, 2), y(4, 2);
+  u << 1, 10, 2, 20, 3, 30, 4, 40;
+  y << 5, 50, 6, 60, 7, 70, 8, 80;
+  Dataset d(Eigen::VectorXd::LinSpaced(4, 0, 3), u, y, {{"a", "%"}, {"b", "V"}},
+            {{"p", "N"}, {"q", "m"}});
+  d.set_source("s.csv");
+  d.set_source_lines({0}, {3});
+  const Dataset all = d.SelectChannels({0, 1}, {0, 1});
+  EXPECT_EQ(all.inputs().data(), d.inputs().data());  // shared, not copied
+  const Dataset one = d.SelectChannels({1}, {0});
+  EXPECT_EQ(one.num_inputs(), 1);
+  EXPECT_EQ(one.num_outputs(), 1);
+  EXPECT_EQ(one.u(), u.col(1));
+  EXPECT_EQ(one.y(), y.col(0));
+  EXPECT_EQ(one.input_channels()[0].name, "b");
+  EXPECT_EQ(one.output_channels()[0].unit, "N");
+  EXPECT_EQ(one.Where(2), "s.csv:5");
+  EXPECT_EQ(d.SelectChannels({}, {1}).num_inputs(), 0);
+  EXPECT_THAT([&] { d.SelectChannels({2}, {0}); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("input 2 out of range [0, 2)")));
+}
+
+TEST(DatasetTest, UniformityFastPathAgreesWithTheMedianTest) {
+  // Intervals 0.01 with one interval off by 2e-5 (0.2 %): not uniform at
+  // 0.1 %, uniform at 0.5 %; all intervals equal: uniform at tolerance 0.
+  Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(101, 0.0, 1.0);
+  const Dataset exact(t, Eigen::MatrixXd::Zero(101, 1), Eigen::MatrixXd::Zero(101, 1));
+  EXPECT_TRUE(exact.IsUniform(1e-9));
+  for (Eigen::Index i = 50; i < 101; ++i) t[i] += 2e-5;
+  Dataset jitter(t, Eigen::MatrixXd::Zero(101, 1), Eigen::MatrixXd::Zero(101, 1));
+  jitter.set_source("j.csv");
+  EXPECT_FALSE(jitter.IsUniform(1e-3));
+  EXPECT_TRUE(jitter.IsUniform(5e-3));
+  EXPECT_THAT([&] { jitter.RequireUniform(1e-3); },
+              ThrowsMessage<DataError>(HasSubstr("sampling is not uniform")));
+  EXPECT_NO_THROW(jitter.RequireUniform(5e-3));
+}
+
 }  // namespace
 }  // namespace pneumid

@@ -352,8 +352,7 @@ TEST(PreprocessTest, FilterMatchesScipySosfiltfilt) {
   EXPECT_LT(GoldenError(Filter(d, FilterSpec::Parse("lowpass:10")), "lp10"), 1e-10);
   EXPECT_LT(GoldenError(Filter(d, FilterSpec::Parse("lowpass:20,order=2")), "lp20o2"), 1e-10);
   EXPECT_LT(GoldenError(Filter(d, FilterSpec::Parse("bandpass:2,15")), "bp2_15"), 1e-10);
-  EXPECT_LT(GoldenError(Filter(d, FilterSpec::Parse("bandpass:1,30,order=4")), "bp1_30o4"),
-            1e-10);
+  EXPECT_LT(GoldenError(Filter(d, FilterSpec::Parse("bandpass:1,30,order=4")), "bp1_30o4"), 1e-10);
 }
 
 TEST(PreprocessTest, FilterSelectedChannelsKeepTimesAndLines) {
@@ -425,8 +424,9 @@ TEST(PreprocessTest, TimeWindowParses) {
   EXPECT_EQ(TimeWindow::Parse(":9").ToString(), ":9");
   EXPECT_TRUE(TimeWindow::Parse(":9").IsSet());
   EXPECT_FALSE(TimeWindow().IsSet());
-  EXPECT_THAT([] { TimeWindow::Parse("9:5"); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("window '9:5': start 9 s is after end 5 s")));
+  EXPECT_THAT(
+      [] { TimeWindow::Parse("9:5"); },
+      ThrowsMessage<InvalidArgument>(HasSubstr("window '9:5': start 9 s is after end 5 s")));
   EXPECT_THAT([] { TimeWindow::Parse("5"); },
               ThrowsMessage<InvalidArgument>(HasSubstr("expected T0:T1")));
   EXPECT_THAT([] { TimeWindow::Parse("a:5"); },
@@ -538,9 +538,9 @@ TEST(PreprocessTest, PreprocessErrorsNameTheData) {
   d.set_source("FILE.csv");
   PreprocessOptions o;
   o.window = TimeWindow::Parse("5:9");
-  EXPECT_THAT([&] { Preprocess(d, o); },
-              ThrowsMessage<DataError>(
-                  HasSubstr("window 5:9 s lies outside the data 0..4 s of FILE.csv")));
+  EXPECT_THAT(
+      [&] { Preprocess(d, o); },
+      ThrowsMessage<DataError>(HasSubstr("window 5:9 s lies outside the data 0..4 s of FILE.csv")));
   o = {};
   o.filter = FilterSpec::Parse("lowpass:60");
   EXPECT_THAT([&] { Preprocess(d, o); },
@@ -572,9 +572,7 @@ TEST(PreprocessTest, ApplyRecordedUsesTheRecordedOffsets) {
   o.detrend = DetrendKind::kLinear;
   o.filter.reset();
   Preprocess(d, o, &r);
-  EXPECT_LT((ApplyRecorded(shifted, r).y().array() - Detrend(d).y().array() - 5.0)
-                .abs()
-                .maxCoeff(),
+  EXPECT_LT((ApplyRecorded(shifted, r).y().array() - Detrend(d).y().array() - 5.0).abs().maxCoeff(),
             1e-9);
   // Channel counts must match the record.
   const Dataset two(d.time(), Eigen::MatrixXd::Zero(d.size(), 2), d.outputs());
@@ -602,11 +600,17 @@ TEST(PreprocessTest, PreprocessRecordJsonRoundTrip) {
   EXPECT_EQ(back.trend_time, r.trend_time);
   EXPECT_EQ(ApplyRecorded(d, back).y(), ApplyRecorded(d, r).y());
   EXPECT_TRUE(PreprocessRecordFromJson(nlohmann::json::object()).IsIdentity());
-  EXPECT_THAT([] { PreprocessRecordFromJson(nlohmann::json{{"filter", "lowpass:x"}}); },
-              ThrowsMessage<InvalidArgument>(
-                  AllOf(HasSubstr("preprocessing: key 'filter'"), HasSubstr("not a frequency"))));
-  EXPECT_THAT([] { PreprocessRecordFromJson(nlohmann::json{{"decimate", "4"}}); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("preprocessing: key 'decimate'")));
+  EXPECT_THAT(
+      [] {
+        PreprocessRecordFromJson(nlohmann::json{{"filter", "lowpass:x"}});
+      },
+      ThrowsMessage<InvalidArgument>(
+          AllOf(HasSubstr("preprocessing: key 'filter'"), HasSubstr("not a frequency"))));
+  EXPECT_THAT(
+      [] {
+        PreprocessRecordFromJson(nlohmann::json{{"decimate", "4"}});
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("preprocessing: key 'decimate'")));
 }
 
 }  // namespace

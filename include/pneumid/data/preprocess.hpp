@@ -243,16 +243,16 @@ DetrendKind DetrendKindFromString(const std::string& s);
 /// of the raw data; decimation last, after the filter, at the rate the filter
 /// spec was written for.
 struct PreprocessOptions {
-  TimeWindow window;                ///< default: all samples
-  double resample_ts = 0.0;         ///< seconds; 0: keep the time base
-  bool remove_initial = false;      ///< subtract the initial steady state
+  TimeWindow window;            ///< default: all samples
+  double resample_ts = 0.0;     ///< seconds; 0: keep the time base
+  bool remove_initial = false;  ///< subtract the initial steady state
   /// With remove_initial: 0 averages the samples before the step found by
   /// DetectStep(step); n > 0 averages the first n samples.
   Eigen::Index initial_samples = 0;
-  StepDetectOptions step;           ///< step search for remove_initial
+  StepDetectOptions step;                    ///< step search for remove_initial
   DetrendKind detrend = DetrendKind::kNone;  ///< not together with remove_initial
-  std::optional<FilterSpec> filter;  ///< none by default
-  int decimate = 1;                 ///< factor >= 1; 1: keep all samples
+  std::optional<FilterSpec> filter;          ///< none by default
+  int decimate = 1;                          ///< factor >= 1; 1: keep all samples
   DecimateOptions decimate_options;
   /// Channels the offsets, trends and the filter apply to.
   ChannelSet channels = ChannelSet::kBoth;
@@ -272,13 +272,13 @@ struct PreprocessOptions {
 ///   offset_i(t) = level_i + slope_i * (t - trend_time)
 /// with slope 0 for remove_initial and constant detrend.
 struct PreprocessRecord {
-  TimeWindow window;          ///< as applied (unbounded when none)
-  double resample_ts = 0.0;   ///< 0: not resampled
+  TimeWindow window;         ///< as applied (unbounded when none)
+  double resample_ts = 0.0;  ///< 0: not resampled
   /// "none", "initial" (remove_initial) or ToString(DetrendKind).
   std::string offsets = "none";
-  OperatingPoint level;       ///< level_i, one value per channel (0 where untouched)
-  OperatingPoint slope;       ///< slope_i per second (zero unless linear detrend)
-  double trend_time = 0.0;    ///< time origin of the slope, s (mean time of the data)
+  OperatingPoint level;     ///< level_i, one value per channel (0 where untouched)
+  OperatingPoint slope;     ///< slope_i per second (zero unless linear detrend)
+  double trend_time = 0.0;  ///< time origin of the slope, s (mean time of the data)
   std::optional<FilterSpec> filter;
   ChannelSet channels = ChannelSet::kBoth;
   int decimate = 1;
