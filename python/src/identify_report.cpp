@@ -1,13 +1,19 @@
 // Bindings of the identify and report areas.
+#include <optional>
+
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/data/preprocess.hpp"
+#include "pneumid/data/preprocess_io.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/initial_state.hpp"
+#include "pneumid/identify/model_evaluation.hpp"
 #include "pneumid/identify/identify.hpp"
 #include "pneumid/identify/step_analysis.hpp"
 #include "pneumid/identify/step_methods.hpp"
@@ -43,6 +49,21 @@ void SaveFigure(const Figure& fig, const std::string& path) {
   fig.Save(path);
 }
 
+PreprocessOptions PythonPreprocessOptions(const std::string& window, double resample,
+                                          bool remove_initial, const std::string& detrend,
+                                          const std::string& filter, int decimate) {
+  PreprocessOptions o;
+  if (!window.empty()) o.window = TimeWindow::Parse(window);
+  o.resample_ts = resample;
+  o.remove_initial = remove_initial;
+  o.detrend = DetrendKindFromString(detrend);
+  if (!filter.empty()) o.filter = FilterSpec::Parse(filter);
+  o.decimate = decimate;
+  std::string why;
+  PNEUMID_CHECK(o.IsValid(&why), "{}", why);
+  return o;
+}
+
 }  // namespace
 
 void BindIdentify(py::module_& m) {
@@ -62,6 +83,30 @@ void BindIdentify(py::module_& m) {
       .def_readonly("fit_percent", &IdentifiedModel::fit_percent, "NRMSE fit [%].")
       .def_readonly("iae", &IdentifiedModel::iae, "Integrated absolute error [units s].")
       .def_readonly("notes", &IdentifiedModel::notes)
+      .def_readonly("u0", &IdentifiedModel::u0,
+                    "Operating point: the model predicts y0 + G (u - u0) (simulate_model).")
+      .def_readonly("y0", &IdentifiedModel::y0)
+      .def_property_readonly(
+          "termination", [](const IdentifiedModel& r) { return ToString(r.termination); },
+          "How the estimator ended: 'convergence', 'no_convergence', ...")
+      .def_readonly("validation_fit_percent", &IdentifiedModel::validation_fit_percent,
+                    "NRMSE fit [%] on held-out data (identify_models), NaN when none.")
+      .def_property_readonly(
+          "flags",
+          [](const IdentifiedModel& r) {
+            py::list l;
+            for (const ModelFlagNote& f : r.flags)
+              l.append(py::dict("flag"_a = ToString(f.flag), "reason"_a = f.reason));
+            return l;
+          },
+          "Reasons not to trust the model: [{'flag': 'nyquist_pole', 'reason': ...}, ...].")
+      .def_property_readonly(
+          "preprocessing",
+          [](const IdentifiedModel& r) -> py::object {
+            if (!r.preprocessing) return py::none();
+            return JsonToPython(ToJson(*r.preprocessing));
+          },
+          "The preprocessing of the estimation data (dict), or None.")
       .def(
           "to_dict", [](const IdentifiedModel& r) { return JsonToPython(ToJson(r)); },
           "The JSON form of `pneumid identify --json`.")
@@ -98,6 +143,83 @@ void BindIdentify(py::module_& m) {
       "(ARX(na, nb, nk), Eq. 4); 'n4sid' (order na, D term when `feedthrough`, weighting "
       "`n4sid_weight` 'moesp', 'n4sid' or 'cva'). Raises DataError when the data do not suit the "
       "method.");
+  m.def(
+      "preprocess",
+      [](const Dataset& data, const std::string& window, double resample, bool remove_initial,
+         const std::string& detrend, const std::string& filter, int decimate) {
+        const PreprocessOptions o = PythonPreprocessOptions(window, resample, remove_initial,
+                                                            detrend, filter, decimate);
+        PreprocessRecord record;
+        Dataset out;
+        {
+          py::gil_scoped_release release;
+          out = Preprocess(data, o, &record);
+        }
+        return py::make_tuple(out, JsonToPython(ToJson(record)));
+      },
+      "data"_a, "window"_a = "", "resample"_a = 0.0, "remove_initial"_a = false,
+      "detrend"_a = "none", "filter"_a = "", "decimate"_a = 1,
+      "Preprocesses data as the command-line flags do (window 'T0:T1', resample Ts, "
+      "remove_initial, detrend 'constant'|'linear', filter 'lowpass:F'|'bandpass:F1,F2', "
+      "decimate N), in that order. Returns (dataset, record) with record the dict stored in "
+      "model files.");
+  m.def(
+      "identify_models",
+      [](const std::vector<std::string>& methods, const Dataset& data, int input, int output,
+         int order, int na, int nb, int nk, int nc, int nd, int nf, double split,
+         std::optional<Dataset> validation, const std::string& window, double resample,
+         bool remove_initial, const std::string& detrend, const std::string& filter,
+         int decimate) {
+        IdentifyRequest r;
+        r.input = input;
+        r.output = output;
+        r.order = order;
+        r.na = na;
+        r.nb = nb;
+        r.nk = nk;
+        r.nc = nc;
+        r.nd = nd;
+        r.nf = nf;
+        IdentifyOptions o;
+        o.split = split;
+        const PreprocessOptions p = PythonPreprocessOptions(window, resample, remove_initial,
+                                                            detrend, filter, decimate);
+        IdentificationSummary s;
+        {
+          py::gil_scoped_release release;
+          PreprocessRecord record;
+          const Dataset d = Preprocess(data, p, &record);
+          std::optional<Dataset> v;
+          if (validation) v = ApplyRecorded(*validation, record);
+          s = IdentifyModels(methods, d, r, o, v ? &*v : nullptr);
+          if (!record.IsIdentity())
+            for (IdentifiedModel& m : s.models) m.preprocessing = record;
+        }
+        py::list failures;
+        for (const auto& [method, reason] : s.failures)
+          failures.append(py::dict("method"_a = method, "reason"_a = reason));
+        return py::dict("models"_a = s.models, "failures"_a = failures,
+                        "best"_a = s.models.empty() ? py::object(py::none())
+                                                    : py::cast(s.models.front().method),
+                        "termination"_a = ToString(s.termination), "message"_a = s.message);
+      },
+      "methods"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3,
+      "nb"_a = 3, "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3, "split"_a = 0.0,
+      "validation"_a = py::none(), "window"_a = "", "resample"_a = 0.0,
+      "remove_initial"_a = false, "detrend"_a = "none", "filter"_a = "", "decimate"_a = 1,
+      "Runs several methods as `pneumid identify -m` does: each fails alone, models are "
+      "flagged and ranked (unflagged first; by validation fit with `split` or `validation` "
+      "data). Returns {'models': [IdentifiedModel, best first], 'failures': [{'method', "
+      "'reason'}], 'best', 'termination', 'message'}.");
+  m.def(
+      "simulate_model",
+      [](const IdentifiedModel& model, const Dataset& data, int input) {
+        py::gil_scoped_release release;
+        return SimulateModel(model, data, input);
+      },
+      "model"_a, "data"_a, "input"_a = 0,
+      "Output of an identified model on the data's input: y0 + G (u - u0), as identify, "
+      "validate and the report compute it.");
   m.def(
       "simulate_on_data",
       [](const TransferFunction& g, const Dataset& data, int input, int output, double y0) {
