@@ -98,16 +98,8 @@ Dataset SisoData(const Dataset& data, const IdentifyRequest& request) {
   PNEUMID_CHECK(request.output >= 0 && request.output < data.num_outputs(),
                 "output column {} out of range [0, {})", request.output, data.num_outputs());
   data.RequireUniform();
-  Eigen::MatrixXd u = data.u(request.input);
-  Eigen::MatrixXd y = data.y(request.output);
-  std::vector<Channel> ic, oc;
-  if (static_cast<int>(data.input_channels().size()) > request.input)
-    ic.push_back(data.input_channels()[request.input]);
-  if (static_cast<int>(data.output_channels().size()) > request.output)
-    oc.push_back(data.output_channels()[request.output]);
-  Dataset d(data.time(), u, y, ic, oc);
-  d.set_source(data.source());
-  return d;
+  // SISO data is shared, not copied.
+  return data.SelectChannels({request.input}, {request.output});
 }
 
 // Fills discrete/tf (d2c when possible), fit and IAE of a transfer-function model.
