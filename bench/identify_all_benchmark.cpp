@@ -2,9 +2,10 @@
 // IdentifyMethodNames() through Identify() on 2e5 samples of the simulated IPA
 // (step 0.61 -> 82 % at 100 s, 2000 s at Ts = 0.01 s, as made by
 // `pneumid simulate --input step:from=0.61,to=82,at=100 --duration 2000`).
-// One benchmark per method and one for the whole list; the data are made once
-// (or read from the file named by PNEUMID_BENCH_DATA; PNEUMID_BENCH_NOTES=1
-// prints each model's fit and notes).
+// One benchmark per method and one for the whole list; the data are made once.
+// Environment: PNEUMID_BENCH_DATA=FILE reads that record instead,
+// PNEUMID_BENCH_DURATION=S simulates S seconds (10000 for 1e6 samples),
+// PNEUMID_BENCH_NOTES=1 prints each model's fit and notes.
 //   build/bench/identify_all_benchmark [--benchmark_filter=all]
 #include <cstdio>
 #include <cstdlib>
@@ -29,7 +30,9 @@ const pneumid::Dataset& LongRecord() {
     pneumid::ExperimentOptions o;
     o.input_channel = pneumid::PlantInputChannel(*plant);
     o.output_channel = pneumid::PlantOutputChannel(*plant);
-    return pneumid::RunExperiment(*plant, *input, 2000.0, o).data;
+    // PNEUMID_BENCH_DURATION=S: S seconds (S / 0.01 samples), e.g. 10000 for 1e6.
+    const char* duration = std::getenv("PNEUMID_BENCH_DURATION");
+    return pneumid::RunExperiment(*plant, *input, duration ? std::atof(duration) : 2000.0, o).data;
   }();
   return data;
 }
