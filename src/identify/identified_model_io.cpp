@@ -41,6 +41,37 @@ ParamValue ParamFromJson(const nlohmann::json& v, const std::string& key) {
   return Numbers(v, key);
 }
 
+// {"names": [n strings], "matrix": [n rows of n numbers]}.
+ParameterCovariance CovarianceFromJson(const nlohmann::json& c) {
+  PNEUMID_CHECK(c.is_object() && c.contains("names") && c.contains("matrix"),
+                "'covariance' must be an object with 'names' and 'matrix', got {}",
+                Excerpt(c.dump()));
+  const nlohmann::json& names = c.at("names");
+  const nlohmann::json& rows = c.at("matrix");
+  PNEUMID_CHECK(names.is_array(), "'covariance.names' must be an array of strings, got {}",
+                Excerpt(names.dump()));
+  ParameterCovariance cov;
+  for (const auto& name : names) {
+    PNEUMID_CHECK(name.is_string(), "'covariance.names' must hold strings, got {}",
+                  Excerpt(name.dump()));
+    cov.names.push_back(name.get<std::string>());
+  }
+  const auto n = static_cast<Eigen::Index>(cov.names.size());
+  PNEUMID_CHECK(rows.is_array() && static_cast<Eigen::Index>(rows.size()) == n,
+                "'covariance.matrix' must be {} rows for the {} names, got {}", n, n,
+                Excerpt(rows.dump()));
+  cov.matrix.resize(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const nlohmann::json& row = rows.at(static_cast<std::size_t>(i));
+    PNEUMID_CHECK(row.is_array() && static_cast<Eigen::Index>(row.size()) == n,
+                  "'covariance.matrix' row {} must hold {} numbers, got {}", i + 1, n,
+                  Excerpt(row.dump()));
+    const std::vector<double> v = Numbers(row, "covariance.matrix");
+    for (Eigen::Index k = 0; k < n; ++k) cov.matrix(i, k) = v[static_cast<std::size_t>(k)];
+  }
+  return cov;
+}
+
 }  // namespace
 
 nlohmann::json ToJson(const ModelParams& params) {
@@ -78,6 +109,16 @@ nlohmann::json ToJson(const IdentifiedModel& model) {
   for (const ModelFlagNote& f : model.flags)
     j["flags"].push_back({{"flag", ToString(f.flag)}, {"reason", f.reason}});
   if (model.preprocessing) j["preprocessing"] = ToJson(*model.preprocessing);
+  if (model.covariance) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (Eigen::Index i = 0; i < model.covariance->matrix.rows(); ++i) {
+      nlohmann::json row = nlohmann::json::array();
+      for (Eigen::Index k = 0; k < model.covariance->matrix.cols(); ++k)
+        row.push_back(model.covariance->matrix(i, k));
+      rows.push_back(std::move(row));
+    }
+    j["covariance"] = {{"names", model.covariance->names}, {"matrix", std::move(rows)}};
+  }
   return j;
 }
 
@@ -134,6 +175,7 @@ IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
     }
   }
   if (j.contains("preprocessing")) m.preprocessing = PreprocessRecordFromJson(j.at("preprocessing"));
+  if (j.contains("covariance")) m.covariance = CovarianceFromJson(j.at("covariance"));
   return m;
 }
 

@@ -65,6 +65,7 @@ IdentifiedModel ToIdentifiedModel(const std::string& method, const PolynomialMod
     const auto names = model.ParameterNames();
     for (std::size_t i = 0; i < names.size(); ++i)
       r.param_std[names[i]] = sd[static_cast<Eigen::Index>(i)];
+    if (model.covariance.allFinite()) r.covariance = ParameterCovariance{names, model.covariance};
   }
   r.discrete = model.ToTransferFunction(0);
   r.tf = ContinuousForm(*r.discrete, &r.notes);

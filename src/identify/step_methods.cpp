@@ -9,6 +9,7 @@
 #include "pneumid/identify/areas.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/model_uncertainty.hpp"
 #include "pneumid/identify/ptn.hpp"
 #include "pneumid/identify/reaction_curve.hpp"
 #include "pneumid/identify/sopdt.hpp"
@@ -100,12 +101,15 @@ IdentifiedModel IdentifyStepMethod(const std::string& method, const Dataset& dat
     const ProcessFitResult r = FitProcessModel(data, in, out, fo);
     m.method = method;
     m.structure = ToString(r.structure) + (r.zero ? "Z" : "");
+    std::vector<std::string> names;
     for (const auto& [name, value] : NamedParams(r.structure, r.zero, r.params)) {
       m.params[name] = value;
+      names.push_back(name);
     }
     for (const auto& [name, value] : NamedParams(r.structure, r.zero, r.param_std)) {
       if (std::isfinite(value)) m.param_std[name] = value;
     }
+    SetDiagonalCovariance(&m, names);
     m.tf = r.tf;
     if (r.summary.termination != FitTermination::kConvergence) {
       m.notes.push_back(r.summary.BriefReport());

@@ -16,6 +16,8 @@
 #include <variant>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/data/preprocess.hpp"
@@ -81,6 +83,17 @@ struct ModelFlagNote {
   bool operator==(const ModelFlagNote&) const = default;
 };
 
+/// Covariance of the estimated parameters: `matrix` (n x n, symmetric) in the
+/// order of `names`, which name entries of IdentifiedModel::params (for
+/// polynomial models the coefficients a1.., b1.., c1.., d1.., f1.. of
+/// PolynomialModel::ParameterNames(), which index into the vectors "a", "b",
+/// ...). Confidence bands of responses are computed from it
+/// (model_uncertainty.hpp).
+struct ParameterCovariance {
+  std::vector<std::string> names;
+  Eigen::MatrixXd matrix;
+};
+
 struct IdentifiedModel {
   std::string method;     ///< e.g. "reaction-curve", "fit-p1d", "arx"
   std::string structure;  ///< e.g. "FOPDT", "PTn", "P2D", "ARX"
@@ -109,6 +122,10 @@ struct IdentifiedModel {
   /// offsets, filter, decimation); u0/y0 above refer to the preprocessed
   /// signals. `validate` re-applies it to new data (ApplyRecorded).
   std::optional<PreprocessRecord> preprocessing;
+  /// Parameter covariance when the estimator gives one (ARX, ARMAX, OE, BJ,
+  /// IV4: full; fit-* process models: diagonal, param_std squared); none for
+  /// the graphical, subspace and correlation methods.
+  std::optional<ParameterCovariance> covariance;
 };
 
 /// Options shared by every method of `pneumid identify`.

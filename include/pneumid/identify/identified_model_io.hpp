@@ -6,7 +6,9 @@
 //    "param_std": {...}                        (only when known)
 //    "tf": {"num": [...], "den": [...], "Ts": 0, "delay": 0.001},
 //    "discrete": {...}                         (polynomial models only)
-//    "fit_percent": 97.1, "iae": 0.8, "notes": [...]   (notes only when any)}
+//    "fit_percent": 97.1, "iae": 0.8, "notes": [...]   (notes only when any)
+//    "covariance": {"names": ["a1", "b1"], "matrix": [[...], [...]]}
+//                                              (only when known; model_uncertainty.hpp)}
 //
 // The keys are a file format read back by `pneumid step/bode/control --model
 // FILE` (lti/model_io.hpp reads "tf") and `pneumid validate` (the polynomial
