@@ -169,7 +169,8 @@ class Simulator {
 
   // Evaluates residuals (and the Jacobian when wanted) at x, caching the result.
   // K and y0 enter linearly and have exact columns (-h scale_K, -scale_y0); the
-  // lags, zero and delay have central differences of K h (one-sided at a bound).
+  // lags, zero and delay have forward differences of K h (step 1e-7 relative,
+  // backward at an upper bound): one simulation per parameter.
   bool Evaluate(const double* x, bool want_jacobian) {
     const int np = num_params();
     const bool same = valid_ && std::equal(x, x + np, x_.data());
@@ -194,10 +195,10 @@ class Simulator {
         J_.col(j).setConstant(-scale_[j]);
         continue;
       }
-      const double step = 1e-6 * std::max(1.0, std::abs(x_[j]));
+      const double step = 1e-7 * std::max(1.0, std::abs(x_[j]));
       const bool can_up = x_[j] + step <= upper_[j];
       const bool can_down = x_[j] - step >= lower_[j];
-      double hu = can_up ? step : 0.0, hd = can_down ? step : 0.0;
+      double hu = can_up ? step : 0.0, hd = can_down && !can_up ? step : 0.0;
       if (!can_up && !can_down) hu = step;  // degenerate bounds: step outside anyway
       xp = x_;
       xp[j] = x_[j] + hu;
