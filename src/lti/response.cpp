@@ -44,8 +44,8 @@ VectorXd SimulateSisoFixed(const StateSpace& g, const VectorXd& u, int d, const 
   const Eigen::Matrix<double, n, 1> b = g.B().col(0);
   const Eigen::Matrix<double, 1, n> c = g.C().row(0);
   const double dd = g.D()(0, 0);
-  Eigen::Matrix<double, n, 1> x = x0.size() == n ? Eigen::Matrix<double, n, 1>(x0)
-                                                 : Eigen::Matrix<double, n, 1>::Zero();
+  Eigen::Matrix<double, n, 1> x =
+      x0.size() == n ? Eigen::Matrix<double, n, 1>(x0) : Eigen::Matrix<double, n, 1>::Zero();
   for (Eigen::Index k = 0; k < N; ++k) {
     const double uk = k >= d ? u[k - d] : 0.0;
     y[k] = dd * uk + c.dot(x);

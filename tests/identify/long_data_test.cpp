@@ -78,14 +78,15 @@ TEST(LongData, DiscreteLsimRunsTheDifferenceEquation) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(seconds, 1.0);
-  for (Eigen::Index k : {Eigen::Index{0}, Eigen::Index{5}, Eigen::Index{255}, Eigen::Index{1000},
-                         n - 1}) {
+  for (Eigen::Index k :
+       {Eigen::Index{0}, Eigen::Index{5}, Eigen::Index{255}, Eigen::Index{1000}, n - 1}) {
     double ref = 0.0;
     for (Eigen::Index i = 0; i < taps && i <= k; ++i) ref += g[i] * u[k - i];
     EXPECT_NEAR(y[k], ref, 1e-12 * (1.0 + std::abs(ref))) << "k = " << k;
   }
   // An IIR model with a delay of 3 samples equals the state-space route.
-  const TransferFunction iir(Eigen::Vector2d(0.2, 0.1), Eigen::Vector3d(1.0, -1.2, 0.5), 0.01, 0.03);
+  const TransferFunction iir(Eigen::Vector2d(0.2, 0.1), Eigen::Vector3d(1.0, -1.2, 0.5), 0.01,
+                             0.03);
   const Eigen::VectorXd a = Lsim(iir, u.head(500), 0.01);
   const Eigen::MatrixXd b = Lsim(ToStateSpace(iir), Eigen::MatrixXd(u.head(500)), 0.01);
   EXPECT_LT((a - b.col(0)).cwiseAbs().maxCoeff(), 1e-12);
