@@ -1,7 +1,7 @@
 // pneumid bode: frequency response and stability margins of a model.
 //
 //   pneumid bode --model fopdt-paper [--w-min 0.1 --w-max 1000 --points 50] [--json]
-//                [--plot bode.svg]
+//                [--plot bode.svg] [--confidence 3]
 #include <cmath>
 #include <iostream>
 
@@ -10,8 +10,10 @@
 
 #include "command.hpp"
 #include "model_options.hpp"
+#include "identified_spec.hpp"
 #include "output_options.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/identify/model_uncertainty.hpp"
 #include "pneumid/lti/frequency.hpp"
 #include "pneumid/report/figures.hpp"
 #include "validators.hpp"
@@ -24,6 +26,7 @@ struct BodeOptions {
   double w_min = 0.0;
   double w_max = 0.0;
   int points = 0;  ///< 0: 50 over --w-min..--w-max, else the automatic grid
+  double confidence = 0.0;  ///< band of +-K standard deviations; 0 = none
   bool json = false;
   std::string plot;
 };
@@ -45,13 +48,19 @@ void Run(const BodeOptions& o) {
   }
   const BodeData b = Bode(g, omega);
   const Margins m = ComputeMargins(g);
+  const std::optional<IdentifiedModel> identified = ModelForConfidence(o.model.model, o.confidence);
+  UncertaintyOptions uo;
+  uo.discrete = g.IsDiscrete();  // the form drawn: "tf" of the file, discrete when it is
+  const BodeStd sd = identified ? BodeResponseStd(*identified, b.omega, uo) : BodeStd{};
   if (!o.plot.empty()) {
     // The figure over the range of the table, on a grid of at least 400 frequencies.
     const Eigen::VectorXd w =
         LogSpace(std::log10(b.omega[0]), std::log10(b.omega[b.omega.size() - 1]),
                  std::max<int>(400, static_cast<int>(b.omega.size())));
     const std::string label = ModelLabel(o.model, g);
-    BodeFigure({{label, g}}, w, "Bode diagram of " + label).Save(o.plot);
+    NamedModel nm{label, g};
+    if (identified) nm.identified = std::make_shared<const IdentifiedModel>(*identified);
+    BodeFigure({nm}, w, "Bode diagram of " + label, o.confidence).Save(o.plot);
   }
   if (o.json) {
     nlohmann::ordered_json j;
@@ -60,6 +69,11 @@ void Run(const BodeOptions& o) {
         std::vector<double>(b.magnitude_db.data(), b.magnitude_db.data() + b.magnitude_db.size());
     j["phase_deg"] =
         std::vector<double>(b.phase_deg.data(), b.phase_deg.data() + b.phase_deg.size());
+    if (identified) {
+      j["confidence"] = o.confidence;
+      j["magnitude_db_std"] = JsonNumbers(sd.magnitude_db);
+      j["phase_deg_std"] = JsonNumbers(sd.phase_deg);
+    }
     nlohmann::ordered_json mj;
     mj["gain_margin"] = JsonNumber(m.gain_margin);
     mj["gain_margin_db"] = JsonNumber(m.gain_margin_db);
@@ -72,10 +86,17 @@ void Run(const BodeOptions& o) {
     return;
   }
   std::cout << "model:\n" << DescribeModel(g.Normalized(), "  ");
-  std::cout << fmt::format("  {:>14} {:>14} {:>14}\n", "omega [rad/s]", "|G| [dB]", "phase [deg]");
+  std::cout << fmt::format("  {:>14} {:>14} {:>14}", "omega [rad/s]", "|G| [dB]", "phase [deg]");
+  const std::string band = fmt::format("+-{:g} sd", o.confidence);
+  if (identified) std::cout << fmt::format(" {:>14} {:>14}", band + " [dB]", band + " [deg]");
+  std::cout << "\n";
   for (Eigen::Index i = 0; i < b.omega.size(); ++i) {
-    std::cout << fmt::format("  {:>14.6g} {:>14.6g} {:>14.6g}\n", b.omega[i], b.magnitude_db[i],
+    std::cout << fmt::format("  {:>14.6g} {:>14.6g} {:>14.6g}", b.omega[i], b.magnitude_db[i],
                              b.phase_deg[i]);
+    if (identified)
+      std::cout << fmt::format(" {:>14.6g} {:>14.6g}", o.confidence * sd.magnitude_db[i],
+                               o.confidence * sd.phase_deg[i]);
+    std::cout << "\n";
   }
   std::cout << fmt::format("gain margin:  {:.6g} ({:.4g} dB) at {:.6g} rad/s\n", m.gain_margin,
                            m.gain_margin_db, m.phase_crossover);
@@ -99,9 +120,11 @@ const Registrar reg("bode",
                                      "Number of log-spaced frequencies (default: 50 from --w-min "
                                      "to --w-max, else the automatic grid)")
                           ->check(AtLeast(2));
+                      AddConfidenceOption(app, o->confidence, "magnitude and phase");
                       app.add_flag("--json", o->json,
                                    "Print {\"omega\", \"magnitude_db\", \"phase_deg\", "
-                                   "\"margins\"} instead");
+                                   "\"margins\"} instead (with --confidence also "
+                                   "\"confidence\", \"magnitude_db_std\", \"phase_deg_std\")");
                       AddPlotOption(app, o->plot, "magnitude and phase");
                       app.callback([o] { Run(*o); });
                     });

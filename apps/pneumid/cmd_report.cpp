@@ -12,6 +12,7 @@
 #include "command.hpp"
 #include "validators.hpp"
 #include "data_options.hpp"
+#include "identified_spec.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
@@ -42,6 +43,7 @@ struct ReportArgs {
   std::string title;
   int order = 2, na = 3, nb = 3, nk = 1;
   int max_lag = 25;
+  double confidence = 0.0;  ///< bands of +-K standard deviations; 0 = none
   bool json = false;
 };
 
@@ -54,6 +56,7 @@ void Run(const ReportArgs& a) {
   o.request.nb = a.nb;
   o.request.nk = a.nk;
   o.residual_max_lag = a.max_lag;
+  o.confidence = a.confidence;
   o.title = a.title;
   std::string error;
   PNEUMID_CHECK(o.IsValid(&error), "{}", error);
@@ -79,6 +82,7 @@ void Run(const ReportArgs& a) {
   if (a.na != 3 || a.nb != 3 || a.nk != 1)
     cmd += fmt::format(" --na {} --nb {} --nk {}", a.na, a.nb, a.nk);
   if (a.max_lag != 25) cmd += fmt::format(" --max-lag {}", a.max_lag);
+  if (a.confidence > 0.0) cmd += fmt::format(" --confidence {:g}", a.confidence);
   if (!a.title.empty()) cmd += " --title " + ShellQuote(a.title);
   cmd += " --output-dir " + ShellQuote(a.out_dir);
   o.commands = {cmd};
@@ -138,6 +142,8 @@ const pneumid::cli::Registrar reg(
           ->capture_default_str()
           ->check(pneumid::cli::AtLeast(1));
       app.add_option("--title", a->title, "Report title (default: from the data file)");
+      pneumid::cli::AddConfidenceOption(app, a->confidence,
+                                        "the step and Bode responses of the models");
       app.add_flag("--json", a->json, "Print the summary as JSON");
       app.callback([a]() { Run(*a); });
     });

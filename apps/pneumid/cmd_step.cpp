@@ -2,6 +2,7 @@
 //
 //   pneumid step --model arx-paper-ct [--json] [--t-final T] [--plot step.png]
 //   pneumid step --num 1 --den 0.245,1 --delay 0.001
+//   pneumid step --model models.json#arx --confidence 3 --plot step.png
 #include <cmath>
 #include <complex>
 #include <iostream>
@@ -12,8 +13,10 @@
 
 #include "command.hpp"
 #include "model_options.hpp"
+#include "identified_spec.hpp"
 #include "output_options.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/identify/model_uncertainty.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/report/figures.hpp"
 
@@ -26,18 +29,24 @@ struct StepOptions {
   double dt = 0.0;
   double settling_threshold = 0.02;
   std::vector<double> rise_limits = {0.1, 0.9};
+  double confidence = 0.0;  ///< band of +-K standard deviations; 0 = none
   bool json = false;
   std::string plot;
 };
 
 // "Step response of MODEL" on a generic output axis.
-void WritePlot(const StepOptions& o, const TransferFunction& g) {
+// With `identified`, a band of o.confidence standard deviations around it.
+void WritePlot(const StepOptions& o, const TransferFunction& g,
+               const std::optional<IdentifiedModel>& identified) {
   StepFigureOptions fo;
   fo.t_final = o.t_final;
   fo.dt = o.dt;
   fo.title = "Step response of " + ModelLabel(o.model, g);
   fo.labels.output = "Output y (unit step input)";
-  StepResponseFigure({{ModelLabel(o.model, g), g}}, fo).Save(o.plot);
+  fo.confidence = o.confidence;
+  NamedModel nm{ModelLabel(o.model, g), g};
+  if (identified) nm.identified = std::make_shared<const IdentifiedModel>(*identified);
+  StepResponseFigure({nm}, fo).Save(o.plot);
 }
 
 // "pole 1.2 outside the unit circle" / "pole 0.5 in the closed right half-plane".
@@ -67,6 +76,7 @@ std::string UnstablePole(const TransferFunction& g) {
 
 void Run(const StepOptions& o) {
   const TransferFunction g = ResolveModel(o.model);
+  const std::optional<IdentifiedModel> identified = ModelForConfidence(o.model.model, o.confidence);
   PNEUMID_CHECK(o.rise_limits.size() == 2, "--rise-limits takes two fractions LOW,HIGH, got {}",
                 o.rise_limits.size());
   StepInfoOptions so;
@@ -78,7 +88,7 @@ void Run(const StepOptions& o) {
   if (!g.IsStable()) {
     // A growing response has no rise or settling time; a finite horizon can still be drawn.
     const bool plotted = !o.plot.empty() && o.t_final > 0.0;
-    if (plotted) WritePlot(o, g);
+    if (plotted) WritePlot(o, g, identified);
     throw InvalidArgument(fmt::format(
         "the model is not stable ({}): its step response does not settle and the step "
         "metrics are undefined{}",
@@ -95,11 +105,20 @@ void Run(const StepOptions& o) {
     so.y_final = g.DcGain();  // stable here: unstable models were refused above
     info = ComputeStepInfo(r.t, r.y, so);
   }
-  if (!o.plot.empty()) WritePlot(o, g);
+  if (!o.plot.empty()) WritePlot(o, g, identified);
   PNEUMID_CHECK(!std::isnan(info.settling_time) || g.DcGain() == 0.0,
                 "the step response has not settled within the simulated horizon{}: the "
                 "metrics are undefined; give a longer --t-final",
                 o.t_final > 0.0 ? fmt::format(" of {} s", o.t_final) : "");
+  // The response and its standard deviation on the simulation grid.
+  TimeResponse band;
+  Eigen::VectorXd sd;
+  if (identified) {
+    UncertaintyOptions uo;
+    uo.discrete = g.IsDiscrete();  // the form drawn: "tf" of the file, discrete when it is
+    band = Step(g, o.t_final, o.dt);
+    sd = StepResponseStd(*identified, band.t, uo);
+  }
   if (o.json) {
     nlohmann::ordered_json j;
     j["rise_time"] = JsonNumber(info.rise_time);
@@ -111,6 +130,12 @@ void Run(const StepOptions& o) {
     j["peak"] = JsonNumber(info.peak);
     j["peak_time"] = JsonNumber(info.peak_time);
     j["steady_state"] = JsonNumber(info.steady_state);
+    if (identified) {
+      j["confidence"] = o.confidence;
+      j["t"] = JsonNumbers(band.t);
+      j["y"] = JsonNumbers(band.y);
+      j["std"] = JsonNumbers(sd);
+    }
     if (!o.plot.empty()) j["plot"] = o.plot;
     std::cout << j.dump() << "\n";
     return;
@@ -129,6 +154,12 @@ void Run(const StepOptions& o) {
   line("peak", info.peak, "");
   line("peak_time", info.peak_time, " s");
   line("steady_state", info.steady_state, "");
+  if (identified) {
+    const Eigen::Index last = band.t.size() - 1;
+    std::cout << fmt::format("  {:<14} +-{:.6g} at t = {:.6g} s (+-{:g} sd, max +-{:.6g})\n",
+                             "band", o.confidence * sd[last], band.t[last], o.confidence,
+                             o.confidence * sd.maxCoeff());
+  }
   if (!o.plot.empty()) std::cout << "plot written to " << o.plot << "\n";
 }
 
@@ -144,9 +175,11 @@ const Registrar reg(
       app.add_option("--rise-limits", o->rise_limits, "Rise-time fractions LOW,HIGH")
           ->delimiter(',')
           ->capture_default_str();
+      AddConfidenceOption(app, o->confidence, "the step response");
       app.add_flag("--json", o->json,
                    "Print {\"rise_time\", \"settling_time\", \"overshoot\", \"undershoot\", "
-                   "\"peak\", \"peak_time\", \"steady_state\", ...} instead");
+                   "\"peak\", \"peak_time\", \"steady_state\", ...} instead (with --confidence "
+                   "also \"confidence\" and the response \"t\", \"y\" and its \"std\")");
       AddPlotOption(app, o->plot, "the step response");
       app.callback([o] { Run(*o); });
     });

@@ -40,6 +40,12 @@ nlohmann::json JsonNumber(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
+nlohmann::json JsonNumbers(const Eigen::VectorXd& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(JsonNumber(v[i]));
+  return a;
+}
+
 void WriteJsonFile(const nlohmann::json& j, const std::string& path) { WriteJson(j, path); }
 void WriteJsonFile(const nlohmann::ordered_json& j, const std::string& path) { WriteJson(j, path); }
 

@@ -10,6 +10,7 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 namespace pneumid::cli {
@@ -19,6 +20,8 @@ CLI::Option* AddPlotOption(CLI::App& app, std::string& path, const std::string& 
 
 /// `v`, or null when it is not finite (JSON has no NaN/Inf).
 nlohmann::json JsonNumber(double v);
+/// The numbers of `v` as a JSON array (null where not finite).
+nlohmann::json JsonNumbers(const Eigen::VectorXd& v);
 
 /// Writes `j` (indented) to `path`. @throws DataError when it cannot be written.
 void WriteJsonFile(const nlohmann::json& j, const std::string& path);

@@ -9,6 +9,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/model_uncertainty.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {
@@ -32,6 +33,23 @@ void CheckModels(const std::vector<NamedModel>& models, const char* what) {
   PNEUMID_CHECK(!models.empty(), "{}: no models to plot", what);
 }
 
+// Propagation through the form drawn (discrete or continuous).
+UncertaintyOptions FormOf(const NamedModel& m) {
+  UncertaintyOptions o;
+  o.discrete = m.model.IsDiscrete();
+  return o;
+}
+
+// The band y +- k sd in the model's colour, when the model has a covariance
+// (sd empty otherwise, or NaN where it could not be computed: no band).
+void AddConfidenceBand(Axes& ax, const NamedModel& m, const Eigen::VectorXd& x,
+                       const Eigen::VectorXd& y, const Eigen::VectorXd& sd, double k, Color c) {
+  if (sd.size() != y.size() || !sd.allFinite()) return;
+  Band& b = ax.AddBand(x, y - k * sd, y + k * sd, fmt::format("{} \u00b1{:g} sd", m.label, k));
+  b.color = c;
+  b.alpha = 0.2;
+}
+
 }  // namespace
 
 bool StepFigureOptions::IsValid(std::string* error) const {
@@ -46,6 +64,9 @@ bool StepFigureOptions::IsValid(std::string* error) const {
     return fail(fmt::format("StepFigureOptions::t_final must be >= 0, got {}", t_final));
   if (!(dt >= 0.0) || !std::isfinite(dt))
     return fail(fmt::format("StepFigureOptions::dt must be >= 0, got {}", dt));
+  if (!(confidence >= 0.0) || !std::isfinite(confidence))
+    return fail(fmt::format("StepFigureOptions::confidence must be >= 0 standard deviations, got {}",
+                            confidence));
   if (t_final > 0.0 && dt > 0.0 && t_final / dt > 1e7)
     return fail(
         fmt::format("StepFigureOptions: t_final / dt = {} samples is too many", t_final / dt));
@@ -88,6 +109,11 @@ Figure ResponseFigure(const char* what, ResponseFunction response,
   int k = 0;
   for (const auto& m : models) {
     const TimeResponse r = response(m.model, t_final, m.model.IsDiscrete() ? 0.0 : options.dt);
+    if (options.confidence > 0.0 && m.identified && response == &Step)
+      AddConfidenceBand(ax, m, r.t, r.y * options.amplitude,
+                        StepResponseStd(*m.identified, r.t, FormOf(m)) *
+                            std::abs(options.amplitude),
+                        options.confidence, PaletteColor(k));
     Curve& s = ax.AddLine(r.t, r.y * options.amplitude, m.label);
     s.color = PaletteColor(k++);
     if (m.model.IsDiscrete()) s.stairs = true;
@@ -236,7 +262,7 @@ Figure ResidualFigure(const ResidualCorrelation& corr, const std::string& title)
 }
 
 Figure BodeFigure(const std::vector<NamedModel>& models, const Eigen::VectorXd& omega,
-                  const std::string& title) {
+                  const std::string& title, double confidence) {
   CheckModels(models, "BodeFigure");
   double nyquist = std::numeric_limits<double>::infinity();
   for (const auto& m : models)
@@ -265,6 +291,8 @@ Figure BodeFigure(const std::vector<NamedModel>& models, const Eigen::VectorXd& 
   }
   PNEUMID_CHECK(w.size() >= 2 && (w.array() > 0.0).all(),
                 "BodeFigure: omega needs at least 2 positive frequencies");
+  PNEUMID_CHECK(confidence >= 0.0 && std::isfinite(confidence),
+                "BodeFigure: confidence must be >= 0 standard deviations, got {}", confidence);
   Figure fig(2);
   fig.title = title;
   Axes& mag = fig.axes(0);
@@ -296,6 +324,11 @@ Figure BodeFigure(const std::vector<NamedModel>& models, const Eigen::VectorXd& 
       phase[i] = prev = p;
     }
     const Color c = PaletteColor(k);
+    if (confidence > 0.0 && m.identified) {
+      const BodeStd sd = BodeResponseStd(*m.identified, wm, FormOf(m));
+      AddConfidenceBand(mag, m, wm, mag_db, sd.magnitude_db, confidence, c);
+      AddConfidenceBand(ph, m, wm, phase, sd.phase_deg, confidence, c);
+    }
     const LineStyle style = k % 2 == 0 ? LineStyle::kSolid : LineStyle::kDashed;
     mag.AddLine(wm, mag_db, m.label, style).color = c;
     ph.AddLine(wm, phase, m.label, style).color = c;

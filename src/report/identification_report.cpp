@@ -62,6 +62,9 @@ bool ReportOptions::IsValid(std::string* error) const {
   if (!(residual_confidence > 0.0 && residual_confidence < 1.0))
     return fail(fmt::format("ReportOptions::residual_confidence must be in (0, 1), got {}",
                             residual_confidence));
+  if (!(confidence >= 0.0) || !std::isfinite(confidence))
+    return fail(fmt::format("ReportOptions::confidence must be >= 0 standard deviations, got {}",
+                            confidence));
   return true;
 }
 
@@ -191,6 +194,7 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
     for (const auto& m : summary.models) {
       NamedModel nm{m.method + " (" + m.structure + ")", m.discrete ? *m.discrete : m.tf, m.u0,
                     m.y0};
+      if (options.confidence > 0.0) nm.identified = std::make_shared<const IdentifiedModel>(m);
       named.push_back(nm);
       if (RankGroup(m) < 2) {
         trusted.push_back(nm);
@@ -222,11 +226,19 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
     }
     so.amplitude = du;
     so.t_final = data.time()[data.size() - 1] - data.time()[0];
+    so.confidence = options.confidence;
+    const std::string band_text =
+        options.confidence > 0.0
+            ? fmt::format(" Shaded: \u00b1{:g} standard deviations of the models with a parameter "
+                          "covariance (first-order propagation).",
+                          options.confidence)
+            : "";
     if (!trusted.empty()) {
       doc.AddFigure(StepResponseFigure(trusted, so),
-                    fmt::format("Responses of the models to an input step of {} (input units).{}",
-                                Num(du), left_out_text));
-      doc.AddFigure(BodeFigure(trusted), "Frequency responses of the models." + left_out_text);
+                    fmt::format("Responses of the models to an input step of {} (input units).{}{}",
+                                Num(du), band_text, left_out_text));
+      doc.AddFigure(BodeFigure(trusted, Eigen::VectorXd(), "Bode diagram", options.confidence),
+                    "Frequency responses of the models." + band_text + left_out_text);
     }
 
     // Residuals of the best model (the first of the ranking).

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,10 @@ struct NamedModel {
   /// y0 + G (u - u0). NaN (default): the levels before the first input change.
   double u0 = std::numeric_limits<double>::quiet_NaN();
   double y0 = std::numeric_limits<double>::quiet_NaN();
+  /// The identified model `model` was drawn from, for confidence bands: its
+  /// parameter covariance propagated to the response (model_uncertainty.hpp)
+  /// in the form of `model` (discrete or continuous). None: no band.
+  std::shared_ptr<const IdentifiedModel> identified;
 };
 
 /// Labels shared by the figures (with units).
@@ -59,6 +64,10 @@ struct StepFigureOptions {
   double dt = 0.0;         ///< sample interval of continuous responses; 0 = automatic
   std::string title = "Step response";
   SignalLabels labels;
+  /// Confidence band of +-confidence standard deviations (shaded, in the
+  /// model's colour, "label ±K sd") around each model with a covariance
+  /// (NamedModel::identified); 0 = none (default). Step figures only.
+  double confidence = 0.0;
   bool IsValid(std::string* error) const;
 };
 
@@ -116,10 +125,13 @@ Figure ResidualFigure(const ResidualCorrelation& corr, const std::string& title 
 
 /// Magnitude (dB) and phase (deg) of each model on a common grid (rad/s);
 /// an empty omega chooses 10^-1 .. 10^3 rad/s bounded by the Nyquist frequency
-/// of discrete models. @throws InvalidArgument when `models` is empty.
+/// of discrete models. `confidence` > 0 adds bands of that many standard
+/// deviations of magnitude and phase around models with a covariance (as the
+/// step figure's). @throws InvalidArgument when `models` is empty or
+/// confidence is negative.
 Figure BodeFigure(const std::vector<NamedModel>& models,
                   const Eigen::VectorXd& omega = Eigen::VectorXd(),
-                  const std::string& title = "Bode diagram");
+                  const std::string& title = "Bode diagram", double confidence = 0.0);
 
 /// One closed-loop run: output y and input u on the common time axis.
 struct ClosedLoopTrace {

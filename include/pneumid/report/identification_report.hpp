@@ -41,6 +41,9 @@ struct ReportOptions {
   std::string title;        ///< default "Identification report: <data source>"
   int residual_max_lag = 25;
   double residual_confidence = 0.99;
+  /// Bands of +-confidence standard deviations on the step and Bode figures
+  /// around models with a parameter covariance (model_uncertainty.hpp); 0 = none.
+  double confidence = 0.0;
   /// Command lines shown in the "Reproduce" section (empty = none given).
   std::vector<std::string> commands;
   /// How the data were preprocessed before the report (listed in the data
