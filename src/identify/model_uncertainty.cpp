@@ -29,10 +29,11 @@ bool IsPolynomialStructure(const std::string& s) {
 // Where each process parameter name goes in ProcessParams.
 double ProcessParams::*ProcessMember(const std::string& name) {
   static const std::map<std::string, double ProcessParams::*> members = {
-      {"K", &ProcessParams::K},     {"tau", &ProcessParams::T1},  {"tau1", &ProcessParams::T1},
-      {"tau2", &ProcessParams::T2}, {"tau3", &ProcessParams::T3}, {"Tw", &ProcessParams::Tw},
-      {"zeta", &ProcessParams::zeta}, {"Tz", &ProcessParams::Tz}, {"theta", &ProcessParams::theta},
-      {"y0", &ProcessParams::y0}};
+      {"K", &ProcessParams::K},         {"tau", &ProcessParams::T1},
+      {"tau1", &ProcessParams::T1},     {"tau2", &ProcessParams::T2},
+      {"tau3", &ProcessParams::T3},     {"Tw", &ProcessParams::Tw},
+      {"zeta", &ProcessParams::zeta},   {"Tz", &ProcessParams::Tz},
+      {"theta", &ProcessParams::theta}, {"y0", &ProcessParams::y0}};
   const auto it = members.find(name);
   return it == members.end() ? nullptr : it->second;
 }
@@ -151,7 +152,8 @@ Eigen::MatrixXd PropagatedStd(const IdentifiedModel& model, const UncertaintyOpt
   const Eigen::MatrixXd& P = model.covariance->matrix;
   const Eigen::VectorXd theta = rebuild.Nominal(model);
   const Eigen::Index np = theta.size();
-  std::vector<Eigen::MatrixXd> J(static_cast<std::size_t>(outputs), Eigen::MatrixXd::Zero(rows, np));
+  std::vector<Eigen::MatrixXd> J(static_cast<std::size_t>(outputs),
+                                 Eigen::MatrixXd::Zero(rows, np));
   try {
     for (Eigen::Index i = 0; i < np; ++i) {
       const double h =
@@ -252,8 +254,7 @@ Eigen::VectorXd StepResponseStd(const IdentifiedModel& model, const Eigen::Vecto
                 "StepResponseStd: times must be finite and >= 0");
   if (!HasCovariance(model)) return {};
   return PropagatedStd(
-      model, options, t.size(), 1,
-      [&t](const TransferFunction& g) { return StepResponseAt(g, t); },
+      model, options, t.size(), 1, [&t](const TransferFunction& g) { return StepResponseAt(g, t); },
       [](const Eigen::VectorXd& a, const Eigen::VectorXd& b, int) -> Eigen::VectorXd {
         return a - b;
       });

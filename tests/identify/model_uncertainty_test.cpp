@@ -3,8 +3,8 @@
 #include <cmath>
 #include <random>
 
-#include <Eigen/Cholesky>
 #include <gtest/gtest.h>
+#include <Eigen/Cholesky>
 
 #include "parametric_test_util.hpp"
 #include "pneumid/common/check.hpp"
@@ -179,8 +179,8 @@ TEST(ModelUncertaintyTest, ProcessModelDiagonalCovarianceMatchesClosedForm) {
     if (s < 0.05) continue;  // the derivative w.r.t. the delay has a kink at t = theta
     const double e = std::exp(-s / 0.5);
     const double dK = 1.0 - e, dtau = -2.0 * e * s / 0.25, dtheta = -2.0 * e / 0.5;
-    const double expected = std::sqrt(std::pow(0.05 * dK, 2) + std::pow(0.02 * dtau, 2) +
-                                      std::pow(0.01 * dtheta, 2));
+    const double expected =
+        std::sqrt(std::pow(0.05 * dK, 2) + std::pow(0.02 * dtau, 2) + std::pow(0.01 * dtheta, 2));
     EXPECT_NEAR(sd[k], expected, 1e-4 * expected) << "t = " << t[k];
   }
 }
