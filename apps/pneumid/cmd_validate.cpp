@@ -33,6 +33,7 @@ struct ValidateArgs {
   int horizon = 0;
   int max_lag = 25;
   int skip = 0;
+  std::string initial_state = "zero";
   std::string plot;
   bool json = false;
 };
@@ -45,14 +46,27 @@ std::optional<PolynomialModel> PolynomialOf(const IdentifiedModel& m) {
   return PolynomialModel::FromParamsJson(ToJson(m.params), m.structure);
 }
 
+// Runs a residual analysis; returns why it is undefined (a constant input or
+// residual has no correlation) instead of failing the command, "" on success.
+template <typename Analyze>
+std::string TryResiduals(ResidualAnalysis* out, Analyze&& analyze) {
+  try {
+    *out = analyze();
+    return "";
+  } catch (const InvalidArgument& e) {
+    return e.what();
+  }
+}
+
 // Simulation fit of an identified model (its operating point applied).
-CompareResult SimulateIdentified(const IdentifiedModel& m, const Dataset& data, int skip) {
+CompareResult SimulateIdentified(const IdentifiedModel& m, const Dataset& data, int skip,
+                                 InitialCondition initial) {
   PNEUMID_CHECK(skip + 2 <= data.size(), "--skip {} leaves fewer than 2 of the {} samples", skip,
                 data.size());
   CompareResult r;
   r.t = data.time();
   r.y = data.y(0);
-  r.yhat = SimulateModel(m, data, 0);
+  r.yhat = SimulateModel(m, data, 0, 0, initial);
   const Eigen::Index n = data.size() - skip;
   if (r.yhat.tail(n).allFinite()) {
     r.fit_percent = NrmseFit(r.y.tail(n), r.yhat.tail(n));
@@ -91,15 +105,17 @@ void Run(const ValidateArgs& a) {
     label = fmt::format("{} {}", identified->method, identified->structure);
     poly = PolynomialOf(*identified);
   }
+  const InitialCondition initial = InitialConditionFromString(a.initial_state);
   CompareOptions co;
   co.skip = a.skip;
   ResidualAnalysisOptions ro;
   ro.max_lag = a.max_lag;
   CompareResult sim, pred;
   ResidualAnalysis res;
+  std::string residuals_unavailable;  // why the residual tests are undefined (constant input)
   bool have_pred = false;
   if (identified) {
-    sim = SimulateIdentified(*identified, data, a.skip);
+    sim = SimulateIdentified(*identified, data, a.skip, initial);
     PNEUMID_CHECK(a.horizon == 0 || poly,
                   "--horizon needs a polynomial model with a noise model; '{}' is a {} model "
                   "(simulation only)",
@@ -109,19 +125,29 @@ void Run(const ValidateArgs& a) {
       pred = Compare(*poly, data, co);
       have_pred = true;
     }
-    res = poly ? AnalyzeResiduals(*poly, data, ro)
-               : AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro);
+    residuals_unavailable = TryResiduals(&res, [&] {
+      return poly ? AnalyzeResiduals(*poly, data, ro)
+                  : AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro);
+    });
   } else {
     PNEUMID_CHECK(a.horizon == 0,
                   "--horizon needs a polynomial model with a noise model; '{}' is a transfer "
                   "function (simulation only)",
                   a.model);
     const TransferFunction g = ParseModelSpec(a.model);
-    sim = Compare(g, data, co);
-    res = AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro);
+    if (initial == InitialCondition::kZero) {
+      sim = Compare(g, data, co);
+    } else {
+      IdentifiedModel m;  // a model spec acts on the signals as they are (u0 = y0 = 0)
+      m.method = a.model;
+      m.tf = g;
+      sim = SimulateIdentified(m, data, a.skip, initial);
+    }
+    residuals_unavailable =
+        TryResiduals(&res, [&] { return AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro); });
   }
   if (!a.plot.empty()) {
-    Figure fig(3);
+    Figure fig(residuals_unavailable.empty() ? 3 : 1);
     fig.title = fmt::format("Validation of {}", label);
     auto& ax = fig.axes(0);
     ax.title = fmt::format("simulation fit {:.2f} %", sim.fit_percent);
@@ -132,19 +158,22 @@ void Run(const ValidateArgs& a) {
     if (have_pred)
       ax.AddLine(pred.t, pred.yhat, fmt::format("{}-step prediction", a.horizon),
                  LineStyle::kDashed);
-    auto& ac = fig.axes(1);
-    ac.title = fmt::format("residual autocorrelation: {}", res.whiteness_passed ? "pass" : "fail");
-    ac.xlabel = "lag [samples]";
-    ac.AddLine(res.lags_auto, res.autocorr, "r_e");
-    ac.AddHorizontalLine(res.bound, "99 % bound");
-    ac.AddHorizontalLine(-res.bound);
-    auto& xc = fig.axes(2);
-    xc.title = fmt::format("residual-input cross-correlation: {}",
-                           res.independence_passed ? "pass" : "fail");
-    xc.xlabel = "lag [samples]";
-    xc.AddLine(res.lags_cross, res.crosscorr, "r_eu");
-    xc.AddHorizontalLine(res.bound, "99 % bound");
-    xc.AddHorizontalLine(-res.bound);
+    if (residuals_unavailable.empty()) {
+      auto& ac = fig.axes(1);
+      ac.title =
+          fmt::format("residual autocorrelation: {}", res.whiteness_passed ? "pass" : "fail");
+      ac.xlabel = "lag [samples]";
+      ac.AddLine(res.lags_auto, res.autocorr, "r_e");
+      ac.AddHorizontalLine(res.bound, "99 % bound");
+      ac.AddHorizontalLine(-res.bound);
+      auto& xc = fig.axes(2);
+      xc.title = fmt::format("residual-input cross-correlation: {}",
+                             res.independence_passed ? "pass" : "fail");
+      xc.xlabel = "lag [samples]";
+      xc.AddLine(res.lags_cross, res.crosscorr, "r_eu");
+      xc.AddHorizontalLine(res.bound, "99 % bound");
+      xc.AddHorizontalLine(-res.bound);
+    }
     fig.Save(a.plot);
   }
   if (a.json) {
@@ -152,12 +181,18 @@ void Run(const ValidateArgs& a) {
     j["model"] = label;
     j["samples"] = data.size();
     j["fit_percent"] = sim.fit_percent;
+    j["initial_state"] = ToString(initial);
     j["rmse"] = sim.rmse;
     if (have_pred) {
       j["prediction"] = {
           {"horizon", a.horizon}, {"fit_percent", pred.fit_percent}, {"rmse", pred.rmse}};
     }
-    j["residuals"] = res.ToJson();
+    if (residuals_unavailable.empty()) {
+      j["residuals"] = res.ToJson();
+    } else {
+      j["residuals"] = nullptr;
+      j["residuals_unavailable"] = residuals_unavailable;
+    }
     if (!a.plot.empty()) j["plot"] = a.plot;
     std::cout << j.dump(2) << "\n";
     return;
@@ -169,6 +204,11 @@ void Run(const ValidateArgs& a) {
   if (have_pred)
     std::cout << fmt::format("{}-step prediction fit: {:.2f} %, RMSE {:.6g}\n", a.horizon,
                              pred.fit_percent, pred.rmse);
+  if (!residuals_unavailable.empty()) {
+    std::cout << "residual analysis: not available: " << residuals_unavailable << "\n";
+    if (!a.plot.empty()) std::cout << "plot written to " << a.plot << "\n";
+    return;
+  }
   std::cout << fmt::format("residual analysis (max lag {}, 99 % bound +-{:.4g}):\n", a.max_lag,
                            res.bound);
   std::cout << fmt::format(
@@ -199,6 +239,11 @@ static Registrar reg(
       app.add_option("--max-lag", args->max_lag, "Largest correlation lag of the residual tests")
           ->capture_default_str()
           ->check(AtLeast(1));
+      app.add_option("--initial-state", args->initial_state,
+                     "Start of the simulation: zero (at rest at the model's operating point) or "
+                     "estimate (the state that best explains the data, as MATLAB compare's 'e')")
+          ->capture_default_str()
+          ->check(CLI::IsMember({"zero", "estimate"}));
       app.add_option("--skip", args->skip, "Initial samples left out of the fit")
           ->capture_default_str()
           ->check(AtLeast(0));

@@ -8,9 +8,12 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/initial_state.hpp"
 #include "pneumid/identify/parametric_model.hpp"
 #include "pneumid/identify/residual_analysis.hpp"
+#include "pneumid/lti/conversion.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {
@@ -49,6 +52,45 @@ Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data,
                                 ? Lsim(TransferFunction(g.num(), g.den(), Ts, g.delay()), du, Ts)
                                 : Lsim(g, du, Ts);
   return (y.array() + model.y0).matrix();
+}
+
+namespace {
+inline constexpr EnumName<InitialCondition> kInitialConditionNames[] = {
+    {InitialCondition::kZero, "zero"}, {InitialCondition::kEstimate, "estimate"}};
+}  // namespace
+
+std::string ToString(InitialCondition c) {
+  return std::string(EnumToString(kInitialConditionNames, c));
+}
+
+InitialCondition InitialConditionFromString(const std::string& name) {
+  return EnumFromString(kInitialConditionNames, name, "initial condition");
+}
+
+Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input,
+                              int output, InitialCondition initial) {
+  if (initial == InitialCondition::kZero) return SimulateModel(model, data, input);
+  PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
+                "output column {} does not exist (the data have {} output(s))", output,
+                data.num_outputs());
+  PNEUMID_CHECK(input >= 0 && input < data.num_inputs(),
+                "input column {} does not exist (the data have {} input(s))", input,
+                data.num_inputs());
+  const double Ts = data.SampleTime();
+  TransferFunction g = SimulatedForm(model);
+  if (g.IsDiscrete()) {
+    PNEUMID_CHECK(std::abs(g.Ts() - Ts) <= 1e-6 * Ts,
+                  "the model '{}' has sample time {} s, the data{} {} s", model.method, g.Ts(),
+                  data.source().empty() ? "" : " of " + data.source(), Ts);
+    g = TransferFunction(g.num(), g.den(), Ts, g.delay());
+  } else {
+    g = C2D(g, Ts);
+  }
+  const StateSpace ss = ToStateSpace(g);
+  const Eigen::MatrixXd du = (data.u(input).array() - model.u0).matrix();
+  const Eigen::MatrixXd dy = (data.y(output).array() - model.y0).matrix();
+  const Eigen::VectorXd x0 = EstimateInitialState(ss, du, dy);
+  return (SimulateFromState(ss, du, x0).col(0).array() + model.y0).matrix();
 }
 
 FitMetrics EvaluateModel(const IdentifiedModel& model, const Dataset& data, int input, int output,

@@ -36,4 +36,21 @@ if "$pneumid" validate "$dir/empty.json" "$dir/prbs.csv" 2>"$dir/err"; then fail
 grep -q "empty" "$dir/err" || fail "empty-models message: $(cat "$dir/err")"
 expect_error "max-lag" "--max-lag: must be an integer >= 1, got 0" validate arx-paper "$dir/prbs.csv" --max-lag 0
 expect_error "plot extension" "must end in .png or .svg" validate arx-paper "$dir/prbs.csv" --plot "$dir/v.eps"
+
+# --initial-state estimate (MATLAB compare 'e'): a record cut in the middle of
+# the step response is explained from the estimated state, not from rest.
+"$PY" - "$SRC/tests/identify/data/fopdt.csv" "$dir/cut.csv" <<'PYEOF'
+import sys
+import numpy as np
+d = np.loadtxt(sys.argv[1], delimiter=",", skiprows=2)
+k = int(np.searchsorted(d[:, 0], 2.0))  # 1 s after the step at t = 1 s
+np.savetxt(sys.argv[2], d[k:, :3], delimiter=",", header="t,u,y", comments="")
+PYEOF
+"$pneumid" identify "$SRC/tests/identify/data/fopdt.csv" -m fit-p1d -o "$dir/p1d.json" > /dev/null 2>&1 \
+  || fail "identify fit-p1d"
+expect_ok "zero state" validate "$dir/p1d.json" "$dir/cut.csv" --json --max-lag 10
+zero=$("$PY" -c "import json,sys; print(json.load(open(sys.argv[1]))['fit_percent'])" "$TMP/out")
+expect_ok "estimated state" validate "$dir/p1d.json" "$dir/cut.csv" --initial-state estimate --json --max-lag 10
+check_json "estimate beats rest" 'j["initial_state"] == "estimate" and j["fit_percent"] > '"$zero"' + 5'
+expect_error "bad initial state" "--initial-state" validate "$dir/p1d.json" "$dir/cut.csv" --initial-state e
 finish

@@ -51,6 +51,23 @@ namespace pneumid {
 ///         model's sample time differs from the data's.
 Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input = 0);
 
+/// How a simulation on data starts (MATLAB compare's 'InitialCondition').
+enum class InitialCondition {
+  kZero,      ///< "zero": at rest at the operating point (the default everywhere)
+  kEstimate,  ///< "estimate": the state that best explains the measured output
+};
+std::string ToString(InitialCondition c);
+/// Parses "zero" or "estimate"; @throws InvalidArgument listing them.
+InitialCondition InitialConditionFromString(const std::string& name);
+
+/// As SimulateModel, started from the least-squares initial state of the
+/// model's discrete state-space form (EstimateInitialState, initial_state.hpp;
+/// a continuous model is first sampled at the data's Ts with a zero-order
+/// hold) fitted to output column `output`, as MATLAB's compare(..., 'e').
+/// @throws InvalidArgument as SimulateModel or for a bad output column.
+Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input,
+                              int output, InitialCondition initial);
+
 /// Fit measures of the model simulated on `data`, over samples [score_from, N).
 /// A model whose simulation is not finite gets fit -inf and IAE/RMSE inf.
 /// @throws InvalidArgument as SimulateModel, for a bad output column, or
