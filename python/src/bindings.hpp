@@ -13,6 +13,7 @@ void BindIdentify(pybind11::module_& m);
 void BindReport(pybind11::module_& m);
 /// Plant, control and closed-loop bindings.
 void BindExtras(pybind11::module_& m);
+void BindUncertainty(pybind11::module_& m);
 
 /// Throws InvalidArgument (Python: pneumid.InvalidArgument, a ValueError)
 /// "function: argument is empty (...)" when an array argument has no elements.

@@ -107,6 +107,14 @@ void BindIdentify(py::module_& m) {
             return JsonToPython(ToJson(*r.preprocessing));
           },
           "The preprocessing of the estimation data (dict), or None.")
+      .def_property_readonly(
+          "covariance",
+          [](const IdentifiedModel& r) -> py::object {
+            if (!r.covariance) return py::none();
+            return py::dict("names"_a = r.covariance->names, "matrix"_a = r.covariance->matrix);
+          },
+          "Parameter covariance {'names': [...], 'matrix': ndarray} (names of params, e.g. "
+          "a1, b1), or None (model_uncertainty: step_response_std, bode_std).")
       .def(
           "to_dict", [](const IdentifiedModel& r) { return JsonToPython(ToJson(r)); },
           "The JSON form of `pneumid identify --json`.")
@@ -310,8 +318,9 @@ void BindReport(py::module_& m) {
   m.def(
       "write_identification_report",
       [](const Dataset& data, const std::string& dir, std::vector<std::string> methods, int order,
-         int na, int nb, int nk) {
+         int na, int nb, int nk, double confidence) {
         ReportOptions o;
+        o.confidence = confidence;
         o.methods = std::move(methods);
         o.request.order = order;
         o.request.na = na;
@@ -332,8 +341,9 @@ void BindReport(py::module_& m) {
                         "tables"_a = s.num_tables);
       },
       "data"_a, "dir"_a, "methods"_a = std::vector<std::string>{"reaction-curve", "ptn", "arx"},
-      "order"_a = 2, "na"_a = 3, "nb"_a = 3, "nk"_a = 1,
-      "Writes DIR/report.html and DIR/models.json (as `pneumid report`); returns a summary "
+      "order"_a = 2, "na"_a = 3, "nb"_a = 3, "nk"_a = 1, "confidence"_a = 0.0,
+      "Writes DIR/report.html and DIR/models.json (as `pneumid report`; confidence > 0 draws "
+      "bands of that many standard deviations on the step and Bode figures); returns a summary "
       "dict.");
 
   // --- the paper -------------------------------------------------------------

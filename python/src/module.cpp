@@ -63,4 +63,5 @@ PYBIND11_MODULE(pneumid, m) {
   pneumid::python::BindIdentify(m);
   pneumid::python::BindReport(m);
   pneumid::python::BindExtras(m);
+  pneumid::python::BindUncertainty(m);
 }
