@@ -88,8 +88,7 @@ void BindUncertainty(py::module_& m) {
          bool discrete, const std::string& title) {
         Save(BodeFigure(Named(models, discrete), Eigen::VectorXd(), title, confidence), path);
       },
-      "models"_a, "path"_a, "confidence"_a = 0.0, "discrete"_a = false,
-      "title"_a = "Bode diagram",
+      "models"_a, "path"_a, "confidence"_a = 0.0, "discrete"_a = false, "title"_a = "Bode diagram",
       "Bode diagram of identified models with bands of +-confidence standard deviations.");
 }
 

@@ -140,8 +140,10 @@ class Rebuilder {
 };
 
 // sd_k = sqrt(J_k P J_k^T) of the rows of the sensitivities J, where column i
-// of J is difference(response(theta + h_i e_i), response(theta - h_i e_i)) / (2 h_i).
-// NaN everywhere when a perturbed model cannot be built or evaluated.
+// of J is difference(response(theta + h_i e_i), response(theta - h_i e_i)) / (2 h_i),
+// or the one-sided difference with the nominal response when the model cannot
+// be built on one side (a parameter at its bound, e.g. a delay of 0).
+// NaN everywhere when it cannot be built on either side or not evaluated.
 template <typename Response, typename Difference>
 Eigen::MatrixXd PropagatedStd(const IdentifiedModel& model, const UncertaintyOptions& options,
                               Eigen::Index rows, int outputs, Response response,
@@ -152,20 +154,37 @@ Eigen::MatrixXd PropagatedStd(const IdentifiedModel& model, const UncertaintyOpt
   const Eigen::MatrixXd& P = model.covariance->matrix;
   const Eigen::VectorXd theta = rebuild.Nominal(model);
   const Eigen::Index np = theta.size();
+  using Value = decltype(response(rebuild.Build(theta)));
+  // The response at theta + step e_i, nothing when that model cannot be built.
+  auto at = [&](Eigen::Index i, double step) -> std::optional<Value> {
+    Eigen::VectorXd p = theta;
+    p[i] += step;
+    std::optional<TransferFunction> g;
+    try {
+      g = rebuild.Build(p);
+    } catch (const InvalidArgument&) {
+      return std::nullopt;
+    }
+    return response(*g);
+  };
   std::vector<Eigen::MatrixXd> J(static_cast<std::size_t>(outputs),
                                  Eigen::MatrixXd::Zero(rows, np));
   try {
+    std::optional<Value> nominal;
     for (Eigen::Index i = 0; i < np; ++i) {
       const double h =
           options.relative_step * std::max(std::abs(theta[i]), std::sqrt(std::max(P(i, i), 0.0)));
       if (!(h > 0.0)) continue;  // a parameter known exactly (P_ii = 0 and theta_i = 0)
-      Eigen::VectorXd up = theta, down = theta;
-      up[i] += h;
-      down[i] -= h;
-      const auto r_up = response(rebuild.Build(up));
-      const auto r_down = response(rebuild.Build(down));
+      std::optional<Value> up = at(i, h), down = at(i, -h);
+      if (!up && !down) return Eigen::MatrixXd::Constant(rows, outputs, kNaN);
+      double width = 2.0 * h;
+      if (!up || !down) {
+        if (!nominal) nominal = response(rebuild.Build(theta));
+        (up ? down : up) = nominal;
+        width = h;
+      }
       for (int o = 0; o < outputs; ++o)
-        J[static_cast<std::size_t>(o)].col(i) = difference(r_up, r_down, o) / (2.0 * h);
+        J[static_cast<std::size_t>(o)].col(i) = difference(*up, *down, o) / width;
     }
   } catch (const InvalidArgument&) {
     return Eigen::MatrixXd::Constant(rows, outputs, kNaN);

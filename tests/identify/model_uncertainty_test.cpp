@@ -185,6 +185,31 @@ TEST(ModelUncertaintyTest, ProcessModelDiagonalCovarianceMatchesClosedForm) {
   }
 }
 
+TEST(ModelUncertaintyTest, DelayAtItsBoundUsesOneSidedDifference) {
+  // theta = 0 cannot be perturbed downwards: dy/dtheta by a forward difference.
+  IdentifiedModel m;
+  m.method = "fit-p1d";
+  m.structure = "P1D";
+  m.params = {{"K", 2.0}, {"tau", 0.5}, {"theta", 0.0}, {"y0", 0.0}};
+  m.param_std = {{"K", 0.05}, {"tau", 0.02}, {"theta", 0.01}};
+  ProcessParams p;
+  p.K = 2.0;
+  p.T1 = 0.5;
+  m.tf = ProcessTransferFunction(ProcessStructure::kP1D, false, p);
+  SetDiagonalCovariance(&m, {"K", "tau", "theta", "y0"});
+  ASSERT_EQ(m.covariance->names.size(), 3u);  // y0 has no standard deviation
+  const Eigen::VectorXd t = Eigen::VectorXd::LinSpaced(101, 0.0, 2.0);
+  const Eigen::VectorXd sd = StepResponseStd(m, t);
+  ASSERT_TRUE(sd.allFinite());
+  for (Eigen::Index k = 5; k < t.size(); ++k) {
+    const double e = std::exp(-t[k] / 0.5);
+    const double dK = 1.0 - e, dtau = -2.0 * e * t[k] / 0.25, dtheta = -2.0 * e / 0.5;
+    const double expected =
+        std::sqrt(std::pow(0.05 * dK, 2) + std::pow(0.02 * dtau, 2) + std::pow(0.01 * dtheta, 2));
+    EXPECT_NEAR(sd[k], expected, 1e-3 * expected) << "t = " << t[k];
+  }
+}
+
 TEST(ModelUncertaintyTest, FitP1dGetsDiagonalCovariance) {
   const TransferFunction g = TransferFunction::Continuous({1.5}, {0.4, 1.0}, 0.2);
   const Eigen::Index n = 400;
