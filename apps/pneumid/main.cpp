@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <malloc.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -29,6 +30,12 @@ bool StderrIsTerminal() { return isatty(STDERR_FILENO) != 0; }
 
 int main(int argc, char** argv) {
   using namespace pneumid::cli;
+  // Long records make many signal-sized temporaries (8 MB per 10^6 samples).
+  // glibc serves each from a fresh mmap and unmaps it when freed, so every one
+  // is paid again in page faults (about half of `identify -m arx` on 10^6
+  // rows). Keeping freed memory in the heap lets the next temporary reuse it.
+  mallopt(M_MMAP_THRESHOLD, 512 * 1024 * 1024);
+  mallopt(M_TRIM_THRESHOLD, 1024 * 1024 * 1024);
   CLI::App app{"pneumid: identify models of a plant from a step test, compare them, and tune,\n"
                "simulate and run predictive controllers (DMC, GPC, PID) against it."};
   app.name("pneumid");

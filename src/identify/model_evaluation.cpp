@@ -172,25 +172,31 @@ std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Datas
     flags.push_back({ModelFlag::kNoConvergence,
                      fmt::format("the estimator ended with '{}'", ToString(model.termination))});
   }
-  const Eigen::VectorXd yhat = SimulateModel(model, data, input);
-  if (!yhat.allFinite()) {
-    flags.push_back({ModelFlag::kNotFinite, "the simulated output is not finite"});
-    return flags;
+  // A model with a finite fit has a finite simulation: simulate (again) only
+  // where the residual test needs it.
+  const bool noise_model = IsPolynomial(model) && model.structure != "OE";
+  Eigen::VectorXd yhat;
+  if (!noise_model || !std::isfinite(model.fit_percent)) {
+    yhat = SimulateModel(model, data, input);
+    if (!yhat.allFinite()) {
+      flags.push_back({ModelFlag::kNotFinite, "the simulated output is not finite"});
+      return flags;
+    }
   }
   ResidualAnalysisOptions ro;
   ro.max_lag = std::min<int>(options.max_lag, static_cast<int>(data.size() / 2) - 1);
   ro.confidence = options.confidence;
   if (ro.max_lag < 1) return flags;
   try {
-    ResidualAnalysis r;
-    const bool noise_model = IsPolynomial(model) && model.structure != "OE";
+    Eigen::VectorXd e;
     if (noise_model) {
       const PolynomialModel poly =
           PolynomialModel::FromParamsJson(ToJson(model.params), model.structure);
-      r = AnalyzeResiduals(poly, data, ro, input, output);
+      e = PredictionErrors(poly, data.y(output), data.u(input));
     } else {
-      r = AnalyzeResiduals(data.y(output) - yhat, data.u(input), ro);
+      e = data.y(output) - yhat;
     }
+    const ResidualAnalysis r = AnalyzeWhiteness(e, ro);
     if (!r.whiteness_passed) {
       flags.push_back(
           {ModelFlag::kResidualsNotWhite,

@@ -77,6 +77,37 @@ ResidualAnalysis AnalyzeResiduals(const Eigen::VectorXd& residuals, const Eigen:
   return r;
 }
 
+ResidualAnalysis AnalyzeWhiteness(const Eigen::VectorXd& residuals,
+                                  const ResidualAnalysisOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "invalid residual-analysis options: {}", error);
+  const Eigen::Index n = residuals.size();
+  PNEUMID_CHECK(2 * options.max_lag < n, "max_lag = {} needs at least {} samples, got {}",
+                options.max_lag, 2 * options.max_lag + 1, n);
+  PNEUMID_CHECK(residuals.allFinite(), "the residuals contain a non-finite value");
+  const int M = options.max_lag;
+  const Eigen::VectorXd e = residuals.array() - residuals.mean();
+  const double s0 = e.squaredNorm();
+  PNEUMID_CHECK(s0 > 0.0, "a constant signal has no correlation");
+  ResidualAnalysis r;
+  r.autocorr.resize(M + 1);
+  for (int tau = 0; tau <= M; ++tau) {
+    const Eigen::Index len = n - tau;
+    r.autocorr[tau] = e.segment(tau, len).dot(e.head(len)) / s0;
+  }
+  r.lags_auto = Eigen::VectorXd::LinSpaced(M + 1, 0, M);
+  const double N = static_cast<double>(n);
+  const boost::math::normal_distribution<double> normal;
+  r.bound = boost::math::quantile(normal, 0.5 + options.confidence / 2.0) / std::sqrt(N);
+  for (int k = 1; k <= M; ++k)
+    if (std::abs(r.autocorr[k]) > r.bound) ++r.auto_outside;
+  r.whiteness_statistic = N * r.autocorr.tail(M).squaredNorm();
+  r.whiteness_threshold =
+      boost::math::quantile(boost::math::chi_squared_distribution<double>(M), options.confidence);
+  r.whiteness_passed = r.whiteness_statistic < r.whiteness_threshold;
+  return r;
+}
+
 ResidualAnalysis AnalyzeResiduals(const PolynomialModel& model, const Dataset& data,
                                   const ResidualAnalysisOptions& options, int input, int output) {
   model.Validate();

@@ -11,6 +11,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/identify.hpp"
+#include "pneumid/identify/residual_analysis.hpp"
 #include "pneumid/identify/validation.hpp"
 #include "step_test_util.hpp"
 
@@ -241,6 +242,37 @@ TEST(IdentifyModelsTest, ValidationDataMustHaveTheSameChannels) {
   IdentifyOptions o;
   o.split = 0.5;
   EXPECT_THROW(IdentifyModels({"arx"}, d, {}, o, &d), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pneumid
+
+namespace pneumid {
+namespace {
+
+TEST(ResidualWhitenessTest, EqualsTheWhitenessPartOfTheFullAnalysis) {
+  std::mt19937 gen(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::VectorXd e(3000), u(3000);
+  double prev = 0.0;
+  for (int k = 0; k < 3000; ++k) {
+    e[k] = 0.3 * prev + n(gen);  // mildly colored
+    prev = e[k];
+    u[k] = n(gen);
+  }
+  ResidualAnalysisOptions o;
+  o.max_lag = 20;
+  const ResidualAnalysis full = AnalyzeResiduals(e, u, o);
+  const ResidualAnalysis white = AnalyzeWhiteness(e, o);
+  ASSERT_EQ(white.autocorr.size(), full.autocorr.size());
+  EXPECT_LT((white.autocorr - full.autocorr).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(white.whiteness_statistic, full.whiteness_statistic, 1e-9);
+  EXPECT_EQ(white.whiteness_threshold, full.whiteness_threshold);
+  EXPECT_EQ(white.whiteness_passed, full.whiteness_passed);
+  EXPECT_FALSE(white.whiteness_passed);  // r(1) ~ 0.3 on 3000 samples
+  EXPECT_EQ(white.auto_outside, full.auto_outside);
+  EXPECT_THROW(AnalyzeWhiteness(Eigen::VectorXd::Ones(100), o), InvalidArgument);
+  EXPECT_THROW(AnalyzeWhiteness(e.head(30), o), InvalidArgument);
 }
 
 }  // namespace

@@ -61,6 +61,15 @@ struct ResidualAnalysis {
 ResidualAnalysis AnalyzeResiduals(const Eigen::VectorXd& residuals, const Eigen::VectorXd& u,
                                   const ResidualAnalysisOptions& options = {});
 
+/// Only the whiteness test of AnalyzeResiduals (autocorrelation at lags
+/// 0..M, its bound and portmanteau statistic): the fields residuals,
+/// lags_cross, crosscorr and the independence results stay empty/false. Costs
+/// M + 1 inner products of the N residuals, a third of AnalyzeResiduals.
+/// @throws InvalidArgument for invalid options, N <= 2M, non-finite or
+///         constant residuals.
+ResidualAnalysis AnalyzeWhiteness(const Eigen::VectorXd& residuals,
+                                  const ResidualAnalysisOptions& options = {});
+
 /// Residual analysis of a polynomial model's one-step prediction errors on
 /// data (input column `input` for the correlation, output column `output`).
 /// @throws InvalidArgument as AnalyzeResiduals, or on a model/data mismatch.
