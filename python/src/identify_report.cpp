@@ -49,6 +49,22 @@ void SaveFigure(const Figure& fig, const std::string& path) {
   fig.Save(path);
 }
 
+// The channels and orders of identify() and identify_models().
+IdentifyRequest MakeRequest(int input, int output, int order, int na, int nb, int nk, int nc,
+                            int nd, int nf) {
+  IdentifyRequest r;
+  r.input = input;
+  r.output = output;
+  r.order = order;
+  r.na = na;
+  r.nb = nb;
+  r.nk = nk;
+  r.nc = nc;
+  r.nd = nd;
+  r.nf = nf;
+  return r;
+}
+
 PreprocessOptions PythonPreprocessOptions(const std::string& window, double resample,
                                           bool remove_initial, const std::string& detrend,
                                           const std::string& filter, int decimate) {
@@ -128,18 +144,9 @@ void BindIdentify(py::module_& m) {
       "identify",
       [](const std::string& method, const Dataset& data, int input, int output, int order, int na,
          int nb, int nk, int nc, int nd, int nf, bool feedthrough, const std::string& n4sid_weight) {
-        IdentifyRequest r;
+        IdentifyRequest r = MakeRequest(input, output, order, na, nb, nk, nc, nd, nf);
         r.feedthrough = feedthrough;
         r.n4sid_weight = SubspaceWeightingFromString(n4sid_weight);
-        r.input = input;
-        r.output = output;
-        r.order = order;
-        r.na = na;
-        r.nb = nb;
-        r.nk = nk;
-        r.nc = nc;
-        r.nd = nd;
-        r.nf = nf;
         py::gil_scoped_release release;
         return Identify(method, data, r);
       },
@@ -178,16 +185,7 @@ void BindIdentify(py::module_& m) {
          std::optional<Dataset> validation, const std::string& window, double resample,
          bool remove_initial, const std::string& detrend, const std::string& filter,
          int decimate) {
-        IdentifyRequest r;
-        r.input = input;
-        r.output = output;
-        r.order = order;
-        r.na = na;
-        r.nb = nb;
-        r.nk = nk;
-        r.nc = nc;
-        r.nd = nd;
-        r.nf = nf;
+        const IdentifyRequest r = MakeRequest(input, output, order, na, nb, nk, nc, nd, nf);
         IdentifyOptions o;
         o.split = split;
         const PreprocessOptions p = PythonPreprocessOptions(window, resample, remove_initial,

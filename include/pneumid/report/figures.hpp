@@ -26,6 +26,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -39,6 +40,17 @@ namespace pneumid {
 
 /// A model with the name it has in a legend.
 struct NamedModel {
+  NamedModel() = default;
+  NamedModel(std::string label_, TransferFunction model_,
+             double u0_ = std::numeric_limits<double>::quiet_NaN(),
+             double y0_ = std::numeric_limits<double>::quiet_NaN(),
+             std::shared_ptr<const IdentifiedModel> identified_ = nullptr)
+      : label(std::move(label_)),
+        model(std::move(model_)),
+        u0(u0_),
+        y0(y0_),
+        identified(std::move(identified_)) {}
+
   std::string label;
   TransferFunction model;
   /// Operating point for simulations on data (IdentifiedModel::u0, y0):
