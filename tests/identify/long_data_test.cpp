@@ -3,7 +3,6 @@
 // every method returns a finite model, the fixes for the long-data failures
 // (spa NaN taps, FIR models simulated in O(N n^2)) hold, and Ceres' glog output
 // is kept off stderr.
-#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -65,19 +64,16 @@ TEST(LongData, SpaGivesAFiniteModelWhereTheInputSpectrumEstimateIsNotPositive) {
 }
 
 TEST(LongData, DiscreteLsimRunsTheDifferenceEquation) {
-  // A 256-tap FIR model: y = g * u exactly (convolution), and fast enough on
-  // 2e5 samples (the order-256 realization took seconds).
+  // A 256-tap FIR model on 2e5 samples: y = g * u exactly (convolution). Its
+  // speed (the order-256 realization took seconds) is measured by
+  // bench/identify_all_benchmark (cra, spa), not here.
   const Eigen::Index taps = 256, n = 200000;
   std::vector<double> g(taps);
   for (Eigen::Index i = 0; i < taps; ++i) g[i] = std::exp(-0.02 * i) * std::cos(0.1 * i);
   const TransferFunction fir = TransferFunction::Discrete(g, {1.0}, 0.01);
   Eigen::VectorXd u(n);
   for (Eigen::Index k = 0; k < n; ++k) u[k] = std::sin(0.001 * k) + (k % 7 == 0 ? 1.0 : 0.0);
-  const auto start = std::chrono::steady_clock::now();
   const Eigen::VectorXd y = Lsim(fir, u, 0.01);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_LT(seconds, 1.0);
   for (Eigen::Index k :
        {Eigen::Index{0}, Eigen::Index{5}, Eigen::Index{255}, Eigen::Index{1000}, n - 1}) {
     double ref = 0.0;

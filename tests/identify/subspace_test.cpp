@@ -3,7 +3,6 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <vector>
 
 #include "parametric_test_util.hpp"
@@ -143,10 +142,7 @@ TEST(Subspace, LongStepRecordWithConstantStart) {
        {SubspaceWeighting::kMoesp, SubspaceWeighting::kN4sid, SubspaceWeighting::kCva}) {
     SubspaceOptions o;  // automatic order, horizon 20: 80 Hankel columns
     o.weighting = w;
-    const auto start = std::chrono::steady_clock::now();
     const SubspaceResult r = EstimateSubspace(y, u, 0.01, o);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     SCOPED_TRACE(ToString(w));
     ASSERT_EQ(r.summary.termination, EstimationTermination::kConvergence) << r.summary.message;
     ASSERT_TRUE(r.singular_values.allFinite());
@@ -154,7 +150,6 @@ TEST(Subspace, LongStepRecordWithConstantStart) {
     ASSERT_TRUE(r.model.IsStable());
     EXPECT_NEAR(r.model.DcGain()(0, 0), truth.DcGain()(0, 0), 0.01 * truth.DcGain()(0, 0));
     EXPECT_GT(NrmseFit(y0, SimulateFromState(r.model, u, r.x0).col(0)), 99.0);
-    EXPECT_LT(seconds, 5.0);
   }
 }
 
