@@ -1,6 +1,7 @@
 // pneumid info DATA: validate a data file and print its summary.
 #include <cmath>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -10,6 +11,7 @@
 #include "data_options.hpp"
 #include "validators.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/strings.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/data/preprocess.hpp"
 
@@ -21,7 +23,7 @@ struct InfoOptions {
   bool json = false;
   bool strict = false;
   double tolerance = 1e-3;
-  std::vector<double> window;
+  std::vector<std::string> window;  // T0,T1 (or T0 T1), or T0:T1 as the other commands
   double resample = -1.0;  // < 0: off; 0: at the median interval
   int decimate = 1;
   std::string save;
@@ -46,8 +48,30 @@ std::string Label(const Channel& c) {
 void Run(const InfoOptions& o) {
   PNEUMID_CHECK(o.tolerance >= 0, "--tolerance must be >= 0, got {}", o.tolerance);
   PNEUMID_CHECK(o.decimate >= 1, "--decimate must be >= 1, got {}", o.decimate);
-  PNEUMID_CHECK(o.window.empty() || o.window.size() == 2,
-                "--window takes two times T0,T1 in seconds, got {} values", o.window.size());
+  std::optional<TimeWindow> window;
+  if (o.window.size() == 1 && o.window[0].find(':') != std::string::npos) {
+    try {
+      window = TimeWindow::Parse(o.window[0]);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(fmt::format("--window: {}", e.what()));
+    }
+  } else if (!o.window.empty()) {
+    PNEUMID_CHECK(o.window.size() == 2,
+                  "--window takes two times T0,T1 (or T0:T1) in seconds, got {} value(s)",
+                  o.window.size());
+    TimeWindow w;
+    auto time = [](const std::string& text, const char* which) {
+      const std::optional<double> v = ParseDouble(text);
+      PNEUMID_CHECK(v.has_value(), "--window: {} must be a time in seconds, got '{}'", which,
+                    text);
+      return *v;
+    };
+    w.start = time(o.window[0], "T0");
+    w.end = time(o.window[1], "T1");
+    std::string why;
+    PNEUMID_CHECK(w.IsValid(&why), "--window: {}", why);
+    window = w;
+  }
   PNEUMID_CHECK(o.save.empty() || !o.window.empty() || o.resample >= 0 || o.decimate > 1,
                 "-o/--output (--save) writes preprocessed data: give --window, --resample or --decimate");
 
@@ -57,9 +81,9 @@ void Run(const InfoOptions& o) {
       load.format == DataFormat::kAuto ? DataFormatFromPath(o.data.path) : load.format;
 
   std::vector<std::string> steps;  // preprocessing applied, in order
-  if (!o.window.empty()) {
-    data = SelectWindow(data, o.window[0], o.window[1]);
-    steps.push_back(fmt::format("window [{:g}, {:g}] s", o.window[0], o.window[1]));
+  if (window) {
+    data = SelectWindow(data, window->start, window->end);
+    steps.push_back(fmt::format("window [{:g}, {:g}] s", window->start, window->end));
   }
   if (o.resample >= 0) {
     data.RequireSamples(2, "resampling");
@@ -240,9 +264,10 @@ static Registrar reg(
           ->capture_default_str()
           ->check(NonNegative());
       app.add_flag("--strict", o->strict, "Exit with an error when the sampling is not uniform");
-      app.add_option("--window", o->window, "Keep only samples with T0 <= t <= T1 (seconds)")
+      app.add_option("--window", o->window,
+                     "Keep only samples with T0 <= t <= T1 (seconds), written T0,T1 or T0:T1")
           ->delimiter(',')
-          ->expected(2);
+          ->expected(1, 2);
       app.add_option("--resample", o->resample,
                      "Resample to a uniform grid with this sample time in s (0: the median "
                      "interval), by linear interpolation")

@@ -12,6 +12,7 @@
 #include "command.hpp"
 #include "validators.hpp"
 #include "data_options.hpp"
+#include "progress.hpp"
 #include "identified_spec.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
@@ -45,6 +46,7 @@ struct ReportArgs {
   int max_lag = 25;
   double confidence = 0.0;  ///< bands of +-K standard deviations; 0 = none
   bool json = false;
+  bool progress = false;
 };
 
 void Run(const ReportArgs& a) {
@@ -91,7 +93,14 @@ void Run(const ReportArgs& a) {
   const Dataset data =
       Preprocess(cli::LoadFromOptions(a.data), cli::ToPreprocessOptions(a.preprocess), &record);
   if (!record.IsIdentity()) o.preprocessing = record;
-  const ReportSummary s = WriteIdentificationReport(data, o, a.out_dir);
+  ReportSummary s;
+  {
+    cli::ProgressBar bar("report", a.progress || cli::StderrIsTerminal());
+    o.progress = [&bar](std::size_t done, std::size_t total, const std::string& method) {
+      bar(static_cast<double>(done) / static_cast<double>(total), method);
+    };
+    s = WriteIdentificationReport(data, o, a.out_dir);
+  }
 
   if (a.json) {
     nlohmann::json j;
@@ -145,6 +154,8 @@ const pneumid::cli::Registrar reg(
       pneumid::cli::AddConfidenceOption(app, a->confidence,
                                         "the step and Bode responses of the models");
       app.add_flag("--json", a->json, "Print the summary as JSON");
+      app.add_flag("--progress", a->progress,
+                   "Draw the progress bar even when stderr is not a terminal");
       app.callback([a]() { Run(*a); });
     });
 

@@ -88,13 +88,9 @@ void Run(const ValidateArgs& a) {
   const PreprocessOptions prep = ToPreprocessOptions(a.preprocess);
   Dataset data = Preprocess(LoadFromOptions(a.data), prep);
   if (identified && identified->preprocessing) {
-    PreprocessOptions window_only;
-    window_only.window = prep.window;
-    PNEUMID_CHECK(prep.IsIdentity() || !window_only.IsIdentity() && [&] {
-      PreprocessOptions rest = prep;
-      rest.window = {};
-      return rest.IsIdentity();
-    }(),
+    PreprocessOptions rest = prep;
+    rest.window = {};
+    PNEUMID_CHECK(rest.IsIdentity(),
                   "{} carries the preprocessing it was identified with ({}); it is applied to "
                   "the data, so give no other preprocessing flag than --window",
                   a.model, fmt::join(identified->preprocessing->steps, "; "));

@@ -757,11 +757,34 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
       sd.*Member(slots[i]) = std::sqrt(std::max(v, 0.0)) * scale[i];
     }
     res.summary.covariance_ok = ok;
+    if (ok) {
+      res.covariance = (scale.asDiagonal() * C * scale.asDiagonal()) * s2;
+      for (Slot slot : slots) res.covariance_names.push_back(SlotName(options.structure, slot));
+    }
   }
   // Lags in decreasing order (with their standard deviations).
   if (options.structure == ProcessStructure::kP2D || options.structure == ProcessStructure::kP3D) {
     std::vector<std::pair<double, double>> lags{{res.params.T1, sd.T1}, {res.params.T2, sd.T2}};
     if (options.structure == ProcessStructure::kP3D) lags.emplace_back(res.params.T3, sd.T3);
+    // The covariance follows the lags: the row of the lag that becomes tau_k
+    // moves to tau_k's position.
+    if (res.covariance.size() > 0) {
+      std::vector<int> order(lags.size());
+      for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+      std::stable_sort(order.begin(), order.end(),
+                       [&lags](int a, int b) { return lags[a].first > lags[b].first; });
+      const std::vector<Slot> lag_slots{kT1, kT2, kT3};
+      std::vector<int> pos(lags.size());  // index of each lag slot in the covariance
+      for (std::size_t i = 0; i < lags.size(); ++i)
+        pos[i] = static_cast<int>(std::find(slots.begin(), slots.end(), lag_slots[i]) -
+                                  slots.begin());
+      Eigen::VectorXi perm = Eigen::VectorXi::LinSpaced(np, 0, np - 1);
+      for (std::size_t k = 0; k < lags.size(); ++k) perm[pos[k]] = pos[order[k]];
+      Eigen::MatrixXd P(np, np);
+      for (int i = 0; i < np; ++i)
+        for (int j = 0; j < np; ++j) P(i, j) = res.covariance(perm[i], perm[j]);
+      res.covariance = P;
+    }
     std::sort(lags.begin(), lags.end(), [](auto a, auto b) { return a.first > b.first; });
     res.params.T1 = lags[0].first;
     sd.T1 = lags[0].second;

@@ -109,7 +109,11 @@ IdentifiedModel IdentifyStepMethod(const std::string& method, const Dataset& dat
     for (const auto& [name, value] : NamedParams(r.structure, r.zero, r.param_std)) {
       if (std::isfinite(value)) m.param_std[name] = value;
     }
-    SetDiagonalCovariance(&m, names);
+    if (r.covariance.size() > 0 && r.covariance.allFinite()) {
+      m.covariance = ParameterCovariance{r.covariance_names, r.covariance};
+    } else {
+      SetDiagonalCovariance(&m, names);
+    }
     m.tf = r.tf;
     if (r.summary.termination != FitTermination::kConvergence) {
       m.notes.push_back(r.summary.BriefReport());

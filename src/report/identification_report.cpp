@@ -94,7 +94,7 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
 
   ReportSummary summary;
   {
-    const IdentificationSummary ids = IdentifyModels(options.methods, data, options.request);
+    const IdentificationSummary ids = IdentifyModels(options.methods, data, options.request, {}, nullptr, options.progress);
     summary.models = ids.models;
     summary.failures = ids.failures;
     if (options.preprocessing)

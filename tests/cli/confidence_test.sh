@@ -13,7 +13,7 @@ expect_ok "identify" identify "$data" -m arx,fit-p1d,reaction-curve -o "$dir/m.j
 check_json "covariance of arx" \
   "[m.get('covariance', {}).get('names') for m in j['models'] if m['method'] == 'arx'] == [['a1','a2','a3','b1','b2','b3']]" \
   "$dir/m.json"
-check_json "fit-p1d diagonal covariance" \
+check_json "fit-p1d covariance" \
   "[len(m['covariance']['matrix']) for m in j['models'] if m['method'] == 'fit-p1d'] == [4]" \
   "$dir/m.json"
 check_json "no covariance for reaction-curve" \

@@ -63,6 +63,11 @@ grep -q "samples: *7" "$dir/out" || fail "resampled size: $(cat "$dir/out")"
 expect_ok "save mat" info "$good" --window 0,1 --save "$dir/step.mat"
 expect_ok "read mat" info "$dir/step.mat" --json
 grep -q '"samples": 101' "$dir/out" || fail "mat samples: $(cat "$dir/out")"
+# The window as the identification commands write it (T0:T1) gives the same.
+expect_ok "window T0:T1" info "$good" --window 0:1 --json
+grep -q '"samples": 101' "$dir/out" || fail "window 0:1 samples: $(cat "$dir/out")"
+expect_error "window one value" "--window takes two times" info "$good" --window 1
+expect_error "window text" "--window: T1 must be a time in seconds, got 'x'" info "$good" --window 0,x
 
 # Every bad input: non-zero exit, message names file, line and column.
 printf 't,u,y\n0,1,2\n0.01,nan,3\n' >"$dir/nan.csv"

@@ -6,6 +6,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include "pneumid/common/check.hpp"
 #include "step_test_util.hpp"
 
@@ -45,6 +47,24 @@ TEST(ProcessModelTest, P2dRecoversSopdtFromTenSteps) {
   EXPECT_TRUE(r.summary.covariance_ok);
   EXPECT_LT(std::abs(r.params.T2 - 0.7), 4.0 * r.param_std.T2);
   EXPECT_NEAR(r.summary.sigma, 0.6, 0.05);
+  // The full covariance: named like NamedParams, its diagonal the squared
+  // standard deviations (after the lags are sorted, so the permutation is
+  // checked), symmetric and positive semi-definite; gain and lags of a step
+  // fit are correlated, which the diagonal alone would miss.
+  ASSERT_EQ(r.covariance_names,
+            (std::vector<std::string>{"K", "tau1", "tau2", "theta", "y0"}));
+  ASSERT_EQ(r.covariance.rows(), 5);
+  const double sd[] = {r.param_std.K, r.param_std.T1, r.param_std.T2, r.param_std.theta,
+                       r.param_std.y0};
+  for (int i = 0; i < 5; ++i)
+    EXPECT_NEAR(std::sqrt(r.covariance(i, i)), sd[i], 1e-9 * sd[i]) << r.covariance_names[i];
+  EXPECT_LT((r.covariance - r.covariance.transpose()).cwiseAbs().maxCoeff(),
+            1e-12 * r.covariance.cwiseAbs().maxCoeff());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(r.covariance);
+  EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12 * eig.eigenvalues().maxCoeff());
+  const double corr = r.covariance(0, 1) / (sd[0] * sd[1]);
+  EXPECT_GT(std::abs(corr), 0.1);
+  EXPECT_LE(std::abs(corr), 1.0);
 }
 
 // Any input: a binary pseudo-random input through each structure (noise-free,

@@ -123,7 +123,8 @@ struct IdentifiedModel {
   /// signals. `validate` re-applies it to new data (ApplyRecorded).
   std::optional<PreprocessRecord> preprocessing;
   /// Parameter covariance when the estimator gives one (ARX, ARMAX, OE, BJ,
-  /// IV4: full; fit-* process models: diagonal, param_std squared); none for
+  /// IV4, fit-* process models: full; diagonal param_std^2 for a fit whose
+  /// full covariance is not finite); none for
   /// the graphical, subspace and correlation methods.
   std::optional<ParameterCovariance> covariance;
 };

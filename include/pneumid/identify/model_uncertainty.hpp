@@ -19,9 +19,9 @@
 //
 // Which models have a covariance: polynomial models the full covariance of
 // their estimator (PolynomialModel::covariance); fit-* process models the
-// diagonal param_std^2 (their correlations are not kept, so the band ignores
-// them: usually wider for K and the lags, which are positively correlated in a
-// step test, than the full one); the graphical, subspace and correlation
+// full covariance of the fit (ProcessFitResult::covariance; the diagonal
+// param_std^2 by SetDiagonalCovariance only when it is not finite); the
+// graphical, subspace and correlation
 // methods none. A model without a covariance has no band: the functions below
 // then return an empty vector (HasCovariance says so beforehand); they never
 // throw for it.
@@ -88,7 +88,8 @@ BodeStd BodeResponseStd(const IdentifiedModel& model, const Eigen::VectorXd& w,
                         const UncertaintyOptions& options = {});
 
 /// Fills model->covariance with the diagonal param_std^2 of the parameters
-/// that have a finite standard deviation (the fit-* process models), in the
+/// that have a finite standard deviation (fit-* models without a finite full
+/// covariance), in the
 /// order of `names`; leaves it unset when none has.
 void SetDiagonalCovariance(IdentifiedModel* model, const std::vector<std::string>& names);
 

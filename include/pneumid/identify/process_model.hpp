@@ -109,6 +109,12 @@ struct ProcessFitResult {
   bool zero = false;
   ProcessParams params;
   ProcessParams param_std;  ///< standard deviations (NaN when not available)
+  /// Covariance of the estimated parameters in physical units,
+  /// sigma^2 (J^T J)^+ (empty when not available), rows and columns named by
+  /// covariance_names (the names of NamedParams: K, tau or tau1.., Tw, zeta,
+  /// Tz, theta, y0, for the parameters that were estimated).
+  Eigen::MatrixXd covariance;
+  std::vector<std::string> covariance_names;
   TransferFunction tf;      ///< the fitted model (continuous, with delay)
   Eigen::VectorXd yhat;     ///< simulated output on the data samples
   ProcessFitSummary summary;

@@ -31,6 +31,7 @@
 #include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/identified_model.hpp"
+#include "pneumid/identify/identify.hpp"
 
 namespace pneumid {
 
@@ -46,6 +47,8 @@ struct ReportOptions {
   double confidence = 0.0;
   /// Command lines shown in the "Reproduce" section (empty = none given).
   std::vector<std::string> commands;
+  /// Called as the methods run (identify.hpp, IdentifyProgress); none by default.
+  IdentifyProgress progress;
   /// How the data were preprocessed before the report (listed in the data
   /// table and stored with each model in models.json); none by default.
   std::optional<PreprocessRecord> preprocessing;
