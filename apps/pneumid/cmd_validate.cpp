@@ -2,14 +2,12 @@
 // residual tests of MATLAB compare and resid, with an optional plot.
 #include <fstream>
 #include <iostream>
-#include <limits>
 #include <memory>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "validators.hpp"
 #include "data_options.hpp"
 #include "identified_spec.hpp"
 #include "output_options.hpp"
@@ -22,6 +20,7 @@
 #include "pneumid/identify/validation.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/report/plot.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -67,14 +66,9 @@ CompareResult SimulateIdentified(const IdentifiedModel& m, const Dataset& data, 
   r.t = data.time();
   r.y = data.y(0);
   r.yhat = SimulateModel(m, data, 0, 0, initial);
-  const Eigen::Index n = data.size() - skip;
-  if (r.yhat.tail(n).allFinite()) {
-    r.fit_percent = NrmseFit(r.y.tail(n), r.yhat.tail(n));
-    r.rmse = Rmse(r.y.tail(n), r.yhat.tail(n));
-  } else {
-    r.fit_percent = -std::numeric_limits<double>::infinity();
-    r.rmse = std::numeric_limits<double>::infinity();
-  }
+  const FitMetrics f = ScoreSimulation(data, 0, r.yhat, skip);
+  r.fit_percent = f.fit_percent;
+  r.rmse = f.rmse;
   return r;
 }
 

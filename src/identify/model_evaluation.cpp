@@ -36,22 +36,31 @@ bool IsPolynomial(const IdentifiedModel& m) {
 
 }  // namespace
 
-Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input) {
+namespace {
+
+// The form SimulateModel runs on the data's grid: a discrete model with the
+// data's sample time (after checking that the two agree), a continuous model
+// as it is (simulated with a zero-order hold at that sample time).
+TransferFunction FormOnDataGrid(const IdentifiedModel& model, const Dataset& data, int input) {
   PNEUMID_CHECK(input >= 0 && input < data.num_inputs(),
                 "input column {} does not exist (the data have {} input(s))", input,
                 data.num_inputs());
   const TransferFunction& g = SimulatedForm(model);
+  if (!g.IsDiscrete()) return g;
   const double Ts = data.SampleTime();
-  if (g.IsDiscrete()) {
-    PNEUMID_CHECK(std::abs(g.Ts() - Ts) <= 1e-6 * Ts,
-                  "the model '{}' has sample time {} s, the data{} {} s", model.method, g.Ts(),
-                  data.source().empty() ? "" : " of " + data.source(), Ts);
-  }
+  PNEUMID_CHECK(std::abs(g.Ts() - Ts) <= 1e-6 * Ts,
+                "the model{} has sample time {} s, the data{} {} s",
+                model.method.empty() ? "" : " '" + model.method + "'", g.Ts(),
+                data.source().empty() ? "" : " of " + data.source(), Ts);
+  return TransferFunction(g.num(), g.den(), Ts, g.delay());
+}
+
+}  // namespace
+
+Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input) {
+  const TransferFunction g = FormOnDataGrid(model, data, input);
   const Eigen::VectorXd du = (data.u(input).array() - model.u0).matrix();
-  const Eigen::VectorXd y = g.IsDiscrete()
-                                ? Lsim(TransferFunction(g.num(), g.den(), Ts, g.delay()), du, Ts)
-                                : Lsim(g, du, Ts);
-  return (y.array() + model.y0).matrix();
+  return (Lsim(g, du, data.SampleTime()).array() + model.y0).matrix();
 }
 
 namespace {
@@ -73,20 +82,8 @@ Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data,
   PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
                 "output column {} does not exist (the data have {} output(s))", output,
                 data.num_outputs());
-  PNEUMID_CHECK(input >= 0 && input < data.num_inputs(),
-                "input column {} does not exist (the data have {} input(s))", input,
-                data.num_inputs());
-  const double Ts = data.SampleTime();
-  TransferFunction g = SimulatedForm(model);
-  if (g.IsDiscrete()) {
-    PNEUMID_CHECK(std::abs(g.Ts() - Ts) <= 1e-6 * Ts,
-                  "the model '{}' has sample time {} s, the data{} {} s", model.method, g.Ts(),
-                  data.source().empty() ? "" : " of " + data.source(), Ts);
-    g = TransferFunction(g.num(), g.den(), Ts, g.delay());
-  } else {
-    g = C2D(g, Ts);
-  }
-  const StateSpace ss = ToStateSpace(g);
+  const TransferFunction g = FormOnDataGrid(model, data, input);
+  const StateSpace ss = ToStateSpace(g.IsDiscrete() ? g : C2D(g, data.SampleTime()));
   const Eigen::MatrixXd du = (data.u(input).array() - model.u0).matrix();
   const Eigen::MatrixXd dy = (data.y(output).array() - model.y0).matrix();
   const Eigen::VectorXd x0 = EstimateInitialState(ss, du, dy);
@@ -95,12 +92,18 @@ Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data,
 
 FitMetrics EvaluateModel(const IdentifiedModel& model, const Dataset& data, int input, int output,
                          Eigen::Index score_from) {
+  return ScoreSimulation(data, output, SimulateModel(model, data, input), score_from);
+}
+
+FitMetrics ScoreSimulation(const Dataset& data, int output, const Eigen::VectorXd& yhat,
+                           Eigen::Index score_from) {
   PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
                 "output column {} does not exist (the data have {} output(s))", output,
                 data.num_outputs());
+  PNEUMID_CHECK(yhat.size() == data.size(), "the simulated output has {} samples, the data {}",
+                yhat.size(), data.size());
   PNEUMID_CHECK(score_from >= 0 && score_from + 2 <= data.size(),
                 "the scored samples must start in [0, {}], got {}", data.size() - 2, score_from);
-  const Eigen::VectorXd yhat = SimulateModel(model, data, input);
   const Eigen::Index n = data.size() - score_from;
   if (!yhat.tail(n).allFinite()) {
     const double inf = std::numeric_limits<double>::infinity();
@@ -134,8 +137,8 @@ bool ModelQualityOptions::IsValid(std::string* error) const {
   return true;
 }
 
-std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Dataset& data,
-                                       int input, int output, const ModelQualityOptions& options) {
+std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Dataset& data, int input,
+                                       int output, const ModelQualityOptions& options) {
   std::string why;
   PNEUMID_CHECK(options.IsValid(&why), "{}", why);
   std::vector<ModelFlagNote> flags;
@@ -146,12 +149,10 @@ std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Datas
     const std::complex<double> p = poles[i];
     const bool unstable = g.IsDiscrete() ? std::abs(p) > 1.0 + tol : p.real() > tol;
     if (unstable) {
-      flags.push_back({ModelFlag::kUnstable, fmt::format("pole at {} = {}{}",
-                                                         g.IsDiscrete() ? "z" : "s", Complex(p),
-                                                         g.IsDiscrete() ? fmt::format(
-                                                                              " (|z| = {:.4g})",
-                                                                              std::abs(p))
-                                                                        : "")});
+      flags.push_back(
+          {ModelFlag::kUnstable,
+           fmt::format("pole at {} = {}{}", g.IsDiscrete() ? "z" : "s", Complex(p),
+                       g.IsDiscrete() ? fmt::format(" (|z| = {:.4g})", std::abs(p)) : "")});
       break;
     }
   }
@@ -221,8 +222,8 @@ int RankGroup(const IdentifiedModel& model) {
 }
 
 double RankScore(const IdentifiedModel& model) {
-  const double s =
-      std::isfinite(model.validation_fit_percent) ? model.validation_fit_percent : model.fit_percent;
+  const double s = std::isfinite(model.validation_fit_percent) ? model.validation_fit_percent
+                                                               : model.fit_percent;
   return std::isnan(s) ? -std::numeric_limits<double>::infinity() : s;
 }
 

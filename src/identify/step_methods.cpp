@@ -56,20 +56,14 @@ bool IsStepMethod(const std::string& name) {
 
 Eigen::VectorXd SimulateOnData(const TransferFunction& g, const Dataset& data, int input,
                                int output, double y0) {
-  const Eigen::VectorXd u = data.u(input), y = data.y(output);
-  const auto [u0, k0] = InitialInput(u);
-  if (std::isnan(y0)) y0 = k0 > 0 ? y.head(k0).mean() : y[0];
-  const double Ts = data.SampleTime();
-  if (g.IsDiscrete()) {
-    PNEUMID_CHECK(std::abs(g.Ts() - Ts) <= 1e-6 * Ts,
-                  "the model's sample time {} s differs from the data's {} s", g.Ts(), Ts);
-  }
-  const Eigen::VectorXd du = (u.array() - u0).matrix();
-  return (Lsim(g.IsDiscrete() ? TransferFunction(g.num(), g.den(), Ts, g.delay()) : g, du,
-               g.IsDiscrete() ? g.Ts() : Ts)
-              .array() +
-          y0)
-      .matrix();
+  // The levels before the first input change as the operating point.
+  IdentifiedModel m;
+  m.tf = g;
+  const Eigen::VectorXd y = data.y(output);
+  const auto [u0, k0] = InitialInput(data.u(input));
+  m.u0 = u0;
+  m.y0 = std::isnan(y0) ? (k0 > 0 ? y.head(k0).mean() : y[0]) : y0;
+  return SimulateModel(m, data, input);
 }
 
 namespace {

@@ -75,6 +75,15 @@ Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data,
 FitMetrics EvaluateModel(const IdentifiedModel& model, const Dataset& data, int input = 0,
                          int output = 0, Eigen::Index score_from = 0);
 
+/// Fit measures of a simulated output `yhat` (N samples) against output
+/// column `output` over samples [score_from, N): EvaluateModel's scoring, for
+/// a simulation made otherwise (e.g. from an estimated initial state).
+/// A non-finite yhat there gives fit -inf and IAE/RMSE inf.
+/// @throws InvalidArgument for a bad output column, a size mismatch or
+///         score_from outside [0, N - 2].
+FitMetrics ScoreSimulation(const Dataset& data, int output, const Eigen::VectorXd& yhat,
+                           Eigen::Index score_from = 0);
+
 /// Sets model->fit_percent and model->iae from EvaluateModel on all samples.
 void ScoreModel(const Dataset& data, int input, int output, IdentifiedModel* model);
 
