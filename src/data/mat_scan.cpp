@@ -188,7 +188,14 @@ class Scanner {
       }
       if (k == 0 && e.type == kMiUint32 && e.nbytes >= 4) {
         cls = U32(e.data, 0) & 0xFF;
-      } else if (k == 1 && e.type == kMiInt32) {
+      } else if (k == 1 && e.type != kMiInt32) {
+        // matio reads the dimensions as int32 whatever the tag says, so a
+        // mistyped tag would reach it unchecked (10 "dimensions" from 50
+        // bytes of text made it allocate 1.8 GB).
+        Fail(fmt::format("{}: its dimensions element has type {}, not miINT32 (5): the file is "
+                         "corrupt",
+                         Variable(), e.type));
+      } else if (k == 1) {
         for (std::size_t d = 0; d + 4 <= e.data.size(); d += 4) {
           const auto n = static_cast<std::int32_t>(U32(e.data, d));
           if (n < 0)

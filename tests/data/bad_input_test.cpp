@@ -270,6 +270,24 @@ TEST_F(BadInputTest, MatVariableClaimingHugeDimensionsIsRejectedQuickly) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
 }
 
+TEST_F(BadInputTest, MatDimensionsOfTheWrongTypeAreRejected) {
+  // Found by mat_fuzz: a dimensions tag of type 10 over 50 bytes, which matio
+  // reads as int32 dimensions anyway (1.8 GB and 6 s for a 464-byte file).
+  std::string flags, dims = "\x01\x00\x00\x00\xfelink access to nothing here, at all!!!!!!!!";
+  PutU32(&flags, 6);  // mxDOUBLE_CLASS
+  PutU32(&flags, 0);
+  const std::string bad = Element(14, Element(6, flags) + Element(10, dims) + Element(1, "t") +
+                                          Element(9, std::string(8, '\0')));
+  const std::string path = Write("dims_type.mat", MatHeader() + bad);
+  EXPECT_THAT([&] { ReadMat(path); },
+              ThrowsMessage<DataError>(HasSubstr(
+                  "variable 1: its dimensions element has type 10, not miINT32 (5): the file is "
+                  "corrupt")));
+  const std::string zpath = Write("zdims_type.mat", MatHeader() + Compress(bad));
+  EXPECT_THAT([&] { ReadMat(zpath); },
+              ThrowsMessage<DataError>(HasSubstr("not miINT32 (5)")));
+}
+
 TEST_F(BadInputTest, MatVariableListIsCappedAndLongNamesAreExcerpts) {
   std::string file = MatHeader();
   for (int i = 0; i < 30; ++i) file += DoubleMatrix(fmt::format("v{}", i), 1, 1, {1.0});
