@@ -1,4 +1,5 @@
 // TOML loader of the IPA parameters (config/ipa_default.toml documents every key).
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -78,6 +79,69 @@ const std::vector<IntKey>& IntKeys() {
   return keys;
 }
 
+struct Range {
+  const char* key;
+  const char* unit;
+  double lower, upper;
+  bool calibratable;
+};
+
+// Physically plausible ranges; docs/simulator.md ("Parameter ranges") gives the sources.
+constexpr Range kRanges[] = {
+    {"cylinder.bore", "m", 0.004, 0.1, true},  // ISO 6432 / ISO 15552 bores 8..100 mm
+    {"cylinder.rod", "m", 0.0, 0.04, true},
+    {"cylinder.stroke", "m", 0.005, 2.0, true},
+    {"cylinder.piston_position", "m", 0.0, 2.0, true},
+    {"cylinder.dead_volume_a", "m^3", 1e-7, 1e-3, true},  // 0.1 cm^3 .. 1 l
+    {"cylinder.dead_volume_b", "m^3", 1e-7, 1e-3, true},
+    {"supply.pressure", "Pa", 1e4, 1.6e6, true},  // gauge; ISO 4414 components <= 1.6 MPa
+    {"supply.atmospheric_pressure", "Pa", 5e4, 1.1e5, true},
+    {"supply.temperature", "K", 233.0, 373.0, true},
+    {"supply.line_conductance", "m^3/(s Pa)", 1e-11, 1e-6, true},
+    {"supply.line_critical_ratio", "", 0.05, 0.6, true},
+    {"gas.gas_constant", "J/(kg K)", 280.0, 300.0, false},
+    {"gas.alpha_in", "", 1.0, 1.4, true},  // polytropic: isothermal .. adiabatic
+    {"gas.alpha_out", "", 1.0, 1.4, true},
+    {"gas.alpha", "", 1.0, 1.4, true},
+    {"valves.inlet_conductance", "m^3/(s Pa)", 1e-11, 1e-7, true},  // 0.001..10 dm^3/(s bar)
+    {"valves.inlet_critical_ratio", "", 0.05, 0.6, true},           // ISO 6358 b
+    {"valves.exhaust_conductance", "m^3/(s Pa)", 1e-11, 1e-7, true},
+    {"valves.exhaust_critical_ratio", "", 0.05, 0.6, true},
+    {"valves.laminar_ratio", "", 0.9, 0.9999, true},
+    {"valves.open_delay", "s", 0.0, 0.05, true},  // solenoid valves 0.3..30 ms
+    {"valves.close_delay", "s", 0.0, 0.05, true},
+    {"valves.min_pulse_width", "s", 0.0, 0.05, true},
+    {"pwm.frequency", "Hz", 1.0, 2000.0, true},
+    {"mechanics.mass", "kg", 0.01, 1000.0, true},
+    {"mechanics.viscous_friction", "N s/m", 0.0, 1e5, true},
+    {"mechanics.coulomb_friction", "N", 0.0, 1e4, true},
+    {"mechanics.static_friction", "N", 0.0, 1e4, true},
+    {"mechanics.stribeck_velocity", "m/s", 1e-5, 1.0, true},
+    {"mechanics.smoothing_velocity", "m/s", 1e-6, 0.1, false},
+    {"mechanics.end_stop_stiffness", "N/m", 1e3, 1e9, false},
+    {"mechanics.end_stop_damping", "N s/m", 0.0, 1e6, false},
+    {"sensors.pressure_noise", "Pa", 0.0, 1e5, false},
+    {"sensors.pressure_full_scale", "Pa", 1e4, 1e8, false},
+    {"sensors.position_noise", "m", 0.0, 0.01, false},
+    {"sensors.adc_range", "V", 0.1, 100.0, false},
+    {"sensors.force_offset", "N", -1e4, 1e4, true},
+    {"simulation.relative_tolerance", "", 1e-12, 1e-2, false},
+    {"simulation.absolute_tolerance", "", 1e-12, 1e-2, false},
+};
+
+double IpaParameters::*FieldOf(const std::string& key) {
+  for (const auto& k : DoubleKeys())
+    if (key == k.key) return k.field;
+  return nullptr;
+}
+
+/// Shortest round-trip decimal that TOML reads as a float (never as an integer).
+std::string TomlFloat(double v) {
+  std::string s = fmt::format("{}", v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
 std::string Where(const std::string& path, const toml::node& node) {
   const auto& src = node.source();
   if (src.begin.line == 0) return path;
@@ -85,6 +149,79 @@ std::string Where(const std::string& path, const toml::node& node) {
 }
 
 }  // namespace
+
+const std::vector<IpaParameterInfo>& IpaParameterTable() {
+  static const std::vector<IpaParameterInfo> table = [] {
+    std::vector<IpaParameterInfo> t;
+    for (const Range& r : kRanges) t.push_back({r.key, r.unit, r.lower, r.upper, r.calibratable});
+    return t;
+  }();
+  return table;
+}
+
+const IpaParameterInfo& FindIpaParameter(const std::string& name) {
+  const IpaParameterInfo* found = nullptr;
+  int matches = 0;
+  for (const auto& info : IpaParameterTable()) {
+    if (info.key == name) return info;
+    const auto dot = info.key.find('.');
+    if (info.key.compare(dot + 1, std::string::npos, name) == 0) {
+      found = &info;
+      ++matches;
+    }
+  }
+  if (matches == 1) return *found;
+  std::string keys;
+  for (const auto& info : IpaParameterTable()) keys += (keys.empty() ? "" : ", ") + info.key;
+  if (matches > 1)
+    throw InvalidArgument(fmt::format(
+        "IPA parameter name '{}' is ambiguous: give it with its section; valid names: {}",
+        Excerpt(name), keys));
+  throw InvalidArgument(fmt::format("unknown IPA parameter '{}'; valid names: {}",
+                                    Excerpt(name), keys));
+}
+
+double GetIpaParameter(const IpaParameters& p, const std::string& name) {
+  return p.*FieldOf(FindIpaParameter(name).key);
+}
+
+void SetIpaParameter(IpaParameters& p, const std::string& name, double value) {
+  p.*FieldOf(FindIpaParameter(name).key) = value;
+}
+
+std::string IpaParametersToToml(const IpaParameters& p, const std::string& comment) {
+  std::string out;
+  std::size_t begin = 0;
+  while (!comment.empty() && begin <= comment.size()) {
+    const auto end = std::min(comment.find('\n', begin), comment.size());
+    out += "# " + comment.substr(begin, end - begin) + "\n";
+    begin = end + 1;
+  }
+  // One table per section, in the order of first appearance; [simulation]
+  // first, with the two modes.
+  std::vector<std::string> sections = {"simulation"};
+  for (const auto& info : IpaParameterTable()) {
+    const std::string sec = info.key.substr(0, info.key.find('.'));
+    if (std::find(sections.begin(), sections.end(), sec) == sections.end()) sections.push_back(sec);
+  }
+  for (const auto& sec : sections) {
+    out += fmt::format("\n[{}]\n", sec);
+    if (sec == "simulation")
+      out += fmt::format("mode = \"{}\"\npwm_mode = \"{}\"\n", ToString(p.mode),
+                         ToString(p.pwm_mode));
+    for (const auto& info : IpaParameterTable()) {
+      const auto dot = info.key.find('.');
+      if (info.key.compare(0, dot, sec) != 0 || dot != sec.size()) continue;
+      out += fmt::format("{} = {}", info.key.substr(dot + 1), TomlFloat(p.*FieldOf(info.key)));
+      out += info.unit.empty() ? "\n" : fmt::format("    # {}\n", info.unit);
+    }
+    if (sec == "sensors") {
+      out += fmt::format("adc_bits = {}\n", p.adc_bits);
+      out += fmt::format("transport_delay_samples = {}\n", p.transport_delay_samples);
+    }
+  }
+  return out;
+}
 
 IpaParameters LoadIpaParameters(const std::string& path) {
   toml::table root;

@@ -206,6 +206,21 @@ void IpaSimulator::Reset() {
   reading_head_ = 0;
 }
 
+void IpaSimulator::SetState(double p_a, double p_b, double x) {
+  PNEUMID_CHECK(std::isfinite(p_a) && p_a > 0.0 && std::isfinite(p_b) && p_b > 0.0,
+                "IPA state: chamber pressures must be positive (absolute), got p_a = {} Pa, "
+                "p_b = {} Pa",
+                p_a, p_b);
+  PNEUMID_CHECK(std::isfinite(x) && x >= 0.0 && x <= p_.stroke,
+                "IPA state: piston position {} m is outside the stroke 0..{} m", x, p_.stroke);
+  x_[0] = p_a / kBar;
+  x_[1] = p_b / kBar;
+  if (p_.mode == IpaMode::kPosition) x_[2] = x / kMm;
+  x_[3] = 0.0;
+  for (double& r : readings_) r = SenseOutput();
+  reading_head_ = 0;
+}
+
 double IpaSimulator::Measure() { return readings_[reading_head_]; }
 
 double IpaSimulator::pressure_a() const { return x_[0] * kBar; }

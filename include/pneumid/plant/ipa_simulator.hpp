@@ -167,6 +167,37 @@ struct IpaParameters {
 /// values that fail IsValid().
 IpaParameters LoadIpaParameters(const std::string& path);
 
+/// One numeric parameter of IpaParameters, named by its TOML key
+/// ("valves.inlet_conductance"), with its unit and the range physics allows
+/// (docs/simulator.md, "Parameter ranges", gives the source of each range).
+/// The range bounds the calibration (identify/ipa_calibration.hpp); values
+/// outside it are not rejected by IsValid, which checks only what the
+/// equations need.
+struct IpaParameterInfo {
+  std::string key;   ///< "section.name" as in config/ipa_default.toml
+  std::string unit;  ///< SI unit, "" for ratios
+  double lower = 0.0;
+  double upper = 0.0;
+  /// False for numerical settings and sensor scaling (tolerances, ADC range,
+  /// noise) that a calibration does not estimate.
+  bool calibratable = true;
+};
+
+/// Every floating-point parameter, in the order of config/ipa_default.toml.
+const std::vector<IpaParameterInfo>& IpaParameterTable();
+/// The table entry of a parameter named by its key or, when unique, by the
+/// key's last part ("bore" -> "cylinder.bore").
+/// @throws InvalidArgument naming the unknown or ambiguous name and listing the valid keys.
+const IpaParameterInfo& FindIpaParameter(const std::string& name);
+/// Value of a parameter named as FindIpaParameter accepts.
+double GetIpaParameter(const IpaParameters& p, const std::string& name);
+/// Sets a parameter named as FindIpaParameter accepts (no range check: call IsValid).
+void SetIpaParameter(IpaParameters& p, const std::string& name, double value);
+/// The parameters as TOML that LoadIpaParameters reads back to the same
+/// values (every key, shortest round-trip decimals). `comment` lines, if any,
+/// are written first as '#' comments.
+std::string IpaParametersToToml(const IpaParameters& p, const std::string& comment = {});
+
 /// ISO 6358 mass flow (kg/s) through a restriction of sonic conductance C
 /// (m^3/(s Pa)) and critical ratio b from p_up to p_down (Pa, absolute), with
 /// upstream temperature T_up (K) and the laminar continuation above
@@ -194,6 +225,13 @@ class IpaSimulator final : public Plant {
   /// "x [m]" and "v [m/s]".
   std::map<std::string, double> Extras() const override;
   std::string Describe() const override;
+
+  /// Sets the true state now: chamber pressures p_a, p_b (Pa absolute) and,
+  /// in position mode, piston position x (m, within the stroke) at rest. The
+  /// sensor delay line is refilled with readings of this state, so Measure()
+  /// returns it at once: the initial state of a measured experiment.
+  /// @throws InvalidArgument for non-positive pressures or x outside the stroke.
+  void SetState(double p_a, double p_b, double x);
 
   /// Holds the valve commands (true = energized/open) for one sample period,
   /// bypassing the PWM generator; valve delays still apply.

@@ -1,0 +1,259 @@
+// pneumid calibrate DATA [DATA ...]: grey-box identification of the IPA
+// simulator's physical parameters from measured experiments (the digital twin
+// of one actuator); writes a parameter TOML for --plant-config / ipa:config=.
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "data_options.hpp"
+#include "output_options.hpp"
+#include "progress.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/common/strings.hpp"
+#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/ipa_calibration.hpp"
+#include "pneumid/report/plot.hpp"
+
+namespace pneumid::cli {
+namespace {
+
+struct CalibrateArgs {
+  std::vector<std::string> files;
+  std::vector<std::string> validation;
+  DataOptions data;
+  std::string plant_config;
+  std::string mode;      // force|position; empty: the config's
+  std::string pwm_mode;  // switching|averaged; empty: the config's
+  std::string free;
+  std::vector<std::string> bounds;
+  std::string initial_state = "measured";
+  int max_iterations = 100;
+  int threads = 2;
+  std::string output;
+  std::string plot;
+  bool json = false;
+  bool progress = false;
+};
+
+std::pair<std::string, std::pair<double, double>> ParseBound(const std::string& text) {
+  const auto eq = text.find('=');
+  const auto colon = text.find(':', eq == std::string::npos ? 0 : eq);
+  PNEUMID_CHECK(eq != std::string::npos && colon != std::string::npos,
+                "--bound '{}': expected NAME=LOWER:UPPER, e.g. bore=0.01:0.03", Excerpt(text));
+  const auto lo = ParseDouble(text.substr(eq + 1, colon - eq - 1));
+  const auto hi = ParseDouble(text.substr(colon + 1));
+  PNEUMID_CHECK(lo && hi, "--bound '{}': LOWER and UPPER must be numbers", Excerpt(text));
+  return {text.substr(0, eq), {*lo, *hi}};
+}
+
+std::string FormatValue(double v, double sd, const std::string& unit) {
+  if (std::isfinite(sd))
+    return fmt::format("{:.6g} +- {:.2g} {}", v, sd, unit);
+  return fmt::format("{:.6g} {} (std n/a)", v, unit);
+}
+
+void Run(const CalibrateArgs& a) {
+  IpaCalibrationOptions options;
+  if (!a.plant_config.empty()) options.start = LoadIpaParameters(a.plant_config);
+  if (!a.mode.empty()) options.start.mode = IpaModeFromString(a.mode);
+  if (!a.pwm_mode.empty()) options.start.pwm_mode = PwmModeFromString(a.pwm_mode);
+  if (!a.free.empty())
+    for (const auto& name : Split(a.free, ','))
+      if (!Trim(name).empty()) options.free.emplace_back(Trim(name));
+  for (const auto& b : a.bounds) options.bounds.insert(ParseBound(b));
+  options.initial_state = CalibrationInitialStateFromString(a.initial_state);
+  options.max_iterations = a.max_iterations;
+  options.num_threads = a.threads;
+
+  std::vector<CalibrationExperiment> experiments;
+  for (const auto& file : a.files) {
+    DataOptions d = a.data;
+    d.path = file;
+    experiments.push_back({LoadFromOptions(d), file});
+  }
+  ProgressBar bar("calibrate", a.progress || StderrIsTerminal());
+  options.progress = [&](int iteration, double cost) {
+    bar(std::min(1.0, static_cast<double>(iteration) / std::max(1, a.max_iterations)),
+        fmt::format("iteration {}, cost {:.4g}", iteration, cost));
+  };
+  std::vector<Dataset> held_out;
+  for (const auto& file : a.validation) {
+    DataOptions d = a.data;
+    d.path = file;
+    held_out.push_back(LoadFromOptions(d));
+  }
+  const IpaCalibrationSummary s = CalibrateIpa(experiments, options);
+  options.progress = nullptr;
+  // The calibrated twin on the held-out experiments.
+  std::vector<double> validation_fit;
+  if (s.termination != Termination::kFailure)
+    for (const auto& d : held_out)
+      validation_fit.push_back(
+          NrmseFit(d.y(0), SimulateIpaOnData(s.parameters, d, options.initial_state,
+                                             options.warmup, options.integration_tolerance)));
+
+  if (s.termination != Termination::kFailure && !a.output.empty()) {
+    std::string comment = fmt::format(
+        "IPA parameters calibrated by `pneumid calibrate` ({}, {} iterations) from:", 
+        ToString(s.termination), s.iterations);
+    for (const auto& e : s.experiments)
+      comment += fmt::format("\n  {} (fit {:.2f} %)", e.name, e.fit_percent);
+    std::string free;
+    for (const auto& e : s.estimates) free += (free.empty() ? "" : ", ") + e.name;
+    comment += "\nfree parameters: " + free;
+    std::ofstream out(a.output);
+    if (!out) throw DataError(fmt::format("{}: cannot open for writing", a.output));
+    out << IpaParametersToToml(s.parameters, comment);
+    if (!out) throw DataError(fmt::format("{}: write failed", a.output));
+  }
+  if (!a.plot.empty() && !s.experiments.empty()) {
+    const int rows = static_cast<int>(std::min<std::size_t>(3, s.experiments.size()));
+    Figure fig(rows);
+    fig.title = "IPA twin calibration: measured and simulated output";
+    for (int i = 0; i < rows; ++i) {
+      const auto& e = s.experiments[static_cast<std::size_t>(i)];
+      auto& ax = fig.axes(i);
+      ax.title = fmt::format("{}: fit {:.2f} % (start {:.2f} %)", e.name, e.fit_percent,
+                             e.initial_fit_percent);
+      ax.xlabel = "Time t [s]";
+      ax.ylabel = options.start.mode == IpaMode::kForce ? "Force F [N]" : "Position x [m]";
+      const Dataset& d = experiments[static_cast<std::size_t>(i)].data;
+      ax.AddLine(d.time(), d.y(0), "measured");
+      if (e.simulated.size() == d.size()) ax.AddLine(d.time(), e.simulated, "calibrated twin");
+    }
+    fig.Save(a.plot);
+  }
+
+  if (a.json) {
+    nlohmann::ordered_json j;
+    nlohmann::ordered_json params = nlohmann::ordered_json::object();
+    for (const auto& e : s.estimates)
+      params[e.name] = {{"value", e.value},
+                        {"std", JsonNumber(e.std)},
+                        {"unit", e.unit},
+                        {"start", e.start},
+                        {"lower", e.lower},
+                        {"upper", e.upper},
+                        {"determined", e.determined},
+                        {"at_bound", e.at_bound}};
+    j["parameters"] = params;
+    nlohmann::ordered_json ex = nlohmann::ordered_json::array();
+    for (const auto& e : s.experiments)
+      ex.push_back({{"file", e.name},
+                    {"samples", e.samples},
+                    {"fit_percent", JsonNumber(e.fit_percent)},
+                    {"initial_fit_percent", JsonNumber(e.initial_fit_percent)}});
+    j["experiments"] = ex;
+    nlohmann::ordered_json val = nlohmann::ordered_json::array();
+    for (std::size_t i = 0; i < validation_fit.size(); ++i)
+      val.push_back({{"file", a.validation[i]}, {"fit_percent", JsonNumber(validation_fit[i])}});
+    j["validation"] = val;
+    nlohmann::ordered_json corr = nlohmann::ordered_json::array();
+    for (const auto& c : s.correlations)
+      corr.push_back({{"first", c.first}, {"second", c.second}, {"correlation", c.correlation}});
+    j["correlations"] = corr;
+    j["warnings"] = s.warnings;
+    j["termination"] = ToString(s.termination);
+    j["message"] = s.message;
+    j["iterations"] = s.iterations;
+    j["initial_cost"] = JsonNumber(s.initial_cost);
+    j["final_cost"] = JsonNumber(s.final_cost);
+    j["simulations"] = s.simulations;
+    j["seconds"] = s.seconds;
+    j["mode"] = ToString(options.start.mode);
+    j["pwm_mode"] = ToString(options.start.pwm_mode);
+    j["initial_state"] = ToString(options.initial_state);
+    if (!a.output.empty() && s.termination != Termination::kFailure) j["output"] = a.output;
+    if (!a.plot.empty()) j["plot"] = a.plot;
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << fmt::format("IPA calibration ({} mode, {} PWM): {} after {} iterations, "
+                             "{} simulations, {:.2f} s\n",
+                             ToString(options.start.mode), ToString(options.start.pwm_mode),
+                             ToString(s.termination), s.iterations, s.simulations, s.seconds);
+    if (!s.message.empty()) std::cout << "  " << s.message << "\n";
+    if (!s.experiments.empty()) std::cout << "experiments (NRMSE fit, start -> calibrated):\n";
+    for (const auto& e : s.experiments)
+      std::cout << fmt::format("  {:<30} {:>7} samples  {:7.2f} % -> {:7.2f} %\n", e.name,
+                               e.samples, e.initial_fit_percent, e.fit_percent);
+    for (std::size_t i = 0; i < validation_fit.size(); ++i)
+      std::cout << fmt::format("  {:<30} validation          {:7.2f} %\n", a.validation[i],
+                               validation_fit[i]);
+    if (!s.estimates.empty()) std::cout << "parameters (value +- standard deviation):\n";
+    for (const auto& e : s.estimates)
+      std::cout << fmt::format("  {:<32} {}{}\n", e.name, FormatValue(e.value, e.std, e.unit),
+                               e.determined ? "" : "  (not determined by the data)");
+    for (const auto& c : s.correlations)
+      std::cout << fmt::format("correlated: {} and {}: {:+.3f}\n", c.first, c.second,
+                               c.correlation);
+    if (!a.output.empty() && s.termination != Termination::kFailure)
+      std::cout << "twin written to " << a.output << "\n";
+    if (!a.plot.empty()) std::cout << "plot written to " << a.plot << "\n";
+  }
+  for (const auto& w : s.warnings) std::cerr << "pneumid calibrate: warning: " << w << "\n";
+  if (s.termination == Termination::kFailure) {
+    std::cerr << "pneumid calibrate: error: " << s.message << "\n";
+    throw ExitCode{1};
+  }
+}
+
+static Registrar reg(
+    "calibrate",
+    "Calibrate the IPA simulator's physical parameters to measured experiments (grey-box "
+    "identification) and write the twin's parameter TOML",
+    [](CLI::App& app) {
+      auto args = std::make_shared<CalibrateArgs>();
+      app.add_option("DATA", args->files,
+                     "Measured experiments (CSV or .mat; steps, staircases, PRBS), each with its "
+                     "own initial state; input: PWM duty in %, output: force in N (or position "
+                     "in m)")
+          ->required()
+          ->check(CLI::ExistingFile);
+      app.add_option("--validation", args->validation,
+                     "Held-out experiments (repeatable): the calibrated twin's fit on each is "
+                     "reported, they are not used for the estimate")
+          ->check(CLI::ExistingFile);
+      AddDataOptions(app, args->data, /*positional=*/false);
+      app.add_option("--plant-config", args->plant_config,
+                     "Starting parameters and fixed values (TOML as config/ipa_default.toml); "
+                     "default: the built-in twin")
+          ->check(CLI::ExistingFile);
+      app.add_option("--mode", args->mode, "force or position (default: the config's)")
+          ->check(CLI::IsMember({"force", "position"}));
+      app.add_option("--pwm", args->pwm_mode,
+                     "PWM simulation: switching or averaged (default: the config's)")
+          ->check(CLI::IsMember({"switching", "averaged", "pwm", "average"}));
+      app.add_option("--free", args->free,
+                     "Comma-separated parameters to estimate (TOML keys such as "
+                     "valves.inlet_conductance or unique last parts such as bore); default "
+                     "force mode: inlet/exhaust conductance and critical ratio, bore, open "
+                     "delay (position mode adds mass, viscous and Coulomb friction)");
+      app.add_option("--bound", args->bounds,
+                     "NAME=LOWER:UPPER replaces the physical range of a free parameter "
+                     "(repeatable)");
+      app.add_option("--initial-state", args->initial_state,
+                     "Start of each experiment's simulation: measured (the state the first "
+                     "output shows) or steady (the steady state of the first input)")
+          ->capture_default_str()
+          ->check(CLI::IsMember({"measured", "steady"}));
+      app.add_option("--max-iterations", args->max_iterations, "Levenberg-Marquardt iterations")
+          ->capture_default_str()
+          ->check(CLI::Range(0, 100000));
+      app.add_option("--threads", args->threads, "Threads for the simulations of the Jacobian")
+          ->capture_default_str()
+          ->check(CLI::Range(1, 256));
+      app.add_option("-o,--output", args->output,
+                     "Write the calibrated twin as TOML (for --plant-config / ipa:config=FILE)");
+      AddPlotOption(app, args->plot, "measured and simulated output of each experiment");
+      app.add_flag("--json", args->json, "Print the results as JSON");
+      app.add_flag("--progress", args->progress,
+                   "Draw the progress bar on stderr even when it is not a terminal");
+      app.callback([args] { Run(*args); });
+    });
+
+}  // namespace
+}  // namespace pneumid::cli
