@@ -14,6 +14,8 @@ void BindReport(pybind11::module_& m);
 /// Plant, control and closed-loop bindings.
 void BindExtras(pybind11::module_& m);
 void BindUncertainty(pybind11::module_& m);
+/// calibrate() and the IPA parameter helpers.
+void BindCalibration(pybind11::module_& m);
 
 /// Throws InvalidArgument (Python: pneumid.InvalidArgument, a ValueError)
 /// "function: argument is empty (...)" when an array argument has no elements.

@@ -64,4 +64,5 @@ PYBIND11_MODULE(pneumid, m) {
   pneumid::python::BindReport(m);
   pneumid::python::BindExtras(m);
   pneumid::python::BindUncertainty(m);
+  pneumid::python::BindCalibration(m);
 }
