@@ -90,11 +90,18 @@ IpaParameters ModelParameters(IpaParameters p, double tolerance) {
   return p;
 }
 
-/// Mean of the leading outputs (at most 5) recorded with the first input value.
+/// The output level the record starts from: the mean of the leading outputs
+/// (at most 5) recorded with the first input, stopping at the first one that
+/// has moved by more than 1 % of the record's range from y(0) (a record that
+/// starts in a transient keeps y(0)).
 double LeadingOutput(const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
+  const double band = 0.01 * (y.maxCoeff() - y.minCoeff());
   double sum = 0.0;
   int n = 0;
-  for (Eigen::Index k = 0; k < y.size() && k < 5 && u[k] == u[0]; ++k, ++n) sum += y[k];
+  for (Eigen::Index k = 0; k < y.size() && k < 5 && u[k] == u[0]; ++k, ++n) {
+    if (std::abs(y[k] - y[0]) > band) break;
+    sum += y[k];
+  }
   return n > 0 ? sum / n : y[0];
 }
 

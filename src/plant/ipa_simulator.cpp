@@ -103,6 +103,7 @@ bool IpaParameters::IsValid(std::string* error) const {
         Check{end_stop_stiffness, "mechanics.end_stop_stiffness", "N/m"},
         Check{end_stop_damping, "mechanics.end_stop_damping", "N s/m"},
         Check{pressure_noise, "sensors.pressure_noise", "Pa"},
+        Check{pressure_filter_time_constant, "sensors.pressure_filter_time_constant", "s"},
         Check{position_noise, "sensors.position_noise", "m"}, Check{rod, "cylinder.rod", "m"}}) {
     if (!(std::isfinite(c.value) && c.value >= 0.0))
       return fail(fmt::format("{} must be >= 0, got {} {}", c.name, c.value, c.unit));
@@ -187,7 +188,8 @@ void IpaSimulator::Reset() {
         p_.piston_position / kMm,
         0.0,
         0.0,
-        0.0};
+        0.0,
+        p_.atmospheric_pressure / kBar};
   t_ = 0.0;
   dt_ = 1e-4;
   steps_ = 0;
@@ -217,6 +219,7 @@ void IpaSimulator::SetState(double p_a, double p_b, double x) {
   x_[1] = p_b / kBar;
   if (p_.mode == IpaMode::kPosition) x_[2] = x / kMm;
   x_[3] = 0.0;
+  x_[6] = x_[0];
   for (double& r : readings_) r = SenseOutput();
   reading_head_ = 0;
 }
@@ -266,7 +269,8 @@ double IpaSimulator::Quantize(double volts) const {
 double IpaSimulator::SenseOutput() {
   const double n = normal_(rng_);
   if (p_.mode == IpaMode::kForce) {
-    const double gauge = pressure_a() + p_.pressure_noise * n - p_.atmospheric_pressure;
+    const double sensed = p_.pressure_filter_time_constant > 0.0 ? x_[6] * kBar : pressure_a();
+    const double gauge = sensed + p_.pressure_noise * n - p_.atmospheric_pressure;
     const double volts = Quantize(gauge / p_.pressure_full_scale * p_.adc_range);
     return p_.AreaA() * volts / p_.adc_range * p_.pressure_full_scale + p_.force_offset +
            load_disturbance_;
@@ -319,6 +323,8 @@ void IpaSimulator::Rhs(const State& x, State& dxdt, double open_in, double open_
   dxdt[1] = dpb / kBar;
   dxdt[4] = in_a / kGram;
   dxdt[5] = out_a / kGram;
+  const double tf = p_.pressure_filter_time_constant;
+  dxdt[6] = tf > 0.0 ? (x[0] - x[6]) / tf : 0.0;
   if (!moving) {
     dxdt[2] = 0.0;
     dxdt[3] = 0.0;

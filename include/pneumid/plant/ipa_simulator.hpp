@@ -45,7 +45,9 @@
 // [4] Friction: Stribeck curve with a smoothed sign, B. Armstrong-Helouvry,
 //     Control of Machines with Friction, 1991:
 //       F_f = (F_c + (F_s - F_c) exp(-(v/v_s)^2)) tanh(v/v_eps) + b v
-// Sensors: pressure transducer with Gaussian noise, 0..full scale -> 0..10 V,
+// Sensors: pressure transducer with an optional first-order low-pass (time
+// constant pressure_filter_time_constant: transducer bandwidth and the
+// RC anti-aliasing filter before the ADC), Gaussian noise, 0..full scale -> 0..10 V,
 // read by a bipolar 16-bit ADC over +-10 V (NI PCI-6221: 20 V / 2^16 = 0.305 mV
 // per code), output delayed by transport_delay_samples sample periods.
 // Integration: Boost.Odeint runge_kutta_dopri5 with error control, restarted
@@ -142,6 +144,9 @@ struct IpaParameters {
   // [sensors]
   double pressure_noise = 150.0;       ///< Pa, standard deviation of the transducer noise
   double pressure_full_scale = 1.0e6;  ///< Pa gauge at 10 V transducer output
+  /// s, time constant of the first-order low-pass between the chamber-A
+  /// pressure and the ADC (transducer bandwidth, RC anti-aliasing filter); 0: none.
+  double pressure_filter_time_constant = 0.0;
   double position_noise = 1.0e-5;      ///< m, standard deviation (position mode)
   int adc_bits = 16;                   ///< ADC resolution; 0 disables quantization
   double adc_range = 10.0;             ///< V, bipolar input range +-adc_range
@@ -256,8 +261,8 @@ class IpaSimulator final : public Plant {
   long long steps() const { return steps_; }
 
   /// Internal state, scaled for the error control: p_a, p_b [bar], x [mm],
-  /// v [m/s], m_in_a, m_out_a [g].
-  using State = std::array<double, 6>;
+  /// v [m/s], m_in_a, m_out_a [g], sensed p_a after the sensor filter [bar].
+  using State = std::array<double, 7>;
 
  private:
   // Advance, AdvanceValves and Measure do not allocate: the valve event queues
