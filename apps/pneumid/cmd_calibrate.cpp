@@ -24,6 +24,7 @@ namespace {
 struct CalibrateArgs {
   std::vector<std::string> files;
   std::vector<std::string> validation;
+  std::vector<double> weights;
   DataOptions data;
   std::string plant_config;
   std::string mode;      // force|position; empty: the config's
@@ -69,11 +70,14 @@ void Run(const CalibrateArgs& a) {
   options.max_iterations = a.max_iterations;
   options.num_threads = a.threads;
 
+  PNEUMID_CHECK(a.weights.empty() || a.weights.size() == a.files.size(),
+                "--weights: {} weights for {} data files; give one per file, in their order",
+                a.weights.size(), a.files.size());
   std::vector<CalibrationExperiment> experiments;
-  for (const auto& file : a.files) {
+  for (std::size_t i = 0; i < a.files.size(); ++i) {
     DataOptions d = a.data;
-    d.path = file;
-    experiments.push_back({LoadFromOptions(d), file});
+    d.path = a.files[i];
+    experiments.push_back({LoadFromOptions(d), a.files[i], a.weights.empty() ? 1.0 : a.weights[i]});
   }
   ProgressBar bar("calibrate", a.progress || StderrIsTerminal());
   options.progress = [&](int iteration, double cost) {
@@ -232,6 +236,11 @@ static Registrar reg(
                      "valves.inlet_conductance or unique last parts such as bore); default "
                      "force mode: inlet/exhaust conductance and critical ratio, bore, open "
                      "delay (position mode adds mass, viscous and Coulomb friction)");
+      app.add_option("--weights", args->weights,
+                     "Weight of each experiment in the cost, one per DATA file in their order "
+                     "(comma-separated; default 1 each: every experiment counts by its fit)")
+          ->delimiter(',')
+          ->check(CLI::PositiveNumber);
       app.add_option("--bound", args->bounds,
                      "NAME=LOWER:UPPER replaces the physical range of a free parameter "
                      "(repeatable)");

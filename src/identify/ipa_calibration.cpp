@@ -135,7 +135,8 @@ struct PreparedExperiment {
   std::string name;
   Eigen::VectorXd u, y;
   double Ts = 0.0;
-  double norm = 1.0;  // ||y - mean(y)||
+  double norm = 1.0;  // ||y - mean(y)|| / sqrt(weight)
+  double weight = 1.0;
 };
 
 /// Output error of every experiment for given scaled variables, and its
@@ -373,8 +374,13 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
                   "{}: no excitation: the input is constant ({} %) over all {} samples, so "
                   "the data say nothing about the dynamics; use a step, staircase or PRBS",
                   name, p.u[0], d.size());
+    const double w = experiments[e].weight;
+    PNEUMID_CHECK(std::isfinite(w) && w > 0.0, "{}: the weight must be positive, got {}", name,
+                  w);
     p.norm = (p.y.array() - p.y.mean()).matrix().norm();
     PNEUMID_CHECK(p.norm > 0.0, "{}: the output is constant ({}), nothing to fit", name, p.y[0]);
+    p.norm /= std::sqrt(w);
+    p.weight = w;
     total += d.size();
     prepared.push_back(std::move(p));
   }
@@ -391,7 +397,7 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
     Eigen::Index offset = 0;
     for (std::size_t e = 0; e < prepared.size(); ++e) {
       const Eigen::Index n = prepared[e].y.size();
-      const double f = FitOf(r.segment(offset, n));
+      const double f = FitOf(r.segment(offset, n) / std::sqrt(prepared[e].weight));
       if (initial) {
         CalibrationExperimentFit fit;
         fit.name = prepared[e].name;

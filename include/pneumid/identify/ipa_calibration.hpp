@@ -8,11 +8,11 @@
 // initial state. Free parameters theta (physical units, named by their TOML
 // keys) are estimated by nonlinear least squares of the output error [1]:
 //
-//   min_theta  sum_e  sum_k  ( (ysim_e(k; theta) - y_e(k)) / ||y_e - mean(y_e)|| )^2
+//   min_theta  sum_e  w_e sum_k  ( (ysim_e(k; theta) - y_e(k)) / ||y_e - mean(y_e)|| )^2
 //   subject to lower_i <= theta_i <= upper_i,
 //
 // so every experiment counts by its relative fit, fit_e = 100 (1 - ||ysim_e - y_e|| /
-// ||y_e - mean(y_e)||) %, whatever its amplitude. Ceres Solver (Levenberg-
+// ||y_e - mean(y_e)||) %, whatever its amplitude, times its weight w_e (default 1). Ceres Solver (Levenberg-
 // Marquardt, bounds) works on the scaled variables z_i = theta_i / s_i with s_i
 // = |start_i| (or the width of the range when the start is 0); the Jacobian is
 // formed by central differences of the simulation (one-sided at a bound), its
@@ -64,6 +64,9 @@ CalibrationInitialState CalibrationInitialStateFromString(const std::string& nam
 struct CalibrationExperiment {
   Dataset data;
   std::string name;  ///< shown in reports; empty: data.source()
+  /// Weight w_e > 0 of the experiment's term in the cost (default 1): its
+  /// residuals are multiplied by sqrt(w_e).
+  double weight = 1.0;
 };
 
 struct IpaCalibrationOptions {

@@ -97,12 +97,12 @@ struct IpaParameters {
   PwmMode pwm_mode = PwmMode::kSwitching;
 
   // [cylinder]
-  double bore = 0.017;   ///< m, piston diameter (effective; calibrated)
+  double bore = 0.020248;  ///< m, piston diameter (effective; calibrated)
   double rod = 0.006;    ///< m, rod diameter (chamber B side)
   double stroke = 0.10;  ///< m
   double piston_position =
       0.05;  ///< m from the chamber-A end (fixed in force mode, initial otherwise)
-  double dead_volume_a = 18.1e-6;  ///< m^3, chamber A ports and tubing to the valves (calibrated)
+  double dead_volume_a = 57.72e-6;  ///< m^3, chamber A ports, manifold and tubing to the valves
   double dead_volume_b = 10.0e-6;  ///< m^3, chamber B ports and tubing
 
   // [supply]
@@ -119,17 +119,17 @@ struct IpaParameters {
   double alpha = 1.2;           ///< coefficient of the volume-change term [1]
 
   // [valves]  sonic conductance in m^3/(s Pa): 1 dm^3/(s bar) = 1e-8 m^3/(s Pa)
-  double inlet_conductance = 0.08e-8;    ///< m^3/(s Pa), C of the inlet valve
-  double inlet_critical_ratio = 0.3;     ///< -, b of the inlet valve
-  double exhaust_conductance = 0.24e-8;  ///< m^3/(s Pa), C of the exhaust valve (calibrated)
-  double exhaust_critical_ratio = 0.3;   ///< -, b of the exhaust valve
+  double inlet_conductance = 0.1301e-8;    ///< m^3/(s Pa), C of the inlet valve
+  double inlet_critical_ratio = 0.473;     ///< -, b of the inlet valve
+  double exhaust_conductance = 0.4829e-8;  ///< m^3/(s Pa), C of the exhaust valve
+  double exhaust_critical_ratio = 0.106;   ///< -, b of the exhaust valve
   double laminar_ratio = 0.999;          ///< -, pressure ratio above which flow is linear in dp
-  double open_delay = 0.002;             ///< s, command rising edge -> valve open
-  double close_delay = 0.001;            ///< s, command falling edge -> valve closed
-  double min_pulse_width = 0.002;        ///< s, shorter command pulses do not open the valve
+  double open_delay = 0.0005;            ///< s, command rising edge -> valve open
+  double close_delay = 0.001457;         ///< s, command falling edge -> valve closed
+  double min_pulse_width = 0.0005;       ///< s, shorter command pulses do not open the valve
 
   // [pwm]
-  double pwm_frequency = 50.0;  ///< Hz
+  double pwm_frequency = 300.0;  ///< Hz (3 periods per 0.01 s sample: no aliased ripple)
 
   // [mechanics] (position mode)
   double mass = 1.0;                            ///< kg, piston + rod + load
@@ -150,7 +150,7 @@ struct IpaParameters {
   double position_noise = 1.0e-5;      ///< m, standard deviation (position mode)
   int adc_bits = 16;                   ///< ADC resolution; 0 disables quantization
   double adc_range = 10.0;             ///< V, bipolar input range +-adc_range
-  int transport_delay_samples = 1;     ///< sample periods between reading and output
+  int transport_delay_samples = 0;     ///< sample periods between reading and output
   double force_offset = 0.0;           ///< N added to the force output
 
   // [simulation]

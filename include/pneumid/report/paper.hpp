@@ -7,6 +7,8 @@
 //      duty 0.61 % held, stepped to 82 % at `step_time`, force recorded at Ts;
 //   2. FOPDT by the reaction curve [1, Eq. 2], PTn (n = 2) by the tangent-line
 //      method [1, Eq. 3], ARX(3,3,1) [1, Eq. 4-5] and its zoh d2c form [1, Eq. 6];
+//   2b. a PRBS experiment on the twin and ARX(3,3,1) from it, next to Eq. 5
+//      (static gain, poles, whether a zoh continuous equivalent exists);
 //   3. the paper's own ARX model (Eq. 5): static gain, discrete poles, d2c
 //      (Eq. 6), continuous poles, 63.2 % time and Ziegler-Nichols tangent of
 //      its unit step;
@@ -50,6 +52,13 @@ struct PaperOptions {
   double u_final = 82.0;       ///< %, duty after the step (paper)
   std::uint64_t seed = 1;      ///< sensor-noise seed of the simulator
   std::string ipa_config;      ///< TOML file with IPA parameters (empty = defaults)
+  /// The twin's PRBS experiment (section 2: ARX(3,3,1) from rich data next to
+  /// Eq. 5), signal spec of plant/signal.hpp and its length in s; an empty
+  /// spec skips it. The ARX is estimated after `prbs_skip` s, with the means
+  /// removed (the model has no offset term).
+  std::string prbs = "prbs:low=0.61,high=82,order=8,clock=0.05";
+  double prbs_duration = 60.0;
+  double prbs_skip = 2.0;
   double loop_duration = 6.0;  ///< s, Figure 6 run
   /// Figure 6 set-point levels (N), each held `loop_dwell` s.
   std::vector<double> loop_levels = {0.0, 100.0, 60.0, 60.0};
@@ -78,6 +87,7 @@ struct PaperResult {
   std::vector<std::string> problems;
   std::vector<PaperRow> rows;
   Dataset step_test;
+  Dataset prbs_test;  ///< the twin's PRBS experiment (empty when skipped)
   std::vector<IdentifiedModel> models;    ///< reaction-curve, ptn, arx (those that succeeded)
   std::vector<Figure> figures;            ///< Figure 4, 5, 6 (those that could be drawn)
   std::vector<std::string> figure_names;  ///< "fig4", "fig5", "fig6"
