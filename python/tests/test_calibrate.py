@@ -132,8 +132,8 @@ def test_unknown_parameter_name_raises(rig):
 
 def test_bad_input_raises_with_the_library_message(rig):
     prbs = rig["prbs"]
-    with pytest.raises(ValueError, match=r"start value of 'cylinder.bore', 0.017 m, is outside"):
-        pneumid.calibrate([prbs], free=["bore"], bounds={"bore": (0.02, 0.03)})
+    with pytest.raises(ValueError, match=r"start value of 'cylinder.bore', 0.020248 m, is outside"):
+        pneumid.calibrate([prbs], free=["bore"], bounds={"bore": (0.03, 0.04)})
     with pytest.raises(ValueError, match="not a physical parameter"):
         pneumid.calibrate([prbs], free=["simulation.relative_tolerance"])
     with pytest.raises(ValueError, match="named twice"):

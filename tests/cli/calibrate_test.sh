@@ -8,15 +8,15 @@ source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 check_help calibrate DATA --validation --plant-config --free --bound --initial-state \
   --max-iterations --threads --output --plot --json
 
-# A perturbed actuator: bore 0.017 -> 0.0178 m (+4.7 %), inlet and exhaust
-# conductance +7.5 % and -6.25 %. Its experiments carry the simulator's
+# A perturbed actuator: bore 0.020248 -> 0.0212 m (+4.7 %), inlet and exhaust
+# conductance +7.6 % and -6.25 %. Its experiments carry the simulator's
 # sensor noise and ADC quantization.
 cat >"$TMP/perturbed.toml" <<'TOML'
 [cylinder]
-bore = 0.0178
+bore = 0.0212
 [valves]
-inlet_conductance = 0.086e-8
-exhaust_conductance = 0.225e-8
+inlet_conductance = 0.14e-8
+exhaust_conductance = 0.4527e-8
 TOML
 "$PNEUMID" simulate --plant ipa --plant-config "$TMP/perturbed.toml" --Ts 0.01 --seed 5 \
   --input prbs:low=10,high=90,order=7,clock=0.05,at=0.5 --duration 4 -o "$TMP/prbs.csv" \
@@ -37,10 +37,10 @@ check_json "default free parameters" "sorted(j['parameters']) == sorted(['cylind
 'valves.inlet_conductance', 'valves.exhaust_conductance', 'valves.inlet_critical_ratio', \
 'valves.exhaust_critical_ratio', 'valves.open_delay'])" "$TMP/calibrate.json"
 check_json "bore within 5 %" \
-  "abs(j['parameters']['cylinder.bore']['value'] / 0.0178 - 1) < 0.05" "$TMP/calibrate.json"
+  "abs(j['parameters']['cylinder.bore']['value'] / 0.0212 - 1) < 0.05" "$TMP/calibrate.json"
 check_json "conductances within 5 %" \
-  "abs(j['parameters']['valves.inlet_conductance']['value'] / 0.086e-8 - 1) < 0.05 and \
-abs(j['parameters']['valves.exhaust_conductance']['value'] / 0.225e-8 - 1) < 0.05" \
+  "abs(j['parameters']['valves.inlet_conductance']['value'] / 0.14e-8 - 1) < 0.05 and \
+abs(j['parameters']['valves.exhaust_conductance']['value'] / 0.4527e-8 - 1) < 0.05" \
   "$TMP/calibrate.json"
 check_json "parameter fields" "all({'value', 'std', 'unit', 'determined'} <= set(p) \
 for p in j['parameters'].values()) and j['parameters']['cylinder.bore']['unit'] == 'm'" \
@@ -58,8 +58,8 @@ grep -q "^# IPA parameters calibrated by \`pneumid calibrate\`" "$TMP/twin.toml"
 
 expect_ok "simulate with the twin" simulate --plant "ipa:config=$TMP/twin.toml" \
   --input step:from=0.61,to=82,at=0.5 --duration 1 --Ts 0.01 -o "$TMP/twin_step.csv"
-# The simulator names the twin's bore in mm: near 17.8, away from the built-in 17.
-grep -o "bore [0-9.]* mm" "$TMP/out" | awk '{ exit !($2 > 17.4 && $2 < 18.2) }' \
+# The simulator names the twin's bore in mm: near 21.2, away from the built-in 20.248.
+grep -o "bore [0-9.]* mm" "$TMP/out" | awk '{ exit !($2 > 20.9 && $2 < 21.5) }' \
   || fail "simulate does not use the twin's bore: $(head -1 "$TMP/out")"
 [ "$(data_rows "$TMP/twin_step.csv")" -eq 101 ] || fail "twin simulation: expected 101 rows"
 expect_ok "twin as --plant-config" simulate --plant ipa --plant-config "$TMP/twin.toml" \
@@ -80,8 +80,8 @@ check_output "text: experiment" "prbs.csv"
 expect_error "unknown parameter" "unknown IPA parameter 'nosuch'" \
   calibrate "$TMP/prbs.csv" --free bore,nosuch
 expect_error "bounds exclude the start" \
-  "the start value of 'cylinder.bore', 0.017 m, is outside its bounds 0.02 .. 0.03" \
-  calibrate "$TMP/prbs.csv" --free bore --bound bore=0.02:0.03
+  "the start value of 'cylinder.bore', 0.020248 m, is outside its bounds 0.03 .. 0.04" \
+  calibrate "$TMP/prbs.csv" --free bore --bound bore=0.03:0.04
 expect_error "empty bounds" "lower < upper" \
   calibrate "$TMP/prbs.csv" --free bore --bound bore=0.03:0.02
 expect_error "malformed bound" "expected NAME=LOWER:UPPER" \

@@ -35,7 +35,17 @@ TEST(IpaReferenceTest, AveragedForceModeMatchesScipy) {
         {2.0, 670979.575766}}},
   };
   for (const Reference& ref : references) {
+    // The parameters of gen_ipa_reference.py (config/ipa_slow_valves.toml).
     IpaParameters p;
+    p.bore = 0.017;
+    p.dead_volume_a = 18.1e-6;
+    p.inlet_conductance = 0.08e-8;
+    p.exhaust_conductance = 0.24e-8;
+    p.inlet_critical_ratio = p.exhaust_critical_ratio = 0.3;
+    p.open_delay = 0.002;
+    p.close_delay = 0.001;
+    p.min_pulse_width = 0.002;
+    p.pwm_frequency = 50.0;
     p.pwm_mode = PwmMode::kAveraged;
     p.pressure_noise = 0.0;
     IpaSimulator sim(p, 0.001);

@@ -194,6 +194,7 @@ TEST(IpaSimulatorTest, SeedsReproduceRuns) {
 TEST(IpaSimulatorTest, SensorQuantizesLikeA16BitAdcAndDelaysOneSample) {
   IpaParameters p = Quiet();
   p.adc_bits = 16;
+  p.transport_delay_samples = 1;
   IpaSimulator sim(p, 0.01);
   // One code of a +-10 V 16-bit ADC is 20/65536 V, with 10 V = 1 MPa: 30.52 Pa.
   const double lsb_force = p.AreaA() * 20.0 / 65536.0 / 10.0 * 1.0e6;
@@ -206,6 +207,37 @@ TEST(IpaSimulatorTest, SensorQuantizesLikeA16BitAdcAndDelaysOneSample) {
     previous_true = sim.force();
   }
   EXPECT_GT(previous_true, 50.0);
+  // Without transport delay (the default twin) the sample shows the state now.
+  p.transport_delay_samples = 0;
+  IpaSimulator now(p, 0.01);
+  for (int k = 0; k < 30; ++k) {
+    now.Advance(70.0);
+    EXPECT_NEAR(now.Measure(), now.force(), 0.5 * lsb_force + 1e-9);
+  }
+}
+
+TEST(IpaSimulatorTest, PressureFilterLagsTheSensedForceByItsTimeConstant) {
+  // First-order sensor: after a pressure step the sensed force approaches the
+  // true one as 1 - exp(-t/tf); with the chamber held (valves closed) the
+  // gap decays exactly so.
+  IpaParameters p = Quiet();
+  p.pressure_filter_time_constant = 0.02;
+  IpaSimulator sim(p, 0.001);
+  sim.SetState(p.atmospheric_pressure + 3e5, sim.pressure_b(), sim.position());
+  EXPECT_NEAR(sim.Measure(), p.AreaA() * 3e5, 1e-9);  // SetState starts the filter there
+  // Fill with the inlet open: the sensed force lags the true one.
+  IpaSimulator fill(p, 0.001);
+  for (int k = 0; k < 20; ++k) fill.AdvanceValves(true, false);
+  const double gap0 = fill.force() - fill.Measure();
+  EXPECT_GT(gap0, 1.0);
+  // Valves closed (the true pressure holds): the gap decays as exp(-t/tf). The
+  // closing delay (1.46 ms) lets gas in for a moment: start after it.
+  for (int k = 0; k < 5; ++k) fill.AdvanceValves(false, false);
+  const double held = fill.force();
+  const double gap1 = held - fill.Measure();
+  for (int k = 0; k < 20; ++k) fill.AdvanceValves(false, false);
+  EXPECT_NEAR(fill.force(), held, 1e-9 * held);
+  EXPECT_NEAR(held - fill.Measure(), gap1 * std::exp(-0.02 / 0.02), 1e-4 * gap1);
 }
 
 TEST(IpaSimulatorTest, PositionModeDrivesThePistonToTheEndStops) {
@@ -222,7 +254,7 @@ TEST(IpaSimulatorTest, PositionModeDrivesThePistonToTheEndStops) {
 
 TEST(IpaSimulatorTest, RejectsBadParametersAndInputs) {
   IpaParameters p;
-  p.rod = 0.02;
+  p.rod = p.bore + 0.001;
   std::string error;
   EXPECT_FALSE(p.IsValid(&error));
   EXPECT_THAT(error, HasSubstr("cylinder.rod"));
