@@ -29,6 +29,20 @@ void PutStepResponse(const M& m, nlohmann::ordered_json& j) {
   j["settling_time"] = Number(m.settling_time);
   j["steady_state_error"] = Number(m.steady_state_error);
   j["first_move"] = Number(m.first_move);
+  j["settling_band"] = Number(m.settling_band);
+  j["settled"] = m.settled;
+}
+
+// Ripple/noise band of y over [begin, end): the largest peak-to-peak range
+// max - min of 4 consecutive samples (see closed_loop.hpp); NaN for fewer than 4.
+double RippleHalfBand(const Eigen::VectorXd& y, Eigen::Index begin, Eigen::Index end) {
+  if (end - begin < 4) return kNaN;
+  double worst = 0.0;
+  for (Eigen::Index k = begin; k + 4 <= end; ++k) {
+    const auto w = y.segment(k, 4);
+    worst = std::max(worst, w.maxCoeff() - w.minCoeff());
+  }
+  return worst;
 }
 }  // namespace
 
@@ -38,6 +52,7 @@ nlohmann::ordered_json StepMetrics::ToJson() const {
   j["from"] = from;
   j["to"] = to;
   PutStepResponse(*this, j);
+  j["ripple"] = Number(ripple);
   return j;
 }
 
@@ -125,9 +140,16 @@ ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen
     s.to = r(k0);
     s.first_move = u(k0) - (k0 > 0 ? u(k0 - 1) : u_before);
     s.steady_state_error = segment_error(k0, k1);
+    const double step = std::abs(s.to - s.from);
+    const Eigen::Index tail = std::max<Eigen::Index>((k1 - k0) / 4, 8);
+    if (k1 - k0 >= 2 * tail) s.ripple = RippleHalfBand(y, k1 - tail, k1);
+    s.settling_band = std::max(options.settling_threshold * step,
+                               std::isfinite(s.ripple) ? s.ripple : 0.0);
     if (k1 - k0 >= 3) {
       StepInfoOptions o;
-      o.settling_threshold = options.settling_threshold;
+      // The band as a fraction of the step (a ripple wider than the step
+      // leaves no meaningful settling: the fraction is capped below 1).
+      o.settling_threshold = std::min(s.settling_band / step, 0.99);
       o.y_initial = s.from;
       o.y_final = s.to;
       const Eigen::VectorXd ts = t.segment(k0, k1 - k0).array() - t(k0);
@@ -136,9 +158,14 @@ ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen
       s.rise_time = info.rise_time;
       s.overshoot_percent = info.overshoot;
       s.settling_time = info.settling_time;
-      // A response still outside the band at the end of the window has not settled.
-      if (std::abs(ys(ys.size() - 1) - s.to) > options.settling_threshold * std::abs(s.to - s.from))
+      // A response still outside the band at the end of the window, or one that
+      // entered it only in the last 10 % of the window (at least 5 samples),
+      // has not been seen to settle.
+      const Eigen::Index hold = std::max<Eigen::Index>(5, (k1 - k0) / 10);
+      if (std::abs(ys(ys.size() - 1) - s.to) > o.settling_threshold * step ||
+          !(s.settling_time <= ts(std::max<Eigen::Index>(0, ys.size() - 1 - hold))))
         s.settling_time = kNaN;
+      s.settled = std::isfinite(s.settling_time);
     }
     m.steps.push_back(s);
   }
@@ -147,6 +174,8 @@ ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen
     m.overshoot_percent = m.steps[0].overshoot_percent;
     m.settling_time = m.steps[0].settling_time;
     m.first_move = m.steps[0].first_move;
+    m.settling_band = m.steps[0].settling_band;
+    m.settled = m.steps[0].settled;
   }
   const Eigen::Index last_begin = changes.empty() ? 0 : changes.back();
   m.steady_state_error = segment_error(last_begin, n);

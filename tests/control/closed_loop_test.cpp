@@ -105,7 +105,8 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
   std::vector<std::string> keys;
   for (const auto& [key, value] : j.items()) keys.push_back(key);
   EXPECT_THAT(keys, ::testing::ElementsAre("rise_time", "overshoot_percent", "settling_time",
-                                           "steady_state_error", "first_move", "iae", "ise",
+                                           "steady_state_error", "first_move", "settling_band",
+                                           "settled", "iae", "ise",
                                            "itae", "tv_u", "u_min", "u_max", "load_peak_deviation",
                                            "load_recovery_time", "steps"));
   EXPECT_EQ(j["rise_time"], 0.1);
@@ -116,9 +117,48 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
   keys.clear();
   for (const auto& [key, value] : j["steps"][0].items()) keys.push_back(key);
   EXPECT_THAT(keys, ::testing::ElementsAre("time", "from", "to", "rise_time", "overshoot_percent",
-                                           "settling_time", "steady_state_error", "first_move"));
+                                           "settling_time", "steady_state_error", "first_move",
+                                           "settling_band", "settled", "ripple"));
   EXPECT_EQ(j["steps"][0]["settling_time"], 0.3);
   EXPECT_TRUE(j["steps"][0]["first_move"].is_null());
+}
+
+// Settling against a band of max(2 % of the step, the measured ripple): a
+// response with a +-3 N alternating ripple (6 N peak to peak, wider than 2 % of
+// a 100 N step) settles, with the band widened to the ripple; a slow +-10 N
+// oscillation does not (4 consecutive samples see little of it, the band
+// stays 2 N).
+TEST(ClosedLoopMetricsTest, SettlingBandWidensToTheMeasuredRippleOnly) {
+  const int n = 400;
+  const double Ts = 0.01;
+  Eigen::VectorXd t(n), r(n), u = Eigen::VectorXd::Zero(n), ripple(n), slow(n);
+  for (int k = 0; k < n; ++k) {
+    t[k] = k * Ts;
+    r[k] = 100.0;
+    const double approach = 100.0 * (1.0 - std::exp(-t[k] / 0.1));
+    ripple[k] = approach + (k % 2 == 0 ? 3.0 : -3.0);
+    slow[k] = approach + 10.0 * std::sin(2.0 * M_PI * t[k] / 0.8);
+  }
+  ClosedLoopOptions o;
+  o.duration = n * Ts;
+  const ClosedLoopMetrics a = ComputeClosedLoopMetrics(t, r, ripple, u, 0.0, 0.0, o);
+  ASSERT_EQ(a.steps.size(), 1u);
+  EXPECT_NEAR(a.steps[0].ripple, 6.0, 0.01);  // the approach adds < 0.01 N in the tail
+  EXPECT_NEAR(a.settling_band, a.steps[0].ripple, 1e-12);
+  EXPECT_TRUE(a.settled);
+  // |y - r| = 100 exp(-t/0.1) + 3 <= 6 from t = 0.1 ln(100/3) = 0.351 s on.
+  EXPECT_NEAR(a.settling_time, 0.1 * std::log(100.0 / 3.0), 0.011);
+  const ClosedLoopMetrics b = ComputeClosedLoopMetrics(t, r, slow, u, 0.0, 0.0, o);
+  EXPECT_LT(b.settling_band, 2.5);  // 4 samples see 20 sin(3 pi / 160) = 1.2 N of it
+  EXPECT_FALSE(b.settled);
+  EXPECT_TRUE(std::isnan(b.settling_time));
+  // Without ripple the band is 2 % of the step.
+  Eigen::VectorXd clean(n);
+  for (int k = 0; k < n; ++k) clean[k] = 100.0 * (1.0 - std::exp(-t[k] / 0.1));
+  const ClosedLoopMetrics c = ComputeClosedLoopMetrics(t, r, clean, u, 0.0, 0.0, o);
+  EXPECT_NEAR(c.settling_band, 2.0, 1e-9);
+  EXPECT_TRUE(c.settled);
+  EXPECT_NEAR(c.settling_time, 0.1 * std::log(50.0), 0.01);
 }
 
 }  // namespace

@@ -12,11 +12,22 @@
 // operating point the run starts from.
 //
 // Metrics (errors e = r - y use the plant output without the added noise):
-//   rise_time, overshoot_percent, settling_time (2 %): of the response to the
+//   rise_time, overshoot_percent, settling_time: of the response to the
 //     first set-point change, over the samples until the next change
 //     (ComputeStepInfo of lti/response.hpp with y_initial = the previous
 //     set-point, y_final = the new one; times from the change), NaN when the
 //     set-point never changes or the response never settles in the window;
+//   settling_band: the half-width of the band |y - r| <= band the settling
+//     time refers to, max(settling_threshold |step|, ripple), where the ripple
+//     is the measured ripple/noise band of the segment's last quarter (at
+//     least 8 samples): the largest peak-to-peak range max - min of 4
+//     consecutive samples there (so a ripple centred up to half its
+//     peak-to-peak off the set-point still counts as settled). A PWM ripple or
+//     noise wider than 2 % of the step thus widens the band instead of hiding
+//     a settled response; a slow oscillation does not (4 samples see little of
+//     it). settled: the output entered the band before the last 10 % of the
+//     segment (at least 5 samples) and stayed in it; otherwise the settling
+//     time is NaN;
 //   steady_state_error: r - y averaged over the last 5 % (at least 1, at most
 //     50 samples) of the final set-point segment;
 //   iae = sum |e| Ts, ise = sum e^2 Ts, itae = sum t |e| Ts;
@@ -72,9 +83,13 @@ struct StepMetrics {
   double settling_time = std::numeric_limits<double>::quiet_NaN();
   double steady_state_error = std::numeric_limits<double>::quiet_NaN();  ///< end of the segment
   double first_move = std::numeric_limits<double>::quiet_NaN();
+  double settling_band = std::numeric_limits<double>::quiet_NaN();  ///< output units (see above)
+  double ripple = std::numeric_limits<double>::quiet_NaN();  ///< measured ripple peak-to-peak
+  bool settled = false;
 
   /// {time, from, to, rise_time, overshoot_percent, settling_time,
-  /// steady_state_error, first_move}; NaN is written as null.
+  /// steady_state_error, first_move, settling_band, settled, ripple}; NaN is
+  /// written as null.
   nlohmann::ordered_json ToJson() const;
 };
 
@@ -84,6 +99,8 @@ struct ClosedLoopMetrics {
   double settling_time = std::numeric_limits<double>::quiet_NaN();
   double steady_state_error = std::numeric_limits<double>::quiet_NaN();
   double first_move = std::numeric_limits<double>::quiet_NaN();
+  double settling_band = std::numeric_limits<double>::quiet_NaN();  ///< of the first step
+  bool settled = false;                                             ///< the first step settled
   double iae = 0.0, ise = 0.0, itae = 0.0;
   double tv_u = 0.0;
   double u_min = 0.0, u_max = 0.0;
@@ -93,7 +110,7 @@ struct ClosedLoopMetrics {
 
   /// The metrics of `pneumid control --json` and `pneumid run --json`:
   /// rise_time, overshoot_percent, settling_time, steady_state_error,
-  /// first_move, iae, ise, itae, tv_u, u_min, u_max, load_peak_deviation,
+  /// first_move, settling_band, settled, iae, ise, itae, tv_u, u_min, u_max, load_peak_deviation,
   /// load_recovery_time and steps (StepMetrics::ToJson); NaN (a quantity that
   /// does not exist in the run) is written as null.
   nlohmann::ordered_json ToJson() const;
