@@ -10,6 +10,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/response.hpp"
+#include "pneumid/plant/actuator.hpp"
 
 namespace pneumid {
 
@@ -235,11 +236,22 @@ ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const 
   res.y.resize(n);
   res.y_meas.resize(n);
   res.u.resize(n);
+  res.u_requested.resize(n);
   res.d.resize(n);
   if (options.time_updates) res.update_seconds.resize(n);
   for (Eigen::Index k = 0; k < n; ++k) res.r(k) = setpoint(res.t(k));
   const double r_before = setpoint(-Ts);
 
+  // The actuator: the options' limits, within the plant's physical input range.
+  InputLimits actuator = options.actuator;
+  if (options.plant_range) {
+    const Actuator a = PlantActuator(plant);
+    actuator.u_min = std::max(actuator.u_min, a.u_min);
+    actuator.u_max = std::min(actuator.u_max, a.u_max);
+    PNEUMID_CHECK(actuator.u_min <= actuator.u_max,
+                  "the actuator limits {} .. {} do not overlap the plant's input range {} .. {}",
+                  options.actuator.u_min, options.actuator.u_max, a.u_min, a.u_max);
+  }
   plant.Reset();
   plant.SetLoadDisturbance(0.0);
   std::mt19937_64 rng(options.seed);
@@ -263,9 +275,11 @@ ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const 
     } else {
       u = controller.Update(res.r(k), ym);
     }
-    u = std::clamp(u, options.actuator.u_min, options.actuator.u_max);
-    if (std::isfinite(options.actuator.du_max))
-      u = std::clamp(u, u_prev - options.actuator.du_max, u_prev + options.actuator.du_max);
+    res.u_requested(k) = u;
+    u = std::clamp(u, actuator.u_min, actuator.u_max);
+    if (std::isfinite(actuator.du_max))
+      u = std::clamp(u, u_prev - actuator.du_max, u_prev + actuator.du_max);
+    if (u != res.u_requested(k)) controller.Applied(u);
     plant.Advance(u);
     res.y(k) = y;
     res.y_meas(k) = ym;

@@ -205,6 +205,18 @@ double DmcController::Update(double setpoint, double measurement) {
   return u;
 }
 
+void DmcController::Applied(double u) {
+  const double delta = u - u_prev_;
+  if (delta == 0.0 || !std::isfinite(delta)) return;
+  // The prediction was shifted with the move du; it should have been du + delta.
+  double* y = yhat_.data();
+  const double* s = step_.data();
+  for (int i = 0; i < N_; ++i) y[i] += s[i + 1] * delta;
+  y[N_] += s[N_] * delta;
+  u_prev_ = u;
+  last_du_ += delta;
+}
+
 std::string DmcController::Describe() const {
   return fmt::format("dmc P={} M={} lambda={:g} N={}{}", options_.P, options_.M, options_.lambda,
                      N_, options_.constrained ? " constrained" : "");

@@ -193,6 +193,15 @@ double GpcController::Update(double setpoint, double measurement) {
   return u;
 }
 
+void GpcController::Applied(double u) {
+  const double delta = u - u_prev_;
+  if (delta == 0.0 || !std::isfinite(delta)) return;
+  // Delta u_f(t) is linear in Delta u(t): the correction adds delta to it.
+  duf_hist_(0) += delta;
+  u_prev_ = u;
+  last_du_ += delta;
+}
+
 std::string GpcController::Describe() const {
   return fmt::format("gpc N1={} N2={} Nu={} lambda={:g} T={}", options_.N1, options_.N2,
                      options_.Nu, options_.lambda,

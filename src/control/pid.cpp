@@ -115,6 +115,15 @@ double PidController::Update(double setpoint, double measurement) {
   return u;
 }
 
+void PidController::Applied(double u) {
+  const double delta = u - u_prev_;
+  if (delta == 0.0 || !std::isfinite(delta)) return;
+  // Back-calculation as for the controller's own limits: the integral
+  // follows the input the actuator applied.
+  if (std::isfinite(options_.gains.Ti) && Tt_ > 0.0) integral_ += Ts_ / Tt_ * delta;
+  u_prev_ = u;
+}
+
 std::string PidController::Describe() const {
   return fmt::format("pid Kc={:.4g} Ti={:.4g} Td={:.4g}", options_.gains.Kc, options_.gains.Ti,
                      options_.gains.Td);

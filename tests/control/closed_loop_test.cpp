@@ -9,6 +9,9 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/dmc.hpp"
+#include "pneumid/control/gpc.hpp"
+#include "pneumid/control/pid.hpp"
+#include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
@@ -121,6 +124,56 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
                                            "settling_band", "settled", "ripple"));
   EXPECT_EQ(j["steps"][0]["settling_time"], 0.3);
   EXPECT_TRUE(j["steps"][0]["first_move"].is_null());
+}
+
+// The plant's input range applies by default, and a controller clipped by it
+// behaves exactly as one given the same limits itself: Applied() makes its
+// internal state (DMC prediction, GPC filtered moves, PID integral) follow the
+// applied input. The requested input is kept beside the applied one.
+TEST(ClosedLoopTest, PlantRangeAppliesByDefaultWithoutWindup) {
+  const double Ts = 0.01;
+  const TransferFunction model = TransferFunction::Fopdt(1.6, 0.245, 0.001);
+  const auto sp = ParseSignal("staircase:levels=20 130 40,dwell=1.5");
+  ClosedLoopOptions o;
+  o.duration = 4.5;
+  InputLimits duty;
+  duty.u_min = 0.0;
+  duty.u_max = 100.0;
+  auto run = [&](Controller& c) {
+    IpaSimulator ipa(IpaParameters{}, Ts, 1);
+    return SimulateClosedLoop(c, ipa, *sp, o);
+  };
+  for (const std::string kind : {"dmc", "gpc", "pid"}) {
+    std::unique_ptr<Controller> free, limited;
+    if (kind == "dmc") {
+      DmcOptions d;
+      free = std::make_unique<DmcController>(model, Ts, d);
+      d.limits = duty;
+      limited = std::make_unique<DmcController>(model, Ts, d);
+    } else if (kind == "gpc") {
+      GpcOptions g;
+      free = std::make_unique<GpcController>(model, Ts, g);
+      g.limits = duty;
+      limited = std::make_unique<GpcController>(model, Ts, g);
+    } else {
+      PidOptions p;
+      p.gains = {2.0, 0.25, 0.0};
+      free = std::make_unique<PidController>(Ts, p);
+      p.limits = duty;
+      limited = std::make_unique<PidController>(Ts, p);
+    }
+    const ClosedLoopResult a = run(*free);
+    const ClosedLoopResult b = run(*limited);
+    EXPECT_GE(a.u.minCoeff(), 0.0) << kind;
+    EXPECT_LE(a.u.maxCoeff(), 100.0) << kind;
+    EXPECT_GT(a.u_requested.maxCoeff(), 100.0) << kind << ": the 130 N step asks for more";
+    EXPECT_LT((a.u - b.u).cwiseAbs().maxCoeff(), 1e-9) << kind;
+    EXPECT_LT((a.y - b.y).cwiseAbs().maxCoeff(), 1e-9) << kind;
+  }
+  // Without the plant range the request is applied as it is.
+  o.plant_range = false;
+  DmcController unlimited(model, Ts, DmcOptions{});
+  EXPECT_GT(run(unlimited).u.maxCoeff(), 100.0);
 }
 
 // Settling against a band of max(2 % of the step, the measured ripple): a

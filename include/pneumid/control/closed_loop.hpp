@@ -6,7 +6,8 @@
 // Loop at sample k = 0 .. n-1 (t_k = k Ts, n = round(duration / Ts)):
 //   d_k applied with plant.SetLoadDisturbance (sum of the load steps with at <= t_k)
 //   y_k = plant.Measure();  y_meas = y_k + v_k   (v Gaussian, std noise_std)
-//   u_k = actuator.Clip(controller.Update(r_k, y_meas))
+//   u_k = actuator.Clip(controller.Update(r_k, y_meas))   (options.actuator within
+//         the plant's input range; controller.Applied(u_k) when clipped)
 //   plant.Advance(u_k)
 // The controller is Reset(u0, y_0) first, with r_{-1} = setpoint(-Ts) the
 // operating point the run starts from.
@@ -66,6 +67,11 @@ struct ClosedLoopOptions {
   std::uint64_t seed = 1;  ///< noise seed
   /// Actuator limits applied after the controller (infinite = none).
   InputLimits actuator;
+  /// Also limit the input to the plant's physical range (PlantActuator of
+  /// plant/actuator.hpp: the IPA's duty 0..100 %; linear plants are
+  /// unbounded), the default. The controller is told the applied input
+  /// (Controller::Applied) whenever a limit changed it.
+  bool plant_range = true;
   double u0 = 0.0;  ///< input before t = 0
   /// Settling band as a fraction of the step (and rise 10-90 %).
   double settling_threshold = 0.02;
@@ -122,6 +128,7 @@ struct ClosedLoopResult {
   Eigen::VectorXd y;               ///< plant output (Measure())
   Eigen::VectorXd y_meas;          ///< what the controller saw (y + noise)
   Eigen::VectorXd u;               ///< applied input
+  Eigen::VectorXd u_requested;     ///< the controller's input before the actuator limits
   Eigen::VectorXd d;               ///< load disturbance
   Eigen::VectorXd update_seconds;  ///< per Update() (empty unless time_updates)
   ClosedLoopMetrics metrics;

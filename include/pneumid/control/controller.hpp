@@ -1,4 +1,4 @@
-// Common interface of the feedback controllers (DMC, GPC, PID), so that the
+// Common interface of the feedback controllers (DMC, GPC, PID, MPC), so that the
 // closed-loop evaluation and the real-time loop drive any of them.
 //
 // Protocol per sample k (period Ts), with the plant protocol of plant.hpp:
@@ -12,9 +12,9 @@
 
 namespace pneumid {
 
-enum class ControllerType { kDmc, kGpc, kPid };
+enum class ControllerType { kDmc, kGpc, kPid, kMpc };
 
-/// "dmc", "gpc", "pid".
+/// "dmc", "gpc", "pid", "mpc".
 std::string ToString(ControllerType type);
 /// Inverse of ToString; throws InvalidArgument listing the valid names.
 ControllerType ControllerTypeFromString(const std::string& name);
@@ -42,6 +42,12 @@ class Controller {
   /// sample; returns the input u to hold over the next period (within the
   /// controller's limits). Allocates no memory.
   virtual double Update(double setpoint, double measurement) = 0;
+  /// The input actually applied after the last Update(), when a layer after
+  /// the controller changed it (the plant's input range, a safety layer, a
+  /// saturating actuator). Controllers that remember their past inputs
+  /// (DMC's prediction, GPC's filtered moves, PID's integral) take it as their
+  /// own (anti-windup); the default does nothing. Allocates no memory.
+  virtual void Applied(double /*u*/) {}
   /// Sample period in seconds.
   virtual double Ts() const = 0;
   /// Short description, e.g. "dmc P=126 M=5 lambda=2.25".

@@ -91,6 +91,7 @@ class DmcController : public Controller {
   void Reset(double u0 = 0.0, double y0 = 0.0) override;
   /// One step; constant reference w = setpoint over the horizon.
   double Update(double setpoint, double measurement) override;
+  void Applied(double u) override;
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
 

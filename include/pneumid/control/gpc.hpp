@@ -90,6 +90,7 @@ class GpcController : public Controller {
 
   void Reset(double u0 = 0.0, double y0 = 0.0) override;
   double Update(double setpoint, double measurement) override;
+  void Applied(double u) override;
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
 

@@ -69,6 +69,7 @@ class PidController : public Controller {
 
   void Reset(double u0 = 0.0, double y0 = 0.0) override;
   double Update(double setpoint, double measurement) override;
+  void Applied(double u) override;
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
   const PidOptions& options() const { return options_; }
