@@ -336,9 +336,10 @@ PaperResult RunPaper(const PaperOptions& o) {
         "(Eq. 6)",
         arx->tf.IsContinuous() ? arx->tf.Normalized().ToString(5)
                                : "none: a pole on the negative real axis",
-        by_tustin ? "a discrete pole on the negative real axis (PWM ripple aliased to the "
-                    "Nyquist frequency) has no real logarithm, so no zoh equivalent exists; the "
-                    "bilinear (tustin) map gives the continuous form"
+        by_tustin ? "a discrete pole on the negative real axis (from one step the third pole "
+                    "is ill-determined; with a PWM ripple aliased to the Nyquist frequency it "
+                    "sits near z = -1) has no real logarithm, so no zoh equivalent exists; the "
+                    "bilinear (tustin) map gives the continuous form; the PRBS ARX above has one"
         : arx->tf.IsContinuous()
             ? kSimulatorNote
             : "a discrete pole on the negative real axis has no real "
@@ -373,8 +374,7 @@ PaperResult RunPaper(const PaperOptions& o) {
               "the paper takes tau = t63 and theta = 0.001 s");
     row(S4, "theta", "0.001 s", G(theta, 3) + " s",
         "the paper sets theta just above zero on purpose; pneumid reads the departure from the "
-        "baseline off the data (valve opening delay, PWM period and sensor transport delay of "
-        "the simulator)");
+        "baseline off the data (the twin's valve opening delay and PWM latch)");
   }
   try {
     const TransferFunction arx_ct = D2C(paper_arx, DiscretizationMethod::kZoh);
@@ -404,8 +404,8 @@ PaperResult RunPaper(const PaperOptions& o) {
     row(S5, "td + tTL (s^1)", "0.2387", G(td + tTL, 4),
         Close(td + tTL, 0.2387, 0.04) ? "" : kSimulatorNote);
     row(S5, "(td/2 + tTL) td (s^2)", "2.39e-4", G((td / 2 + tTL) * td, 3),
-        "td is the tangent's delay; the paper's td ~ 0.001 s is near zero, the simulator's "
-        "valve and sensor delays make it larger");
+        "td is the tangent's delay, near zero for the paper (~0.001 s) and the twin alike; the "
+        "product is dominated by tTL");
     row(S5, "td, tTL", "~0.001 s, ~0.2377 s", G(td, 3) + " s, " + G(tTL, 4) + " s", kSimulatorNote);
   }
   row(S5, "s^3 coefficient", "(td/6 + tTL/2) td", "(td/6 + tTL/2) td^2",
