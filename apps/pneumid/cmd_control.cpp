@@ -145,7 +145,7 @@ void WriteCsv(const std::string& path, const std::vector<Run>& runs) {
   if (!out) throw DataError(fmt::format("{}: write failed", path));
 }
 
-// "DMC", "GPC", "PID".
+// "DMC", "GPC", "PID", "MPC".
 std::string TypeName(ControllerType type) {
   std::string name = ToString(type);
   for (char& ch : name) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));

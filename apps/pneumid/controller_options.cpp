@@ -6,7 +6,9 @@ namespace pneumid::cli {
 
 void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
   // Names are checked by the control area (the message lists the valid ones).
-  app.add_option("--controller", s.controller, "dmc, gpc or pid")->capture_default_str();
+  app.add_option("--controller", s.controller,
+                 "dmc, gpc, pid or mpc (state-space MPC with a Kalman filter and an "
+                 "integrating output disturbance; a QP when a limit is set)")->capture_default_str();
   app.add_option("--rule", s.rule,
                  "Tuning rule: shridhar-cooper (conventional), paper-modified, explicit "
                  "(default: shridhar-cooper, or explicit when --P --M --lambda are all given)");
@@ -15,7 +17,7 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
   app.add_option("--lambda", s.lambda, "Move suppression")->check(NonNegative());
   app.add_flag("--constrained", s.constrained,
                "DMC: optimize the moves under the input limits (QDMC, QP solver) instead of "
-               "clipping");
+               "clipping (MPC always does when a limit is set)");
   app.add_option("--pid-rule", s.pid_rule, "PID tuning: simc or imc")->capture_default_str();
 }
 

@@ -15,6 +15,7 @@ constexpr EnumName<ControllerType> kControllerTypeNames[] = {
     {ControllerType::kDmc, "dmc"},
     {ControllerType::kGpc, "gpc"},
     {ControllerType::kPid, "pid"},
+    {ControllerType::kMpc, "mpc"},
 };
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include "pneumid/common/spec.hpp"
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/gpc.hpp"
+#include "pneumid/control/mpc.hpp"
 
 namespace pneumid {
 
@@ -105,7 +106,8 @@ BuiltController MakeController(const PredictionModel& model, const ControllerSpe
     }
     case ControllerType::kGpc: {
       PNEUMID_CHECK(!spec.constrained,
-                    "the constrained form is implemented for dmc (QDMC); gpc clips its input");
+                    "the constrained form is implemented for dmc (QDMC) and mpc; gpc clips its "
+                    "input");
       b.tuning = Tune(model, spec.tuning);
       GpcOptions o;
       o.N1 = 1;
@@ -121,6 +123,18 @@ BuiltController MakeController(const PredictionModel& model, const ControllerSpe
         o.t_polynomial = Eigen::Map<const Eigen::VectorXd>(coef.data(), coef.size());
       }
       b.controller = std::make_unique<GpcController>(model, o);
+      break;
+    }
+    case ControllerType::kMpc: {
+      b.tuning = Tune(model, spec.tuning);
+      MpcOptions o;
+      o.P = b.tuning.P;
+      o.M = b.tuning.M;
+      o.lambda = b.tuning.lambda;
+      o.limits = spec.limits;
+      o.y_min = spec.y_min;
+      o.y_max = spec.y_max;
+      b.controller = std::make_unique<MpcController>(model.model(), model.Ts(), o);
       break;
     }
     case ControllerType::kPid:

@@ -138,4 +138,7 @@ grep -q '^# safety: u in \[0, 100\], .*safe state hold$' "$TMP/hold.csv" ||
 grep -q '"controller": "dmc P=50 M=4 lambda=1.5' "$TMP/x.json" || fail "run explicit: $(grep controller "$TMP/x.json")"
 "$PNEUMID" run --fast --duration 0.2 --P 50 --json > "$TMP/y.json" || fail "run override"
 grep -q '"controller": "dmc P=50 M=5 lambda=' "$TMP/y.json" || fail "run override: $(grep controller "$TMP/y.json")"
+"$PNEUMID" run --controller mpc --fast --duration 0.2 --json > "$TMP/m.json" || fail "run mpc"
+grep -q '"controller": "mpc P=126 M=5 lambda=.* disturbance=output' "$TMP/m.json" ||
+  fail "run mpc: $(grep controller "$TMP/m.json")"
 finish

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -53,13 +54,36 @@ TEST(ControllerSettingsTest, ToSpecParsesNamesAndKeepsOverrides) {
   EXPECT_EQ(spec.t_filter, "A");
   EXPECT_EQ(spec.pid_rule, PidTuningRule::kImc);
 
-  s.controller = "mpc";
+  s.controller = "lqg";
   EXPECT_THAT([&] { ToControllerSpec(s); },
-              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("'mpc'")));
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("'lqg'")));
   s.controller = "pid";
   s.pid_rule = "zn";
   EXPECT_THAT([&] { ToControllerSpec(s); },
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("'zn'")));
+}
+
+TEST(ControllerSettingsTest, MpcTakesHorizonsFromTheRuleAndLimits) {
+  ControllerSettings s;
+  s.controller = "mpc";
+  s.rule = "shridhar-cooper";
+  s.limits.u_min = 0.0;
+  s.limits.u_max = 100.0;
+  const ControllerSpec spec = ToControllerSpec(s);
+  EXPECT_EQ(spec.type, ControllerType::kMpc);
+  const BuiltController b = MakeController(PaperFopdtModel(), kTs, spec);
+  // The same P, M, lambda as the DMC the rule designs (tuning_test: 126, 5, 2.25).
+  EXPECT_EQ(b.tuning.P, 126);
+  EXPECT_EQ(b.tuning.M, 5);
+  EXPECT_EQ(b.controller->Describe(),
+            fmt::format("mpc P=126 M=5 lambda={:g} disturbance=output constrained",
+                        b.tuning.lambda));
+  EXPECT_EQ(b.Label(), "shridhar-cooper");
+  EXPECT_EQ(ToString(ControllerType::kMpc), "mpc");
+  EXPECT_EQ(ControllerTypeFromString("mpc"), ControllerType::kMpc);
+  s.limits = InputLimits{};
+  const BuiltController u = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  EXPECT_THAT(u.controller->Describe(), ::testing::Not(::testing::HasSubstr("constrained")));
 }
 
 TEST(BuiltControllerTest, LabelSummaryAndSettingsJson) {

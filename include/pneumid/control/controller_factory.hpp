@@ -1,4 +1,4 @@
-// Builds a controller (DMC, GPC or PID) from a model, a tuning rule and
+// Builds a controller (DMC, GPC, PID or MPC) from a model, a tuning rule and
 // limits: the one place where the command line, the bindings and the
 // real-time loop turn settings into a Controller.
 //
@@ -8,6 +8,11 @@
 //        coefficients "1 -0.8" (ascending powers of q^-1)
 //   pid  gains by SIMC or IMC from the model's FOPDT description (tuning.hpp,
 //        FopdtFromModel), tau_c <= 0 = the rule's default
+//   mpc  state-space MPC (mpc.hpp) from the model with its delay as states:
+//        P, M, lambda from the tuning rule as for dmc, the input limits and
+//        soft output bounds (a QP whenever one is finite), the other options
+//        at their defaults (output disturbance model, Kalman noise R = 1,
+//        disturbance noise 1)
 #pragma once
 
 #include <limits>
@@ -26,10 +31,10 @@ namespace pneumid {
 
 struct ControllerSpec {
   ControllerType type = ControllerType::kDmc;
-  TuningOptions tuning;  ///< P, M, lambda (dmc, gpc)
+  TuningOptions tuning;  ///< P, M, lambda (dmc, gpc, mpc)
   InputLimits limits;
   bool constrained = false;                                 ///< dmc: QDMC with the QP solver
-  double y_min = -std::numeric_limits<double>::infinity();  ///< soft output bounds (QDMC)
+  double y_min = -std::numeric_limits<double>::infinity();  ///< soft output bounds (QDMC, mpc)
   double y_max = std::numeric_limits<double>::infinity();
   std::string t_filter = "1";  ///< gpc
   PidTuningRule pid_rule = PidTuningRule::kSimc;
@@ -39,7 +44,7 @@ struct ControllerSpec {
 /// Controller settings as a user states them (command line, configuration,
 /// bindings): names as strings, unset numbers as 0 / NaN.
 struct ControllerSettings {
-  std::string controller = "dmc";  ///< dmc, gpc or pid
+  std::string controller = "dmc";  ///< dmc, gpc, pid or mpc
   /// Tuning rule name (TuningRuleFromString); empty: inferred (InferTuningRule).
   std::string rule;
   int P = 0;  ///< prediction horizon override (0 = the rule's)
@@ -68,7 +73,7 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings);
 struct BuiltController {
   std::unique_ptr<Controller> controller;
   ControllerType type = ControllerType::kDmc;
-  TuningResult tuning;    ///< horizons and lambda (dmc, gpc)
+  TuningResult tuning;    ///< horizons and lambda (dmc, gpc, mpc)
   PidTuningRule pid_rule = PidTuningRule::kSimc;  ///< (pid)
   PidGains pid_gains;     ///< (pid)
   FopdtEstimate fopdt;  ///< the FOPDT the PID was tuned from (pid)
@@ -79,16 +84,17 @@ struct BuiltController {
   /// or the PID rule, the FOPDT it used and the gains.
   std::string Summary() const;
   /// `settings` of `pneumid control --json`: {rule, P, M, lambda, formula}
-  /// (dmc, gpc) or {Kc, Ti, Td, rule} (pid; Ti null when infinite).
+  /// (dmc, gpc, mpc) or {Kc, Ti, Td, rule} (pid; Ti null when infinite).
   nlohmann::ordered_json SettingsToJson() const;
 };
 
 /// Designs the controller from a sampled model (dmc and gpc use it as is; pid
-/// tunes from the FOPDT description of model.model()).
+/// tunes from the FOPDT description of model.model(); mpc samples
+/// model.model() at model.Ts() as a state space, SampledStateSpace).
 /// @throws InvalidArgument for invalid settings (messages name the setting).
 BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec);
-/// dmc, gpc: MakeController(PredictionModel(model, Ts), spec), the design's
-/// one discretization; pid: from the FOPDT description of `model`.
+/// dmc, gpc, mpc: MakeController(PredictionModel(model, Ts), spec), the
+/// design's one discretization; pid: from the FOPDT description of `model`.
 /// @throws InvalidArgument for invalid settings (messages name the setting).
 BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec);

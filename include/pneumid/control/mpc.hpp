@@ -149,7 +149,7 @@ class MpcController : public Controller {
   /// The input actually applied after the last Update() when a later layer
   /// changed it (anti-windup): the observer's prediction and u_{k-1} use it.
   /// Allocates no memory.
-  void Applied(double u);
+  void Applied(double u) override;
   double Ts() const override { return Ts_; }
   /// e.g. "mpc P=126 M=5 lambda=2.25 disturbance=output" (+ " constrained").
   std::string Describe() const override;
