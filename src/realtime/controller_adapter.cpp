@@ -21,4 +21,12 @@ double ControllerAdapter::Update(std::int64_t, double r, double y) noexcept {
   }
 }
 
+void ControllerAdapter::Applied(double u) noexcept {
+  try {
+    controller_->Applied(u);
+  } catch (...) {
+    // The next Update() reports a failing controller.
+  }
+}
+
 }  // namespace pneumid

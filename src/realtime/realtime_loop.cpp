@@ -253,6 +253,7 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
         unsigned lim = 0;
         rec.u = safety.LimitOutput(rec.u_ctrl, options.period, &lim);
         rec.flags |= lim;
+        if (std::isfinite(rec.u) && rec.u != rec.u_ctrl) controller.Applied(rec.u);
         if (!std::isfinite(rec.u)) {
           f = Fault::kControllerError;
         } else {

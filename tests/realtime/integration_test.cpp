@@ -45,6 +45,47 @@ TEST(Integration, DmcOnTheIpaSimulatorTracks) {
   EXPECT_GT(log.records().back().aux, 1e5);
 }
 
+// The safety layer's range clips a controller that has no limits of its own;
+// the loop tells it the applied input (anti-windup), so it acts exactly as a
+// controller given the same limits: identical inputs and outputs.
+TEST(Integration, SafetyClippedControllerFollowsTheAppliedInput) {
+  std::vector<std::vector<double>> u(2), y(2);
+  for (int limited = 0; limited < 2; ++limited) {
+    DmcOptions d;
+    if (limited) {
+      d.limits.u_min = 0.0;
+      d.limits.u_max = 100.0;
+    }
+    ControllerAdapter dmc(std::make_unique<DmcController>(PaperFopdtModel(), 0.01, d));
+    SimBackend io(MakePlant("ipa", 0.01));
+    SafetyOptions so;  // duty 0..100 % by default
+    SafetyMonitor safety(so);
+    LogWriterOptions lo;
+    lo.keep_in_memory = true;
+    LogWriter log("", {}, lo);
+    LoopOptions o;
+    o.duration = 2.0;
+    o.fast = true;
+    std::vector<double> r(200, 20.0);
+    for (int k = 50; k < 200; ++k) r[k] = 150.0;  // beyond what 100 % duty can hold quickly
+    const LoopSummary s = RunLoop(o, io, dmc, r, safety, &log);
+    log.Close();
+    ASSERT_EQ(s.termination, LoopTermination::kSuccess) << s.message;
+    for (const auto& rec : log.records()) {
+      u[limited].push_back(rec.u);
+      y[limited].push_back(rec.y);
+    }
+  }
+  ASSERT_EQ(u[0].size(), u[1].size());
+  double top = 0.0;
+  for (std::size_t k = 0; k < u[0].size(); ++k) {
+    EXPECT_NEAR(u[0][k], u[1][k], 1e-9) << k;
+    EXPECT_NEAR(y[0][k], y[1][k], 1e-9) << k;
+    top = std::max(top, u[0][k]);
+  }
+  EXPECT_EQ(top, 100.0);  // the limit was reached
+}
+
 // The loop speaks of hold and release; the plant behind the backend names them
 // (the IPA: valves-closed, exhaust-open) and states its units.
 TEST(Integration, SafeStateNamedByThePlantBehindTheBackend) {

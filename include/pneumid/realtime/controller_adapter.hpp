@@ -20,6 +20,7 @@ class ControllerAdapter : public LoopController {
                              double y0 = 0.0);
   void Reset() override;
   double Update(std::int64_t k, double r, double y) noexcept override;
+  void Applied(double u) noexcept override;
   std::string Describe() const override { return controller_->Describe(); }
   Controller& controller() { return *controller_; }
 

@@ -43,6 +43,10 @@ class LoopController {
   /// Input u_k for set point r and measurement y at sample k (the actuator's units,
   /// IoBackend::actuator(): for the IPA duty % from force N).
   virtual double Update(std::int64_t k, double r, double y) noexcept = 0;
+  /// The input the safety layer applied, when it changed Update()'s (rate or
+  /// range limit): controllers with memory follow it (Controller::Applied,
+  /// anti-windup). Same rules as Update. Default: nothing.
+  virtual void Applied(double /*u*/) noexcept {}
   /// Description for the log header, e.g. "dmc P=126 M=5 lambda=2.25".
   virtual std::string Describe() const = 0;
 };
