@@ -66,6 +66,15 @@ TransferFunction FromModelJson(const nlohmann::json& j, const std::string& where
     PNEUMID_CHECK(j.contains("method") && j.at("method") == select,
                   "{}: the model is not of method '{}'", where, select);
   }
+  // An identified discrete model whose continuous form is only the bilinear
+  // (tustin) approximation (no zoh equivalent: a pole on the negative real
+  // axis) is used as identified: the tustin form is biproper and its step
+  // response differs from the data's model between and at the samples.
+  if (j.contains("discrete") && j.contains("notes") && j.at("notes").is_array()) {
+    for (const auto& note : j.at("notes"))
+      if (note.is_string() && note.get<std::string>().find("tustin d2c") != std::string::npos)
+        return TransferFunctionFromJson(j.at("discrete"));
+  }
   if (j.contains("tf")) return TransferFunctionFromJson(j.at("tf"));
   return TransferFunctionFromJson(j);
 }

@@ -93,6 +93,24 @@ TEST(ModelIoTest, JsonFiles) {
               ThrowsMessage<DataError>(HasSubstr("/nonexistent/model.json: cannot open")));
 }
 
+// An identified discrete model whose continuous form is only its tustin
+// approximation is read as identified (discrete, strictly proper); with an
+// exact (zoh) continuous form the continuous one is read.
+TEST(ModelIoTest, TustinOnlyModelsAreReadInDiscreteForm) {
+  const std::string tustin = WriteTemp("tustin.json", R"({"method": "arx",
+    "tf": {"num": [0.1, 1, 100], "den": [1, 50, 100], "Ts": 0, "delay": 0},
+    "discrete": {"num": [0, 0.5, 0.2], "den": [1, -0.5, 0.2], "Ts": 0.01, "delay": 0},
+    "notes": ["continuous form by tustin d2c: no zoh equivalent (d2c zoh: pole at z = -0.3)"]})");
+  const TransferFunction g = ParseModelSpec(tustin);
+  EXPECT_TRUE(g.IsDiscrete());
+  EXPECT_DOUBLE_EQ(g.Ts(), 0.01);
+  const std::string exact = WriteTemp("exact.json", R"({"method": "arx",
+    "tf": {"num": [1], "den": [1, 1], "Ts": 0, "delay": 0},
+    "discrete": {"num": [0, 0.5], "den": [1, -0.5], "Ts": 0.01, "delay": 0},
+    "notes": ["fit by least squares"]})");
+  EXPECT_TRUE(ParseModelSpec(exact).IsContinuous());
+}
+
 TEST(ModelIoTest, BadSpecsNameTheField) {
   EXPECT_THAT([] { ParseModelSpec("fopdt:K=1.6,tau=abc"); },
               ThrowsMessage<InvalidArgument>(HasSubstr("key 'tau': not a finite number: 'abc'")));
