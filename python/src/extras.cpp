@@ -138,7 +138,7 @@ void BindExtras(py::module_& m) {
       "lambda_"_a = std::numeric_limits<double>::quiet_NaN(),
       "Horizons and move suppression: rule 'shridhar-cooper' (conventional), "
       "'paper-modified' or 'explicit' (dict with P, M, lambda, formula).");
-  py::class_<Controller>(m, "Controller", "A sampled controller (DMC, GPC, PID).")
+  py::class_<Controller>(m, "Controller", "A sampled controller (DMC, GPC, PID, MPC).")
       .def("reset", &Controller::Reset, "u0"_a = 0.0, "y0"_a = 0.0)
       .def("update", &Controller::Update, "setpoint"_a, "measurement"_a,
            "One control step; returns the input to hold over the next period.")
@@ -165,7 +165,7 @@ void BindExtras(py::module_& m) {
       "lambda_"_a = std::numeric_limits<double>::quiet_NaN(),
       "u_min"_a = -std::numeric_limits<double>::infinity(),
       "u_max"_a = std::numeric_limits<double>::infinity(), "constrained"_a = false,
-      "Controller of type 'dmc', 'gpc' or 'pid' designed from `model` at Ts.");
+      "Controller of type 'dmc', 'gpc', 'pid' or 'mpc' designed from `model` at Ts.");
   m.def(
       "simulate_closed_loop",
       [](Controller& controller, Plant& plant, const std::string& setpoint, double duration,
