@@ -97,10 +97,10 @@ TEST(ModelIoTest, JsonFiles) {
 // approximation is read as identified (discrete, strictly proper); with an
 // exact (zoh) continuous form the continuous one is read.
 TEST(ModelIoTest, TustinOnlyModelsAreReadInDiscreteForm) {
-  const std::string tustin = WriteTemp("tustin.json", R"({"method": "arx",
+  const std::string tustin = WriteTemp("tustin.json", R"json({"method": "arx",
     "tf": {"num": [0.1, 1, 100], "den": [1, 50, 100], "Ts": 0, "delay": 0},
     "discrete": {"num": [0, 0.5, 0.2], "den": [1, -0.5, 0.2], "Ts": 0.01, "delay": 0},
-    "notes": ["continuous form by tustin d2c: no zoh equivalent (d2c zoh: pole at z = -0.3)"]})");
+    "notes": ["continuous form by tustin d2c: no zoh equivalent (d2c zoh: pole at z = -0.3)"]})json");
   const TransferFunction g = ParseModelSpec(tustin);
   EXPECT_TRUE(g.IsDiscrete());
   EXPECT_DOUBLE_EQ(g.Ts(), 0.01);
