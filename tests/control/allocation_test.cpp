@@ -10,6 +10,7 @@
 
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/gpc.hpp"
+#include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
 #include "pneumid/lti/model_io.hpp"
 
@@ -72,6 +73,27 @@ TEST(AllocationTest, DmcAndQdmcStepsDoNotAllocate) {
   DmcController qdmc(PaperFopdtModel(), 0.01, o);
   EXPECT_EQ(AllocationsDuringUpdates(qdmc), 0);
   EXPECT_EQ(qdmc.qp_failures(), 0);
+}
+
+TEST(AllocationTest, MpcStepsDoNotAllocate) {
+  MpcOptions o;
+  o.P = 150;
+  o.M = 10;
+  MpcController unconstrained(PaperFopdtModel(), 0.01, o);
+  EXPECT_EQ(AllocationsDuringUpdates(unconstrained), 0);
+  o.limits.u_min = 0.0;
+  o.limits.u_max = 0.9;
+  o.limits.du_max = 0.15;
+  o.y_max = 1.25;
+  o.disturbance = DisturbanceModel::kInput;
+  MpcController constrained(PaperFopdtModel(), 0.01, o);
+  EXPECT_EQ(AllocationsDuringUpdates(constrained), 0);
+  EXPECT_EQ(constrained.qp_failures(), 0);
+  g_allocations = 0;
+  g_counting = true;
+  constrained.Applied(0.5);
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0);
 }
 
 TEST(AllocationTest, GpcAndPidStepsDoNotAllocate) {
