@@ -15,7 +15,8 @@
 //                                    the input into its bounds; counters: the
 //                                    median, 99th percentile and worst step
 //                                    (us, wall clock), the share of steps with
-//                                    an active constraint, and QP failures
+//                                    an active constraint, QP failures and
+//                                    active-set changes (p99, max)
 //
 //   build-<dir>/bench/mpc_benchmark
 #include <algorithm>
@@ -69,8 +70,9 @@ void BM_MpcConstrainedLoop(benchmark::State& state) {
   o.limits.du_max = 0.15;
   if (state.range(1)) o.y_max = 1.25;
   constexpr int kSteps = 10000;
-  std::vector<double> times(kSteps);
+  std::vector<double> times(kSteps), iterations(kSteps);
   double median = 0, p99 = 0, worst = 0, active_fraction = 0, failures = 0, nz = 0;
+  double iterations_p99 = 0, iterations_max = 0;
   for (auto _ : state) {
     MpcController mpc(Model(which), 0.01, o);
     LinearPlant plant(Model(which, 1.6 * 1.2), 0.01);
@@ -83,7 +85,8 @@ void BM_MpcConstrainedLoop(benchmark::State& state) {
       const double u = mpc.Update(r, y);
       const auto stop = std::chrono::steady_clock::now();
       times[k] = std::chrono::duration<double, std::micro>(stop - start).count();
-      active += mpc.last_qp_summary().num_active > 0 ? 1 : 0;
+      active += mpc.last_step_constrained() ? 1 : 0;
+      iterations[k] = mpc.last_step_constrained() ? mpc.last_qp_summary().iterations : 0;
       plant.Advance(u);
     }
     std::vector<double> sorted = times;
@@ -93,6 +96,9 @@ void BM_MpcConstrainedLoop(benchmark::State& state) {
     worst = sorted.back();
     active_fraction = static_cast<double>(active) / kSteps;
     failures = mpc.qp_failures();
+    std::sort(iterations.begin(), iterations.end());
+    iterations_p99 = iterations[kSteps * 99 / 100];
+    iterations_max = iterations.back();
   }
   state.counters["median_us"] = median;
   state.counters["p99_us"] = p99;
@@ -100,6 +106,8 @@ void BM_MpcConstrainedLoop(benchmark::State& state) {
   state.counters["steps_with_active_constraints"] = active_fraction;
   state.counters["qp_failures"] = failures;
   state.counters["nz"] = nz;
+  state.counters["qp_iterations_p99"] = iterations_p99;
+  state.counters["qp_iterations_max"] = iterations_max;
 }
 BENCHMARK(BM_MpcConstrainedLoop)
     ->Args({0, 0})

@@ -281,7 +281,29 @@ void MpcController::Reset(double u0, double y0) {
   us_ = u0;
   moves_.setZero();
   qp_failures_ = 0;
+  last_active_ = false;
   qp_->ClearWarmStart();
+}
+
+bool MpcController::UnconstrainedMovesFeasible() {
+  const InputLimits& lim = options_.limits;
+  const int M = options_.M;
+  double u = u_prev_;
+  for (int j = 0; j < M; ++j) {
+    const double du = moves_(j);
+    u += du;
+    if (!(std::abs(du) <= lim.du_max) || !(u >= lim.u_min) || !(u <= lim.u_max)) return false;
+  }
+  if (soft_output_) {
+    // free_ holds the free response; y^ = free_ + Theta du.
+    const int P = options_.P;
+    for (int i = 0; i < P; ++i) {
+      const int n = std::min(i + 1, M);
+      const double y = free_(i) + Theta_.row(i).head(n).dot(moves_.head(n));
+      if (!(y >= options_.y_min) || !(y <= options_.y_max)) return false;
+    }
+  }
+  return true;
 }
 
 double MpcController::disturbance_estimate() const {
@@ -307,45 +329,48 @@ double MpcController::Update(double setpoint, double measurement) {
       us = setpoint / G_;
       break;
   }
-  bool solved = false;
+  // The unconstrained moves; in constrained mode they are the QP's solution
+  // whenever they satisfy every bound (and the soft output bounds with e = 0:
+  // the cost is separable in du and e, and e = 0 minimizes rho1 e + rho2/2 e^2).
+  moves_.noalias() = Fz_ * z_post_;
+  moves_ += Fu_ * u_prev_ + Fr_ * setpoint + Fs_ * us;
+  last_active_ = false;
   if (constrained_) {
     const InputLimits& lim = options_.limits;
-    const int P = options_.P;
-    g_.head(M).noalias() = Gz_ * z_post_;
-    g_.head(M) += Gu_ * u_prev_ + Gr_ * setpoint + Gs_ * us;
-    if (soft_output_) g_(M) = options_.slack_linear_weight;
-    int row = 0;
-    if (u_rows_) {
-      lb_.head(M).setConstant(lim.u_min - u_prev_);
-      ub_.head(M).setConstant(lim.u_max - u_prev_);
-      row += M;
-    }
     if (soft_output_) {
       free_.noalias() = Psi_ * z_post_;
       free_ += Ups_ * u_prev_;
     }
-    if (std::isfinite(options_.y_min)) {
-      lb_.segment(row, P).setConstant(options_.y_min);
-      lb_.segment(row, P) -= free_;
-      ub_.segment(row, P).setConstant(kInf);
-      row += P;
+    if (!UnconstrainedMovesFeasible()) {
+      last_active_ = true;
+      const int P = options_.P;
+      g_.head(M).noalias() = Gz_ * z_post_;
+      g_.head(M) += Gu_ * u_prev_ + Gr_ * setpoint + Gs_ * us;
+      if (soft_output_) g_(M) = options_.slack_linear_weight;
+      int row = 0;
+      if (u_rows_) {
+        lb_.head(M).setConstant(lim.u_min - u_prev_);
+        ub_.head(M).setConstant(lim.u_max - u_prev_);
+        row += M;
+      }
+      if (std::isfinite(options_.y_min)) {
+        lb_.segment(row, P).setConstant(options_.y_min);
+        lb_.segment(row, P) -= free_;
+        ub_.segment(row, P).setConstant(kInf);
+        row += P;
+      }
+      if (std::isfinite(options_.y_max)) {
+        lb_.segment(row, P).setConstant(-kInf);
+        ub_.segment(row, P).setConstant(options_.y_max);
+        ub_.segment(row, P) -= free_;
+      }
+      const QpSummary& s = qp_->Solve(g_, lb_, ub_, lbx_, ubx_);
+      if (s.status == QpStatus::kSolved) {
+        moves_ = qp_->x().head(M);
+      } else {
+        ++qp_failures_;  // keep the unconstrained moves (clipped below)
+      }
     }
-    if (std::isfinite(options_.y_max)) {
-      lb_.segment(row, P).setConstant(-kInf);
-      ub_.segment(row, P).setConstant(options_.y_max);
-      ub_.segment(row, P) -= free_;
-    }
-    const QpSummary& s = qp_->Solve(g_, lb_, ub_, lbx_, ubx_);
-    if (s.status == QpStatus::kSolved) {
-      moves_ = qp_->x().head(M);
-      solved = true;
-    } else {
-      ++qp_failures_;
-    }
-  }
-  if (!solved) {
-    moves_.noalias() = Fz_ * z_post_;
-    moves_ += Fu_ * u_prev_ + Fr_ * setpoint + Fs_ * us;
   }
   const double u = options_.limits.Clip(u_prev_ + moves_(0), u_prev_);
   // Prediction to the next sample with the input applied.

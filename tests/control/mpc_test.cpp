@@ -152,6 +152,7 @@ TEST_P(MpcConstrainedStepTest, MatchesIndependentQpSolution) {
   c.Reset(0.1, 0.2);
   const double u = c.Update(1.0, 0.25);
   const std::vector<double>& m = GetParam().moves;
+  EXPECT_TRUE(c.last_step_constrained());
   EXPECT_EQ(c.last_qp_summary().status, QpStatus::kSolved);
   EXPECT_NEAR(u, 0.1 + m[0], 1e-10);
   for (int j = 0; j < 5; ++j) EXPECT_NEAR(c.planned_moves()(j), m[j], 1e-9) << "move " << j;

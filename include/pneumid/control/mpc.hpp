@@ -47,7 +47,9 @@
 //   u_min <= u_{k-1} + T du <= u_max,   |du_j| <= du_max,
 //   y_min - e <= y^ <= y_max + e,  e >= 0   (soft output bounds, slack e)
 // by QpSolver (Goldfarb-Idnani, qp_solver.hpp), set up once and warm-started
-// from the previous active set. Update() allocates nothing.
+// from the previous active set; a step whose unconstrained moves satisfy
+// every bound (with e = 0) skips the QP, their being its solution. Update()
+// allocates nothing.
 //
 // [1] J. M. Maciejowski, Predictive Control with Constraints, Prentice Hall,
 //     2002, ch. 2 (prediction, observer) and 3 (constrained QP).
@@ -182,7 +184,10 @@ class MpcController : public Controller {
   double target_input() const { return us_; }
   /// The M moves planned at the last Update() (unconstrained or QP).
   const Eigen::VectorXd& planned_moves() const { return moves_; }
-  /// Summary of the last QP (constrained only).
+  /// True when the last Update() solved the QP: its unconstrained moves
+  /// violated a bound (otherwise they are the constrained solution too).
+  bool last_step_constrained() const { return last_active_; }
+  /// Summary of the last QP solved (constrained only).
   const QpSummary& last_qp_summary() const { return qp_->summary(); }
   /// Constrained steps whose QP did not return kSolved (the clipped
   /// unconstrained move was applied instead).
@@ -190,6 +195,8 @@ class MpcController : public Controller {
 
  private:
   void Build(const StateSpace& model);
+  // The unconstrained moves_ satisfy the bounds on u, du and (free_ set) y.
+  bool UnconstrainedMovesFeasible();
 
   MpcOptions options_;
   double Ts_ = 0.0;
@@ -220,6 +227,7 @@ class MpcController : public Controller {
   double u_prev_ = 0.0;
   double us_ = 0.0;
   int qp_failures_ = 0;
+  bool last_active_ = false;
 };
 
 }  // namespace pneumid
