@@ -305,6 +305,41 @@ TEST(MpcTest, IpaLargeStepStaysWithinDutyLimits) {
   EXPECT_LT(std::abs(err / 100.0), 1.0);
 }
 
+TEST(MpcTest, AppliedInputIsWhatTheObserverPredictsWith) {
+  // After Applied(v), measuring exactly the model's output for v leaves the
+  // disturbance estimate unchanged (zero innovation).
+  MpcController c(PaperFopdtModel(), kTs, MpcOptions{});
+  c.Reset(10.0, 16.0);
+  const double u = c.Update(40.0, 16.0);
+  const double v = 0.5 * (u + 10.0);
+  c.Applied(v);
+  const Eigen::VectorXd z_next = c.Az() * c.state_estimate() + c.Bz() * v;
+  const double d = z_next(z_next.size() - 1);
+  c.Update(40.0, c.Cz().dot(z_next));
+  EXPECT_NEAR(c.disturbance_estimate(), d, 1e-12);
+}
+
+TEST(MpcTest, SoftOutputBoundHoldsTheOutputBelowIt) {
+  // Plant = model, set-point 1 above the soft bound y_max = 0.9: the exact
+  // penalty (rho1 = 1e4 exceeds the tracking cost's gradient) keeps the slack
+  // at zero, so the output approaches the bound and never crosses it; without
+  // the bound it reaches the set-point.
+  auto run = [](double y_max) {
+    MpcOptions o;
+    o.y_max = y_max;
+    const TransferFunction g = TransferFunction::Fopdt(1.6, 0.245, 0.001);
+    MpcController c(g, kTs, o);
+    LinearPlant plant(g, kTs);
+    const auto sp = ParseSignal("step:from=0,to=1,at=0.1");
+    return RunLoop(c, plant, *sp, 4.0, 0.0, 0.0).y;
+  };
+  const std::vector<double> bounded = run(0.9);
+  EXPECT_LE(*std::max_element(bounded.begin(), bounded.end()), 0.9 + 1e-9);
+  EXPECT_NEAR(bounded.back(), 0.9, 1e-3);
+  const std::vector<double> free = run(std::numeric_limits<double>::infinity());
+  EXPECT_NEAR(free.back(), 1.0, 1e-6);
+}
+
 TEST(MpcTest, DisturbanceModelNamesRoundTrip) {
   for (DisturbanceModel d :
        {DisturbanceModel::kOutput, DisturbanceModel::kInput, DisturbanceModel::kNone})
