@@ -36,7 +36,8 @@ using namespace pneumid;
 TransferFunction Model(int which, double gain = 1.6) {
   if (which == 0) return TransferFunction::Fopdt(gain, 0.245, 0.001);
   Eigen::VectorXd den = Eigen::VectorXd::Ones(1);
-  for (double tau : {0.2, 0.1, 0.05, 0.03, 0.02}) den = poly::Multiply(den, Eigen::Vector2d(tau, 1.0));
+  for (double tau : {0.2, 0.1, 0.05, 0.03, 0.02})
+    den = poly::Multiply(den, Eigen::Vector2d(tau, 1.0));
   return TransferFunction(Eigen::VectorXd::Constant(1, gain), den, 0.0, 0.04);
 }
 
@@ -79,7 +80,8 @@ void BM_MpcConstrainedLoop(benchmark::State& state) {
     nz = static_cast<double>(mpc.Az().rows());
     int active = 0;
     for (int k = 0; k < kSteps; ++k) {
-      const double r = (k / 150) % 2 ? 1.2 : 0.1;  // 1.2 needs u = 0.63: more than du allows at once
+      const double r =
+          (k / 150) % 2 ? 1.2 : 0.1;  // 1.2 needs u = 0.63: more than du allows at once
       const double y = plant.Measure();
       const auto start = std::chrono::steady_clock::now();
       const double u = mpc.Update(r, y);

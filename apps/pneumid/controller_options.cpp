@@ -8,7 +8,8 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
   // Names are checked by the control area (the message lists the valid ones).
   app.add_option("--controller", s.controller,
                  "dmc, gpc, pid or mpc (state-space MPC with a Kalman filter and an "
-                 "integrating output disturbance; a QP when a limit is set)")->capture_default_str();
+                 "integrating output disturbance; a QP when a limit is set)")
+      ->capture_default_str();
   app.add_option("--rule", s.rule,
                  "Tuning rule: shridhar-cooper (conventional), paper-modified, explicit "
                  "(default: shridhar-cooper, or explicit when --P --M --lambda are all given)");

@@ -88,8 +88,8 @@ DareResult SolveDare(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const E
   for (int it = 1; it <= options.max_iterations; ++it) {
     s.iterations = it;
     Eigen::PartialPivLU<Eigen::MatrixXd> lu(I + Gk * Hk);
-    const Eigen::MatrixXd WA = lu.solve(Ak);   // W^-1 A_k
-    const Eigen::MatrixXd WG = lu.solve(Gk);   // W^-1 G_k
+    const Eigen::MatrixXd WA = lu.solve(Ak);  // W^-1 A_k
+    const Eigen::MatrixXd WG = lu.solve(Gk);  // W^-1 G_k
     Eigen::MatrixXd G_next = Gk + Ak * WG * Ak.transpose();
     Eigen::MatrixXd H_next = Hk + Ak.transpose() * Hk * WA;
     Eigen::MatrixXd A_next = Ak * WA;
@@ -128,8 +128,9 @@ DareResult SolveDare(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const E
   }
   if (!(s.closed_loop_spectral_radius < 1.0)) {
     s.status = DareStatus::kNotStabilizing;
-    s.message = "the solution does not stabilize A - BK ((A, B) not stabilizable, or "
-                "(A, Q) with an unobservable mode on the unit circle)";
+    s.message =
+        "the solution does not stabilize A - BK ((A, B) not stabilizable, or "
+        "(A, Q) with an unobservable mode on the unit circle)";
     return result;
   }
   s.status = DareStatus::kConverged;

@@ -57,9 +57,10 @@ bool MpcOptions::IsValid(std::string* error) const {
     return fail(fmt::format("state noise must be finite and >= 0, got {}", state_noise));
   if (disturbance != DisturbanceModel::kNone &&
       (!(disturbance_noise > 0.0) || !std::isfinite(disturbance_noise)))
-    return fail(fmt::format("disturbance noise must be finite and > 0 with the {} disturbance "
-                            "model, got {}",
-                            ToString(disturbance), disturbance_noise));
+    return fail(
+        fmt::format("disturbance noise must be finite and > 0 with the {} disturbance "
+                    "model, got {}",
+                    ToString(disturbance), disturbance_noise));
   if (!dare.IsValid(&e)) return fail("dare: " + e);
   if (!qp.IsValid(&e)) return fail("qp: " + e);
   return true;
@@ -117,8 +118,8 @@ void MpcController::Build(const StateSpace& model_in) {
                 "MPC needs a single-input single-output model, got {} inputs and {} outputs",
                 model_in.num_inputs(), model_in.num_outputs());
   PNEUMID_CHECK(model_in.num_states() >= 1, "MPC needs a model with at least one state");
-  PNEUMID_CHECK(model_in.A().allFinite() && model_in.B().allFinite() &&
-                    model_in.C().allFinite() && model_in.D().allFinite(),
+  PNEUMID_CHECK(model_in.A().allFinite() && model_in.B().allFinite() && model_in.C().allFinite() &&
+                    model_in.D().allFinite(),
                 "the model's matrices must be finite");
   const StateSpace model = DelayAsStates(model_in);
   PNEUMID_CHECK(model.D()(0, 0) == 0.0,

@@ -75,9 +75,9 @@ TEST(ControllerSettingsTest, MpcTakesHorizonsFromTheRuleAndLimits) {
   // The same P, M, lambda as the DMC the rule designs (tuning_test: 126, 5, 2.25).
   EXPECT_EQ(b.tuning.P, 126);
   EXPECT_EQ(b.tuning.M, 5);
-  EXPECT_EQ(b.controller->Describe(),
-            fmt::format("mpc P=126 M=5 lambda={:g} disturbance=output constrained",
-                        b.tuning.lambda));
+  EXPECT_EQ(
+      b.controller->Describe(),
+      fmt::format("mpc P=126 M=5 lambda={:g} disturbance=output constrained", b.tuning.lambda));
   EXPECT_EQ(b.Label(), "shridhar-cooper");
   EXPECT_EQ(ToString(ControllerType::kMpc), "mpc");
   EXPECT_EQ(ControllerTypeFromString("mpc"), ControllerType::kMpc);

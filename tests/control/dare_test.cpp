@@ -39,18 +39,18 @@ TEST(DareTest, ScalarMatchesClosedForm) {
 }
 
 TEST(DareTest, MatchesScipyOnUnstableTwoInputCase) {
-  const Eigen::MatrixXd A = Mat(4, 4, {1.1, 0.2, 0, 0, 0, 0.9, 0.3, 0, 0.1, 0, 0.8, 0.2, 0, 0, -0.3,
-                                       1.05});
+  const Eigen::MatrixXd A =
+      Mat(4, 4, {1.1, 0.2, 0, 0, 0, 0.9, 0.3, 0, 0.1, 0, 0.8, 0.2, 0, 0, -0.3, 1.05});
   const Eigen::MatrixXd B = Mat(4, 2, {1, 0, 0, 0, 0, 1, 0.5, 0.2});
   const Eigen::MatrixXd Q = Eigen::Vector4d(1.0, 2.0, 0.5, 1.0).asDiagonal();
   const Eigen::MatrixXd R = Mat(2, 2, {1.0, 0.2, 0.2, 0.5});
   // scipy.linalg.solve_discrete_are, gen_mpc_reference.py
-  const Eigen::MatrixXd expected = Mat(
-      4, 4,
-      {4.5539897973820338, -0.2434524202762588, 2.1597054863669731, -4.6398976694680716,
-       -0.2434524202762588, 5.9295930527310086, 1.1877966097872426, 0.93771993372687767,
-       2.1597054863669731, 1.1877966097872426, 2.7889667104921032, -3.3532693372731934,
-       -4.6398976694680716, 0.93771993372687767, -3.3532693372731934, 9.1584755150347394});
+  const Eigen::MatrixXd expected =
+      Mat(4, 4,
+          {4.5539897973820338, -0.2434524202762588, 2.1597054863669731, -4.6398976694680716,
+           -0.2434524202762588, 5.9295930527310086, 1.1877966097872426, 0.93771993372687767,
+           2.1597054863669731, 1.1877966097872426, 2.7889667104921032, -3.3532693372731934,
+           -4.6398976694680716, 0.93771993372687767, -3.3532693372731934, 9.1584755150347394});
   const DareResult res = SolveDare(A, B, Q, R);
   ASSERT_EQ(res.summary.status, DareStatus::kConverged) << res.summary.BriefReport();
   EXPECT_LT((res.X - expected).norm(), 1e-11 * expected.norm());
@@ -86,12 +86,21 @@ TEST(DareTest, BadInputThrows) {
               ThrowsMessage<InvalidArgument>(HasSubstr("R must be positive definite")));
   EXPECT_THAT([&] { SolveDare(A, B, Mat(1, 1, {-1.0}), Mat(1, 1, {1.0})); },
               ThrowsMessage<InvalidArgument>(HasSubstr("positive semidefinite")));
-  EXPECT_THAT([&] { SolveDare(Mat(1, 2, {1, 2}), B, Q, Q); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("square")));
-  EXPECT_THAT([&] { SolveDare(A, Mat(2, 1, {1, 1}), Q, Q); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("B must be")));
-  EXPECT_THAT([&] { SolveDare(A, B, Mat(2, 2, {1, 2, 2, 1}), Q); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("Q must be 1 x 1")));
+  EXPECT_THAT(
+      [&] {
+        SolveDare(Mat(1, 2, {1, 2}), B, Q, Q);
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("square")));
+  EXPECT_THAT(
+      [&] {
+        SolveDare(A, Mat(2, 1, {1, 1}), Q, Q);
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("B must be")));
+  EXPECT_THAT(
+      [&] {
+        SolveDare(A, B, Mat(2, 2, {1, 2, 2, 1}), Q);
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("Q must be 1 x 1")));
   EXPECT_THAT([&] { SolveDare(Mat(1, 1, {NAN}), B, Q, Q); },
               ThrowsMessage<InvalidArgument>(HasSubstr("finite")));
   DareOptions o;

@@ -72,13 +72,12 @@ TEST(MpcTest, FopdtGainsMatchScipyReference) {
   EXPECT_NEAR(c.static_gain(), 1.6, 1e-12);
   const Eigen::VectorXd X = Vec({0.1272829854721152, 5.294741255407081e-18, -0.11922812853402176,
                                  5.294741255407081e-18, 0.01, 8.5770116713974251e-17,
-                                 -0.11922812853402176, 8.5770116713974251e-17,
-                                 1.7408585743307168});
+                                 -0.11922812853402176, 8.5770116713974251e-17, 1.7408585743307168});
   const Eigen::MatrixXd Xm = c.estimator_covariance().transpose();  // row-major
   ExpectNearRel(Eigen::Map<const Eigen::VectorXd>(Xm.data(), Xm.size()), X, 1e-10, "X");
-  ExpectNearRel(c.kalman_gain(), Vec({0.0030630497610176556, 3.4629564942495891e-17,
-                                      0.6166633110472387}),
-                1e-10, "L");
+  ExpectNearRel(c.kalman_gain(),
+                Vec({0.0030630497610176556, 3.4629564942495891e-17, 0.6166633110472387}), 1e-10,
+                "L");
   const MpcGain& k = c.gain();
   EXPECT_NEAR(k.K_r, 0.67205850213187857, 1e-10);
   EXPECT_NEAR(k.K_s, 0.0, 1e-14);
@@ -112,18 +111,18 @@ TEST(MpcTest, SecondOrderInputDisturbanceWithDelayMatchesScipyReference) {
   ASSERT_EQ(c.Az().rows(), 5);
   EXPECT_NEAR(c.static_gain(), 4.5000000000000089, 1e-12);
   const Eigen::MatrixXd Xm = c.estimator_covariance().transpose();
-  ExpectNearRel(
-      Eigen::Map<const Eigen::VectorXd>(Xm.data(), Xm.size()),
-      Vec({11.208616168940035, 5.7958610711578178, 3.1184040580370955, 3.1184040580370969,
-           3.1184040580370951, 5.7958610711578178, 3.5537386511973827, 1.160742504327839,
-           1.1607425043278394, 1.1607425043278385, 3.1184040580370955, 1.160742504327839,
-           2.3210089801901406, 1.8210089801901397, 2.3210089801901406, 3.1184040580370969,
-           1.1607425043278394, 1.8210089801901397, 1.8210089801901392, 1.8210089801901397,
-           3.1184040580370951, 1.1607425043278385, 2.3210089801901406, 1.8210089801901397,
-           2.8210089801901397}),
-      1e-9, "X");
-  ExpectNearRel(c.kalman_gain(), Vec({4.8373177450546514, 2.6373030983086081, 1.2354836656748032,
-                                      1.2354836656748034, 1.2354836656748027}),
+  ExpectNearRel(Eigen::Map<const Eigen::VectorXd>(Xm.data(), Xm.size()),
+                Vec({11.208616168940035, 5.7958610711578178, 3.1184040580370955, 3.1184040580370969,
+                     3.1184040580370951, 5.7958610711578178, 3.5537386511973827, 1.160742504327839,
+                     1.1607425043278394, 1.1607425043278385, 3.1184040580370955, 1.160742504327839,
+                     2.3210089801901406, 1.8210089801901397, 2.3210089801901406, 3.1184040580370969,
+                     1.1607425043278394, 1.8210089801901397, 1.8210089801901392, 1.8210089801901397,
+                     3.1184040580370951, 1.1607425043278385, 2.3210089801901406, 1.8210089801901397,
+                     2.8210089801901397}),
+                1e-9, "X");
+  ExpectNearRel(c.kalman_gain(),
+                Vec({4.8373177450546514, 2.6373030983086081, 1.2354836656748032, 1.2354836656748034,
+                     1.2354836656748027}),
                 1e-9, "L");
   EXPECT_NEAR(c.gain().K_r, 1.0503321468952587, 1e-9);
   EXPECT_NEAR(c.gain().K_s, 0.014227507129199509, 1e-11);
@@ -352,11 +351,17 @@ TEST(MpcTest, BadInputThrows) {
   const TransferFunction fopdt = PaperFopdtModel();
   MpcOptions ok;
   // Unstable model.
-  EXPECT_THAT([&] { MpcController(TransferFunction::Continuous({1.0}, {1.0, -1.0}), kTs, ok); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("stable")));
+  EXPECT_THAT(
+      [&] {
+        MpcController(TransferFunction::Continuous({1.0}, {1.0, -1.0}), kTs, ok);
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("stable")));
   // Integrator (pole at z = 1) is not stable either.
-  EXPECT_THAT([&] { MpcController(TransferFunction::Continuous({1.0}, {1.0, 0.0}), kTs, ok); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("stable")));
+  EXPECT_THAT(
+      [&] {
+        MpcController(TransferFunction::Continuous({1.0}, {1.0, 0.0}), kTs, ok);
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("stable")));
   // Not SISO.
   const StateSpace two_out(Eigen::MatrixXd::Constant(1, 1, 0.5), Eigen::MatrixXd::Ones(1, 1),
                            Eigen::MatrixXd::Ones(2, 1), Eigen::MatrixXd::Zero(2, 1), kTs);

@@ -56,8 +56,8 @@ std::string ToString(DareStatus status);
 DareStatus DareStatusFromString(const std::string& name);
 
 struct DareOptions {
-  int max_iterations = 100;   ///< doubling steps (each squares the convergence factor)
-  double tolerance = 1e-13;   ///< relative change of H_k that counts as converged
+  int max_iterations = 100;  ///< doubling steps (each squares the convergence factor)
+  double tolerance = 1e-13;  ///< relative change of H_k that counts as converged
   bool IsValid(std::string* error) const;
 };
 
