@@ -1,10 +1,17 @@
 // pneumid tune: prediction horizon P, control horizon M and move suppression
-// lambda of a predictive controller from a model.
+// lambda of a predictive controller from a model, or (--rule auto) the settings
+// of an MPC, DMC or PID for a specification (control/auto_tuning.hpp).
 //
 //   pneumid tune --model fopdt:K=1.6,tau=0.245,theta=0.001 --Ts 0.01
 //                --rule shridhar-cooper [--M 5] [--json]
 //   -> {"rule": "shridhar-cooper", "P": 126, "M": 5, "lambda": 2.2508, ...,
 //       "formula": "..."}
+//   pneumid tune --model fopdt-paper --Ts 0.01 --rule auto [--controller mpc|dmc|pid]
+//                [--response-time T] [--overshoot PCT] [--aggressiveness A]
+//                [--u-min U --u-max U] [--json]
+//   -> {"rule": "auto", "controller": "mpc", "P": 126, "M": 5, "lambda": ...,
+//       "predicted": {...}, "robustness": [...], "review": [...],
+//       "termination": "converged", "message": "..."}
 #include <cmath>
 #include <iostream>
 #include <limits>
@@ -15,6 +22,7 @@
 #include "command.hpp"
 #include "validators.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/control/auto_tuning.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/model_io.hpp"
 
@@ -30,11 +38,50 @@ struct TuneCli {
   double lambda = std::numeric_limits<double>::quiet_NaN();
   int tau_digits = 2;
   bool json = false;
+  // --rule auto
+  std::string controller;
+  double response_time = std::numeric_limits<double>::quiet_NaN();
+  std::string measure;
+  double overshoot = std::numeric_limits<double>::quiet_NaN();
+  double aggressiveness = std::numeric_limits<double>::quiet_NaN();
+  double u_min = -std::numeric_limits<double>::infinity();
+  double u_max = std::numeric_limits<double>::infinity();
+  double du_max = std::numeric_limits<double>::infinity();
 };
+
+void RunAuto(const TuneCli& c, const TransferFunction& model) {
+  PNEUMID_CHECK(c.P == 0 && std::isnan(c.lambda),
+                "--rule auto chooses P and lambda itself; drop --P/--lambda");
+  AutoTuneOptions o;
+  if (!c.controller.empty()) o.controller = ControllerTypeFromString(c.controller);
+  o.response_time = c.response_time;
+  if (!c.measure.empty()) o.measure = ResponseMeasureFromString(c.measure);
+  if (!std::isnan(c.overshoot)) o.max_overshoot = c.overshoot;
+  if (!std::isnan(c.aggressiveness)) o.aggressiveness = c.aggressiveness;
+  o.limits.u_min = c.u_min;
+  o.limits.u_max = c.u_max;
+  o.limits.du_max = c.du_max;
+  o.M = c.M;
+  const AutoTuneResult r = AutoTune(model, c.Ts, o);
+  if (c.json) {
+    std::cout << r.ToJson().dump(2) << "\n";
+    return;
+  }
+  std::cout << r.FullReport();
+}
 
 void Run(const TuneCli& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   const TransferFunction model = ParseModelSpec(c.model);
+  if (c.rule == "auto") {
+    RunAuto(c, model);
+    return;
+  }
+  PNEUMID_CHECK(c.controller.empty() && std::isnan(c.response_time) && c.measure.empty() &&
+                    std::isnan(c.overshoot) && std::isnan(c.aggressiveness) &&
+                    std::isinf(c.u_min) && std::isinf(c.u_max) && std::isinf(c.du_max),
+                "--controller, --response-time, --measure, --overshoot, --aggressiveness and "
+                "the input limits apply to --rule auto only");
   TuningOptions o;
   o.rule = TuningRuleFromString(c.rule);
   o.M = c.M;
@@ -71,7 +118,8 @@ const Registrar reg(
           ->check(Positive());
       app.add_option("--rule", c->rule,
                      "shridhar-cooper (conventional), paper-modified (P=126, M=10, lambda=1.92), "
-                     "explicit (needs --P --M --lambda)")
+                     "explicit (needs --P --M --lambda), auto (to a specification: see "
+                     "--controller, --response-time, --overshoot, --aggressiveness)")
           ->capture_default_str();
       app.add_option("--M", c->M,
                      "Control horizon (default: 5 shridhar-cooper, 10 paper-modified)");
@@ -80,6 +128,21 @@ const Registrar reg(
       app.add_option("--tau-digits", c->tau_digits,
                      "Significant digits tau is rounded to in the P formula (0 = none)")
           ->capture_default_str();
+      app.add_option("--controller", c->controller,
+                     "auto: controller to design, mpc (default), dmc or pid");
+      app.add_option("--response-time", c->response_time,
+                     "auto: target response time in s (default: about the model's time "
+                     "constant, tau + theta)")
+          ->check(Positive());
+      app.add_option("--measure", c->measure,
+                     "auto: what --response-time measures, rise (10-90 %, default) or settling "
+                     "(2 %)");
+      app.add_option("--overshoot", c->overshoot, "auto: maximum overshoot in percent (default 5)");
+      app.add_option("--aggressiveness", c->aggressiveness,
+                     "auto: 0 robust .. 1 aggressive (default 0.5)");
+      app.add_option("--u-min", c->u_min, "auto: lower input limit");
+      app.add_option("--u-max", c->u_max, "auto: upper input limit");
+      app.add_option("--du-max", c->du_max, "auto: largest input change per sample");
       app.add_flag("--json", c->json, "Print a JSON object");
       app.callback([c] { Run(*c); });
     });

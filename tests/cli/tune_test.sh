@@ -36,4 +36,24 @@ expect_error "negative Ts" "--Ts: must be > 0, got -1" tune --model fopdt-paper 
 # --sample-time is an alias of --Ts.
 expect_ok "sample-time alias" tune --model fopdt-paper --sample-time 0.01 --json
 check_json "sample-time alias" "j['P'] == 126"
+
+# --rule auto: MPC settings for a specification, predicted metrics on the
+# model, robustness rows and a design review (control/auto_tuning.hpp).
+expect_ok "auto mpc" tune --rule auto --controller mpc --model fopdt-paper --Ts 0.01 --json
+check_json "auto mpc keys" "all(k in j for k in ('rule', 'controller', 'P', 'M', 'lambda', 'predicted', 'robustness', 'review', 'termination', 'message'))"
+check_json "auto mpc settings" "j['rule'] == 'auto' and j['controller'] == 'mpc' and j['P'] == 126 and j['M'] == 5 and j['lambda'] > 0"
+check_json "auto mpc spec met" "j['termination'] == 'converged' and j['predicted']['overshoot_percent'] <= 5.05 and abs(j['predicted']['rise_time'] / 0.246 - 1) <= 0.2"
+check_json "auto mpc robustness" "len(j['robustness']) == 3 and all(r['pass'] for r in j['robustness'])"
+check_json "auto mpc review" "{r['check'] for r in j['review']} >= {'nominal stability', 'offset-free', 'QP Hessian condition', 'constraint conflicts', 'specification'} and all(r['status'] != 'fail' for r in j['review'])"
+expect_ok "auto pid" tune --rule auto --controller pid --model fopdt-paper --Ts 0.01 --aggressiveness 0.2 --json
+check_json "auto pid gains" "j['Kc'] > 0 and j['Ti'] > 0 and j['Td'] == 0 and abs(j['phase_margin'] - 69) < 2 and j['P'] is None"
+expect_ok "auto text" tune --rule auto --controller dmc --model fopdt-paper --Ts 0.01
+check_output "auto text review" "review:"
+check_output "auto text termination" "termination: converged"
+# A spec that cannot be met is a review that says why, not a crash.
+expect_ok "auto impossible" tune --rule auto --model fopdt-paper --Ts 0.01 --response-time 0.001 --u-min 0 --u-max 100 --json
+check_json "auto impossible" "j['termination'] == 'spec_not_met' and any(r['check'] == 'specification' and r['status'] == 'fail' and 'input held at its limit' in r['message'] for r in j['review'])"
+expect_error "auto gpc" "not gpc" tune --rule auto --controller gpc --model fopdt-paper --Ts 0.01
+expect_error "auto knob" "aggressiveness must be in [0, 1]" tune --rule auto --model fopdt-paper --Ts 0.01 --aggressiveness 2
+expect_error "auto flags without auto" "apply to --rule auto only" tune --model fopdt-paper --Ts 0.01 --overshoot 3
 finish

@@ -1,0 +1,206 @@
+// Tuning to specifications: settings of an MPC, DMC or PID controller chosen
+// from a model for a target closed-loop response time and overshoot, checked
+// against model error and reviewed before the controller runs.
+//
+// Specification: response time t_r (10-90 % rise time, or 2 % settling time),
+// maximum overshoot OS (percent), aggressiveness a in [0, 1] (0 robust,
+// 1 aggressive, as the single slider of MATLAB's tuners) and input limits.
+// Without t_r it comes from the model's FOPDT description K, tau, theta
+// (tuning.hpp, FopdtFromModel), about the open-loop time constant:
+//   rise:      t_r = tau + theta        (2.2 times faster than open loop)
+//   settling:  t_r = 2 tau + theta
+// The knob shifts the response time aimed at and the robustness demanded:
+//   t* = t_r 1.5^(1 - 2a)               (a = 0.5: t* = t_r)
+//   OS_rob = OS (1 + 2a) + 0.05         (overshoot allowed under model error)
+//   t_rob = (1.5 + a) t*                (response time allowed under model error)
+//
+// Evaluation: a set-point step on the model itself (LinearPlant, exact zoh;
+// SimulateClosedLoop of closed_loop.hpp) in deviation variables: a unit step
+// without input limits, otherwise from 20 % to 80 % of the output range the
+// limits reach at steady state, [K u_min, K u_max]. Robustness rows repeat it
+// with the plant's gain +20 %, -20 % and one more sample of dead time; a row
+// passes when the loop settles, overshoots at most OS_rob and responds within
+// t_rob. The window is 10 max(t*, tau + theta) after the step.
+//
+// MPC and DMC [3, 4, 5]: P by Shridhar-Cooper from the model's settling time,
+// P = round(5 tau/Ts + theta/Ts + 1), M = 5 (M <= P) [5]; then the move
+// suppression lambda by a search in log lambda on the closed-loop simulation:
+//   feasible(lambda) = nominal OS <= OS and every robustness row passes;
+//   lambda_f = the smallest feasible lambda (a scan of 4 points per decade over
+//              lambda_0 10^-6 .. lambda_0 10^4, lambda_0 = lambda_max(A'A)/500
+//              the Shridhar-Cooper value, refined by bisection of log lambda);
+//   lambda* = argmin_{lambda >= lambda_f} |ln(t(lambda) / t*)|, by bisection
+//             of log lambda on t(lambda) = t* (t grows with lambda) when
+//             t(lambda_f) < t*, else lambda_f (the fastest that is robust).
+// Garriga and Soroush [4] review the rules; Maciejowski [3, ch. 7] the
+// trade-off that lambda sets between speed and robustness.
+//
+// PID [1, 2], as MATLAB's pidtune: a crossover frequency and a phase margin
+//   wc = 2 / t*  (t* as a rise time; a settling time counts as 2 rise times),
+//   PM = 75 - 30 a degrees (60 at a = 0.5),
+// and the discrete loop L(z) = C(z) G(z) of the controller as PidController
+// computes it (backward differences, integral of the previous errors,
+// derivative on y filtered with N = 10) and the model sampled with a
+// zero-order hold:
+//   C(z) = Kc [1 + (Ts/Ti) z^-1/(1 - z^-1) + (N Td/(Td + N Ts)) (1 - z^-1)/(1 - beta z^-1)],
+//   beta = Td/(Td + N Ts),
+// solved for |L(e^{j wc Ts})| = 1 and arg L(e^{j wc Ts}) = -180 + PM: PI when
+// the phase C must supply, phi_C = -180 + PM - arg G(e^{j wc Ts}), is at most
+// -10 degrees (Ti from arg C = phi_C by bisection, then Kc = 1/|C_1 G| with
+// C_1 = C/Kc), else PID with Td = Ti/4 [1, sec. 4.4]. The set-point weight b
+// (P = Kc (b r - y)) does not change L; it is the largest b in [0, 1] whose
+// step meets OS [1, sec. 3.4] (b = 1 when the loop itself does).
+//
+// Design review (AutoTuneResult::review): nominal stability (the step
+// settles), offset-free steady state (a constant output disturbance of 20 %
+// of the step is removed: |steady-state error| <= 1e-3 of it), the condition
+// number of the QP Hessian (A'A + lambda I for DMC, the MPC's H; ok <= 1e4,
+// warning <= 1e8), constraint conflicts (the step must lie in the reachable
+// set-point range), robustness and the specification. A fail in any check
+// makes the termination kSpecNotMet (or kFailure when no stable design was
+// found) with a message that says why.
+//
+// [1] K. J. Astrom, T. Hagglund, Advanced PID Control, ISA, 2006, ch. 3-4.
+// [2] O. Garpinger, T. Hagglund, "Software-based optimal PID design with
+//     robustness and noise sensitivity constraints", J. Process Control 33
+//     (2015) 90-101.
+// [3] J. M. Maciejowski, Predictive Control with Constraints, Prentice Hall,
+//     2002.
+// [4] J. L. Garriga, M. Soroush, "Model predictive control tuning methods: a
+//     review", Ind. Eng. Chem. Res. 49 (2010) 3505-3515.
+// [5] R. Shridhar, D. J. Cooper, "A tuning strategy for unconstrained SISO
+//     model predictive control", Ind. Eng. Chem. Res. 36 (1997) 729-746.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "pneumid/control/controller.hpp"
+#include "pneumid/control/pid.hpp"
+#include "pneumid/control/tuning.hpp"
+#include "pneumid/lti/transfer_function.hpp"
+
+namespace pneumid {
+
+/// What the response time of a specification measures.
+enum class ResponseMeasure { kRise, kSettling };
+/// "rise" (10-90 %), "settling" (2 %).
+std::string ToString(ResponseMeasure measure);
+/// Inverse of ToString; throws InvalidArgument listing the valid names.
+ResponseMeasure ResponseMeasureFromString(const std::string& name);
+
+enum class ReviewStatus { kOk, kWarning, kFail };
+/// "ok", "warning", "fail".
+std::string ToString(ReviewStatus status);
+
+enum class AutoTuneTermination {
+  kConverged,   ///< every check passed
+  kSpecNotMet,  ///< the best design found misses the specification (review says why)
+  kFailure,     ///< no stable design was found
+};
+/// "converged", "spec_not_met", "failure".
+std::string ToString(AutoTuneTermination termination);
+
+struct AutoTuneOptions {
+  /// mpc, dmc or pid (gpc is not tuned this way).
+  ControllerType controller = ControllerType::kMpc;
+  /// Target response time (s, > 0); NaN = from the model (file comment).
+  double response_time = std::numeric_limits<double>::quiet_NaN();
+  ResponseMeasure measure = ResponseMeasure::kRise;
+  /// Maximum overshoot of a set-point step (percent, >= 0).
+  double max_overshoot = 5.0;
+  /// 0 robust .. 1 aggressive (file comment).
+  double aggressiveness = 0.5;
+  /// Input limits of the controller (and the evaluation).
+  InputLimits limits;
+  /// Control horizon for mpc/dmc (0 = 5).
+  int M = 0;
+  /// True when the options are usable; otherwise false and *error says why.
+  bool IsValid(std::string* error) const;
+};
+
+/// Step metrics of one closed-loop simulation (NaN when they do not exist).
+struct PredictedMetrics {
+  double rise_time = std::numeric_limits<double>::quiet_NaN();          ///< s, 10-90 %
+  double overshoot_percent = std::numeric_limits<double>::quiet_NaN();  ///< %
+  double settling_time = std::numeric_limits<double>::quiet_NaN();      ///< s, 2 %
+  /// The one the specification measures (rise or settling time).
+  double response_time = std::numeric_limits<double>::quiet_NaN();
+  double u_min = 0.0, u_max = 0.0;  ///< applied input range (deviation from the start)
+  bool settled = false;
+};
+
+struct RobustnessRow {
+  std::string name;  ///< "gain +20%", "gain -20%", "dead time +1 sample"
+  PredictedMetrics metrics;
+  bool pass = false;
+};
+
+struct ReviewItem {
+  std::string check;  ///< e.g. "nominal stability"
+  ReviewStatus status = ReviewStatus::kOk;
+  std::string message;
+};
+
+struct AutoTuneResult {
+  ControllerType controller = ControllerType::kMpc;
+  double Ts = 0.0;
+  /// mpc/dmc settings.
+  int P = 0;
+  int M = 0;
+  double lambda = std::numeric_limits<double>::quiet_NaN();
+  /// pid settings (Ti infinite = no integral action).
+  PidGains pid;
+  double setpoint_weight = 1.0;     ///< b
+  double derivative_filter = 10.0;  ///< N
+  /// pid design targets and what the discrete loop achieves.
+  double crossover_target = std::numeric_limits<double>::quiet_NaN();     ///< rad/s
+  double phase_margin_target = std::numeric_limits<double>::quiet_NaN();  ///< deg
+  double crossover = std::numeric_limits<double>::quiet_NaN();            ///< rad/s
+  double phase_margin = std::numeric_limits<double>::quiet_NaN();         ///< deg
+  double gain_margin = std::numeric_limits<double>::quiet_NaN();          ///< absolute
+  /// Specification as used.
+  double response_time_target = 0.0;  ///< t_r (given or from the model)
+  double response_time_aimed = 0.0;   ///< t* after the knob
+  ResponseMeasure measure = ResponseMeasure::kRise;
+  double max_overshoot = 0.0;
+  double aggressiveness = 0.0;
+  double robust_overshoot = 0.0;      ///< OS_rob
+  double robust_response_time = 0.0;  ///< t_rob
+  FopdtEstimate fopdt;
+  /// The evaluation step (deviation from the operating point at the start).
+  double step_from = 0.0, step_to = 1.0;
+  PredictedMetrics predicted;
+  std::vector<RobustnessRow> robustness;
+  std::vector<ReviewItem> review;
+  double hessian_condition = std::numeric_limits<double>::quiet_NaN();   ///< mpc/dmc
+  double steady_state_error = std::numeric_limits<double>::quiet_NaN();  ///< after the load step
+  int evaluations = 0;  ///< closed-loop simulations run
+  AutoTuneTermination termination = AutoTuneTermination::kFailure;
+  std::string message;
+
+  /// The TuningResult of these settings (rule explicit; mpc/dmc), for
+  /// MakeController and the like.
+  TuningResult ToTuningResult() const;
+  /// One line per setting, metric, robustness row and review item.
+  std::string FullReport() const;
+  /// The JSON form of `pneumid tune --rule auto --json`: rule ("auto"),
+  /// controller, P, M, lambda (null for pid), Kc, Ti, Td, b, N (pid),
+  /// Ts, specification, predicted, robustness, review, termination, message.
+  /// NaN and infinity are written as null.
+  nlohmann::ordered_json ToJson() const;
+};
+
+/// Settings of options.controller for `model` sampled at Ts (file comment).
+/// A specification that cannot be met is not an error: the result holds the
+/// best design, a review with status kFail that says why, and termination
+/// kSpecNotMet.
+/// @throws InvalidArgument for invalid options, Ts <= 0, a discrete model
+/// with another sample time, or a model FopdtFromModel rejects (unstable,
+/// zero static gain).
+AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTuneOptions& options);
+
+}  // namespace pneumid

@@ -1,0 +1,261 @@
+// Tuning to specifications (auto_tuning.hpp): the designs meet their targets
+// on the model, survive the robustness cases, and a spec that cannot be met
+// is reported as such.
+#include "pneumid/control/auto_tuning.hpp"
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/lti/frequency.hpp"
+#include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/linear_plant.hpp"
+
+namespace pneumid {
+namespace {
+
+constexpr double kTs = 0.01;
+
+// The paper's FOPDT 1.6 exp(-0.001 s) / (0.245 s + 1) and a second-order
+// model with a little dead time.
+TransferFunction Fopdt() { return PaperFopdtModel(); }
+TransferFunction SecondOrder() { return TransferFunction::Sopdt(2.0, 0.4, 0.15, 0.02); }
+
+std::string Describe(const AutoTuneResult& r) { return r.FullReport(); }
+
+const ReviewItem* Find(const AutoTuneResult& r, const std::string& check) {
+  for (const ReviewItem& item : r.review)
+    if (item.check == check) return &item;
+  return nullptr;
+}
+
+void ExpectMeetsSpec(const AutoTuneResult& r, double t_target, double os_max) {
+  SCOPED_TRACE(Describe(r));
+  EXPECT_EQ(r.termination, AutoTuneTermination::kConverged);
+  EXPECT_TRUE(r.predicted.settled);
+  EXPECT_LE(r.predicted.overshoot_percent, os_max + 0.05);
+  EXPECT_NEAR(r.predicted.response_time / t_target, 1.0, 0.2);
+  ASSERT_EQ(r.robustness.size(), 3u);
+  for (const RobustnessRow& row : r.robustness) EXPECT_TRUE(row.pass) << row.name;
+  for (const ReviewItem& item : r.review) EXPECT_NE(item.status, ReviewStatus::kFail) << item.check;
+  ASSERT_NE(Find(r, "offset-free"), nullptr);
+  EXPECT_EQ(Find(r, "offset-free")->status, ReviewStatus::kOk);
+  EXPECT_LE(std::abs(r.steady_state_error), 1e-3 * 0.2 * std::abs(r.step_to - r.step_from));
+}
+
+struct Case {
+  const char* name;
+  ControllerType type;
+  bool second_order;
+};
+
+class PredictiveAutoTuneTest : public ::testing::TestWithParam<Case> {};
+
+TEST_P(PredictiveAutoTuneTest, MeetsOvershootAndResponseTimeWithRobustness) {
+  const Case c = GetParam();
+  AutoTuneOptions o;
+  o.controller = c.type;
+  const TransferFunction g = c.second_order ? SecondOrder() : Fopdt();
+  const AutoTuneResult r = AutoTune(g, kTs, o);
+  // Default target: the FOPDT's tau + theta as a 10-90 % rise time.
+  EXPECT_NEAR(r.response_time_target, r.fopdt.tau + r.fopdt.theta, 1e-12);
+  ExpectMeetsSpec(r, r.response_time_target, 5.0);
+  EXPECT_GT(r.lambda, 0.0);
+  if (!c.second_order) {
+    EXPECT_EQ(r.P, 126);  // Shridhar-Cooper, as tuning_test.cpp
+    EXPECT_EQ(r.M, 5);
+  }
+}
+
+TEST_P(PredictiveAutoTuneTest, ExplicitTargetAndLimits) {
+  const Case c = GetParam();
+  AutoTuneOptions o;
+  o.controller = c.type;
+  o.response_time = c.second_order ? 0.5 : 0.35;
+  o.max_overshoot = 2.0;
+  o.limits.u_min = 0.0;
+  o.limits.u_max = 100.0;
+  const TransferFunction g = c.second_order ? SecondOrder() : Fopdt();
+  const AutoTuneResult r = AutoTune(g, kTs, o);
+  ExpectMeetsSpec(r, o.response_time, 2.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, PredictiveAutoTuneTest,
+                         ::testing::Values(Case{"mpc_fopdt", ControllerType::kMpc, false},
+                                           Case{"dmc_fopdt", ControllerType::kDmc, false},
+                                           Case{"mpc_second_order", ControllerType::kMpc, true},
+                                           Case{"dmc_second_order", ControllerType::kDmc, true}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// Loop L(e^{jwTs}) = C(z) G(z) computed here from the PID law of pid.hpp
+// (integral of the previous errors, derivative on y filtered by N) and the
+// zoh-sampled model, independently of the library's design code.
+std::complex<double> Loop(const AutoTuneResult& r, const TransferFunction& Gd, double w) {
+  const std::complex<double> z = std::exp(std::complex<double>(0.0, w * kTs));
+  const double Kc = r.pid.Kc, Ti = r.pid.Ti, Td = r.pid.Td, N = r.derivative_filter;
+  std::complex<double> c = 1.0 + kTs / Ti / (z - 1.0);
+  if (Td > 0.0) c += N * Td * (z - 1.0) / ((Td + N * kTs) * z - Td);
+  return Kc * c * Gd.FrequencyResponse(w);
+}
+
+void ExpectMargins(const AutoTuneResult& r, const TransferFunction& g) {
+  SCOPED_TRACE(Describe(r));
+  const TransferFunction Gd = LinearPlant(g, kTs).model();
+  // |L| = 1 by bisection between wc/3 and 3 wc (|L| decreases there).
+  double lo = r.crossover_target / 3.0, hi = r.crossover_target * 3.0;
+  ASSERT_GT(std::abs(Loop(r, Gd, lo)), 1.0);
+  ASSERT_LT(std::abs(Loop(r, Gd, hi)), 1.0);
+  for (int i = 0; i < 100; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    (std::abs(Loop(r, Gd, mid)) > 1.0 ? lo : hi) = mid;
+  }
+  const double wc = std::sqrt(lo * hi);
+  EXPECT_NEAR(wc / r.crossover_target, 1.0, 0.1);
+  // Phase of L at wc: the continuous phase of the zoh model (Bode) plus the
+  // controller's angle, which lies within (-180, 180).
+  const Eigen::VectorXd grid = LogSpace(std::log10(wc) - 4.0, std::log10(wc), 400);
+  const BodeData b = Bode(Gd, grid);
+  const std::complex<double> c = Loop(r, Gd, wc) / Gd.FrequencyResponse(wc);
+  const double phase = b.phase_deg(grid.size() - 1) + std::arg(c) * 180.0 / std::numbers::pi;
+  EXPECT_NEAR(180.0 + phase, r.phase_margin_target, 2.0);
+  EXPECT_NEAR(r.phase_margin, r.phase_margin_target, 2.0);
+}
+
+TEST(PidAutoTuneTest, FopdtPiMeetsPhaseMarginAndCrossover) {
+  AutoTuneOptions o;
+  o.controller = ControllerType::kPid;
+  const AutoTuneResult r = AutoTune(Fopdt(), kTs, o);
+  EXPECT_EQ(r.pid.Td, 0.0);  // a PI suffices for a first-order model
+  EXPECT_NEAR(r.phase_margin_target, 60.0, 1e-12);
+  EXPECT_NEAR(r.crossover_target, 2.0 / r.response_time_aimed, 1e-12);
+  ExpectMargins(r, Fopdt());
+  EXPECT_EQ(Find(r, "offset-free")->status, ReviewStatus::kOk);
+  // A PI with a 60 deg margin on a first-order lag is an underdamped second-
+  // order loop (zeta about 0.6): about 10 % overshoot even with b = 0, which
+  // the review states.
+  EXPECT_EQ(r.setpoint_weight, 0.0);
+  EXPECT_EQ(Find(r, "specification")->status, ReviewStatus::kFail);
+  EXPECT_THAT(Find(r, "specification")->message, ::testing::HasSubstr("overshoot"));
+  // The robust end of the knob (75 deg) meets the 5 % overshoot.
+  o.aggressiveness = 0.0;
+  const AutoTuneResult robust = AutoTune(Fopdt(), kTs, o);
+  ExpectMargins(robust, Fopdt());
+  EXPECT_LE(robust.predicted.overshoot_percent, 5.05) << Describe(robust);
+  for (const RobustnessRow& row : robust.robustness)
+    EXPECT_TRUE(row.pass) << row.name << Describe(robust);
+}
+
+TEST(PidAutoTuneTest, SecondOrderNeedsPidAndMeetsMargins) {
+  AutoTuneOptions o;
+  o.controller = ControllerType::kPid;
+  o.response_time = 0.2;
+  const AutoTuneResult r = AutoTune(SecondOrder(), kTs, o);
+  EXPECT_GT(r.pid.Td, 0.0) << Describe(r);
+  ExpectMargins(r, SecondOrder());
+  EXPECT_EQ(Find(r, "offset-free")->status, ReviewStatus::kOk);
+}
+
+TEST(PidAutoTuneTest, KnobSetsPhaseMargin) {
+  AutoTuneOptions o;
+  o.controller = ControllerType::kPid;
+  o.aggressiveness = 0.0;
+  const AutoTuneResult robust = AutoTune(Fopdt(), kTs, o);
+  EXPECT_NEAR(robust.phase_margin_target, 75.0, 1e-12);
+  ExpectMargins(robust, Fopdt());
+  o.aggressiveness = 1.0;
+  const AutoTuneResult aggressive = AutoTune(Fopdt(), kTs, o);
+  EXPECT_NEAR(aggressive.phase_margin_target, 45.0, 1e-12);
+  ExpectMargins(aggressive, Fopdt());
+  EXPECT_GT(aggressive.crossover, robust.crossover);
+}
+
+TEST(AutoTuneTest, AggressivenessShiftsTheMpcDesign) {
+  AutoTuneOptions o;
+  o.aggressiveness = 0.0;
+  const AutoTuneResult robust = AutoTune(Fopdt(), kTs, o);
+  o.aggressiveness = 1.0;
+  const AutoTuneResult aggressive = AutoTune(Fopdt(), kTs, o);
+  EXPECT_GT(robust.lambda, aggressive.lambda);
+  EXPECT_GT(robust.predicted.rise_time, aggressive.predicted.rise_time);
+}
+
+// On the IPA scale (duty 0..100 %, force in N), a 10-90 % rise in 1 ms is
+// below one sample and beyond what the valve can do.
+TEST(AutoTuneTest, ImpossibleResponseTimeIsReviewedAsFail) {
+  for (ControllerType type : {ControllerType::kMpc, ControllerType::kDmc, ControllerType::kPid}) {
+    AutoTuneOptions o;
+    o.controller = type;
+    o.response_time = 0.001;
+    o.limits.u_min = 0.0;
+    o.limits.u_max = 100.0;
+    const AutoTuneResult r = AutoTune(Fopdt(), kTs, o);
+    SCOPED_TRACE(Describe(r));
+    EXPECT_NE(r.termination, AutoTuneTermination::kConverged);
+    const ReviewItem* spec = Find(r, "specification");
+    ASSERT_NE(spec, nullptr);
+    EXPECT_EQ(spec->status, ReviewStatus::kFail);
+    EXPECT_THAT(spec->message, ::testing::HasSubstr("slower than the target"));
+    EXPECT_THAT(r.message, ::testing::HasSubstr("specification not met"));
+    if (type != ControllerType::kPid) {
+      EXPECT_THAT(spec->message, ::testing::HasSubstr("dead time plus one sample"));
+      EXPECT_THAT(spec->message, ::testing::HasSubstr("input held at its limit"));
+    }
+  }
+}
+
+TEST(AutoTuneTest, ZeroOvershootWithImpossibleTimeFails) {
+  AutoTuneOptions o;
+  o.max_overshoot = 0.0;
+  o.response_time = 0.005;
+  const AutoTuneResult r = AutoTune(SecondOrder(), kTs, o);
+  SCOPED_TRACE(Describe(r));
+  EXPECT_EQ(r.termination, AutoTuneTermination::kSpecNotMet);
+  EXPECT_EQ(Find(r, "specification")->status, ReviewStatus::kFail);
+  EXPECT_LE(r.predicted.overshoot_percent, 0.05);
+}
+
+TEST(AutoTuneTest, JsonHasTheDocumentedKeys) {
+  const AutoTuneResult r = AutoTune(Fopdt(), kTs, AutoTuneOptions{});
+  const nlohmann::ordered_json j = r.ToJson();
+  for (const char* key : {"rule", "controller", "P", "M", "lambda", "predicted", "robustness",
+                          "review", "termination", "message"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["rule"], "auto");
+  EXPECT_EQ(j["robustness"].size(), 3u);
+  EXPECT_EQ(r.ToTuningResult().P, r.P);
+}
+
+TEST(AutoTuneTest, BadOptionsThrow) {
+  auto expect_throw = [](AutoTuneOptions o, const std::string& what) {
+    EXPECT_THAT([&] { AutoTune(Fopdt(), kTs, o); },
+                ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr(what)));
+  };
+  AutoTuneOptions o;
+  o.controller = ControllerType::kGpc;
+  expect_throw(o, "not gpc");
+  o = {};
+  o.response_time = -1.0;
+  expect_throw(o, "response_time must be positive");
+  o = {};
+  o.max_overshoot = -1.0;
+  expect_throw(o, "max_overshoot");
+  o = {};
+  o.aggressiveness = 1.5;
+  expect_throw(o, "aggressiveness must be in [0, 1]");
+  o = {};
+  o.limits.u_min = 5.0;
+  o.limits.u_max = 1.0;
+  expect_throw(o, "input limits");
+  EXPECT_THROW(AutoTune(Fopdt(), 0.0, AutoTuneOptions{}), InvalidArgument);
+  // Unstable model.
+  EXPECT_THROW(AutoTune(TransferFunction::Continuous({1.0}, {1.0, -1.0}), kTs, AutoTuneOptions{}),
+               InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pneumid
