@@ -277,6 +277,9 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
   std::function<std::unique_ptr<Controller>()> make_final;
   Eigen::MatrixXd hessian;
   std::unique_ptr<PredictionModel> pm_ptr;  // outlive make_final
+  // mpc/dmc: the response time of lambda_f, the fastest robust design.
+  double t_fastest = std::numeric_limits<double>::quiet_NaN();
+  double lambda_fastest = t_fastest;
   StateSpace ss;
 
   if (options.controller == ControllerType::kMpc || options.controller == ControllerType::kDmc) {
@@ -353,7 +356,9 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
         auto c = make(lambda);
         return OrInf(ev.Run(*c, 0).response_time);
       };
-      if (time_of(lambda_f) < t_aim) {
+      lambda_fastest = lambda_f;
+      t_fastest = time_of(lambda_f);
+      if (t_fastest < t_aim) {
         // Bracket t(lambda) = t* above lambda_f, then bisect in log lambda.
         double lo = std::log(lambda_f), hi = lo;
         bool bracketed = false;
@@ -381,7 +386,7 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
         // Even lambda_f is too slow: the response is limited by the model,
         // the horizons or the actuator, and flat in lambda. Take the largest
         // lambda that is hardly slower (2 % of t*): better conditioned, as fast.
-        const double t_f = time_of(lambda_f);
+        const double t_f = t_fastest;
         const double t_ok = t_f + 0.02 * t_aim;
         double lo = std::log(lambda_f), hi = lo;
         bool bracketed = false;
@@ -629,6 +634,13 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
       if (options.controller != ControllerType::kPid || std::abs(rel) > 1.0) warn_only = false;
       // Why it cannot be faster: sample time, dead time, actuator.
       if (rel > 0) {
+        if (std::isfinite(t_fastest) && t_fastest > (1.0 + kTimeTolerance) * t_aim)
+          why.push_back(
+              fmt::format("the fastest design within the overshoot and robustness "
+                          "limits (lambda = {:.4g}) responds in {:.4g} s",
+                          lambda_fastest, t_fastest));
+        else if (options.controller != ControllerType::kPid && std::isnan(lambda_fastest))
+          why.push_back("no lambda meets the overshoot and robustness limits");
         const double t_min_delay = f.theta + Ts;
         if (t_aim < t_min_delay)
           why.push_back(

@@ -216,6 +216,8 @@ TEST(AutoTuneTest, ZeroOvershootWithImpossibleTimeFails) {
   SCOPED_TRACE(Describe(r));
   EXPECT_EQ(r.termination, AutoTuneTermination::kSpecNotMet);
   EXPECT_EQ(Find(r, "specification")->status, ReviewStatus::kFail);
+  EXPECT_THAT(Find(r, "specification")->message,
+              ::testing::HasSubstr("fastest design within the overshoot and robustness limits"));
   EXPECT_LE(r.predicted.overshoot_percent, 0.05);
 }
 
