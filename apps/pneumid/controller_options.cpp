@@ -11,8 +11,20 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
                  "integrating output disturbance; a QP when a limit is set)")
       ->capture_default_str();
   app.add_option("--rule", s.rule,
-                 "Tuning rule: shridhar-cooper (conventional), paper-modified, explicit "
-                 "(default: shridhar-cooper, or explicit when --P --M --lambda are all given)");
+                 "Tuning rule: shridhar-cooper (conventional), paper-modified, explicit, or auto "
+                 "(mpc, dmc, pid: tuned to --response-time and --overshoot by closed-loop "
+                 "search, `pneumid tune --rule auto` shows the design review) (default: "
+                 "shridhar-cooper, or explicit when --P --M --lambda are all given)");
+  app.add_option("--response-time", s.response_time,
+                 "--rule auto: target 10-90 % rise time in s (default: from the model)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--overshoot", s.overshoot, "--rule auto: largest overshoot in %")
+      ->capture_default_str()
+      ->check(NonNegative());
+  app.add_option("--aggressiveness", s.aggressiveness,
+                 "--rule auto: 0 robust .. 1 aggressive")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--P", s.P, "Prediction horizon (samples)")->check(AtLeast(1));
   app.add_option("--M", s.M, "Control horizon (samples)")->check(AtLeast(1));
   app.add_option("--lambda", s.lambda, "Move suppression")->check(NonNegative());
@@ -20,6 +32,11 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
                "DMC: optimize the moves under the input limits (QDMC, QP solver) instead of "
                "clipping (MPC always does when a limit is set)");
   app.add_option("--pid-rule", s.pid_rule, "PID tuning: simc or imc")->capture_default_str();
+  app.add_option("--disturbance", s.disturbance,
+                 "MPC disturbance model for offset-free tracking: output (an integrating "
+                 "output disturbance), input (at the plant input) or none")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"output", "input", "none"}));
 }
 
 }  // namespace pneumid::cli

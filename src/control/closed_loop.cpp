@@ -134,7 +134,15 @@ ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen
   };
   for (std::size_t c = 0; c < changes.size(); ++c) {
     const Eigen::Index k0 = changes[c];
-    const Eigen::Index k1 = c + 1 < changes.size() ? changes[c + 1] : n;
+    Eigen::Index k1 = c + 1 < changes.size() ? changes[c + 1] : n;
+    // The step's window ends at a load step inside it: what follows is the
+    // disturbance response (load_peak_deviation, load_recovery_time), not
+    // the set-point response.
+    for (const LoadStep& l : options.load_steps) {
+      Eigen::Index k = k0 + 1;
+      while (k < k1 && t(k) - t(0) < l.at - 1e-9 * Ts) ++k;
+      if (k > k0 + 1 && k < k1) k1 = k;
+    }
     StepMetrics s;
     s.time = t(k0);
     s.from = k0 > 0 ? r(k0 - 1) : r_before;

@@ -1,5 +1,7 @@
 #include "pneumid/control/controller_factory.hpp"
 
+#include <optional>
+
 #include <cmath>
 #include <sstream>
 #include <vector>
@@ -24,7 +26,14 @@ TuningRule InferTuningRule(const std::string& rule, int P, int M, double lambda)
 ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   ControllerSpec spec;
   spec.type = ControllerTypeFromString(settings.controller);
-  spec.tuning.rule = InferTuningRule(settings.rule, settings.P, settings.M, settings.lambda);
+  spec.auto_tune = settings.rule == "auto";
+  spec.tuning.rule = spec.auto_tune
+                         ? TuningRule::kShridharCooper
+                         : InferTuningRule(settings.rule, settings.P, settings.M, settings.lambda);
+  spec.auto_options.response_time = settings.response_time;
+  spec.auto_options.max_overshoot = settings.overshoot;
+  spec.auto_options.aggressiveness = settings.aggressiveness;
+  spec.auto_options.M = settings.M;
   spec.tuning.P = settings.P;
   spec.tuning.M = settings.M;
   spec.tuning.lambda = settings.lambda;
@@ -35,6 +44,7 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   spec.t_filter = settings.t_filter;
   spec.pid_rule = PidTuningRuleFromString(settings.pid_rule);
   spec.tau_c = settings.tau_c;
+  spec.disturbance = DisturbanceModelFromString(settings.disturbance);
   return spec;
 }
 
@@ -43,12 +53,17 @@ std::string BuiltController::Label() const {
 }
 
 std::string BuiltController::Summary() const {
+  const std::string tail = auto_summary.empty() ? "" : "; auto: " + auto_summary;
+  if (type == ControllerType::kPid && !auto_summary.empty())
+    return fmt::format("pid auto from FOPDT K={:g} tau={:g} theta={:g}: Kc={:g} Ti={:g} Td={:g}{}",
+                       fopdt.K, fopdt.tau, fopdt.theta, pid_gains.Kc, pid_gains.Ti, pid_gains.Td,
+                       tail);
   if (type == ControllerType::kPid)
     return fmt::format("pid {} from FOPDT K={:g} tau={:g} theta={:g} ({}): Kc={:g} Ti={:g} Td={:g}",
                        ToString(pid_rule), fopdt.K, fopdt.tau, fopdt.theta, fopdt.method,
                        pid_gains.Kc, pid_gains.Ti, pid_gains.Td);
-  return fmt::format("{}: P={} M={} lambda={:g}; {}", ToString(tuning.rule), tuning.P, tuning.M,
-                     tuning.lambda, tuning.formula);
+  return fmt::format("{}: P={} M={} lambda={:g}; {}{}", ToString(tuning.rule), tuning.P, tuning.M,
+                     tuning.lambda, tuning.formula, tail);
 }
 
 nlohmann::ordered_json BuiltController::SettingsToJson() const {
@@ -68,8 +83,38 @@ nlohmann::ordered_json BuiltController::SettingsToJson() const {
   return j;
 }
 
+namespace {
+
+// The spec's tuning replaced by the auto-tuner's design (rule "auto").
+AutoTuneResult AutoTuned(const TransferFunction& model, double Ts, const ControllerSpec& spec) {
+  PNEUMID_CHECK(spec.type != ControllerType::kGpc,
+                "--rule auto tunes mpc, dmc and pid; for gpc give a tuning rule");
+  AutoTuneOptions o = spec.auto_options;
+  o.controller = spec.type;
+  o.limits = spec.limits;
+  return AutoTune(model, Ts, o);
+}
+
+}  // namespace
+
 BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec) {
+  if (spec.auto_tune && spec.type == ControllerType::kPid) {
+    const AutoTuneResult a = AutoTuned(model, Ts, spec);
+    BuiltController b;
+    b.type = spec.type;
+    b.pid_rule = spec.pid_rule;
+    b.fopdt = FopdtFromModel(model);
+    b.pid_gains = a.pid;
+    b.auto_summary = a.message;
+    PidOptions o;
+    o.gains = a.pid;
+    o.setpoint_weight = a.setpoint_weight;
+    o.derivative_filter = a.derivative_filter;
+    o.limits = spec.limits;
+    b.controller = std::make_unique<PidController>(Ts, o);
+    return b;
+  }
   // A PID is tuned from the continuous FOPDT description; it needs no sampled model.
   if (spec.type == ControllerType::kPid) {
     BuiltController b;
@@ -86,8 +131,24 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
   return MakeController(PredictionModel(model, Ts), spec);
 }
 
-BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec) {
+BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec_in) {
+  if (spec_in.auto_tune && spec_in.type == ControllerType::kPid)
+    return MakeController(model.model(), model.Ts(), spec_in);
+  ControllerSpec spec = spec_in;
+  std::string auto_summary;
+  std::optional<TuningResult> auto_tuning;
+  if (spec.auto_tune) {
+    const AutoTuneResult a = AutoTuned(model.model(), model.Ts(), spec);
+    auto_tuning = a.ToTuningResult();
+    spec.auto_tune = false;
+    spec.tuning.rule = TuningRule::kExplicit;
+    spec.tuning.P = a.P;
+    spec.tuning.M = a.M;
+    spec.tuning.lambda = a.lambda;
+    auto_summary = a.message;
+  }
   BuiltController b;
+  b.auto_summary = auto_summary;
   b.type = spec.type;
   b.pid_rule = spec.pid_rule;
   switch (spec.type) {
@@ -134,12 +195,14 @@ BuiltController MakeController(const PredictionModel& model, const ControllerSpe
       o.limits = spec.limits;
       o.y_min = spec.y_min;
       o.y_max = spec.y_max;
+      o.disturbance = spec.disturbance;
       b.controller = std::make_unique<MpcController>(model.model(), model.Ts(), o);
       break;
     }
     case ControllerType::kPid:
       return MakeController(model.model(), model.Ts(), spec);
   }
+  if (auto_tuning) b.tuning = *auto_tuning;
   return b;
 }
 

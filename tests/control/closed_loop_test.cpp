@@ -126,6 +126,28 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
   EXPECT_TRUE(j["steps"][0]["first_move"].is_null());
 }
 
+// A load step inside a set-point segment ends the step's window: the dip it
+// causes is the load response, not overshoot of the set-point step.
+TEST(ClosedLoopMetricsTest, LoadStepEndsTheStepWindow) {
+  const int n = 400;
+  Eigen::VectorXd t(n), r = Eigen::VectorXd::Constant(n, 100.0), y(n), u = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < n; ++k) {
+    t[k] = 0.01 * k;
+    y[k] = 100.0 * (1.0 - std::exp(-t[k] / 0.1)) - (t[k] >= 2.0 ? 30.0 * std::exp(-(t[k] - 2.0) / 0.1) : 0.0);
+  }
+  ClosedLoopOptions o;
+  o.duration = 4.0;
+  o.load_steps.push_back({2.0, -30.0});
+  const ClosedLoopMetrics m = ComputeClosedLoopMetrics(t, r, y, u, 0.0, 0.0, o);
+  ASSERT_EQ(m.steps.size(), 1u);
+  EXPECT_NEAR(m.overshoot_percent, 0.0, 1e-9);
+  EXPECT_NEAR(m.settling_time, 0.1 * std::log(50.0), 0.01);
+  EXPECT_NEAR(m.load_peak_deviation, -30.0, 0.5);
+  // Not told of the load step, the dip counts against the step's settling.
+  o.load_steps.clear();
+  EXPECT_GT(ComputeClosedLoopMetrics(t, r, y, u, 0.0, 0.0, o).settling_time, 2.0);
+}
+
 // The plant's input range applies by default, and a controller clipped by it
 // behaves exactly as one given the same limits itself: Applied() makes its
 // internal state (DMC prediction, GPC filtered moves, PID integral) follow the

@@ -14,7 +14,8 @@
 //
 // Metrics (errors e = r - y use the plant output without the added noise):
 //   rise_time, overshoot_percent, settling_time: of the response to the
-//     first set-point change, over the samples until the next change
+//     first set-point change, over the samples until the next change or a
+//     load step, whichever comes first
 //     (ComputeStepInfo of lti/response.hpp with y_initial = the previous
 //     set-point, y_final = the new one; times from the change), NaN when the
 //     set-point never changes or the response never settles in the window;

@@ -22,6 +22,8 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "pneumid/control/controller.hpp"
+#include "pneumid/control/auto_tuning.hpp"
+#include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
 #include "pneumid/control/prediction_model.hpp"
 #include "pneumid/control/tuning.hpp"
@@ -39,6 +41,12 @@ struct ControllerSpec {
   std::string t_filter = "1";  ///< gpc
   PidTuningRule pid_rule = PidTuningRule::kSimc;
   double tau_c = 0.0;  ///< pid closed-loop time constant (s); <= 0 = rule default
+  DisturbanceModel disturbance = DisturbanceModel::kOutput;  ///< mpc (mpc.hpp)
+  /// Tune from specifications (auto_tuning.hpp) instead of the tuning rule:
+  /// mpc and dmc get P, M, lambda, pid its gains; auto_options.controller and
+  /// .limits are taken from type and limits.
+  bool auto_tune = false;
+  AutoTuneOptions auto_options;
 };
 
 /// Controller settings as a user states them (command line, configuration,
@@ -57,6 +65,11 @@ struct ControllerSettings {
   std::string t_filter = "1";
   std::string pid_rule = "simc";
   double tau_c = 0.0;
+  std::string disturbance = "output";  ///< mpc: output, input or none
+  /// rule "auto": the specifications (auto_tuning.hpp; NaN = from the model).
+  double response_time = std::numeric_limits<double>::quiet_NaN();
+  double overshoot = 5.0;
+  double aggressiveness = 0.5;
 };
 
 /// The tuning rule settings ask for: the named rule when `rule` is not empty;
@@ -77,6 +90,8 @@ struct BuiltController {
   PidTuningRule pid_rule = PidTuningRule::kSimc;  ///< (pid)
   PidGains pid_gains;     ///< (pid)
   FopdtEstimate fopdt;  ///< the FOPDT the PID was tuned from (pid)
+  /// Rule "auto": the auto-tuner's message (what it met or why not).
+  std::string auto_summary;
 
   /// "pid" for a PID, else the tuning rule's name (as in a comparison table).
   std::string Label() const;
