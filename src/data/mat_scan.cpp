@@ -222,10 +222,11 @@ class Scanner {
   /// logical) or one 8-byte tag (cell, struct field).
   void CheckElementCount(std::uint32_t cls, double elements, const std::string& dims,
                          std::uint64_t nbytes) const {
-    if (cls == kClassSparse || cls == kClassObject || cls == kClassFunction ||
-        cls == kClassOpaque) {
-      return;  // sizes not tied to the dimensions
-    }
+    // Sparse, object and opaque arrays store sizes not tied to the
+    // dimensions. Function handles are checked like numeric arrays: matio
+    // allocates their dimensions' worth of doubles (a 416-byte file with a
+    // 1296629765x1 function-class array made it ask for 10 GB).
+    if (cls == kClassSparse || cls == kClassObject || cls == kClassOpaque) return;
     const double min_bytes = (cls == kClassCell || cls == kClassStruct ? 8.0 : 1.0) * elements;
     if (min_bytes > static_cast<double>(nbytes)) {
       Fail(

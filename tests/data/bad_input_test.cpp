@@ -288,6 +288,22 @@ TEST_F(BadInputTest, MatDimensionsOfTheWrongTypeAreRejected) {
               ThrowsMessage<DataError>(HasSubstr("not miINT32 (5)")));
 }
 
+TEST_F(BadInputTest, MatFunctionClassDimensionsAreCheckedLikeNumericOnes) {
+  // Found by mat_fuzz: a function-class (16) array claiming 1296629765x1
+  // elements in 88 bytes; matio allocated 10 GB of doubles for it.
+  std::string flags, dims;
+  PutU32(&flags, 16);  // mxFUNCTION_CLASS
+  PutU32(&flags, 0);
+  PutU32(&dims, 1296629765);
+  PutU32(&dims, 1);
+  const std::string bad = Element(14, Element(6, flags) + Element(5, dims) + Element(1, "t") +
+                                          Element(9, std::string(40, '\0')));
+  const std::string path = Write("function_dims.mat", MatHeader() + bad);
+  EXPECT_THAT([&] { ReadMat(path); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("claims dimensions 1296629765x1"),
+                                             HasSubstr("the file is corrupt"))));
+}
+
 TEST_F(BadInputTest, MatVariableListIsCappedAndLongNamesAreExcerpts) {
   std::string file = MatHeader();
   for (int i = 0; i < 30; ++i) file += DoubleMatrix(fmt::format("v{}", i), 1, 1, {1.0});
