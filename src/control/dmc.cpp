@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
+#include "move_qp_bounds.hpp"
 #include "pneumid/common/check.hpp"
 
 namespace pneumid {
@@ -168,24 +169,8 @@ double DmcController::Update(double setpoint, double measurement) {
     err_ -= free_;
     g_.head(M).noalias() = -AtQ_ * err_;
     if (soft_output_) g_(M) = options_.slack_linear_weight;
-    int row = 0;
-    if (std::isfinite(lim.u_min) || std::isfinite(lim.u_max)) {
-      lb_.head(M).setConstant(lim.u_min - u_prev_);
-      ub_.head(M).setConstant(lim.u_max - u_prev_);
-      row += M;
-    }
-    constexpr double kInf = std::numeric_limits<double>::infinity();
-    if (std::isfinite(options_.y_min)) {
-      lb_.segment(row, P).setConstant(options_.y_min);
-      lb_.segment(row, P) -= free_;
-      ub_.segment(row, P).setConstant(kInf);
-      row += P;
-    }
-    if (std::isfinite(options_.y_max)) {
-      lb_.segment(row, P).setConstant(-kInf);
-      ub_.segment(row, P).setConstant(options_.y_max);
-      ub_.segment(row, P) -= free_;
-    }
+    internal::FillMoveQpBounds(std::isfinite(lim.u_min) || std::isfinite(lim.u_max), lim, u_prev_,
+                               options_.y_min, options_.y_max, free_, M, P, lb_, ub_);
     const QpSummary& s = qp_->Solve(g_, lb_, ub_, lbx_, ubx_);
     if (s.status == QpStatus::kSolved) {
       du = qp_->x()(0);

@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
+#include "move_qp_bounds.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/enum_names.hpp"
 #include "pneumid/lti/conversion.hpp"
@@ -348,23 +349,8 @@ double MpcController::Update(double setpoint, double measurement) {
       g_.head(M).noalias() = Gz_ * z_post_;
       g_.head(M) += Gu_ * u_prev_ + Gr_ * setpoint + Gs_ * us;
       if (soft_output_) g_(M) = options_.slack_linear_weight;
-      int row = 0;
-      if (u_rows_) {
-        lb_.head(M).setConstant(lim.u_min - u_prev_);
-        ub_.head(M).setConstant(lim.u_max - u_prev_);
-        row += M;
-      }
-      if (std::isfinite(options_.y_min)) {
-        lb_.segment(row, P).setConstant(options_.y_min);
-        lb_.segment(row, P) -= free_;
-        ub_.segment(row, P).setConstant(kInf);
-        row += P;
-      }
-      if (std::isfinite(options_.y_max)) {
-        lb_.segment(row, P).setConstant(-kInf);
-        ub_.segment(row, P).setConstant(options_.y_max);
-        ub_.segment(row, P) -= free_;
-      }
+      internal::FillMoveQpBounds(u_rows_, lim, u_prev_, options_.y_min, options_.y_max, free_, M,
+                                 P, lb_, ub_);
       const QpSummary& s = qp_->Solve(g_, lb_, ub_, lbx_, ubx_);
       if (s.status == QpStatus::kSolved) {
         moves_ = qp_->x().head(M);
