@@ -52,15 +52,6 @@ struct ControlCli {
   std::string compare;
 };
 
-LoadStep ParseLoadStep(const std::string& text) {
-  Spec fields("--load-step", text, {.has_kind = false});
-  LoadStep l;
-  l.at = fields.Number("at");
-  l.size = fields.Number("size");
-  fields.Finish();
-  return l;
-}
-
 struct Run {
   BuiltController built;
   ClosedLoopResult result;
@@ -177,7 +168,7 @@ void WritePlot(const std::string& path, const std::vector<Run>& runs, const Cont
   options.labels.input = in.unit == "%" ? "Duty cycle u [%]" : "Input u";
   options.title = fmt::format("{} on {} (model {}, Ts = {:g} s)", TypeName(runs[0].built.type),
                               plant_spec, c.model, c.Ts);
-  if (!c.load_steps.empty()) options.disturbance_time = ParseLoadStep(c.load_steps[0]).at;
+  if (!c.load_steps.empty()) options.disturbance_time = ParseLoadStep("--load-step", c.load_steps[0]).at;
   std::vector<ClosedLoopTrace> traces;
   for (const Run& r : runs) traces.push_back({ControllerLabel(r.built), r.result.y, r.result.u});
   ClosedLoopFigure(runs[0].result.t, runs[0].result.r, traces, options).Save(path);
@@ -192,7 +183,7 @@ void Execute(const ControlCli& c) {
   cl.duration = c.duration;
   cl.noise_std = c.noise;
   cl.seed = c.seed;
-  for (const std::string& l : c.load_steps) cl.load_steps.push_back(ParseLoadStep(l));
+  for (const std::string& l : c.load_steps) cl.load_steps.push_back(ParseLoadStep("--load-step", l));
   PlantOptions po;
   po.seed = c.seed;
   const std::string plant_spec = c.plant.empty() ? c.model : c.plant;

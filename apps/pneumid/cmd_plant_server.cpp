@@ -6,15 +6,16 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "command.hpp"
-#include "validators.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/realtime/plant_server.hpp"
 #include "pneumid/realtime/realtime_loop.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -28,6 +29,7 @@ struct ServerOptions {
   std::uint64_t seed = 1;
   std::optional<double> noise;
   std::int64_t stop_answering_after = -1;
+  std::vector<std::string> load_steps;
 };
 
 void Serve(const ServerOptions& o) {
@@ -40,6 +42,8 @@ void Serve(const ServerOptions& o) {
   so.bind_address = o.bind;
   so.port = o.port;
   so.stop_answering_after = o.stop_answering_after;
+  for (const std::string& l : o.load_steps)
+    so.load_steps.push_back(ParseLoadStep("--load-step", l));
   PlantServer server(MakePlant(o.plant, o.Ts, po), so);
   InstallStopSignalHandlers();
   ClearStopRequest();
@@ -75,11 +79,13 @@ static Registrar reg(
           ->capture_default_str()
           ->check(Positive());
       app.add_option("--seed", o->seed, "noise seed")->capture_default_str();
-      app.add_option("--noise", o->noise, "measurement noise (output units)")
-          ->check(NonNegative());
+      app.add_option("--noise", o->noise, "measurement noise (output units)")->check(NonNegative());
       app.add_option("--stop-answering-after", o->stop_answering_after,
                      "fault drill: go silent after this many steps (-1: never)")
           ->capture_default_str();
+      app.add_option("--load-step", o->load_steps,
+                     "load disturbance on the output at=T,size=D (repeatable), T in plant time "
+                     "since the client's session began");
       app.callback([o] { Serve(*o); });
     });
 

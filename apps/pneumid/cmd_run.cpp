@@ -6,14 +6,13 @@
 #include <iostream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
 #include "controller_options.hpp"
-#include "validators.hpp"
-#include "realtime_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller.hpp"
@@ -25,6 +24,9 @@
 #include "pneumid/realtime/io_factory.hpp"
 #include "pneumid/realtime/realtime_config.hpp"
 #include "pneumid/realtime/realtime_session.hpp"
+#include "pneumid/realtime/sim_backend.hpp"
+#include "realtime_options.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -37,6 +39,7 @@ struct RunOptions {
   std::optional<double> u_min, u_max, rate_max, y_min, y_max;
   std::optional<int> frozen_samples;
   bool offline = false;
+  std::vector<std::string> load_steps;
 };
 
 // The control area's settings and factory (controller_factory.hpp).
@@ -76,6 +79,9 @@ void Run(const RunOptions& o, CLI::App& app) {
 
   const PlantOptions plant_options = SimulatedPlantOptions(o.rt);
   auto io = MakeIoBackend(spec, config, plant_options);
+  std::vector<LoadStep> loads;
+  for (const std::string& l : o.load_steps) loads.push_back(ParseLoadStep("--load-step", l));
+  if (auto* sim = dynamic_cast<SimBackend*>(io.get())) sim->SetLoadSteps(loads);
 
   SessionOptions so;
   so.loop = config.loop;
@@ -96,6 +102,7 @@ void Run(const RunOptions& o, CLI::App& app) {
   ClosedLoopOptions clo;
   clo.duration = config.loop.duration;
   clo.actuator = limits;
+  clo.load_steps = loads;
   const auto m = static_cast<Eigen::Index>(res.records.size());
   if (m >= 2) {
     Eigen::VectorXd t(m), rr(m), y(m), u(m);
@@ -139,8 +146,7 @@ void Run(const RunOptions& o, CLI::App& app) {
                          v("steady_state_error"), v("iae"));
     };
     std::cout << line("metrics", metrics) << line("offline", offline);
-    if (!o.rt.log.empty())
-      std::cout << fmt::format("log: {} ({} rows)\n", o.rt.log, res.log_rows);
+    if (!o.rt.log.empty()) std::cout << fmt::format("log: {} ({} rows)\n", o.rt.log, res.log_rows);
   }
   FinishSession("run", sum);
 }
@@ -170,6 +176,10 @@ static Registrar reg(
       app.add_option("--y-max", o->y_max, "measurement range, upper (N)");
       app.add_option("--frozen-samples", o->frozen_samples,
                      "unchanged readings that count as a frozen sensor (0 = off)");
+      app.add_option("--load-step", o->load_steps,
+                     "load disturbance on the output at=T,size=D (repeatable): applied to the "
+                     "sim backend and --offline; with udp or comedi it states when the plant's "
+                     "load changes (plant-server --load-step), for the metrics");
       app.add_flag("--offline", o->offline,
                    "also simulate the same scenario offline on --plant and print its metrics");
       app.callback([o, &app] { Run(*o, app); });

@@ -8,7 +8,7 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
   // Names are checked by the control area (the message lists the valid ones).
   app.add_option("--controller", s.controller,
                  "dmc, gpc, pid or mpc (state-space MPC with a Kalman filter and an "
-                 "integrating output disturbance; a QP when a limit is set)")
+                 "integrating input disturbance; a QP when a limit is set)")
       ->capture_default_str();
   app.add_option("--rule", s.rule,
                  "Tuning rule: shridhar-cooper (conventional), paper-modified, explicit, or auto "
@@ -33,8 +33,8 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
                "clipping (MPC always does when a limit is set)");
   app.add_option("--pid-rule", s.pid_rule, "PID tuning: simc or imc")->capture_default_str();
   app.add_option("--disturbance", s.disturbance,
-                 "MPC disturbance model for offset-free tracking: output (an integrating "
-                 "output disturbance), input (at the plant input) or none")
+                 "MPC disturbance model for offset-free tracking: input (an integrating "
+                 "disturbance at the plant input), output (on the output) or none")
       ->capture_default_str()
       ->check(CLI::IsMember({"output", "input", "none"}));
 }

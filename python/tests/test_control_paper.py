@@ -86,7 +86,7 @@ def test_make_controller_mpc_by_name():
     c = pneumid.make_controller(pneumid.paper_fopdt_model(), 0.01, "mpc", "shridhar-cooper",
                                 u_min=0.0, u_max=100.0)
     assert c.describe().startswith("mpc P=126 M=5 ")
-    assert "disturbance=output" in c.describe()
+    assert "disturbance=input" in c.describe()
     c.reset(0.0, 0.0)
     u = [c.update(80.0, 0.0) for _ in range(5)]
     assert all(0.0 <= v <= 100.0 for v in u)

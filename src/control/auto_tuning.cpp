@@ -227,17 +227,19 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
           ? (options.measure == ResponseMeasure::kRise ? f.tau + f.theta : 2.0 * f.tau + f.theta)
           : options.response_time;
   r.response_time_aimed = r.response_time_target * std::pow(1.5, 1.0 - 2.0 * a);
-  r.robust_overshoot = options.max_overshoot * (1.0 + 2.0 * a) + kOvershootTolerance;
+  r.robust_overshoot = options.max_overshoot * (1.0 + 4.0 * a) + kOvershootTolerance;
   r.robust_response_time = (1.5 + a) * r.response_time_aimed;
-  const double t_aim = r.response_time_aimed;
+  // mpc/dmc without a response time: the fastest robust design (file comment).
+  r.fastest = std::isnan(options.response_time) && options.controller != ControllerType::kPid;
+  double t_aim = r.response_time_aimed;
 
   // The evaluation step in input space, then deviation variables.
   const InputLimits& L = options.limits;
   const double K = f.K;
   double u_from = 0.0, u_to = 1.0 / K;
   if (std::isfinite(L.u_min) && std::isfinite(L.u_max)) {
-    u_from = L.u_min + 0.2 * (L.u_max - L.u_min);
-    u_to = L.u_min + 0.8 * (L.u_max - L.u_min);
+    u_from = L.u_min + 0.4 * (L.u_max - L.u_min);
+    u_to = L.u_min + 0.6 * (L.u_max - L.u_min);
   } else if (std::isfinite(L.u_min)) {
     u_from = L.u_min + 1.0 / std::abs(K);
     u_to = L.u_min + 2.0 / std::abs(K);
@@ -301,6 +303,7 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
         o.M = r.M;
         o.lambda = lambda;
         o.limits = ev.limits;
+        o.disturbance = options.disturbance;
         return std::make_unique<MpcController>(ss, o);
       }
       DmcOptions o;
@@ -358,6 +361,11 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
       };
       lambda_fastest = lambda_f;
       t_fastest = time_of(lambda_f);
+      if (r.fastest && std::isfinite(t_fastest)) {
+        // The target is the fastest robust response itself.
+        r.response_time_target = r.response_time_aimed = t_aim = t_fastest;
+        r.robust_response_time = (1.5 + a) * t_aim;
+      }
       if (t_fastest < t_aim) {
         // Bracket t(lambda) = t* above lambda_f, then bisect in log lambda.
         double lo = std::log(lambda_f), hi = lo;
@@ -387,7 +395,7 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
         // the horizons or the actuator, and flat in lambda. Take the largest
         // lambda that is hardly slower (2 % of t*): better conditioned, as fast.
         const double t_f = t_fastest;
-        const double t_ok = t_f + 0.02 * t_aim;
+        const double t_ok = t_f + (r.fastest ? 0.005 : 0.02) * t_aim;
         double lo = std::log(lambda_f), hi = lo;
         bool bracketed = false;
         for (int i = 0; i < 12 && !bracketed; ++i) {
@@ -717,9 +725,10 @@ TuningResult AutoTuneResult::ToTuningResult() const {
   t.lambda_explicit = true;
   t.formula = fmt::format(
       "auto: P = round(5 tau/Ts + theta/Ts + 1) = {}, M = {}, lambda = {:.6g} "
-      "from the closed-loop search for a {} time of {:.4g} s and overshoot "
+      "from the closed-loop search for {}a {} time of {:.4g} s and overshoot "
       "<= {:.3g} %",
-      P, M, lambda, ToString(measure), response_time_aimed, max_overshoot);
+      P, M, lambda, fastest ? "the fastest robust design, " : "", ToString(measure),
+      response_time_aimed, max_overshoot);
   return t;
 }
 
@@ -764,6 +773,7 @@ nlohmann::ordered_json AutoTuneResult::ToJson() const {
   j["Ts"] = Ts;
   j["specification"] = {{"measure", ToString(measure)},
                         {"response_time", response_time_target},
+                        {"response_time_source", fastest ? "fastest robust" : "given or model"},
                         {"response_time_aimed", response_time_aimed},
                         {"max_overshoot", max_overshoot},
                         {"aggressiveness", aggressiveness},
@@ -810,9 +820,11 @@ std::string AutoTuneResult::FullReport() const {
     s += fmt::format("P           {}\nM           {}\nlambda      {:.6g}\n", P, M, lambda);
   }
   s += fmt::format(
-      "target      {} time {:.4g} s (aimed {:.4g} s, aggressiveness {:.2g}), "
+      "target      {} time {:.4g} s ({}, aggressiveness {:.2g}), "
       "overshoot <= {:.3g} %\n",
-      ToString(measure), response_time_target, response_time_aimed, aggressiveness, max_overshoot);
+      ToString(measure), response_time_target,
+      fastest ? "the fastest robust design" : fmt::format("aimed {:.4g} s", response_time_aimed),
+      aggressiveness, max_overshoot);
   auto line = [](const std::string& name, const PredictedMetrics& m) {
     return fmt::format(
         "  {:<20} {:>9} {:>10} {:>9}", name, Seconds(m.rise_time),

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/spec.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/plant/actuator.hpp"
 
@@ -71,6 +72,24 @@ nlohmann::ordered_json ClosedLoopMetrics::ToJson() const {
   j["steps"] = nlohmann::ordered_json::array();
   for (const StepMetrics& s : steps) j["steps"].push_back(s.ToJson());
   return j;
+}
+
+double LoadAt(const std::vector<LoadStep>& steps, double t, double Ts) {
+  double d = 0.0;
+  for (const LoadStep& l : steps)
+    if (t >= l.at - 1e-9 * Ts) d += l.size;
+  return d;
+}
+
+LoadStep ParseLoadStep(const std::string& what, const std::string& spec) {
+  Spec fields(what, spec, {.has_kind = false});
+  LoadStep l;
+  l.at = fields.Number("at");
+  l.size = fields.Number("size");
+  fields.Finish();
+  PNEUMID_CHECK(std::isfinite(l.at) && l.at >= 0.0 && std::isfinite(l.size),
+                "{} '{}': need a finite time at >= 0 and a finite size", what, spec);
+  return l;
 }
 
 bool ClosedLoopOptions::IsValid(std::string* error) const {
@@ -152,8 +171,8 @@ ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen
     const double step = std::abs(s.to - s.from);
     const Eigen::Index tail = std::max<Eigen::Index>((k1 - k0) / 4, 8);
     if (k1 - k0 >= 2 * tail) s.ripple = RippleHalfBand(y, k1 - tail, k1);
-    s.settling_band = std::max(options.settling_threshold * step,
-                               std::isfinite(s.ripple) ? s.ripple : 0.0);
+    s.settling_band =
+        std::max(options.settling_threshold * step, std::isfinite(s.ripple) ? s.ripple : 0.0);
     if (k1 - k0 >= 3) {
       StepInfoOptions o;
       // The band as a fraction of the step (a ripple wider than the step
@@ -266,9 +285,7 @@ ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const 
   std::normal_distribution<double> noise(0.0, 1.0);
   double u_prev = options.u0;
   for (Eigen::Index k = 0; k < n; ++k) {
-    double d = 0.0;
-    for (const LoadStep& l : options.load_steps)
-      if (res.t(k) >= l.at - 1e-9 * Ts) d += l.size;
+    const double d = LoadAt(options.load_steps, res.t(k), Ts);
     if (k == 0 || d != res.d(k - 1)) plant.SetLoadDisturbance(d);
     res.d(k) = d;
     const double y = plant.Measure();

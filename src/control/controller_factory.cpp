@@ -45,6 +45,7 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   spec.pid_rule = PidTuningRuleFromString(settings.pid_rule);
   spec.tau_c = settings.tau_c;
   spec.disturbance = DisturbanceModelFromString(settings.disturbance);
+  spec.auto_options.disturbance = spec.disturbance;
   return spec;
 }
 

@@ -111,6 +111,7 @@ bool PlantServer::Handle(const std::uint8_t* data, std::size_t size, udp::Packet
         break;
       }
       plant_->Reset();
+      plant_->SetLoadDisturbance(LoadAt(options_.load_steps, plant_->time(), plant_->Ts()));
       session_ = true;
       have_last_ = false;
       break;
@@ -126,6 +127,7 @@ bool PlantServer::Handle(const std::uint8_t* data, std::size_t size, udp::Packet
       if (options_.stop_answering_after >= 0 && stats_.steps >= options_.stop_answering_after)
         return false;
       plant_->Advance(req.u);
+      plant_->SetLoadDisturbance(LoadAt(options_.load_steps, plant_->time(), plant_->Ts()));
       ++stats_.steps;
       break;
     case udp::PacketType::kSafe:

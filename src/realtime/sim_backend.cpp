@@ -15,6 +15,7 @@ void SimBackend::Open(double period) {
   PNEUMID_CHECK(std::abs(period - plant_->Ts()) <= 1e-9,
                 "loop period {} s differs from the plant's sample time {} s", period, plant_->Ts());
   plant_->Reset();
+  plant_->SetLoadDisturbance(LoadAt(load_steps_, plant_->time(), plant_->Ts()));
   in_safe_state_ = false;
 }
 
@@ -32,6 +33,8 @@ IoStatus SimBackend::Write(double u) noexcept {
   if (in_safe_state_) return IoStatus::kOk;
   try {
     plant_->Advance(u);
+    if (!load_steps_.empty())
+      plant_->SetLoadDisturbance(LoadAt(load_steps_, plant_->time(), plant_->Ts()));
   } catch (...) {
     return IoStatus::kError;
   }
@@ -53,6 +56,11 @@ IoStatus SimBackend::EnterSafeState(SafeState state) noexcept {
   in_safe_state_ = true;
   safe_state_ = state;
   return status;
+}
+
+void SimBackend::SetLoadSteps(std::vector<LoadStep> steps) {
+  load_steps_ = std::move(steps);
+  plant_->SetLoadDisturbance(LoadAt(load_steps_, plant_->time(), plant_->Ts()));
 }
 
 std::string SimBackend::Describe() const { return "sim (" + plant_->Describe() + ")"; }

@@ -69,7 +69,7 @@ expect_error "u-min above the plant range" "above --u-max 100" \
   control --controller dmc --model fopdt-paper --plant ipa --Ts 0.01 --u-min 150 \
   --setpoint step:from=0,to=50,at=0.1 --duration 1
 
-# State-space MPC (Kalman filter, output disturbance model) on the same loop:
+# State-space MPC (Kalman filter, input disturbance model by default) on the same loop:
 # within the duty range, the QP on the plant's limits, offset-free at the end.
 "$PNEUMID" control --controller mpc --model fopdt-paper --plant ipa --rule shridhar-cooper --Ts 0.01 \
   --setpoint step:from=20,to=100,at=0.5 --duration 4 --json | $PY -c '
@@ -78,7 +78,7 @@ j = json.load(sys.stdin)
 m = j["metrics"] if "metrics" in j else j
 assert m["u_min"] >= 0 and m["u_max"] <= 100, (m["u_min"], m["u_max"])
 assert abs(m["steady_state_error"]) < 1.0, m["steady_state_error"]
-assert "mpc P=126 M=5" in json.dumps(j) and "disturbance=output" in json.dumps(j)
+assert "mpc P=126 M=5" in json.dumps(j) and "disturbance=input" in json.dumps(j)
 ' || fail "mpc on the ipa"
 
 # Errors.

@@ -54,6 +54,30 @@ grep -q '^# timing: 100 samples' "$TMP/udp.csv" || fail "timing statistics missi
 stop_server
 grep -q "safe-state requests" "$TMP/server.txt" || fail "server summary"
 
+# a load step on the server's plant (plant-server --load-step), the same step
+# told to run for the metrics: the real-time loop over udp gives the metrics of
+# the same scenario simulated offline (--offline applies the load itself)
+start_server --load-step at=1.2,size=-10
+"$PNEUMID" run --controller mpc --model fopdt-paper --io "udp://127.0.0.1:$PORT" \
+  --setpoint step:from=0,to=40,at=0.2 --duration 2 --max-overruns -1 --load-step at=1.2,size=-10 \
+  --offline --json > "$TMP/load.json" || fail "run with a load step over udp"
+$PY - "$TMP/load.json" <<'PYEOF' || fail "udp load step metrics: $(cat "$TMP/load.json")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+m, o = j["metrics"], j["offline_metrics"]
+assert m["load_peak_deviation"] < -5 and abs(m["load_peak_deviation"] - o["load_peak_deviation"]) < 0.5, (m, o)
+assert m["load_recovery_time"] is not None and abs(m["load_recovery_time"] - o["load_recovery_time"]) <= 0.02
+assert abs(m["iae"] - o["iae"]) <= 0.05 * o["iae"], (m["iae"], o["iae"])
+PYEOF
+stop_server
+# the same load on the simulator backend
+"$PNEUMID" run --controller mpc --model fopdt-paper --io sim --fast --duration 2 \
+  --setpoint step:from=0,to=40,at=0.2 --load-step at=1.2,size=-10 --json > "$TMP/simload.json" ||
+  fail "run --io sim --load-step"
+$PY -c 'import json,sys; m=json.load(open(sys.argv[1]))["metrics"]; assert m["load_peak_deviation"] < -5, m' \
+  "$TMP/simload.json" || fail "sim load step not applied: $(cat "$TMP/simload.json")"
+expect_error "bad load step" "--load-step" run --fast --duration 0.1 --load-step at=-1,size=2
+
 # a server that stops answering: timeout fault, safe state, complete log, exit 3
 start_server --stop-answering-after 30
 "$PNEUMID" run --controller pid --model fopdt-paper --io "udp://127.0.0.1:$PORT" \
@@ -139,6 +163,6 @@ grep -q '"controller": "dmc P=50 M=4 lambda=1.5' "$TMP/x.json" || fail "run expl
 "$PNEUMID" run --fast --duration 0.2 --P 50 --json > "$TMP/y.json" || fail "run override"
 grep -q '"controller": "dmc P=50 M=5 lambda=' "$TMP/y.json" || fail "run override: $(grep controller "$TMP/y.json")"
 "$PNEUMID" run --controller mpc --fast --duration 0.2 --json > "$TMP/m.json" || fail "run mpc"
-grep -q '"controller": "mpc P=126 M=5 lambda=.* disturbance=output' "$TMP/m.json" ||
+grep -q '"controller": "mpc P=126 M=5 lambda=.* disturbance=input' "$TMP/m.json" ||
   fail "run mpc: $(grep controller "$TMP/m.json")"
 finish

@@ -42,9 +42,13 @@ check_json "sample-time alias" "j['P'] == 126"
 expect_ok "auto mpc" tune --rule auto --controller mpc --model fopdt-paper --Ts 0.01 --json
 check_json "auto mpc keys" "all(k in j for k in ('rule', 'controller', 'P', 'M', 'lambda', 'predicted', 'robustness', 'review', 'termination', 'message'))"
 check_json "auto mpc settings" "j['rule'] == 'auto' and j['controller'] == 'mpc' and j['P'] == 126 and j['M'] == 5 and j['lambda'] > 0"
-check_json "auto mpc spec met" "j['termination'] == 'converged' and j['predicted']['overshoot_percent'] <= 5.05 and abs(j['predicted']['rise_time'] / 0.246 - 1) <= 0.2"
+# Without --response-time: the fastest design that passes the robustness rows.
+check_json "auto mpc spec met" "j['termination'] == 'converged' and j['predicted']['overshoot_percent'] <= 5.05 and j['specification']['response_time_source'] == 'fastest robust' and abs(j['predicted']['rise_time'] / j['specification']['response_time'] - 1) <= 0.2 and j['predicted']['rise_time'] < 0.246"
 check_json "auto mpc robustness" "len(j['robustness']) == 3 and all(r['pass'] for r in j['robustness'])"
 check_json "auto mpc review" "{r['check'] for r in j['review']} >= {'nominal stability', 'offset-free', 'QP Hessian condition', 'constraint conflicts', 'specification'} and all(r['status'] != 'fail' for r in j['review'])"
+# With a response time: the design aims at it.
+expect_ok "auto mpc target" tune --rule auto --controller mpc --model fopdt-paper --Ts 0.01 --response-time 0.246 --json
+check_json "auto mpc target met" "j['termination'] == 'converged' and j['predicted']['overshoot_percent'] <= 5.05 and abs(j['predicted']['rise_time'] / 0.246 - 1) <= 0.2 and j['specification']['response_time_source'] == 'given or model'"
 expect_ok "auto pid" tune --rule auto --controller pid --model fopdt-paper --Ts 0.01 --aggressiveness 0.2 --json
 check_json "auto pid gains" "j['Kc'] > 0 and j['Ti'] > 0 and j['Td'] == 0 and abs(j['phase_margin'] - 69) < 2 and j['P'] is None"
 expect_ok "auto text" tune --rule auto --controller dmc --model fopdt-paper --Ts 0.01

@@ -77,7 +77,7 @@ TEST(ControllerSettingsTest, MpcTakesHorizonsFromTheRuleAndLimits) {
   EXPECT_EQ(b.tuning.M, 5);
   EXPECT_EQ(
       b.controller->Describe(),
-      fmt::format("mpc P=126 M=5 lambda={:g} disturbance=output constrained", b.tuning.lambda));
+      fmt::format("mpc P=126 M=5 lambda={:g} disturbance=input constrained", b.tuning.lambda));
   EXPECT_EQ(b.Label(), "shridhar-cooper");
   EXPECT_EQ(ToString(ControllerType::kMpc), "mpc");
   EXPECT_EQ(ControllerTypeFromString("mpc"), ControllerType::kMpc);

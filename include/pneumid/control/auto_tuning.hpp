@@ -5,19 +5,26 @@
 // Specification: response time t_r (10-90 % rise time, or 2 % settling time),
 // maximum overshoot OS (percent), aggressiveness a in [0, 1] (0 robust,
 // 1 aggressive, as the single slider of MATLAB's tuners) and input limits.
-// Without t_r it comes from the model's FOPDT description K, tau, theta
+// Without t_r, MPC and DMC aim at the fastest design that passes the
+// robustness rows below (t_r = t* = the response time of lambda_f), as fast
+// as the model, the horizons, the input limits and the robustness demanded
+// allow; PID takes t_r from the model's FOPDT description K, tau, theta
 // (tuning.hpp, FopdtFromModel), about the open-loop time constant:
 //   rise:      t_r = tau + theta        (2.2 times faster than open loop)
 //   settling:  t_r = 2 tau + theta
 // The knob shifts the response time aimed at and the robustness demanded:
-//   t* = t_r 1.5^(1 - 2a)               (a = 0.5: t* = t_r)
-//   OS_rob = OS (1 + 2a) + 0.05         (overshoot allowed under model error)
+//   t* = t_r 1.5^(1 - 2a)               (a = 0.5: t* = t_r; a given t_r only)
+//   OS_rob = OS (1 + 4a) + 0.05         (overshoot allowed under model error:
+//                                        3 OS at a = 0.5)
 //   t_rob = (1.5 + a) t*                (response time allowed under model error)
 //
 // Evaluation: a set-point step on the model itself (LinearPlant, exact zoh;
 // SimulateClosedLoop of closed_loop.hpp) in deviation variables: a unit step
-// without input limits, otherwise from 20 % to 80 % of the output range the
-// limits reach at steady state, [K u_min, K u_max]. Robustness rows repeat it
+// without input limits, otherwise from 40 % to 60 % of the output range the
+// limits reach at steady state, [K u_min, K u_max]: a set-point change of a
+// fifth of the range, in which the response time is the loop's and not only
+// the actuator's (a step across most of the range saturates the input and
+// is as slow as the input at its limit makes it, whatever the tuning). Robustness rows repeat it
 // with the plant's gain +20 %, -20 % and one more sample of dead time; a row
 // passes when the loop settles, overshoots at most OS_rob and responds within
 // t_rob. The window is 10 max(t*, tau + theta) after the step.
@@ -79,6 +86,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "pneumid/control/controller.hpp"
+#include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/transfer_function.hpp"
@@ -118,6 +126,9 @@ struct AutoTuneOptions {
   InputLimits limits;
   /// Control horizon for mpc/dmc (0 = 5).
   int M = 0;
+  /// mpc: the estimator's disturbance model, used in the evaluation as in
+  /// the controller it designs (mpc.hpp).
+  DisturbanceModel disturbance = DisturbanceModel::kInput;
   /// True when the options are usable; otherwise false and *error says why.
   bool IsValid(std::string* error) const;
 };
@@ -163,8 +174,11 @@ struct AutoTuneResult {
   double phase_margin = std::numeric_limits<double>::quiet_NaN();         ///< deg
   double gain_margin = std::numeric_limits<double>::quiet_NaN();          ///< absolute
   /// Specification as used.
-  double response_time_target = 0.0;  ///< t_r (given or from the model)
-  double response_time_aimed = 0.0;   ///< t* after the knob
+  double response_time_target = 0.0;  ///< t_r (given, from the model, or the fastest)
+  /// mpc/dmc without a given response time: t_r = t* is the response time of
+  /// the fastest robust design (JSON specification.response_time_source).
+  bool fastest = false;
+  double response_time_aimed = 0.0;  ///< t* after the knob
   ResponseMeasure measure = ResponseMeasure::kRise;
   double max_overshoot = 0.0;
   double aggressiveness = 0.0;

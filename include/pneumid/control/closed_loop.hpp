@@ -61,6 +61,15 @@ struct LoadStep {
   double size = 0.0;  ///< output units, added to the disturbance from `at` on
 };
 
+/// The load disturbance at time t (s): the sum of the sizes of the steps with
+/// at <= t (to 1e-9 of the sample time Ts, so a step at a sample instant
+/// acts on that sample).
+double LoadAt(const std::vector<LoadStep>& steps, double t, double Ts);
+/// A load step from its spec "at=T,size=D" (the `--load-step` syntax).
+/// @throws InvalidArgument naming `what` and the spec when a key is missing,
+/// unknown or not a number, or at is negative or not finite.
+LoadStep ParseLoadStep(const std::string& what, const std::string& spec);
+
 struct ClosedLoopOptions {
   double duration = 1.0;  ///< s (> 0)
   std::vector<LoadStep> load_steps;

@@ -11,7 +11,7 @@
 //   mpc  state-space MPC (mpc.hpp) from the model with its delay as states:
 //        P, M, lambda from the tuning rule as for dmc, the input limits and
 //        soft output bounds (a QP whenever one is finite), the other options
-//        at their defaults (output disturbance model, Kalman noise R = 1,
+//        at their defaults (input disturbance model, Kalman noise R = 1,
 //        disturbance noise 1)
 #pragma once
 
@@ -21,8 +21,8 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "pneumid/control/controller.hpp"
 #include "pneumid/control/auto_tuning.hpp"
+#include "pneumid/control/controller.hpp"
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
 #include "pneumid/control/prediction_model.hpp"
@@ -41,7 +41,7 @@ struct ControllerSpec {
   std::string t_filter = "1";  ///< gpc
   PidTuningRule pid_rule = PidTuningRule::kSimc;
   double tau_c = 0.0;  ///< pid closed-loop time constant (s); <= 0 = rule default
-  DisturbanceModel disturbance = DisturbanceModel::kOutput;  ///< mpc (mpc.hpp)
+  DisturbanceModel disturbance = DisturbanceModel::kInput;  ///< mpc (mpc.hpp)
   /// Tune from specifications (auto_tuning.hpp) instead of the tuning rule:
   /// mpc and dmc get P, M, lambda, pid its gains; auto_options.controller and
   /// .limits are taken from type and limits.
@@ -65,7 +65,7 @@ struct ControllerSettings {
   std::string t_filter = "1";
   std::string pid_rule = "simc";
   double tau_c = 0.0;
-  std::string disturbance = "output";  ///< mpc: output, input or none
+  std::string disturbance = "input";  ///< mpc: input, output or none
   /// rule "auto": the specifications (auto_tuning.hpp; NaN = from the model).
   double response_time = std::numeric_limits<double>::quiet_NaN();
   double overshoot = 5.0;
@@ -86,10 +86,10 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings);
 struct BuiltController {
   std::unique_ptr<Controller> controller;
   ControllerType type = ControllerType::kDmc;
-  TuningResult tuning;    ///< horizons and lambda (dmc, gpc, mpc)
+  TuningResult tuning;                            ///< horizons and lambda (dmc, gpc, mpc)
   PidTuningRule pid_rule = PidTuningRule::kSimc;  ///< (pid)
-  PidGains pid_gains;     ///< (pid)
-  FopdtEstimate fopdt;  ///< the FOPDT the PID was tuned from (pid)
+  PidGains pid_gains;                             ///< (pid)
+  FopdtEstimate fopdt;                            ///< the FOPDT the PID was tuned from (pid)
   /// Rule "auto": the auto-tuner's message (what it met or why not).
   std::string auto_summary;
 

@@ -95,7 +95,12 @@ struct MpcOptions {
   /// Slack penalty rho1 e + rho2/2 e^2 (rho1 >= 0, rho2 > 0).
   double slack_linear_weight = 1e4;
   double slack_quadratic_weight = 1e2;
-  DisturbanceModel disturbance = DisturbanceModel::kOutput;
+  /// The input model is the default: an actuator's model errors (a dead
+  /// band, a gain that varies with the operating point, a bias) act at its
+  /// input, where this model estimates them; the output model (MATLAB's
+  /// default) only shifts the predicted output and recovers more slowly from
+  /// them (docs/control.md gives both on the IPA).
+  DisturbanceModel disturbance = DisturbanceModel::kInput;
   /// Kalman filter noise covariances: measurement noise R (> 0, output
   /// units squared), process noise on each model state (>= 0; delay states
   /// get none) and on the integrating disturbance (> 0 with a disturbance

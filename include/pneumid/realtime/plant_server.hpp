@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "pneumid/control/closed_loop.hpp"
 #include "pneumid/plant/plant.hpp"
 #include "pneumid/realtime/safety.hpp"
 #include "pneumid/realtime/udp_protocol.hpp"
@@ -23,6 +24,9 @@ struct PlantServerOptions {
   /// Fault drill: stop answering after this many Step requests (-1: never). The
   /// server keeps receiving, so a client sees a silent server.
   std::int64_t stop_answering_after = -1;
+  /// Load disturbances on the plant's output (closed_loop.hpp), by plant time
+  /// since the session's Hello (the plant's Reset).
+  std::vector<LoadStep> load_steps;
   bool IsValid(std::string* error) const;
 };
 

@@ -15,6 +15,9 @@
 #include <memory>
 #include <string>
 
+#include <vector>
+
+#include "pneumid/control/closed_loop.hpp"
 #include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/plant.hpp"
@@ -38,6 +41,9 @@ class SimBackend : public IoBackend {
   Actuator actuator() const override { return PlantActuator(*plant_); }
 
   Plant& plant() { return *plant_; }
+  /// Load disturbances on the plant's output (closed_loop.hpp) by plant time
+  /// since Open(), applied after every Write().
+  void SetLoadSteps(std::vector<LoadStep> steps);
   /// True once EnterSafeState was called; which state.
   bool in_safe_state() const { return in_safe_state_; }
   SafeState safe_state() const { return safe_state_; }
@@ -47,6 +53,7 @@ class SimBackend : public IoBackend {
   IpaSimulator* ipa_ = nullptr;  // plant_ when it is the IPA simulator
   bool in_safe_state_ = false;
   SafeState safe_state_ = SafeState::kHold;
+  std::vector<LoadStep> load_steps_;
 };
 
 }  // namespace pneumid
