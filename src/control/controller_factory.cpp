@@ -13,6 +13,7 @@
 #include "pneumid/common/spec.hpp"
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/gpc.hpp"
+#include "pneumid/control/inverse_map_controller.hpp"
 #include "pneumid/control/mpc.hpp"
 
 namespace pneumid {
@@ -98,8 +99,28 @@ AutoTuneResult AutoTuned(const TransferFunction& model, double Ts, const Control
 
 }  // namespace
 
+namespace {
+
+// The controller of `spec` without its input map, designed by `make` on the
+// linear part with the map's image of the limits, behind the map's inverse.
+template <typename Make>
+BuiltController WithInverseMap(const ControllerSpec& spec, Make make) {
+  ControllerSpec inner = spec;
+  inner.input_map.reset();
+  inner.limits = InnerLimits(*spec.input_map, spec.limits);
+  BuiltController b = make(inner);
+  b.controller =
+      std::make_unique<InverseMapController>(std::move(b.controller), *spec.input_map, spec.limits);
+  return b;
+}
+
+}  // namespace
+
 BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec) {
+  if (spec.input_map)
+    return WithInverseMap(spec,
+                          [&](const ControllerSpec& s) { return MakeController(model, Ts, s); });
   if (spec.auto_tune && spec.type == ControllerType::kPid) {
     const AutoTuneResult a = AutoTuned(model, Ts, spec);
     BuiltController b;
@@ -133,6 +154,9 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
 }
 
 BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec_in) {
+  if (spec_in.input_map)
+    return WithInverseMap(spec_in,
+                          [&](const ControllerSpec& s) { return MakeController(model, s); });
   if (spec_in.auto_tune && spec_in.type == ControllerType::kPid)
     return MakeController(model.model(), model.Ts(), spec_in);
   ControllerSpec spec = spec_in;

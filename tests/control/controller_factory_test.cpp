@@ -109,5 +109,34 @@ TEST(BuiltControllerTest, LabelSummaryAndSettingsJson) {
   EXPECT_EQ(p["rule"], "simc");
 }
 
+// A static input map puts every controller behind its inverse, designed on
+// the linear part with the map's image of the limits.
+TEST(ControllerFactoryTest, InputMapPutsEachControllerBehindTheInverse) {
+  const TransferFunction unit_gain(Eigen::VectorXd::Constant(1, 1.0), Eigen::Vector2d(0.2, 1.0));
+  const StaticMap map({0, 10, 50, 90, 100}, {0, 0, 60, 140, 140});
+  for (const char* type : {"dmc", "gpc", "pid", "mpc"}) {
+    ControllerSettings s;
+    s.controller = type;
+    s.limits.u_min = 0.0;
+    s.limits.u_max = 100.0;
+    ControllerSpec spec = ToControllerSpec(s);
+    spec.input_map = map;
+    const BuiltController b = MakeController(unit_gain, kTs, spec);
+    EXPECT_THAT(b.controller->Describe(), ::testing::HasSubstr("with inverse map (5 knots")) << type;
+    b.controller->Reset(10.0, 0.0);
+    // 100 N needs f^-1(100) = 70 % at steady state; the input stays in 0..100 %.
+    double y = 0.0, x = 0.0, u = 0.0;
+    for (int k = 0; k < 600; ++k) {
+      u = b.controller->Update(100.0, y);
+      ASSERT_GE(u, 0.0) << type;
+      ASSERT_LE(u, 100.0) << type;
+      x += (kTs / 0.2) * (map.Evaluate(u) - x);  // Euler step of 1/(0.2 s + 1)
+      y = x;
+    }
+    EXPECT_NEAR(u, 70.0, 0.5) << type;
+    EXPECT_NEAR(y, 100.0, 0.5) << type;
+  }
+}
+
 }  // namespace
 }  // namespace pneumid

@@ -17,6 +17,7 @@
 
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json_fwd.hpp>
@@ -27,6 +28,7 @@
 #include "pneumid/control/pid.hpp"
 #include "pneumid/control/prediction_model.hpp"
 #include "pneumid/control/tuning.hpp"
+#include "pneumid/lti/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
@@ -47,6 +49,11 @@ struct ControllerSpec {
   /// .limits are taken from type and limits.
   bool auto_tune = false;
   AutoTuneOptions auto_options;
+  /// The actuator's static map f (a Hammerstein model's input map): the
+  /// controller is designed on the linear part with input v = f(u), limits
+  /// InnerLimits(f, limits), and runs behind f's inverse
+  /// (inverse_map_controller.hpp); `limits` stay the limits on u.
+  std::optional<StaticMap> input_map;
 };
 
 /// Controller settings as a user states them (command line, configuration,

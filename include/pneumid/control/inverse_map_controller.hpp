@@ -1,0 +1,76 @@
+// A linear controller behind the inverse of the actuator's static map: the
+// linearizing input transformation of a Hammerstein plant [1, sec. 2.3; 2].
+//
+// Plant (Hammerstein): y = G(q) v with v = f(u), f the static map of the
+// actuator (lti/static_map.hpp; for the IPA the steady force in N at duty u
+// in %), G the linear dynamics (unit static gain when f is the steady-state
+// map). The inner controller is designed on G: its input is v, in f's output
+// units. At every sample
+//   v_k = inner.Update(r_k, y_k),   u_k = clip(f^-1(v_k)),
+// with f^-1 the map's inverse (StaticMap::Inverse: on a dead zone its edge
+// where the output starts to move, beyond the output range the end of the
+// input range) and clip the input limits of the actuator (u_min, u_max, and
+// |u_k - u_{k-1}| <= du_max). When the clipped input differs from the
+// inverse the inner controller is told v = f(u_k) (Controller::Applied),
+// as it is for an input a later layer changes: anti-windup through the map.
+// The inner controller's own limits are the image of the input range,
+// v in [f(u_min), f(u_max)] (InnerLimits).
+//
+// [1] G. Tao, P. V. Kokotovic, Adaptive Control of Systems with Actuator and
+//     Sensor Nonlinearities, Wiley, 1996.
+// [2] E.-W. Bai, "An optimal two-stage identification algorithm for
+//     Hammerstein-Wiener nonlinear systems", Automatica 34 (1998) 333-338
+//     (the plant structure).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "pneumid/control/controller.hpp"
+#include "pneumid/lti/static_map.hpp"
+
+namespace pneumid {
+
+/// The limits of the inner controller's input v = f(u) for input limits
+/// `limits` on u: v in [min, max] of f over [u_min, u_max] (clipped to the
+/// map's input range), and a change per sample of du_max times the map's
+/// steepest slope (so that the u-rate limit, applied after the inverse, is
+/// never looser than this one). @throws InvalidArgument for a map that is
+/// not monotone or invalid limits.
+InputLimits InnerLimits(const StaticMap& map, const InputLimits& limits);
+
+class InverseMapController : public Controller {
+ public:
+  /// `inner` designed on the linear part G, with limits InnerLimits(map,
+  /// limits) or looser; `limits` the actuator's limits on u.
+  /// @throws InvalidArgument for a null controller, a map that is not
+  /// monotone (naming where it turns) or constant, or invalid limits.
+  InverseMapController(std::unique_ptr<Controller> inner, StaticMap map,
+                       const InputLimits& limits = {});
+
+  /// The inner controller at rest at v0 = f(u0), y0.
+  void Reset(double u0 = 0.0, double y0 = 0.0) override;
+  /// u = clip(f^-1(inner.Update(r, y))). Allocates no memory.
+  double Update(double setpoint, double measurement) override;
+  /// The input applied after the last Update(): the inner controller takes
+  /// f(u). Allocates no memory.
+  void Applied(double u) override;
+  double Ts() const override { return inner_->Ts(); }
+  /// The inner controller's description + " with inverse map (N knots, u in
+  /// [a, b])".
+  std::string Describe() const override;
+
+  const Controller& inner() const { return *inner_; }
+  const StaticMap& map() const { return map_; }
+  /// v of the last Update() (the inner controller's request).
+  double last_virtual_input() const { return v_; }
+
+ private:
+  std::unique_ptr<Controller> inner_;
+  StaticMap map_;
+  InputLimits limits_;
+  double u_prev_ = 0.0;
+  double v_ = 0.0;
+};
+
+}  // namespace pneumid
