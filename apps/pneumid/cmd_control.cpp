@@ -197,7 +197,7 @@ void Execute(const ControlCli& c) {
                 settings.limits.u_min, settings.limits.u_max, actuator.u_min, actuator.u_max);
   cl.actuator.u_min = settings.limits.u_min;
   cl.actuator.u_max = settings.limits.u_max;
-  const ControllerSpec base = ToControllerSpec(settings);
+  const ControllerSpec base = WithModelInputMap(ToControllerSpec(settings), c.model);
 
   // --compare: the same controller with each rule's own settings.
   std::vector<ControllerSpec> specs;

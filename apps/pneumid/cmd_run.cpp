@@ -47,7 +47,7 @@ BuiltController BuildController(const RunOptions& o, const TransferFunction& mod
                                 const InputLimits& limits) {
   ControllerSettings c = o.controller;
   c.limits = limits;  // the safety layer's clamp
-  return MakeController(model, Ts, ToControllerSpec(c));
+  return MakeController(model, Ts, WithModelInputMap(ToControllerSpec(c), o.model));
 }
 
 void Run(const RunOptions& o, CLI::App& app) {

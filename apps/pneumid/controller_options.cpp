@@ -21,8 +21,7 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
   app.add_option("--overshoot", s.overshoot, "--rule auto: largest overshoot in %")
       ->capture_default_str()
       ->check(NonNegative());
-  app.add_option("--aggressiveness", s.aggressiveness,
-                 "--rule auto: 0 robust .. 1 aggressive")
+  app.add_option("--aggressiveness", s.aggressiveness, "--rule auto: 0 robust .. 1 aggressive")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--P", s.P, "Prediction horizon (samples)")->check(AtLeast(1));
@@ -32,6 +31,11 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
                "DMC: optimize the moves under the input limits (QDMC, QP solver) instead of "
                "clipping (MPC always does when a limit is set)");
   app.add_option("--pid-rule", s.pid_rule, "PID tuning: simc or imc")->capture_default_str();
+  app.add_option("--input-map", s.input_map,
+                 "the actuator's static map, whose inverse goes in front of the controller "
+                 "(designed on the model scaled to unit gain): a static-map or Hammerstein "
+                 "model file (FILE.json[#method]) or {\"u\": [...], \"y\": [...]}; a "
+                 "Hammerstein --model brings its own");
   app.add_option("--disturbance", s.disturbance,
                  "MPC disturbance model for offset-free tracking: input (an integrating "
                  "disturbance at the plant input), output (on the output) or none")

@@ -15,6 +15,7 @@
 #include "pneumid/control/gpc.hpp"
 #include "pneumid/control/inverse_map_controller.hpp"
 #include "pneumid/control/mpc.hpp"
+#include "pneumid/lti/model_io.hpp"
 
 namespace pneumid {
 
@@ -47,6 +48,12 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   spec.tau_c = settings.tau_c;
   spec.disturbance = DisturbanceModelFromString(settings.disturbance);
   spec.auto_options.disturbance = spec.disturbance;
+  if (!settings.input_map.empty()) spec.input_map = ReadStaticMap(settings.input_map);
+  return spec;
+}
+
+ControllerSpec WithModelInputMap(ControllerSpec spec, const std::string& model_spec) {
+  if (!spec.input_map) spec.input_map = ParseModelInputMap(model_spec);
   return spec;
 }
 
@@ -114,13 +121,25 @@ BuiltController WithInverseMap(const ControllerSpec& spec, Make make) {
   return b;
 }
 
+// `model` scaled to a unit static gain: behind the inverse map the map holds
+// the actuator's gain and the linear part only the dynamics.
+TransferFunction UnitGain(const TransferFunction& model) {
+  const double K = model.DcGain();
+  PNEUMID_CHECK(std::isfinite(K) && K != 0.0,
+                "a controller behind an input map needs a model with a finite nonzero static "
+                "gain, got {}",
+                K);
+  return TransferFunction(model.num() / K, model.den(), model.Ts(), model.delay());
+}
+
 }  // namespace
 
 BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec) {
-  if (spec.input_map)
-    return WithInverseMap(spec,
-                          [&](const ControllerSpec& s) { return MakeController(model, Ts, s); });
+  if (spec.input_map) {
+    const TransferFunction g = UnitGain(model);
+    return WithInverseMap(spec, [&](const ControllerSpec& s) { return MakeController(g, Ts, s); });
+  }
   if (spec.auto_tune && spec.type == ControllerType::kPid) {
     const AutoTuneResult a = AutoTuned(model, Ts, spec);
     BuiltController b;
@@ -154,9 +173,11 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
 }
 
 BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec_in) {
-  if (spec_in.input_map)
+  if (spec_in.input_map) {
+    const PredictionModel unit(UnitGain(model.model()), model.Ts());
     return WithInverseMap(spec_in,
-                          [&](const ControllerSpec& s) { return MakeController(model, s); });
+                          [&](const ControllerSpec& s) { return MakeController(unit, s); });
+  }
   if (spec_in.auto_tune && spec_in.type == ControllerType::kPid)
     return MakeController(model.model(), model.Ts(), spec_in);
   ControllerSpec spec = spec_in;

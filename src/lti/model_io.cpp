@@ -39,33 +39,40 @@ double JsonScalar(const nlohmann::json& j, const char* key, double fallback) {
   return j.at(key).get<double>();
 }
 
-// A TF object, a model object holding one under "tf", or {"models": [...]}.
-TransferFunction FromModelJson(const nlohmann::json& j, const std::string& where,
-                               const std::string& select) {
-  if (j.is_object() && j.contains("models")) {
-    const nlohmann::json& models = j.at("models");
-    PNEUMID_CHECK(models.is_array() && !models.empty(), "{}: 'models' must be a non-empty array",
-                  where);
-    if (select.empty()) return FromModelJson(models.at(0), where, "");
+// The model object `select` names in a model object, a list of them or
+// {"models": [...]} (the first when `select` is empty).
+const nlohmann::json& SelectModelJson(const nlohmann::json& j, const std::string& where,
+                                      const std::string& select) {
+  const bool listed = j.is_object() && j.contains("models");
+  if (listed || j.is_array()) {
+    const nlohmann::json& models = listed ? j.at("models") : j;
+    if (listed)
+      PNEUMID_CHECK(models.is_array() && !models.empty(), "{}: 'models' must be a non-empty array",
+                    where);
+    PNEUMID_CHECK(!models.empty(), "{}: empty list of models", where);
+    if (select.empty()) return SelectModelJson(models.at(0), where, "");
     std::vector<std::string> names;
     for (const auto& m : models) {
       if (m.is_object() && m.contains("method") && m.at("method").is_string()) {
         names.push_back(m.at("method").get<std::string>());
-        if (names.back() == select) return FromModelJson(m, where, "");
+        if (names.back() == select) return SelectModelJson(m, where, "");
       }
     }
     PNEUMID_CHECK(false, "{}: no model with method '{}' (available: {})", where, select,
                   fmt::join(names, ", "));
-  }
-  if (j.is_array()) {
-    PNEUMID_CHECK(!j.empty(), "{}: empty list of models", where);
-    return FromModelJson(nlohmann::json{{"models", j}}, where, select);
   }
   PNEUMID_CHECK(j.is_object(), "{}: expected a JSON object, got {}", where, j.type_name());
   if (!select.empty()) {
     PNEUMID_CHECK(j.contains("method") && j.at("method") == select,
                   "{}: the model is not of method '{}'", where, select);
   }
+  return j;
+}
+
+// A TF object, a model object holding one under "tf", or {"models": [...]}.
+TransferFunction FromModelJson(const nlohmann::json& j_in, const std::string& where,
+                               const std::string& select) {
+  const nlohmann::json& j = SelectModelJson(j_in, where, select);
   // An identified discrete model whose continuous form is only the bilinear
   // (tustin) approximation (no zoh equivalent: a pole on the negative real
   // axis) is used as identified: the tustin form is biproper and its step
@@ -79,13 +86,18 @@ TransferFunction FromModelJson(const nlohmann::json& j, const std::string& where
   return TransferFunctionFromJson(j);
 }
 
-TransferFunction ParseFile(const std::string& spec) {
+// The JSON of the model file `spec` (FILE.json[#method]), its path and the
+// method selected.
+nlohmann::json ReadModelFile(const std::string& spec, std::string* path_out,
+                             std::string* select_out) {
   std::string path = spec, select;
   const std::size_t hash = spec.rfind('#');
   if (hash != std::string::npos) {
     path = spec.substr(0, hash);
     select = spec.substr(hash + 1);
   }
+  *path_out = path;
+  *select_out = select;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     throw DataError(fmt::format("{}: is a directory, not a model file", path));
@@ -124,11 +136,22 @@ TransferFunction ParseFile(const std::string& spec) {
     }
     throw DataError(fmt::format("{}: invalid model JSON: {}", where, what));
   }
+  return j;
+}
+
+TransferFunction ParseFile(const std::string& spec) {
+  std::string path, select;
+  const nlohmann::json j = ReadModelFile(spec, &path, &select);
   try {
     return FromModelJson(j, path, select);
   } catch (const InvalidArgument& e) {
     throw DataError(fmt::format("{}: {}", path, e.what()));
   }
+}
+
+bool IsBareStaticMap(const nlohmann::json& j) {
+  return j.is_object() && j.contains("u") && j.contains("y") && !j.contains("models") &&
+         !j.contains("tf") && !j.contains("num");
 }
 
 }  // namespace
@@ -204,6 +227,41 @@ TransferFunction TransferFunctionFromJson(const nlohmann::json& j) {
   const double delay = JsonScalar(j, "delay", 0.0);
   return TransferFunction(Eigen::Map<const Eigen::VectorXd>(num.data(), num.size()),
                           Eigen::Map<const Eigen::VectorXd>(den.data(), den.size()), Ts, delay);
+}
+
+std::optional<StaticMap> ParseModelInputMap(const std::string& spec) {
+  std::error_code ec;
+  std::string path = spec;
+  if (const std::size_t hash = spec.rfind('#'); hash != std::string::npos)
+    path = spec.substr(0, hash);
+  if (path.empty() || !std::filesystem::is_regular_file(path, ec)) return std::nullopt;
+  std::string select;
+  const nlohmann::json j = ReadModelFile(spec, &path, &select);
+  try {
+    if (IsBareStaticMap(j)) return StaticMapFromJson(j);
+    const nlohmann::json& m = SelectModelJson(j, path, select);
+    if (m.contains("input_map")) return StaticMapFromJson(m.at("input_map"));
+  } catch (const InvalidArgument& e) {
+    throw DataError(fmt::format("{}: {}", path, e.what()));
+  }
+  return std::nullopt;
+}
+
+StaticMap ReadStaticMap(const std::string& spec) {
+  std::error_code ec;
+  std::string path = spec;
+  if (const std::size_t hash = spec.rfind('#'); hash != std::string::npos)
+    path = spec.substr(0, hash);
+  if (!std::filesystem::exists(path, ec))
+    throw DataError(
+        fmt::format("{}: cannot open static map file: {}", path, std::strerror(ENOENT)));
+  const std::optional<StaticMap> map = ParseModelInputMap(spec);
+  if (!map)
+    throw DataError(fmt::format(
+        "{}: holds no static map (the input_map of a static-map or Hammerstein model written by "
+        "pneumid identify, or an object {{\"u\": [...], \"y\": [...]}})",
+        spec));
+  return *map;
 }
 
 }  // namespace pneumid

@@ -129,4 +129,21 @@ check_json "no load step" "j['load_peak_deviation'] is None and j['settings']['r
 expect_ok "override" control --model fopdt-paper --Ts 0.01 --setpoint step:from=0,to=1,at=0 \
   --duration 0.5 --P 50 --M 4 --json
 check_json "override" "j['settings']['rule'] == 'shridhar-cooper' and j['settings']['P'] == 50 and j['settings']['M'] == 4"
+# --input-map: the controller behind the inverse of an actuator map (here an
+# S-shaped map with a dead zone up to 10 %), designed on the model at unit gain.
+cat > "$TMP/map.json" <<'JSON'
+{"u": [0, 10, 30, 50, 70, 90, 100], "y": [0, 0, 20, 60, 110, 140, 140]}
+JSON
+expect_ok "input map" control --controller mpc --model fopdt:K=1,tau=0.2,theta=0.01 \
+  --plant fopdt:K=1,tau=0.2,theta=0.01 --Ts 0.01 --setpoint step:from=0,to=80,at=0.1 \
+  --duration 3 --input-map "$TMP/map.json" --json
+check_json "input map" "'with inverse map (7 knots' in j['controller'] and j['u_min'] >= 0 and j['u_max'] <= 100"
+echo '{"u": [0, 50, 100], "y": [0, 80, 40]}' > "$TMP/bad_map.json"
+expect_error "input map not monotone" "not monotone" control --model fopdt-paper --Ts 0.01 \
+  --setpoint step:from=0,to=1,at=0 --duration 0.5 --input-map "$TMP/bad_map.json"
+expect_error "input map missing" "cannot open static map file" control --model fopdt-paper \
+  --Ts 0.01 --setpoint step:from=0,to=1,at=0 --duration 0.5 --input-map "$TMP/none.json"
+echo '{"num": [1], "den": [0.2, 1]}' > "$TMP/map_none.json"
+expect_error "input map absent" "holds no static map" control --model fopdt-paper --Ts 0.01 \
+  --setpoint step:from=0,to=1,at=0 --duration 0.5 --input-map "$TMP/map_none.json"
 finish

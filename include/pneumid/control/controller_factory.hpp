@@ -77,6 +77,10 @@ struct ControllerSettings {
   double response_time = std::numeric_limits<double>::quiet_NaN();
   double overshoot = 5.0;
   double aggressiveness = 0.5;
+  /// A file with the actuator's static map (lti/model_io.hpp ReadStaticMap:
+  /// a static-map or Hammerstein model file, or {"u", "y"}); empty = none,
+  /// or the model file's own input map (WithModelInputMap).
+  std::string input_map;
 };
 
 /// The tuning rule settings ask for: the named rule when `rule` is not empty;
@@ -88,7 +92,11 @@ TuningRule InferTuningRule(const std::string& rule, int P, int M, double lambda)
 /// The spec of `settings`: names parsed, the rule inferred, P, M and lambda
 /// as overrides of the rule.
 /// @throws InvalidArgument for an unknown controller, rule or PID rule name.
+/// @throws DataError naming the file of an input map that cannot be read.
 ControllerSpec ToControllerSpec(const ControllerSettings& settings);
+/// `spec` with the input map of the model file `model_spec` (a Hammerstein
+/// model's, lti/model_io.hpp ParseModelInputMap) when it has none yet.
+ControllerSpec WithModelInputMap(ControllerSpec spec, const std::string& model_spec);
 
 struct BuiltController {
   std::unique_ptr<Controller> controller;

@@ -9,14 +9,18 @@
 //                       TransferFunction, delay in seconds; syntax in common/spec.hpp)
 //   * a model JSON file written by pneumid (`pneumid identify --json`, a single
 //     model object, or an object {"num","den","Ts","delay"}); for a list of
-//     models the first (best) one is taken, or `FILE.json#method` selects one.
+//     models the first (best) one is taken, or `FILE.json#method` selects one;
+//     a model with a static input map (Hammerstein, static map) gives its
+//     linear part here and its map by ParseModelInputMap.
 // JSON form of a transfer function: {"num": [...], "den": [...], "Ts": x, "delay": s}.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "pneumid/lti/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
@@ -25,6 +29,17 @@ namespace pneumid {
 /// the offending key, or DataError naming the file for an unreadable file,
 /// a directory or invalid JSON.
 TransferFunction ParseModelSpec(const std::string& spec);
+
+/// The static input map of a model file spec: the "input_map" of the selected
+/// model (a static-map or Hammerstein model written by `pneumid identify`),
+/// or the file itself when it is a static map {"u": [...], "y": [...]}
+/// (StaticMapFromJson). std::nullopt for built-in and inline specs and for
+/// models without an input map.
+/// @throws DataError naming the file for an unreadable file or an invalid map.
+std::optional<StaticMap> ParseModelInputMap(const std::string& spec);
+/// ParseModelInputMap, required: @throws DataError naming the file when it
+/// holds no static map.
+StaticMap ReadStaticMap(const std::string& spec);
 
 /// {"num", "den", "Ts", "delay"} with a monic denominator.
 nlohmann::json ToJson(const TransferFunction& g);
