@@ -388,8 +388,32 @@ void GenerateGpc(const GpcController& c, Module& m) {
   m.Member({Field::kReal, "free", rows, "free response"});
   m.Member({Field::kReal, "u_prev", 0, "last input"});
   m.Member({Field::kReal, "last_du", 0, "last move"});
+  // Single precision: the free response from the deviations y_f(t-i) - y_f(t),
+  // with du = (sum k)(w - T(1) y_f(t)) - k'(F (y_f - y_f(t)) + Gamma Du_f),
+  // which is the same as every row F_j sums to T(1) (T = E_j Delta A + q^-j F_j
+  // at q = 1), without the cancellation of k' F y_f against (sum k) w.
+  const bool deviation = m.is_float();
+  std::string free =
+      fmt::format("  PFX_gemv_col(PFX_F, {0}, {0}, {1}, s->yf, s->free, 0, PFX_ONE);\n", rows, nF);
+  std::string move = "  du = PFX_GAIN_SUM * setpoint - PFX_dot(PFX_gain, s->free, {2});\n";
+  if (deviation) {
+    const double t1 = T.sum();
+    for (int r = 0; r < rows; ++r)
+      PNEUMID_CHECK(
+          std::abs(F.row(r).sum() - t1) <= 1e-9 * (F.row(r).cwiseAbs().sum() + std::abs(t1)),
+          "GPC: row {} of F sums to {}, not T(1) = {}", r, F.row(r).sum(), t1);
+    m.Member({Field::kReal, "dyf", nF, "y_f(t-i) - y_f(t)"});
+    free = fmt::format(
+        "  for (i = 0; i < {1}; ++i) s->dyf[i] = s->yf[i] - s->yf[0];\n"
+        "  PFX_gemv_col(PFX_F, {0}, {0}, {1}, s->dyf, s->free, 0, PFX_ONE);\n",
+        rows, nF);
+    move =
+        "  du = PFX_GAIN_SUM * (setpoint - PFX_T_SUM * s->yf[0]) - PFX_dot(PFX_gain, s->free, "
+        "{2});\n";
+  }
   EmitClip(m, c.options().limits);
-  m.code_ += fmt::format(R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
+  m.code_ +=
+      fmt::format(R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
   int i;
   for (i = 0; i < {0}; ++i) s->yf[i] = y0 / PFX_T_SUM;
   for (i = 0; i < {1}; ++i) s->duf[i] = PFX_ZERO;
@@ -404,10 +428,8 @@ PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
   for (i = {0} - 1; i > 0; --i) s->yf[i] = s->yf[i - 1];
   for (i = 1; i < {3}; ++i) yf -= PFX_T[i] * s->yf[i];
   s->yf[0] = yf;
-  PFX_gemv_col(PFX_F, {2}, {2}, {4}, s->yf, s->free, 0, PFX_ONE);
-  PFX_gemv_col(PFX_Gamma, {2}, {2}, {5}, s->duf, s->free, 1, PFX_ONE);
-  du = PFX_GAIN_SUM * setpoint - PFX_dot(PFX_gain, s->free, {2});
-  u = PFX_clip(s->u_prev + du, s->u_prev);
+{6}  PFX_gemv_col(PFX_Gamma, {2}, {2}, {5}, s->duf, s->free, 1, PFX_ONE);
+{7}  u = PFX_clip(s->u_prev + du, s->u_prev);
   du = u - s->u_prev;
   for (i = {1} - 1; i > 0; --i) s->duf[i] = s->duf[i - 1];
   duf = du;
@@ -426,7 +448,7 @@ void PFX_applied(PFX_state* s, PFX_real u) {{
   s->last_du += delta;
 }}
 )C",
-                         ny, nu, rows, nT, nF, nG);
+                  ny, nu, rows, nT, nF, nG, free, fmt::format(fmt::runtime(move), 0, 0, rows));
 }
 
 void GenerateMpc(const MpcController& c, Module& m) {
