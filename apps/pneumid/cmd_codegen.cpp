@@ -91,7 +91,6 @@ void Execute(const CodegenCli& c) {
   if (c.json) {
     nlohmann::ordered_json j = result.ToJson();
     j["settings"] = built.SettingsToJson();
-    j["precision"] = ToString(options.precision);
     j["Ts"] = c.Ts;
     j["paths"] = paths;
     std::cout << j.dump(2) << "\n";

@@ -34,7 +34,6 @@ void BindCodegen(py::module_& m) {
         d["header"] = r.header;
         d["source"] = r.source;
         d["readme"] = r.readme;
-        d["precision"] = precision;
         return d;
       },
       "controller"_a, "precision"_a = "double", "prefix"_a = "pneumid_ctrl", "max_ram"_a = 0,

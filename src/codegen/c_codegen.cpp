@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
 
 #include <fmt/format.h>
 #include <Eigen/Core>
@@ -69,7 +70,28 @@ class Module {
   // #define PFX_NAME literal (a scalar constant; macros cost no flash of their own).
   void Scalar(const std::string& name, double v, const std::string& comment) {
     constants_ += fmt::format("#define PFX_{} {} /* {} */\n", name, Literal(v), comment);
+    macros_.insert(name);
   }
+
+  // Names written PFX_NAME that are macros (upper-case prefix in the output).
+  std::set<std::string> macros_ = {"ZERO",
+                                   "ONE",
+                                   "THOUSAND",
+                                   "INF",
+                                   "EPSILON",
+                                   "FABS",
+                                   "HYPOT",
+                                   "ISFINITE",
+                                   "TS",
+                                   "STATE_BYTES",
+                                   "QP_N",
+                                   "QP_M",
+                                   "QP_SOLVED",
+                                   "QP_INFEASIBLE",
+                                   "QP_MAX_ITERATIONS",
+                                   "QP_MAX_ITERATIONS_REACHED",
+                                   "QP_WARM_START",
+                                   "QP_TOLERANCE"};
 
   // static const PFX_real PFX_name[n] (a matrix column-major); at least one entry.
   void Array(const std::string& name, const Eigen::Ref<const Eigen::MatrixXd>& m,
@@ -706,18 +728,28 @@ void PFX_applied(PFX_state* s, PFX_real u) {{
                          nz);
 }
 
-std::string Replace(std::string text, const std::string& from, const std::string& to) {
-  std::size_t pos = 0;
-  while ((pos = text.find(from, pos)) != std::string::npos) {
-    text.replace(pos, from.size(), to);
-    pos += to.size();
-  }
-  return text;
-}
-
 std::string Upper(std::string s) {
   for (char& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
   return s;
+}
+
+// PFX_name -> prefix_name, and PFX_MACRO -> PREFIX_MACRO for the macros.
+std::string WithPrefix(const std::string& text, const std::string& prefix,
+                       const std::set<std::string>& macros) {
+  std::string out;
+  std::size_t pos = 0;
+  for (std::size_t at; (at = text.find("PFX_", pos)) != std::string::npos;) {
+    out.append(text, pos, at - pos);
+    std::size_t end = at + 4;
+    while (end < text.size() &&
+           (std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_'))
+      ++end;
+    const std::string name = text.substr(at + 4, end - at - 4);
+    out += (macros.count(name) ? Upper(prefix) : prefix) + "_" + name;
+    pos = end;
+  }
+  out.append(text, pos, std::string::npos);
+  return out;
 }
 
 }  // namespace
@@ -750,6 +782,7 @@ nlohmann::ordered_json CodegenResult::ToJson() const {
   j["prefix"] = prefix;
   j["controller"] = pneumid::ToString(type);
   j["description"] = description;
+  j["precision"] = ToString(precision);
   j["constrained"] = constrained;
   j["ram_bytes"] = ram_bytes;
   j["const_bytes"] = const_bytes;
@@ -763,6 +796,7 @@ CodegenResult GenerateC(const Controller& controller, const CodegenOptions& opti
   Module m(options);
   CodegenResult result;
   result.prefix = options.prefix;
+  result.precision = options.precision;
   result.description = controller.Describe();
   if (const auto* pid = dynamic_cast<const PidController*>(&controller)) {
     result.type = ControllerType::kPid;
@@ -867,8 +901,8 @@ void PFX_applied(PFX_state* s, PFX_real u);
   c += m.code_;
   c += "\nvoid PFX_init(PFX_state* s) { PFX_reset(s, PFX_ZERO, PFX_ZERO); }\n";
   // The step uses PFX_ISFINITE only in some controllers; keep every macro used.
-  result.header = Replace(h, "PFX_", name + "_");
-  result.source = Replace(c, "PFX_", name + "_");
+  result.header = WithPrefix(h, name, m.macros_);
+  result.source = WithPrefix(c, name, m.macros_);
 
   // README.
   result.readme = fmt::format(
@@ -903,7 +937,7 @@ void control_init(void) {{ {0}_init(&ctrl); }}   /* or {0}_reset(&ctrl, u0, y0) 
 | `{0}_step(s, r, y)` | one sample: set-point r, measurement y -> input u within the limits |
 | `{0}_applied(s, u)` | the input actually applied (anti-windup), when it differs from the returned one |
 
-Sample time: `{0}_TS` = {4} s. State: `sizeof({0}_state)` = `{0}_STATE_BYTES` = {3} bytes;
+Sample time: `{7}_TS` = {4} s. State: `sizeof({0}_state)` = `{7}_STATE_BYTES` = {3} bytes;
 constant tables: {5} bytes.
 {6}
 The arithmetic follows pneumid's library controller step by step (same
@@ -914,12 +948,13 @@ reproduces the library's inputs to rounding.
       result.constrained
           ? fmt::format(
                 "\nConstrained: every step may solve a dense QP (Goldfarb-Idnani dual active "
-                "set, warm-started) with an iteration cap; `s->qp.status` is `{0}_QP_SOLVED`, "
-                "`{0}_QP_INFEASIBLE` or `{0}_QP_MAX_ITERATIONS_REACHED`, `s->qp.iterations` the "
+                "set, warm-started) with an iteration cap; `s->qp.status` is `{1}_QP_SOLVED`, "
+                "`{1}_QP_INFEASIBLE` or `{1}_QP_MAX_ITERATIONS_REACHED`, `s->qp.iterations` the "
                 "work done; a step whose QP fails applies the clipped unconstrained move and "
                 "counts it in `s->qp_failures` (reset by `{0}_reset`).\n",
-                name)
-          : std::string());
+                name, Upper(name))
+          : std::string(),
+      Upper(name));
   return result;
 }
 

@@ -1,5 +1,6 @@
 #include "pneumid/codegen/plant_codegen.hpp"
 
+#include <cctype>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -28,6 +29,11 @@ std::string List(const Eigen::Ref<const Eigen::MatrixXd>& m, bool is_float) {
   return s;
 }
 
+std::string Upper(std::string s) {
+  for (char& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  return s;
+}
+
 }  // namespace
 
 CodegenResult GenerateLinearPlantC(const StateSpace& model, const CodegenOptions& options) {
@@ -52,6 +58,7 @@ CodegenResult GenerateLinearPlantC(const StateSpace& model, const CodegenOptions
   const std::size_t rs = f ? 4 : 8;
   CodegenResult r;
   r.prefix = name;
+  r.precision = options.precision;
   r.description = fmt::format("linear plant, {} states, Ts = {} s", n, model.Ts());
   r.ram_bytes = 2 * n * rs;
   r.const_bytes = (n * n + 3 * n + 1) * rs;
@@ -99,7 +106,7 @@ static const {0}_real {0}_A[{2}] = {{{3}}}; /* column-major */
 static const {0}_real {0}_B[{4}] = {{{5}}};
 static const {0}_real {0}_C[{4}] = {{{6}}};
 static const {0}_real {0}_xs[{4}] = {{{7}}}; /* (I - A)^-1 B */
-#define {0}_D {8}
+#define {9}_D {8}
 
 void {0}_reset({0}_state* p, {0}_real u0) {{
   int i;
@@ -107,7 +114,7 @@ void {0}_reset({0}_state* p, {0}_real u0) {{
 }}
 
 {0}_real {0}_output(const {0}_state* p, {0}_real u) {{
-  {0}_real y = {0}_D * u;
+  {0}_real y = {9}_D * u;
   int i;
   for (i = 0; i < {4}; ++i) y += {0}_C[i] * p->x[i];
   return y;
@@ -124,7 +131,7 @@ void {0}_advance({0}_state* p, {0}_real u) {{
 }}
 )C",
                          name, r.description, n * n, List(model.A(), f), n, List(model.B(), f),
-                         List(model.C(), f), List(xs, f), Literal(model.D()(0, 0), f));
+                         List(model.C(), f), List(xs, f), Literal(model.D()(0, 0), f), Upper(name));
   r.readme = fmt::format("# {0}\n\n{1}: `{0}_reset`, `{0}_output`, `{0}_advance` ({0}.h).\n", name,
                          r.description);
   return r;

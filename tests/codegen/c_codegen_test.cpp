@@ -391,6 +391,7 @@ TEST(CodegenTest, ModuleUsesOnlyMathAndString) {
   const nlohmann::ordered_json j = gen.ToJson();
   EXPECT_EQ(j["controller"], "mpc");
   EXPECT_EQ(j["ram_bytes"], gen.ram_bytes);
+  EXPECT_EQ(j["precision"], "double");
 }
 
 }  // namespace

@@ -75,6 +75,7 @@ struct CodegenOptions {
 
 struct CodegenResult {
   ControllerType type = ControllerType::kDmc;
+  CodegenPrecision precision = CodegenPrecision::kDouble;
   std::string prefix;
   std::string header;  ///< NAME.h
   std::string source;  ///< NAME.c
