@@ -11,6 +11,7 @@
 // instants and a different run) and its inputs must stay within 1e-4 of the
 // largest input.
 #include "pneumid/codegen/c_codegen.hpp"
+#include "pneumid/codegen/plant_codegen.hpp"
 
 #include <dlfcn.h>
 #include <algorithm>
@@ -33,6 +34,7 @@
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
+#include "pneumid/control/prediction_model.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
@@ -120,7 +122,7 @@ const LibraryRun& Library(const Case& c) {
   return cache.emplace(c.name, std::move(run)).first->second;
 }
 
-int Run(const std::string& command) { return std::system((command + " 2>&1").c_str()); }
+int Shell(const std::string& command) { return std::system((command + " 2>&1").c_str()); }
 
 std::string Read(const fs::path& path) {
   std::ifstream in(path);
@@ -216,22 +218,23 @@ fs::path Compile(const CodegenResult& gen, const fs::path& dir) {
     probe.replace(p, 4, gen.prefix);
   std::ofstream(dir / "size.c") << probe;
   const std::string src = (dir / (gen.prefix + ".c")).string();
-  EXPECT_EQ(Run(fmt::format("gcc -std=c99 -Wall -Wextra -Werror -pedantic -O2 -c {} -o {}", src,
-                            (dir / "gcc.o").string())),
+  EXPECT_EQ(Shell(fmt::format("gcc -std=c99 -Wall -Wextra -Werror -pedantic -O2 -c {} -o {}", src,
+                              (dir / "gcc.o").string())),
             0)
       << "gcc rejected " << src;
   // clang: everything but -Wpadded (the state layout is the documented one),
   // -Wfloat-equal (exact comparisons mirror the library's, e.g. delta == 0),
   // -Wunused-macros (every module defines the same set of precision macros).
-  EXPECT_EQ(Run(fmt::format("clang -std=c99 -Weverything -Wno-padded -Wno-float-equal "
-                            "-Wno-unused-macros -Werror -pedantic -O2 -c {} -o {}",
-                            src, (dir / "clang.o").string())),
+  EXPECT_EQ(Shell(fmt::format("clang -std=c99 -Weverything -Wno-padded -Wno-float-equal "
+                              "-Wno-unused-macros -Werror -pedantic -O2 -c {} -o {}",
+                              src, (dir / "clang.o").string())),
             0)
       << "clang rejected " << src;
   const fs::path so = dir / ("lib" + gen.prefix + ".so");
-  EXPECT_EQ(Run(fmt::format("gcc -std=c99 -O2 -ffp-contract=off -fPIC -shared -I{} {} {} -o {} -lm",
-                            dir.string(), src, (dir / "size.c").string(), so.string())),
-            0);
+  EXPECT_EQ(
+      Shell(fmt::format("gcc -std=c99 -O2 -ffp-contract=off -fPIC -shared -I{} {} {} -o {} -lm",
+                        dir.string(), src, (dir / "size.c").string(), so.string())),
+      0);
   return so;
 }
 
@@ -368,6 +371,46 @@ TEST(CodegenTest, RejectsOtherControllers) {
   EXPECT_THAT([&] { GenerateC(other, CodegenOptions{}); },
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr(
                   "supports the dmc, gpc, pid and mpc controllers, not 'other'")));
+}
+
+// The plant module (plant_codegen.hpp) of the paper's FOPDT: its unit step
+// response equals the model's sampled step response s_i = y(i Ts)
+// (PredictionModel::StepResponse, from the transfer function), to 1e-12.
+TEST(PlantCodegenTest, StepResponseEqualsTheModels) {
+  CodegenOptions o;
+  o.prefix = "fopdt";
+  const CodegenResult gen = GenerateLinearPlantC(SampledStateSpace(PaperFopdtModel(), kTs), o);
+  TempDir dir;
+  WriteCodegenFiles(gen, dir.path().string());
+  std::ofstream(dir.path() / "main.c") << R"C(#include <stdio.h>
+#include "fopdt.h"
+int main(void) {
+  fopdt_state p;
+  int i;
+  fopdt_reset(&p, 0.0);
+  for (i = 0; i <= 100; ++i) {
+    printf("%a\n", fopdt_output(&p, 1.0));
+    fopdt_advance(&p, 1.0);
+  }
+  fopdt_reset(&p, 2.0);
+  printf("%a\n", fopdt_output(&p, 2.0));
+  return 0;
+}
+)C";
+  const fs::path exe = dir.path() / "step";
+  ASSERT_EQ(Shell(fmt::format("gcc -std=c99 -Wall -Wextra -Werror -pedantic -I{0} {0}/fopdt.c "
+                              "{0}/main.c -o {1} -lm",
+                              dir.path().string(), exe.string())),
+            0);
+  ASSERT_EQ(Shell(fmt::format("{} > {}", exe.string(), (dir.path() / "out.txt").string())), 0);
+  std::istringstream lines(Read(dir.path() / "out.txt"));
+  std::vector<double> y;
+  for (std::string tok; lines >> tok;) y.push_back(std::strtod(tok.c_str(), nullptr));
+  ASSERT_EQ(y.size(), 102u);
+  const Eigen::VectorXd s = PredictionModel(PaperFopdtModel(), kTs).StepResponse(100);
+  for (int i = 0; i <= 100; ++i) EXPECT_NEAR(y[i], s(i), 1e-12) << "sample " << i;
+  // At the steady state of u0 = 2 the output is twice the static gain.
+  EXPECT_NEAR(y[101], 2.0 * PaperFopdtModel().DcGain(), 1e-12);
 }
 
 TEST(CodegenTest, ModuleUsesOnlyMathAndString) {
