@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "c_runtime.hpp"
+#include "c_text.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/enum_names.hpp"
 #include "pneumid/control/dmc.hpp"
@@ -51,21 +52,7 @@ class Module {
   bool is_float() const { return is_float_; }
 
   // A C literal of v in the module's precision ("PFX_INF" for infinities).
-  std::string Literal(double v) const {
-    if (std::isinf(v)) return v > 0 ? "PFX_INF" : "(-PFX_INF)";
-    PNEUMID_CHECK(std::isfinite(v), "cannot generate code for a non-finite constant ({})", v);
-    std::string s;
-    if (is_float_) {
-      const float f = static_cast<float>(v);
-      PNEUMID_CHECK(std::isfinite(f), "the constant {} overflows single precision; use double", v);
-      s = fmt::format("{:.9g}", f);
-    } else {
-      s = fmt::format("{:.17g}", v);
-    }
-    if (s.find_first_of(".e") == std::string::npos) s += ".0";
-    if (is_float_) s += "f";
-    return v < 0 ? "(" + s + ")" : s;
-  }
+  std::string Literal(double v) const { return internal::CLiteral(v, is_float_); }
 
   // #define PFX_NAME literal (a scalar constant; macros cost no flash of their own).
   void Scalar(const std::string& name, double v, const std::string& comment) {
@@ -96,13 +83,8 @@ class Module {
   // static const PFX_real PFX_name[n] (a matrix column-major); at least one entry.
   void Array(const std::string& name, const Eigen::Ref<const Eigen::MatrixXd>& m,
              const std::string& comment) {
-    const Eigen::Index n = m.size();
-    const Eigen::Index stored = std::max<Eigen::Index>(n, 1);
-    std::string body;
-    for (Eigen::Index i = 0; i < stored; ++i) {
-      const double v = i < n ? m(i % m.rows(), i / m.rows()) : 0.0;  // column-major
-      body += (i % 4 == 0 ? "\n    " : " ") + Literal(v) + (i + 1 < stored ? "," : "");
-    }
+    const Eigen::Index stored = std::max<Eigen::Index>(m.size(), 1);
+    const std::string body = internal::CInitializer(m, is_float_);
     constants_ += fmt::format("/* {} */\nstatic const PFX_real PFX_{}[{}] = {{{}}};\n", comment,
                               name, stored, body);
     const_bytes_ += static_cast<std::size_t>(stored) * RealSize();
@@ -728,11 +710,6 @@ void PFX_applied(PFX_state* s, PFX_real u) {{
                          nz);
 }
 
-std::string Upper(std::string s) {
-  for (char& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-  return s;
-}
-
 // PFX_name -> prefix_name, and PFX_MACRO -> PREFIX_MACRO for the macros.
 std::string WithPrefix(const std::string& text, const std::string& prefix,
                        const std::set<std::string>& macros) {
@@ -745,7 +722,7 @@ std::string WithPrefix(const std::string& text, const std::string& prefix,
            (std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_'))
       ++end;
     const std::string name = text.substr(at + 4, end - at - 4);
-    out += (macros.count(name) ? Upper(prefix) : prefix) + "_" + name;
+    out += (macros.count(name) ? internal::Upper(prefix) : prefix) + "_" + name;
     pos = end;
   }
   out.append(text, pos, std::string::npos);
@@ -817,7 +794,7 @@ CodegenResult GenerateC(const Controller& controller, const CodegenOptions& opti
                   controller.Describe());
   }
   const std::string name = options.prefix;
-  const std::string guard = Upper(name) + "_H_";
+  const std::string guard = internal::Upper(name) + "_H_";
   const bool is_float = m.is_float();
   const std::string real = is_float ? "float" : "double";
 
@@ -952,9 +929,9 @@ reproduces the library's inputs to rounding.
                 "`{1}_QP_INFEASIBLE` or `{1}_QP_MAX_ITERATIONS_REACHED`, `s->qp.iterations` the "
                 "work done; a step whose QP fails applies the clipped unconstrained move and "
                 "counts it in `s->qp_failures` (reset by `{0}_reset`).\n",
-                name, Upper(name))
+                name, internal::Upper(name))
           : std::string(),
-      Upper(name));
+      internal::Upper(name));
   return result;
 }
 

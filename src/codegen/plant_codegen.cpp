@@ -6,33 +6,16 @@
 #include <fmt/format.h>
 #include <Eigen/Dense>
 
+#include "c_text.hpp"
 #include "pneumid/common/check.hpp"
 
 namespace pneumid {
 
 namespace {
 
-std::string Literal(double v, bool is_float) {
-  PNEUMID_CHECK(std::isfinite(v), "cannot generate code for a non-finite constant ({})", v);
-  std::string s =
-      is_float ? fmt::format("{:.9g}", static_cast<float>(v)) : fmt::format("{:.17g}", v);
-  if (s.find_first_of(".e") == std::string::npos) s += ".0";
-  if (is_float) s += "f";
-  return v < 0 ? "(" + s + ")" : s;
-}
-
-std::string List(const Eigen::Ref<const Eigen::MatrixXd>& m, bool is_float) {
-  std::string s;
-  for (Eigen::Index i = 0; i < m.size(); ++i)
-    s += (i % 4 == 0 ? "\n    " : " ") + Literal(m(i % m.rows(), i / m.rows()), is_float) +
-         (i + 1 < m.size() ? "," : "");
-  return s;
-}
-
-std::string Upper(std::string s) {
-  for (char& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
-  return s;
-}
+using internal::CInitializer;
+using internal::CLiteral;
+using internal::Upper;
 
 }  // namespace
 
@@ -47,6 +30,9 @@ CodegenResult GenerateLinearPlantC(const StateSpace& model, const CodegenOptions
                 "the plant module needs the input delay as states (DelayAsStates), got a delay "
                 "of {} s",
                 model.delay());
+  PNEUMID_CHECK(model.A().allFinite() && model.B().allFinite() && model.C().allFinite() &&
+                    model.D().allFinite(),
+                "the plant module needs finite matrices");
   const int n = model.num_states();
   PNEUMID_CHECK(n >= 1, "the plant module needs at least one state");
   const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(n, n);
@@ -130,8 +116,9 @@ void {0}_advance({0}_state* p, {0}_real u) {{
   for (i = 0; i < {4}; ++i) p->x[i] = p->tmp[i];
 }}
 )C",
-                         name, r.description, n * n, List(model.A(), f), n, List(model.B(), f),
-                         List(model.C(), f), List(xs, f), Literal(model.D()(0, 0), f), Upper(name));
+                         name, r.description, n * n, CInitializer(model.A(), f), n,
+                         CInitializer(model.B(), f), CInitializer(model.C(), f),
+                         CInitializer(xs, f), CLiteral(model.D()(0, 0), f), Upper(name));
   r.readme = fmt::format("# {0}\n\n{1}: `{0}_reset`, `{0}_output`, `{0}_advance` ({0}.h).\n", name,
                          r.description);
   return r;
