@@ -159,7 +159,10 @@ unsigned long NAME_state_size(void) { return (unsigned long)sizeof(NAME_state); 
 class GeneratedController : public Controller {
  public:
   GeneratedController(const fs::path& so, const CodegenResult& gen, bool single, double Ts)
-      : single_(single), Ts_(Ts), description_("generated " + gen.description) {
+      : single_(single),
+        Ts_(Ts),
+        description_("generated " + gen.description),
+        prefix_(gen.prefix) {
     handle_ = dlopen(so.c_str(), RTLD_NOW | RTLD_LOCAL);
     PNEUMID_CHECK(handle_ != nullptr, "dlopen {}: {}", so.string(), dlerror());
     auto sym = [&](const std::string& name) {
@@ -198,11 +201,19 @@ class GeneratedController : public Controller {
   double Ts() const override { return Ts_; }
   std::string Describe() const override { return description_; }
   std::size_t state_size() const { return state_size_; }
+  /// s.qp_failures of a constrained module.
+  int qp_failures() const {
+    auto f =
+        reinterpret_cast<int (*)(const void*)>(dlsym(handle_, (prefix_ + "_qp_failures").c_str()));
+    PNEUMID_CHECK(f != nullptr, "{}_qp_failures: not a constrained module", prefix_);
+    return f(state_.data());
+  }
 
  private:
   bool single_;
   double Ts_;
   std::string description_;
+  std::string prefix_;
   void* handle_ = nullptr;
   void *reset_ = nullptr, *step_ = nullptr, *applied_ = nullptr;
   std::size_t state_size_ = 0;
@@ -216,6 +227,14 @@ fs::path Compile(const CodegenResult& gen, const fs::path& dir) {
   std::string probe = kSizeProbe;
   for (std::size_t p; (p = probe.find("NAME")) != std::string::npos;)
     probe.replace(p, 4, gen.prefix);
+  if (gen.constrained) {
+    // The QP's bookkeeping, for the tests of its failure paths.
+    probe +=
+        "int NAME_qp_failures(const NAME_state* s);\n"
+        "int NAME_qp_failures(const NAME_state* s) { return s->qp_failures; }\n";
+    for (std::size_t p; (p = probe.find("NAME")) != std::string::npos;)
+      probe.replace(p, 4, gen.prefix);
+  }
   std::ofstream(dir / "size.c") << probe;
   const std::string src = (dir / (gen.prefix + ".c")).string();
   EXPECT_EQ(Shell(fmt::format("gcc -std=c99 -Wall -Wextra -Werror -pedantic -O2 -c {} -o {}", src,
@@ -357,6 +376,47 @@ TEST(CodegenTest, RejectsBadPrefixesAndPrecisions) {
   EXPECT_EQ(CodegenPrecisionFromString("float"), CodegenPrecision::kFloat);
 }
 
+// The QP's failure paths mirror the library's: a QDMC whose QP is capped at
+// 2 iterations (max_iterations) and which is told of an applied input far
+// outside its limits (u = 150 with u <= 100 and |du| <= 4: the QP is
+// infeasible for several steps) applies the clipped unconstrained move on the
+// same steps, counts the same failures, and returns the same inputs.
+TEST(CodegenQpTest, FailuresFallBackAsInTheLibrary) {
+  DmcOptions d;
+  d.P = 60;
+  d.M = 4;
+  d.lambda = 1.0;
+  d.limits.u_min = 0.0;
+  d.limits.u_max = 100.0;
+  d.limits.du_max = 4.0;
+  d.constrained = true;
+  d.y_max = 60.0;
+  d.qp.max_iterations = 2;
+  DmcController lib(PaperFopdtModel(), kTs, d);
+  CodegenOptions o;
+  o.prefix = "qdmc_capped";
+  const CodegenResult gen = GenerateC(lib, o);
+  TempDir dir;
+  const fs::path so = Compile(gen, dir.path());
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  GeneratedController c(so, gen, false, kTs);
+  lib.Reset(0.0, 0.0);
+  c.Reset(0.0, 0.0);
+  double y = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    const double r = k < 200 ? 50.0 : 70.0;
+    const double u = lib.Update(r, y);
+    ASSERT_EQ(c.Update(r, y), u) << "step " << k;
+    if (k == 250) {
+      lib.Applied(150.0);
+      c.Applied(150.0);
+    }
+    y = 0.96 * y + 0.04 * 1.6 * (k == 250 ? 150.0 : u);
+  }
+  EXPECT_GT(lib.qp_failures(), 5);
+  EXPECT_EQ(c.qp_failures(), lib.qp_failures());
+}
+
 // A controller type the generator does not know is rejected by name.
 class OtherController : public Controller {
  public:
@@ -431,6 +491,15 @@ TEST(CodegenTest, ModuleUsesOnlyMathAndString) {
                                               "#include <string.h>"));
   for (const char* word : {"malloc", "calloc", "free(", "printf"})
     EXPECT_EQ(gen.source.find(word), std::string::npos) << word;
+  // Re-entrant: every file-scope object is a constant table.
+  std::istringstream source(gen.source);
+  int tables = 0;
+  for (std::string line; std::getline(source, line);) {
+    if (line.rfind("static ", 0) != 0 || line.find('(') != std::string::npos) continue;
+    EXPECT_EQ(line.rfind("static const ", 0), 0u) << line;
+    ++tables;
+  }
+  EXPECT_GT(tables, 5);
   const nlohmann::ordered_json j = gen.ToJson();
   EXPECT_EQ(j["controller"], "mpc");
   EXPECT_EQ(j["ram_bytes"], gen.ram_bytes);
