@@ -102,6 +102,12 @@ class DmcController : public Controller {
   const Eigen::MatrixXd& dynamic_matrix() const { return A_; }
   /// k' (1 x P), the first row of (A'QA + lambda R)^-1 A'Q.
   const Eigen::RowVectorXd& gain() const { return gain_; }
+  /// Sum of the entries of k' (the set-point's gain).
+  double gain_sum() const { return gain_sum_; }
+  /// A'Q (M x P), whose product with w 1 - f is minus the QP's linear term.
+  const Eigen::MatrixXd& weighted_dynamic_matrix_transpose() const { return AtQ_; }
+  /// The QP solver of the constrained mode (not set up when unconstrained).
+  const QpSolver& qp_solver() const { return *qp_; }
   /// Free response f_1..f_P used at the last Update() (bias included).
   const Eigen::VectorXd& free_response() const { return free_; }
   /// Move applied at the last Update().

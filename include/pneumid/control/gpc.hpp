@@ -103,6 +103,13 @@ class GpcController : public Controller {
   /// Rows Gamma_j acting on Delta u_f(t-1), Delta u_f(t-2), ...
   const Eigen::MatrixXd& gamma_matrix() const { return Gamma_; }
   const Eigen::RowVectorXd& gain() const { return gain_; }
+  /// Sum of the entries of k' (the set-point's gain).
+  double gain_sum() const { return gain_sum_; }
+  /// The observer polynomial T in use (ascending powers of q^-1, t0 = 1).
+  const Eigen::VectorXd& t_polynomial() const { return T_; }
+  /// Lengths of the stored histories of y_f and Delta u_f.
+  Eigen::Index y_history_length() const { return yf_hist_.size(); }
+  Eigen::Index move_history_length() const { return duf_hist_.size(); }
   const Eigen::VectorXd& free_response() const { return free_; }
   double last_move() const { return last_du_; }
 

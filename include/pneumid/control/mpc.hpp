@@ -178,6 +178,25 @@ class MpcController : public Controller {
   const Eigen::MatrixXd& hessian() const { return H_; }
   const Eigen::MatrixXd& dynamic_matrix() const { return Theta_; }
   const Eigen::MatrixXd& free_response_matrix() const { return Psi_; }
+  /// Ups_1..Ups_P, the response of y^ to u_{k-1} (P).
+  const Eigen::VectorXd& input_response() const { return Ups_; }
+  /// (I - A)^-1 B of the model with its delay states (nx): the steady state per unit input.
+  const Eigen::VectorXd& unit_steady_state() const { return xs_unit_; }
+  /// Model states nx (delay states included; nz = nx + 1 with a disturbance model).
+  int num_model_states() const { return nx_; }
+  /// The QP's linear term g = Gz z + Gu u_{k-1} + Gr r + Gs u_s: Gz (M x nz), Gu, Gr, Gs (M).
+  const Eigen::MatrixXd& gradient_state() const { return Gz_; }
+  const Eigen::VectorXd& gradient_input() const { return Gu_; }
+  const Eigen::VectorXd& gradient_setpoint() const { return Gr_; }
+  const Eigen::VectorXd& gradient_target() const { return Gs_; }
+  /// The unconstrained moves -H^-1 g = Fz z + Fu u_{k-1} + Fr r + Fs u_s: Fz (M x nz), Fu, Fr, Fs
+  /// (M).
+  const Eigen::MatrixXd& moves_state() const { return Fz_; }
+  const Eigen::VectorXd& moves_input() const { return Fu_; }
+  const Eigen::VectorXd& moves_setpoint() const { return Fr_; }
+  const Eigen::VectorXd& moves_target() const { return Fs_; }
+  /// The QP solver of the constrained form (not set up when unconstrained).
+  const QpSolver& qp_solver() const { return *qp_; }
   /// True when Update() solves a QP (a finite bound on u, du or y).
   bool constrained() const { return constrained_; }
 

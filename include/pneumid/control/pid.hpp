@@ -73,6 +73,8 @@ class PidController : public Controller {
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
   const PidOptions& options() const { return options_; }
+  /// Tracking time Tt (s) of the back-calculation actually used (0: none).
+  double tracking_time() const { return Tt_; }
 
  private:
   PidOptions options_;

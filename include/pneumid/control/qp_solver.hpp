@@ -112,6 +112,20 @@ class QpSolver {
   const Eigen::VectorXd& y_bounds() const { return y_x_; }
   const QpSummary& summary() const { return summary_; }
   int num_variables() const { return n_; }
+  const QpSolverOptions& options() const { return options_; }
+  /// The data fixed at Setup(): H, C, the Cholesky factor L of H = L L'
+  /// (lower triangle, zeros above), J0 = L^-T, and the norms of the rows of
+  /// C (0 replaced by 1) used to scale violations.
+  const Eigen::MatrixXd& hessian() const { return H_; }
+  const Eigen::MatrixXd& constraint_matrix() const { return C_; }
+  Eigen::MatrixXd cholesky_factor() const { return llt_.matrixL().toDenseMatrix(); }
+  const Eigen::MatrixXd& initial_basis() const { return J0_; }
+  /// Row norms of C (m); the bounds' normals have norm 1.
+  Eigen::VectorXd row_norms() const {
+    Eigen::VectorXd r(m_);
+    for (int i = 0; i < m_; ++i) r(i) = row_norm_(2 * i);
+    return r;
+  }
   int num_constraints() const { return m_; }
 
  private:

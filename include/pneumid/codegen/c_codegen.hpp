@@ -1,0 +1,108 @@
+// Embedded C code generation: a designed controller (DMC/QDMC, GPC, PID, MPC)
+// written as a self-contained C99 module for a microcontroller.
+//
+// The generated NAME.h / NAME.c use fixed-size static arrays, no dynamic
+// allocation and no library beyond <math.h> and <string.h>; all state lives
+// in a struct the caller owns (re-entrant):
+//
+//   NAME_state s;
+//   NAME_init(&s);                      // at rest: NAME_reset(&s, 0, 0)
+//   NAME_reset(&s, u0, y0);             // Controller::Reset
+//   u = NAME_step(&s, setpoint, y);     // Controller::Update
+//   NAME_applied(&s, u_applied);        // Controller::Applied (anti-windup)
+//
+// What the module computes is the library controller's Update() with the
+// matrices and gains the library designed (read through the controllers'
+// accessors, never re-derived), in the library's order of operations:
+//  * PID: the discrete law of pid.hpp with the constants Kc Ts / Ti,
+//    Td / (Td + N Ts), Kc Td N / (Td + N Ts), Ts / Tt folded in as the
+//    library's expressions evaluate them;
+//  * DMC: the free response from the stored prediction yhat_0..yhat_N and
+//    the move du = (sum k') w - k' f (dmc.hpp); QDMC: the QP below;
+//  * GPC: the filtered histories and the free response F y_f + Gamma Du_f
+//    (gpc.hpp);
+//  * MPC: the Kalman correction, the target, the unconstrained moves
+//    Fz z + Fu u + Fr r + Fs u_s and, when a bound is violated, the QP
+//    (mpc.hpp).
+// Sums are evaluated in the order of the library's Eigen 3.4 kernels with
+// SSE2 (inner products in two lanes of two-element packets, column-major
+// matrix-vector products row by row), so that in double precision the
+// generated code reproduces the library's inputs to rounding (agreement to
+// about 1e-13 relative over long closed-loop runs; tests/codegen).
+//
+// The constrained controllers carry a C version of QpSolver (qp_solver.hpp,
+// Goldfarb-Idnani with warm start): the same constraint ordering, violation
+// test, step lengths, Givens updates and iteration cap; a step whose QP does
+// not return "solved" applies the clipped unconstrained move as the library
+// does, and counts it in qp_failures.
+//
+// Single precision: the tables are rounded to float and so is the
+// arithmetic. The MPC computes its moves (and the QP's linear term) from the
+// deviation of the state and input from the target's steady state, and the
+// GPC its free response from the deviations of the filtered output from its
+// latest value: the dropped terms cancel exactly, and without them the
+// rounding of large cancelling terms biases the moves and the input's
+// integrator accumulates the bias. The QP's feasibility tolerance is
+// max(tolerance, 1e-4) (units of the moves) and its degeneracy threshold uses
+// the float epsilon. See docs/codegen.md for the measured agreement.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "pneumid/control/controller.hpp"
+
+namespace pneumid {
+
+enum class CodegenPrecision { kDouble, kFloat };
+/// "double", "float".
+std::string ToString(CodegenPrecision precision);
+/// Inverse of ToString; throws InvalidArgument listing the valid names.
+CodegenPrecision CodegenPrecisionFromString(const std::string& name);
+
+struct CodegenOptions {
+  CodegenPrecision precision = CodegenPrecision::kDouble;
+  /// Prefix of every exported name and of the file names: a C identifier of
+  /// at most 32 characters (letters, digits, '_', not starting with a digit).
+  std::string prefix = "pneumid_ctrl";
+  /// RAM budget in bytes for the controller's state struct (0 = none).
+  std::size_t max_ram_bytes = 0;
+  bool IsValid(std::string* error) const;
+};
+
+struct CodegenResult {
+  ControllerType type = ControllerType::kDmc;
+  CodegenPrecision precision = CodegenPrecision::kDouble;
+  std::string prefix;
+  std::string header;  ///< NAME.h
+  std::string source;  ///< NAME.c
+  std::string readme;  ///< README.md of the interface
+  /// sizeof(NAME_state) on a target with 4-byte int and naturally aligned
+  /// float/double (x86-64, Cortex-M EABI): the RAM the caller provides.
+  std::size_t ram_bytes = 0;
+  /// Bytes of the constant tables (flash; code not included).
+  std::size_t const_bytes = 0;
+  bool constrained = false;  ///< the module contains the QP solver
+  std::string description;   ///< controller.Describe()
+  /// {prefix, controller, description, precision, constrained, ram_bytes,
+  /// const_bytes, files}.
+  nlohmann::ordered_json ToJson() const;
+};
+
+/// Generates the C module of `controller` (a PidController, DmcController,
+/// GpcController or MpcController).
+/// @throws InvalidArgument for invalid options, another Controller type, a
+/// non-finite design constant, or a state above options.max_ram_bytes (the
+/// message gives the size and what it grows with).
+CodegenResult GenerateC(const Controller& controller, const CodegenOptions& options);
+
+/// Writes NAME.h, NAME.c and README.md of `result` into `directory`
+/// (created if missing), skipping an empty text; returns the paths written.
+/// @throws DataError when a file cannot be written.
+std::vector<std::string> WriteCodegenFiles(const CodegenResult& result,
+                                           const std::string& directory);
+
+}  // namespace pneumid

@@ -1,0 +1,55 @@
+// Embedded C code generation (pneumid/codegen/c_codegen.hpp) from Python:
+// generate_c() returns the module's texts and sizes, write_c() writes them.
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "pneumid/codegen/c_codegen.hpp"
+
+namespace py = pybind11;
+using namespace py::literals;
+
+namespace pneumid::python {
+
+namespace {
+
+CodegenOptions Options(const std::string& precision, const std::string& prefix,
+                       std::size_t max_ram) {
+  CodegenOptions o;
+  o.precision = CodegenPrecisionFromString(precision);
+  o.prefix = prefix;
+  o.max_ram_bytes = max_ram;
+  return o;
+}
+
+}  // namespace
+
+void BindCodegen(py::module_& m) {
+  m.def(
+      "generate_c",
+      [](const Controller& controller, const std::string& precision, const std::string& prefix,
+         std::size_t max_ram) {
+        const CodegenResult r = GenerateC(controller, Options(precision, prefix, max_ram));
+        py::dict d = JsonToPython(r.ToJson());
+        d["header"] = r.header;
+        d["source"] = r.source;
+        d["readme"] = r.readme;
+        return d;
+      },
+      "controller"_a, "precision"_a = "double", "prefix"_a = "pneumid_ctrl", "max_ram"_a = 0,
+      "The controller as an embedded C99 module (pneumid codegen): a dict with header, source, "
+      "readme, ram_bytes, const_bytes, constrained, description, files. Raises InvalidArgument "
+      "for a state above max_ram bytes (0: no budget) or bad options.");
+  m.def(
+      "write_c",
+      [](const Controller& controller, const std::string& directory, const std::string& precision,
+         const std::string& prefix, std::size_t max_ram) {
+        return WriteCodegenFiles(GenerateC(controller, Options(precision, prefix, max_ram)),
+                                 directory);
+      },
+      "controller"_a, "directory"_a, "precision"_a = "double", "prefix"_a = "pneumid_ctrl",
+      "max_ram"_a = 0,
+      "Writes PREFIX.h, PREFIX.c and README.md into directory; returns the paths.");
+}
+
+}  // namespace pneumid::python

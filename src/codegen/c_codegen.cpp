@@ -1,0 +1,963 @@
+#include "pneumid/codegen/c_codegen.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+
+#include <fmt/format.h>
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <nlohmann/json.hpp>
+
+#include "c_runtime.hpp"
+#include "c_text.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
+#include "pneumid/control/dmc.hpp"
+#include "pneumid/control/gpc.hpp"
+#include "pneumid/control/mpc.hpp"
+#include "pneumid/control/pid.hpp"
+
+namespace pneumid {
+
+namespace {
+
+constexpr EnumName<CodegenPrecision> kPrecisionNames[] = {
+    {CodegenPrecision::kDouble, "double"},
+    {CodegenPrecision::kFloat, "float"},
+};
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// One member of a generated struct.
+struct Field {
+  enum Kind { kReal, kInt, kByte } kind;
+  std::string name;
+  int count;  // 0: a scalar
+  std::string comment;
+};
+
+// Builds the text of one module: constants (counted as flash), struct
+// members (counted as RAM), and the code, with "PFX_" for the prefix.
+class Module {
+ public:
+  explicit Module(const CodegenOptions& options)
+      : options_(options), is_float_(options.precision == CodegenPrecision::kFloat) {}
+
+  std::size_t RealSize() const { return is_float_ ? 4 : 8; }
+  bool is_float() const { return is_float_; }
+
+  // A C literal of v in the module's precision ("PFX_INF" for infinities).
+  std::string Literal(double v) const { return internal::CLiteral(v, is_float_); }
+
+  // #define PFX_NAME literal (a scalar constant; macros cost no flash of their own).
+  void Scalar(const std::string& name, double v, const std::string& comment) {
+    constants_ += fmt::format("#define PFX_{} {} /* {} */\n", name, Literal(v), comment);
+    macros_.insert(name);
+  }
+
+  // Names written PFX_NAME that are macros (upper-case prefix in the output).
+  std::set<std::string> macros_ = {"ZERO",
+                                   "ONE",
+                                   "THOUSAND",
+                                   "INF",
+                                   "EPSILON",
+                                   "FABS",
+                                   "HYPOT",
+                                   "ISFINITE",
+                                   "TS",
+                                   "STATE_BYTES",
+                                   "QP_N",
+                                   "QP_M",
+                                   "QP_SOLVED",
+                                   "QP_INFEASIBLE",
+                                   "QP_MAX_ITERATIONS",
+                                   "QP_MAX_ITERATIONS_REACHED",
+                                   "QP_WARM_START",
+                                   "QP_TOLERANCE"};
+
+  // static const PFX_real PFX_name[n] (a matrix column-major); at least one entry.
+  void Array(const std::string& name, const Eigen::Ref<const Eigen::MatrixXd>& m,
+             const std::string& comment) {
+    const Eigen::Index stored = std::max<Eigen::Index>(m.size(), 1);
+    const std::string body = internal::CInitializer(m, is_float_);
+    constants_ += fmt::format("/* {} */\nstatic const PFX_real PFX_{}[{}] = {{{}}};\n", comment,
+                              name, stored, body);
+    const_bytes_ += static_cast<std::size_t>(stored) * RealSize();
+  }
+
+  void Member(Field f) { state_.push_back(std::move(f)); }
+  void QpMember(Field f) { qp_.push_back(std::move(f)); }
+
+  // Struct text and size (reals, then ints, then bytes; padded to the
+  // alignment of its widest member).
+  std::string StructText(const std::vector<Field>& fields, const std::string& extra,
+                         std::size_t extra_bytes, std::size_t* bytes) const {
+    std::string text;
+    std::size_t size = 0;
+    auto put = [&](Field::Kind kind, const char* type, std::size_t unit) {
+      for (const Field& f : fields) {
+        if (f.kind != kind) continue;
+        const int count = std::max(f.count, 1);
+        text += f.count > 0 ? fmt::format("  {} {}[{}]; /* {} */\n", type, f.name, count, f.comment)
+                            : fmt::format("  {} {}; /* {} */\n", type, f.name, f.comment);
+        size += static_cast<std::size_t>(count) * unit;
+      }
+    };
+    put(Field::kReal, "PFX_real", RealSize());
+    text += extra;
+    size += extra_bytes;
+    put(Field::kInt, "int", 4);
+    put(Field::kByte, "unsigned char", 1);
+    const std::size_t align = std::max<std::size_t>(RealSize(), 4);
+    *bytes = (size + align - 1) / align * align;
+    return text;
+  }
+
+  const CodegenOptions& options() const { return options_; }
+  std::string constants_;
+  std::string code_;
+  std::vector<Field> state_, qp_;
+  std::size_t const_bytes_ = 0;
+  // Kernels the code calls.
+  bool dot_ = false, dot_strided_ = false, gemv_col_ = false, qp_solver_ = false;
+
+ private:
+  CodegenOptions options_;
+  bool is_float_ = false;
+};
+
+// Clip of InputLimits (controller.cpp): std::clamp to u_prev +- du_max, then
+// to [u_min, u_max]; sides that are infinite are left out.
+void EmitClip(Module& m, const InputLimits& lim) {
+  std::string body;
+  if (std::isfinite(lim.du_max)) {
+    body += fmt::format(
+        "  {{\n    const PFX_real lo = u_prev - {0}, hi = u_prev + {0};\n"
+        "    u = u < lo ? lo : (hi < u ? hi : u);\n  }}\n",
+        m.Literal(lim.du_max));
+  } else {
+    body += "  (void)u_prev;\n";
+  }
+  const bool lo = std::isfinite(lim.u_min), hi = std::isfinite(lim.u_max);
+  if (lo && hi)
+    body += fmt::format("  u = u < {0} ? {0} : ({1} < u ? {1} : u);\n", m.Literal(lim.u_min),
+                        m.Literal(lim.u_max));
+  else if (lo)
+    body += fmt::format("  if (u < {0}) u = {0};\n", m.Literal(lim.u_min));
+  else if (hi)
+    body += fmt::format("  if ({0} < u) u = {0};\n", m.Literal(lim.u_max));
+  m.code_ +=
+      "/* u clipped to u_prev +- du_max, then to [u_min, u_max] (InputLimits::Clip). */\n"
+      "static PFX_real PFX_clip(PFX_real u, PFX_real u_prev) {\n" +
+      body + "  return u;\n}\n\n";
+}
+
+// The QP data of a constrained controller and the members it needs.
+void EmitQpData(Module& m, const QpSolver& qp, const InputLimits& lim, bool soft_output) {
+  const int n = qp.num_variables(), rows = qp.num_constraints();
+  PNEUMID_CHECK(n > 0, "the controller's QP is not set up");
+  m.qp_solver_ = m.dot_ = m.dot_strided_ = m.gemv_col_ = true;
+  m.constants_ += fmt::format("#define PFX_QP_N {} /* QP variables */\n", n);
+  m.constants_ += fmt::format("#define PFX_QP_M {} /* QP constraint rows */\n", rows);
+  m.constants_ +=
+      fmt::format("#define PFX_QP_MAX_ITERATIONS {} /* 0: 10 (n + finite sides) + 10 */\n",
+                  qp.options().max_iterations);
+  m.constants_ += fmt::format("#define PFX_QP_WARM_START {}\n", qp.options().warm_start ? 1 : 0);
+  const double tol = m.is_float() ? std::max(qp.options().feasibility_tolerance, 1e-4)
+                                  : qp.options().feasibility_tolerance;
+  m.Scalar("QP_TOLERANCE", tol, "feasibility tolerance (units of the moves)");
+  m.Array("qp_C", qp.constraint_matrix(), "QP constraint matrix C (column-major)");
+  m.Array("qp_L", qp.cholesky_factor(),
+          "Cholesky factor L of the QP Hessian H = L L' (column-major)");
+  m.Array("qp_J0", qp.initial_basis(), "J0 = L^-T (column-major)");
+  m.Array("qp_norm", qp.row_norms(), "norms of the rows of C");
+  Eigen::VectorXd lbx = Eigen::VectorXd::Constant(n, -lim.du_max);
+  Eigen::VectorXd ubx = Eigen::VectorXd::Constant(n, lim.du_max);
+  if (soft_output) {
+    lbx(n - 1) = 0.0;
+    ubx(n - 1) = kInf;
+  }
+  m.Array("qp_lbx", lbx, "lower bounds of the moves (and the slack)");
+  m.Array("qp_ubx", ubx, "upper bounds of the moves (and the slack)");
+  const int m_rows = std::max(rows, 1);
+  m.QpMember({Field::kReal, "J", n * n, "J = L^-T Q (column-major)"});
+  m.QpMember({Field::kReal, "R", n * n, "R of J' N = [R; 0] (column-major)"});
+  m.QpMember({Field::kReal, "x", n, "solution"});
+  m.QpMember({Field::kReal, "u", n + 1, "multipliers of the active set"});
+  m.QpMember({Field::kReal, "np", n, "normal of the constraint being added"});
+  m.QpMember({Field::kReal, "d", n, "J' n_p"});
+  m.QpMember({Field::kReal, "z", n, "primal direction"});
+  m.QpMember({Field::kReal, "r", n, "dual direction"});
+  m.QpMember({Field::kReal, "g", n, "linear term"});
+  m.QpMember({Field::kReal, "cx", m_rows, "C x"});
+  m.QpMember({Field::kReal, "lb", m_rows, "lower row bounds"});
+  m.QpMember({Field::kReal, "ub", m_rows, "upper row bounds"});
+  m.QpMember({Field::kInt, "active", n, "active constraint ids"});
+  m.QpMember({Field::kInt, "warm", n, "active inequalities of the last solution"});
+  m.QpMember({Field::kInt, "q", 0, "number of active constraints"});
+  m.QpMember({Field::kInt, "nwarm", 0, "entries of warm"});
+  m.QpMember({Field::kInt, "status", 0, "PFX_QP_SOLVED, ..."});
+  m.QpMember({Field::kInt, "iterations", 0, "active-set changes of the last solve"});
+  m.QpMember({Field::kByte, "is_active", 2 * (rows + n), "per constraint side"});
+  m.Member({Field::kInt, "qp_failures", 0,
+            "steps whose QP did not return PFX_QP_SOLVED (clipped unconstrained move applied)"});
+}
+
+// The row bounds of the move QP (move_qp_bounds.hpp) from the free response `free`.
+std::string QpBoundsCode(const Module& m, bool u_rows, const InputLimits& lim, double y_min,
+                         double y_max, int M, int P, const std::string& free) {
+  std::string c;
+  int row = 0;
+  if (u_rows) {
+    c += fmt::format(
+        "  for (i = 0; i < {}; ++i) {{\n    s->qp.lb[i] = {} - s->u_prev;\n"
+        "    s->qp.ub[i] = {} - s->u_prev;\n  }}\n",
+        M, m.Literal(lim.u_min), m.Literal(lim.u_max));
+    row += M;
+  }
+  if (std::isfinite(y_min)) {
+    c += fmt::format(
+        "  for (i = 0; i < {0}; ++i) {{\n    s->qp.lb[{1} + i] = {2} - {3}[i];\n"
+        "    s->qp.ub[{1} + i] = PFX_INF;\n  }}\n",
+        P, row, m.Literal(y_min), free);
+    row += P;
+  }
+  if (std::isfinite(y_max)) {
+    c += fmt::format(
+        "  for (i = 0; i < {0}; ++i) {{\n    s->qp.lb[{1} + i] = -PFX_INF;\n"
+        "    s->qp.ub[{1} + i] = {2} - {3}[i];\n  }}\n",
+        P, row, m.Literal(y_max), free);
+  }
+  return c;
+}
+
+std::string RamHint(ControllerType type) {
+  switch (type) {
+    case ControllerType::kDmc:
+      return "it grows with the model horizon N and P, and with P M for QDMC";
+    case ControllerType::kGpc:
+      return "it grows with the prediction horizon N2";
+    case ControllerType::kMpc:
+      return "it grows with the model order and, constrained, with P M";
+    case ControllerType::kPid:
+      return "a PID needs a few values";
+  }
+  return "";
+}
+
+void GeneratePid(const PidController& c, Module& m) {
+  const PidOptions& o = c.options();
+  const PidGains& g = o.gains;
+  const double Ts = c.Ts(), Tt = c.tracking_time();
+  const bool integral = std::isfinite(g.Ti), derivative = g.Td > 0.0;
+  const double nts = o.derivative_filter * Ts;
+  m.Scalar("KC", g.Kc, "proportional gain Kc");
+  m.Scalar("B", o.setpoint_weight, "set-point weight b");
+  m.Scalar("KR", g.Kc * (o.setpoint_weight - 1.0), "Kc (b - 1), for the bumpless reset");
+  if (integral) m.Scalar("CI", g.Kc * Ts / g.Ti, "Kc Ts / Ti");
+  if (derivative) {
+    m.Scalar("AD", g.Td / (g.Td + nts), "Td / (Td + N Ts)");
+    m.Scalar("BD", g.Kc * g.Td * o.derivative_filter / (g.Td + nts), "Kc Td N / (Td + N Ts)");
+  }
+  const bool tracking = integral && Tt > 0.0;
+  if (tracking) m.Scalar("CT", Ts / Tt, "Ts / Tt (back-calculation)");
+  m.Member({Field::kReal, "integral", 0, "I"});
+  m.Member({Field::kReal, "derivative", 0, "D (filtered, on y)"});
+  m.Member({Field::kReal, "y_prev", 0, "last measurement"});
+  m.Member({Field::kReal, "u_prev", 0, "last input"});
+  EmitClip(m, o.limits);
+  m.code_ += R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {
+  s->integral = u0 - PFX_KR * y0;
+  s->derivative = PFX_ZERO;
+  s->y_prev = y0;
+  s->u_prev = u0;
+}
+
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {
+)C";
+  if (integral) m.code_ += "  const PFX_real e = setpoint - measurement;\n";
+  m.code_ += "  const PFX_real p = PFX_KC * (PFX_B * setpoint - measurement);\n  PFX_real v, u;\n";
+  if (derivative)
+    m.code_ += "  s->derivative = PFX_AD * s->derivative - PFX_BD * (measurement - s->y_prev);\n";
+  m.code_ += "  v = p + s->integral + s->derivative;\n  u = PFX_clip(v, s->u_prev);\n";
+  if (integral)
+    m.code_ += tracking ? "  s->integral += PFX_CI * e + PFX_CT * (u - v);\n"
+                        : "  s->integral += PFX_CI * e;\n";
+  m.code_ += R"C(  s->y_prev = measurement;
+  s->u_prev = u;
+  return u;
+}
+
+void PFX_applied(PFX_state* s, PFX_real u) {
+  const PFX_real delta = u - s->u_prev;
+  if (delta == PFX_ZERO || !PFX_ISFINITE(delta)) return;
+)C";
+  if (tracking) m.code_ += "  s->integral += PFX_CT * delta;\n";
+  m.code_ += "  s->u_prev = u;\n}\n";
+}
+
+void GenerateDmc(const DmcController& c, Module& m) {
+  const DmcOptions& o = c.options();
+  const int P = o.P, M = o.M;
+  const int N = static_cast<int>(c.step_coefficients().size()) - 1;
+  m.dot_ = true;
+  m.Array("step_response", c.step_coefficients(), "step response s_0..s_N");
+  m.Array("gain", c.gain().transpose(), "k', the first row of (A'QA + lambda R)^-1 A'Q");
+  m.Scalar("GAIN_SUM", c.gain_sum(), "sum of k'");
+  m.Member({Field::kReal, "yhat", N + 1, "prediction yhat_0..yhat_N"});
+  m.Member({Field::kReal, "free", P, "free response f_1..f_P"});
+  m.Member({Field::kReal, "u_prev", 0, "last input"});
+  m.Member({Field::kReal, "last_du", 0, "last move"});
+  const bool soft = std::isfinite(o.y_min) || std::isfinite(o.y_max);
+  const bool u_rows = std::isfinite(o.limits.u_min) || std::isfinite(o.limits.u_max);
+  if (o.constrained) {
+    m.Array("AtQ", c.weighted_dynamic_matrix_transpose(), "A'Q (M x P, column-major)");
+    m.Scalar("RHO1", o.slack_linear_weight, "linear slack weight");
+    m.Member({Field::kReal, "err", P, "w - f"});
+    EmitQpData(m, c.qp_solver(), o.limits, soft);
+  }
+  EmitClip(m, o.limits);
+  m.code_ += fmt::format(R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
+  int i;
+  for (i = 0; i <= {0}; ++i) s->yhat[i] = y0;
+  for (i = 0; i < {1}; ++i) s->free[i] = y0;
+  s->u_prev = u0;
+  s->last_du = PFX_ZERO;
+{2}}}
+
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
+  const PFX_real bias = measurement - s->yhat[0];
+  PFX_real du, u;
+  int i;
+  for (i = 0; i < {1}; ++i) s->free[i] = s->yhat[i + 1] + bias;
+  du = PFX_GAIN_SUM * setpoint - PFX_dot(PFX_gain, s->free, {1});
+)C",
+                         N, P, o.constrained ? "  s->qp_failures = 0;\n  s->qp.nwarm = 0;\n" : "");
+  if (o.constrained) {
+    m.code_ += fmt::format(
+        "  for (i = 0; i < {0}; ++i) s->err[i] = setpoint - s->free[i];\n"
+        "  PFX_gemv_col(PFX_AtQ, {1}, {1}, {0}, s->err, s->qp.g, 0, -PFX_ONE);\n",
+        P, M);
+    if (soft) m.code_ += fmt::format("  s->qp.g[{}] = PFX_RHO1;\n", M);
+    m.code_ += QpBoundsCode(m, u_rows, o.limits, o.y_min, o.y_max, M, P, "s->free");
+    m.code_ +=
+        "  if (PFX_qp_solve(&s->qp) == PFX_QP_SOLVED)\n    du = s->qp.x[0];\n  else\n"
+        "    ++s->qp_failures;\n";
+  }
+  m.code_ += fmt::format(R"C(  u = PFX_clip(s->u_prev + du, s->u_prev);
+  du = u - s->u_prev;
+  for (i = 0; i < {0}; ++i) s->yhat[i] = s->yhat[i + 1] + PFX_step_response[i + 1] * du;
+  s->yhat[{0}] += PFX_step_response[{0}] * du;
+  s->u_prev = u;
+  s->last_du = du;
+  return u;
+}}
+
+void PFX_applied(PFX_state* s, PFX_real u) {{
+  const PFX_real delta = u - s->u_prev;
+  int i;
+  if (delta == PFX_ZERO || !PFX_ISFINITE(delta)) return;
+  for (i = 0; i < {0}; ++i) s->yhat[i] += PFX_step_response[i + 1] * delta;
+  s->yhat[{0}] += PFX_step_response[{0}] * delta;
+  s->u_prev = u;
+  s->last_du += delta;
+}}
+)C",
+                         N);
+}
+
+void GenerateGpc(const GpcController& c, Module& m) {
+  const Eigen::MatrixXd& F = c.f_matrix();
+  const Eigen::MatrixXd& Gamma = c.gamma_matrix();
+  const Eigen::VectorXd& T = c.t_polynomial();
+  const int rows = static_cast<int>(F.rows());
+  const int nF = static_cast<int>(F.cols()), nG = static_cast<int>(Gamma.cols());
+  const int nT = static_cast<int>(T.size());
+  const int ny = static_cast<int>(c.y_history_length());
+  const int nu = static_cast<int>(c.move_history_length());
+  m.dot_ = m.gemv_col_ = true;
+  m.Array("F", F, "F_j rows acting on y_f(t), y_f(t-1), ... (column-major)");
+  m.Array("Gamma", Gamma, "Gamma_j rows acting on Du_f(t-1), ... (column-major)");
+  m.Array("T", T, "observer polynomial T (ascending powers of q^-1)");
+  m.Array("gain", c.gain().transpose(), "k', the first row of (G'G + lambda I)^-1 G'");
+  m.Scalar("GAIN_SUM", c.gain_sum(), "sum of k'");
+  m.Scalar("T_SUM", T.sum(), "T(1)");
+  m.Member({Field::kReal, "yf", ny, "y_f(t), y_f(t-1), ..."});
+  m.Member({Field::kReal, "duf", nu, "Du_f(t-1), Du_f(t-2), ..."});
+  m.Member({Field::kReal, "free", rows, "free response"});
+  m.Member({Field::kReal, "u_prev", 0, "last input"});
+  m.Member({Field::kReal, "last_du", 0, "last move"});
+  // Single precision: the free response from the deviations y_f(t-i) - y_f(t),
+  // with du = (sum k)(w - T(1) y_f(t)) - k'(F (y_f - y_f(t)) + Gamma Du_f),
+  // which is the same as every row F_j sums to T(1) (T = E_j Delta A + q^-j F_j
+  // at q = 1), without the cancellation of k' F y_f against (sum k) w.
+  const bool deviation = m.is_float();
+  std::string free =
+      fmt::format("  PFX_gemv_col(PFX_F, {0}, {0}, {1}, s->yf, s->free, 0, PFX_ONE);\n", rows, nF);
+  std::string move = "  du = PFX_GAIN_SUM * setpoint - PFX_dot(PFX_gain, s->free, {2});\n";
+  if (deviation) {
+    const double t1 = T.sum();
+    for (int r = 0; r < rows; ++r)
+      PNEUMID_CHECK(
+          std::abs(F.row(r).sum() - t1) <= 1e-9 * (F.row(r).cwiseAbs().sum() + std::abs(t1)),
+          "GPC: row {} of F sums to {}, not T(1) = {}", r, F.row(r).sum(), t1);
+    m.Member({Field::kReal, "dyf", nF, "y_f(t-i) - y_f(t)"});
+    free = fmt::format(
+        "  for (i = 0; i < {1}; ++i) s->dyf[i] = s->yf[i] - s->yf[0];\n"
+        "  PFX_gemv_col(PFX_F, {0}, {0}, {1}, s->dyf, s->free, 0, PFX_ONE);\n",
+        rows, nF);
+    move =
+        "  du = PFX_GAIN_SUM * (setpoint - PFX_T_SUM * s->yf[0]) - PFX_dot(PFX_gain, s->free, "
+        "{2});\n";
+  }
+  EmitClip(m, c.options().limits);
+  m.code_ +=
+      fmt::format(R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
+  int i;
+  for (i = 0; i < {0}; ++i) s->yf[i] = y0 / PFX_T_SUM;
+  for (i = 0; i < {1}; ++i) s->duf[i] = PFX_ZERO;
+  for (i = 0; i < {2}; ++i) s->free[i] = y0;
+  s->u_prev = u0;
+  s->last_du = PFX_ZERO;
+}}
+
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
+  PFX_real yf = measurement, du, duf, u;
+  int i;
+  for (i = {0} - 1; i > 0; --i) s->yf[i] = s->yf[i - 1];
+  for (i = 1; i < {3}; ++i) yf -= PFX_T[i] * s->yf[i];
+  s->yf[0] = yf;
+{6}  PFX_gemv_col(PFX_Gamma, {2}, {2}, {5}, s->duf, s->free, 1, PFX_ONE);
+{7}  u = PFX_clip(s->u_prev + du, s->u_prev);
+  du = u - s->u_prev;
+  for (i = {1} - 1; i > 0; --i) s->duf[i] = s->duf[i - 1];
+  duf = du;
+  for (i = 1; i < {3}; ++i) duf -= PFX_T[i] * s->duf[i];
+  s->duf[0] = duf;
+  s->u_prev = u;
+  s->last_du = du;
+  return u;
+}}
+
+void PFX_applied(PFX_state* s, PFX_real u) {{
+  const PFX_real delta = u - s->u_prev;
+  if (delta == PFX_ZERO || !PFX_ISFINITE(delta)) return;
+  s->duf[0] += delta;
+  s->u_prev = u;
+  s->last_du += delta;
+}}
+)C",
+                  ny, nu, rows, nT, nF, nG, free, fmt::format(fmt::runtime(move), 0, 0, rows));
+}
+
+void GenerateMpc(const MpcController& c, Module& m) {
+  const MpcOptions& o = c.options();
+  const int P = o.P, M = o.M, nx = c.num_model_states();
+  const int nz = static_cast<int>(c.Az().rows());
+  const bool constrained = c.constrained();
+  const bool soft = std::isfinite(o.y_min) || std::isfinite(o.y_max);
+  const bool u_rows = std::isfinite(o.limits.u_min) || std::isfinite(o.limits.u_max);
+  const int rows_F = constrained ? M : 1;  // unconstrained: only the first move is used
+  m.dot_ = m.gemv_col_ = true;
+  m.Array("Az", c.Az(), "augmented A (column-major)");
+  m.Array("Bz", c.Bz(), "augmented B");
+  m.Array("Cz", c.Cz().transpose(), "augmented C");
+  m.Array("L", c.kalman_gain(), "Kalman gain");
+  // Single precision: the moves are computed from the deviation of the state
+  // and input from the target's steady state, Fz (z - z_s) + Fu (u - u_s) (the
+  // terms Fz z_s + Fu u_s + Fr r + Fs u_s cancel exactly: no move is optimal
+  // at a steady state on target), so that the rounding of the gains causes no
+  // bias that the input's integrator would accumulate; xs and G are those of
+  // the rounded A, B, C, for the same reason.
+  const bool deviation = m.is_float();
+  Eigen::VectorXd xs = c.unit_steady_state();
+  double G = c.static_gain();
+  if (deviation) {
+    const Eigen::MatrixXd A = c.Az().topLeftCorner(nx, nx).cast<float>().cast<double>();
+    const Eigen::VectorXd B = c.Bz().head(nx).cast<float>().cast<double>();
+    const Eigen::RowVectorXd C = c.Cz().head(nx).cast<float>().cast<double>();
+    xs = (Eigen::MatrixXd::Identity(nx, nx) - A).partialPivLu().solve(B);
+    G = C.dot(xs);
+    // The cancellation the deviation form relies on, checked on the design.
+    const Eigen::MatrixXd& Fz = c.moves_state();
+    const Eigen::VectorXd xs0 = c.unit_steady_state();
+    const double G0 = c.static_gain();
+    const int d = nz > nx ? 1 : 0;
+    for (int i = 0; i < M; ++i) {
+      const double fx = Fz.row(i).head(nx).dot(xs0);
+      const double fd = d ? Fz(i, nx) : 0.0;
+      double per_us = fx + c.moves_input()(i) + c.moves_setpoint()(i) * G0 + c.moves_target()(i);
+      double per_d = 0.0;
+      if (o.disturbance == DisturbanceModel::kOutput) per_d = fd + c.moves_setpoint()(i);
+      if (o.disturbance == DisturbanceModel::kInput) per_d = fx + fd + c.moves_setpoint()(i) * G0;
+      const double scale = Fz.row(i).cwiseAbs().sum() * (1.0 + xs0.cwiseAbs().maxCoeff()) +
+                           std::abs(c.moves_input()(i)) +
+                           std::abs(c.moves_setpoint()(i)) * (1.0 + std::abs(G0)) +
+                           std::abs(c.moves_target()(i));
+      PNEUMID_CHECK(std::abs(per_us) <= 1e-8 * scale && std::abs(per_d) <= 1e-8 * scale,
+                    "the MPC's moves do not vanish at a steady state on target (row {}: {} per "
+                    "unit target, {} per unit disturbance)",
+                    i, per_us, per_d);
+    }
+  }
+  m.Array("xs", xs, "(I - A)^-1 B");
+  m.Scalar("G", G, "static gain C (I - A)^-1 B");
+  m.Array("Fz", c.moves_state().topRows(rows_F), "moves per state estimate (column-major)");
+  m.Array("Fu", c.moves_input().head(rows_F), "moves per u_{k-1}");
+  if (!deviation) {
+    m.Array("Fr", c.moves_setpoint().head(rows_F), "moves per set-point");
+    m.Array("Fs", c.moves_target().head(rows_F), "moves per target input u_s");
+  }
+  m.Member({Field::kReal, "z_prior", nz, "z_k|k-1"});
+  m.Member({Field::kReal, "z_post", nz, "z_k|k"});
+  m.Member({Field::kReal, "z_tmp", nz, "work"});
+  m.Member({Field::kReal, "moves", rows_F, "planned moves"});
+  m.Member({Field::kReal, "u_prev", 0, "last input"});
+  m.Member({Field::kReal, "us", 0, "target input u_s"});
+  if (constrained) {
+    m.dot_strided_ = true;
+    if (soft) {
+      m.Array("Psi", c.free_response_matrix(), "Psi (P x nz, column-major)");
+      m.Array("Ups", c.input_response(), "Ups (P)");
+      m.Member({Field::kReal, "free", P, "free response"});
+      m.Array("Theta", c.dynamic_matrix(), "Theta (P x M, column-major)");
+    }
+    m.Array("Gz", c.gradient_state(), "QP linear term per state (column-major)");
+    m.Array("Gu", c.gradient_input(), "QP linear term per u_{k-1}");
+    if (!deviation) {
+      m.Array("Gr", c.gradient_setpoint(), "QP linear term per set-point");
+      m.Array("Gs", c.gradient_target(), "QP linear term per target input");
+    }
+    m.Scalar("RHO1", o.slack_linear_weight, "linear slack weight");
+    m.Member({Field::kInt, "last_active", 0, "the last step solved the QP"});
+    EmitQpData(m, c.qp_solver(), o.limits, soft);
+  }
+  EmitClip(m, o.limits);
+  // Reset: the observer at the steady state of u0 (mpc.cpp).
+  std::string reset;
+  switch (o.disturbance) {
+    case DisturbanceModel::kOutput:
+      reset = fmt::format(
+          "  for (i = 0; i < {0}; ++i) s->z_prior[i] = PFX_xs[i] * u0;\n"
+          "  s->z_prior[{0}] = y0 - PFX_dot(PFX_Cz, s->z_prior, {0});\n",
+          nx);
+      break;
+    case DisturbanceModel::kInput:
+      reset = fmt::format(
+          "  {{\n    const PFX_real d = y0 / PFX_G - u0;\n"
+          "    for (i = 0; i < {0}; ++i) s->z_prior[i] = PFX_xs[i] * (u0 + d);\n"
+          "    s->z_prior[{0}] = d;\n  }}\n",
+          nx);
+      break;
+    case DisturbanceModel::kNone:
+      reset = fmt::format(
+          "  (void)y0;\n  for (i = 0; i < {0}; ++i) s->z_prior[i] = PFX_xs[i] * u0;\n", nx);
+      break;
+  }
+  std::string target;
+  switch (o.disturbance) {
+    case DisturbanceModel::kOutput:
+      target = fmt::format("  us = (setpoint - s->z_post[{}]) / PFX_G;\n", nx);
+      break;
+    case DisturbanceModel::kInput:
+      target = fmt::format("  us = setpoint / PFX_G - s->z_post[{}];\n", nx);
+      break;
+    case DisturbanceModel::kNone:
+      target = "  us = setpoint / PFX_G;\n";
+      break;
+  }
+  std::string moves;
+  if (deviation) {
+    switch (o.disturbance) {
+      case DisturbanceModel::kOutput:
+        moves = fmt::format(
+            "  for (i = 0; i < {0}; ++i) s->z_tmp[i] = s->z_post[i] - PFX_xs[i] * us;\n"
+            "  s->z_tmp[{0}] = PFX_ZERO;\n",
+            nx);
+        break;
+      case DisturbanceModel::kInput:
+        moves = fmt::format(
+            "  for (i = 0; i < {0}; ++i) s->z_tmp[i] = s->z_post[i] - PFX_xs[i] * (us + "
+            "s->z_post[{0}]);\n"
+            "  s->z_tmp[{0}] = PFX_ZERO;\n",
+            nx);
+        break;
+      case DisturbanceModel::kNone:
+        moves = fmt::format(
+            "  for (i = 0; i < {0}; ++i) s->z_tmp[i] = s->z_post[i] - PFX_xs[i] * us;\n", nx);
+        break;
+    }
+    moves += fmt::format(
+        "  PFX_gemv_col(PFX_Fz, {0}, {0}, {1}, s->z_tmp, s->moves, 0, PFX_ONE);\n"
+        "  for (i = 0; i < {0}; ++i) s->moves[i] += PFX_Fu[i] * (s->u_prev - us);\n",
+        rows_F, nz);
+  } else {
+    moves = fmt::format(
+        "  PFX_gemv_col(PFX_Fz, {0}, {0}, {1}, s->z_post, s->moves, 0, PFX_ONE);\n"
+        "  for (i = 0; i < {0}; ++i)\n"
+        "    s->moves[i] += PFX_Fu[i] * s->u_prev + PFX_Fr[i] * setpoint + PFX_Fs[i] * us;\n",
+        rows_F, nz);
+  }
+  m.code_ += fmt::format(
+      R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
+  int i;
+{0}  for (i = 0; i < {1}; ++i) s->z_post[i] = s->z_prior[i];
+  for (i = 0; i < {2}; ++i) s->moves[i] = PFX_ZERO;
+  s->u_prev = u0;
+  s->us = u0;
+{3}}}
+
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
+  const PFX_real innovation = measurement - PFX_dot(PFX_Cz, s->z_prior, {1});
+  PFX_real us, u;
+  int i;
+  for (i = 0; i < {1}; ++i) s->z_post[i] = s->z_prior[i] + PFX_L[i] * innovation;
+{4}{5})C",
+      reset, nz, rows_F,
+      constrained ? "  s->qp_failures = 0;\n  s->last_active = 0;\n  s->qp.nwarm = 0;\n" : "",
+      target, moves);
+  if (constrained) {
+    m.code_ += "  s->last_active = 0;\n";
+    if (soft)
+      m.code_ += fmt::format(
+          "  PFX_gemv_col(PFX_Psi, {0}, {0}, {1}, s->z_post, s->free, 0, PFX_ONE);\n"
+          "  for (i = 0; i < {0}; ++i) s->free[i] += PFX_Ups[i] * s->u_prev;\n",
+          P, nz);
+    // UnconstrainedMovesFeasible().
+    std::string check;
+    const InputLimits& lim = o.limits;
+    std::vector<std::string> tests;
+    if (std::isfinite(lim.du_max))
+      tests.push_back(fmt::format("!(PFX_FABS(du) <= {})", m.Literal(lim.du_max)));
+    if (std::isfinite(lim.u_min)) tests.push_back(fmt::format("!(uj >= {})", m.Literal(lim.u_min)));
+    if (std::isfinite(lim.u_max)) tests.push_back(fmt::format("!(uj <= {})", m.Literal(lim.u_max)));
+    check += "  {\n    int feasible = 1;\n";
+    if (!tests.empty()) {
+      std::string cond;
+      for (std::size_t k = 0; k < tests.size(); ++k) cond += (k ? " || " : "") + tests[k];
+      check += fmt::format(
+          "    PFX_real uj = s->u_prev;\n    for (i = 0; i < {} && feasible; ++i) {{\n"
+          "      const PFX_real du = s->moves[i];\n      uj += du;\n"
+          "      if ({}) feasible = 0;\n    }}\n",
+          M, cond);
+    }
+    if (soft) {
+      std::vector<std::string> ytests;
+      if (std::isfinite(o.y_min)) ytests.push_back(fmt::format("!(y >= {})", m.Literal(o.y_min)));
+      if (std::isfinite(o.y_max)) ytests.push_back(fmt::format("!(y <= {})", m.Literal(o.y_max)));
+      std::string cond;
+      for (std::size_t k = 0; k < ytests.size(); ++k) cond += (k ? " || " : "") + ytests[k];
+      check += fmt::format(
+          "    for (i = 0; i < {0} && feasible; ++i) {{\n"
+          "      const int n = i + 1 < {1} ? i + 1 : {1};\n"
+          "      const PFX_real y = s->free[i] + PFX_dot_strided(PFX_Theta + i, {0}, s->moves, "
+          "n);\n"
+          "      if ({2}) feasible = 0;\n    }}\n",
+          P, M, cond);
+    }
+    check += "    if (!feasible) {\n      s->last_active = 1;\n";
+    check +=
+        deviation
+            ? fmt::format(
+                  "      PFX_gemv_col(PFX_Gz, {0}, {0}, {1}, s->z_tmp, s->qp.g, 0, PFX_ONE);\n"
+                  "      for (i = 0; i < {0}; ++i) s->qp.g[i] += PFX_Gu[i] * (s->u_prev - us);\n",
+                  M, nz)
+            : fmt::format(
+                  "      PFX_gemv_col(PFX_Gz, {0}, {0}, {1}, s->z_post, s->qp.g, 0, PFX_ONE);\n"
+                  "      for (i = 0; i < {0}; ++i)\n"
+                  "        s->qp.g[i] += PFX_Gu[i] * s->u_prev + PFX_Gr[i] * setpoint + PFX_Gs[i] "
+                  "* us;\n",
+                  M, nz);
+    if (soft) check += fmt::format("      s->qp.g[{}] = PFX_RHO1;\n", M);
+    std::string bounds = QpBoundsCode(m, u_rows, lim, o.y_min, o.y_max, M, P, "s->free");
+    // Indent the bounds code one level further.
+    std::string indented;
+    std::size_t start = 0;
+    while (start < bounds.size()) {
+      const std::size_t end = bounds.find('\n', start);
+      indented += "    " + bounds.substr(start, end - start + 1);
+      start = end + 1;
+    }
+    check += indented;
+    check += fmt::format(
+        "      if (PFX_qp_solve(&s->qp) == PFX_QP_SOLVED)\n"
+        "        for (i = 0; i < {}; ++i) s->moves[i] = s->qp.x[i];\n"
+        "      else\n        ++s->qp_failures;\n    }}\n  }}\n",
+        M);
+    m.code_ += check;
+  }
+  m.code_ += fmt::format(R"C(  u = PFX_clip(s->u_prev + s->moves[0], s->u_prev);
+  PFX_gemv_col(PFX_Az, {0}, {0}, {0}, s->z_post, s->z_tmp, 0, PFX_ONE);
+  for (i = 0; i < {0}; ++i) s->z_prior[i] = s->z_tmp[i] + PFX_Bz[i] * u;
+  s->u_prev = u;
+  s->us = us;
+  return u;
+}}
+
+void PFX_applied(PFX_state* s, PFX_real u) {{
+  const PFX_real delta = u - s->u_prev;
+  int i;
+  if (delta == PFX_ZERO || !PFX_ISFINITE(delta)) return;
+  for (i = 0; i < {0}; ++i) s->z_prior[i] += PFX_Bz[i] * delta;
+  s->u_prev = u;
+}}
+)C",
+                         nz);
+}
+
+// PFX_name -> prefix_name, and PFX_MACRO -> PREFIX_MACRO for the macros.
+std::string WithPrefix(const std::string& text, const std::string& prefix,
+                       const std::set<std::string>& macros) {
+  std::string out;
+  std::size_t pos = 0;
+  for (std::size_t at; (at = text.find("PFX_", pos)) != std::string::npos;) {
+    out.append(text, pos, at - pos);
+    std::size_t end = at + 4;
+    while (end < text.size() &&
+           (std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_'))
+      ++end;
+    const std::string name = text.substr(at + 4, end - at - 4);
+    out += (macros.count(name) ? internal::Upper(prefix) : prefix) + "_" + name;
+    pos = end;
+  }
+  out.append(text, pos, std::string::npos);
+  return out;
+}
+
+}  // namespace
+
+std::string ToString(CodegenPrecision v) { return std::string(EnumToString(kPrecisionNames, v)); }
+
+CodegenPrecision CodegenPrecisionFromString(const std::string& name) {
+  return EnumFromString(kPrecisionNames, name, "precision");
+}
+
+bool CodegenOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (prefix.empty() || prefix.size() > 32)
+    return fail(fmt::format("the prefix must have 1 to 32 characters, got {}", prefix.size()));
+  if (std::isdigit(static_cast<unsigned char>(prefix[0])))
+    return fail(fmt::format("the prefix '{}' must not start with a digit", Excerpt(prefix)));
+  for (char ch : prefix) {
+    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'))
+      return fail(fmt::format(
+          "the prefix '{}' is not a C identifier (letters, digits and '_' only)", Excerpt(prefix)));
+  }
+  return true;
+}
+
+nlohmann::ordered_json CodegenResult::ToJson() const {
+  nlohmann::ordered_json j;
+  j["prefix"] = prefix;
+  j["controller"] = pneumid::ToString(type);
+  j["description"] = description;
+  j["precision"] = ToString(precision);
+  j["constrained"] = constrained;
+  j["ram_bytes"] = ram_bytes;
+  j["const_bytes"] = const_bytes;
+  j["files"] = {prefix + ".h", prefix + ".c", "README.md"};
+  return j;
+}
+
+CodegenResult GenerateC(const Controller& controller, const CodegenOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "invalid code generation options: {}", error);
+  Module m(options);
+  CodegenResult result;
+  result.prefix = options.prefix;
+  result.precision = options.precision;
+  result.description = controller.Describe();
+  if (const auto* pid = dynamic_cast<const PidController*>(&controller)) {
+    result.type = ControllerType::kPid;
+    GeneratePid(*pid, m);
+  } else if (const auto* dmc = dynamic_cast<const DmcController*>(&controller)) {
+    result.type = ControllerType::kDmc;
+    result.constrained = dmc->options().constrained;
+    GenerateDmc(*dmc, m);
+  } else if (const auto* gpc = dynamic_cast<const GpcController*>(&controller)) {
+    result.type = ControllerType::kGpc;
+    GenerateGpc(*gpc, m);
+  } else if (const auto* mpc = dynamic_cast<const MpcController*>(&controller)) {
+    result.type = ControllerType::kMpc;
+    result.constrained = mpc->constrained();
+    GenerateMpc(*mpc, m);
+  } else {
+    PNEUMID_CHECK(false, "code generation supports the dmc, gpc, pid and mpc controllers, not '{}'",
+                  controller.Describe());
+  }
+  const std::string name = options.prefix;
+  const std::string guard = internal::Upper(name) + "_H_";
+  const bool is_float = m.is_float();
+  const std::string real = is_float ? "float" : "double";
+
+  // Structs.
+  std::size_t qp_bytes = 0;
+  std::string qp_struct;
+  if (m.qp_solver_) {
+    qp_struct = "typedef struct {\n" + m.StructText(m.qp_, "", 0, &qp_bytes) + "} PFX_qp;\n\n";
+  }
+  std::size_t state_bytes = 0;
+  const std::string state_body = m.StructText(
+      m.state_, m.qp_solver_ ? "  PFX_qp qp; /* QP solver data and work arrays */\n" : "", qp_bytes,
+      &state_bytes);
+  result.ram_bytes = state_bytes;
+  result.const_bytes = m.const_bytes_;
+  PNEUMID_CHECK(options.max_ram_bytes == 0 || result.ram_bytes <= options.max_ram_bytes,
+                "the {} controller's state needs {} bytes of RAM in {} precision, above the "
+                "budget of {} bytes ({}: {}); reduce the horizons, or try --precision float",
+                pneumid::ToString(result.type), result.ram_bytes, ToString(options.precision),
+                options.max_ram_bytes, result.description, RamHint(result.type));
+
+  // Header.
+  std::string h;
+  h += fmt::format(
+      "/* {0}.h: {1}\n * Generated by pneumid codegen ({2} precision). C99, no dynamic memory;\n"
+      " * all state in {0}_state, which the caller owns (re-entrant).\n */\n",
+      name, result.description, real);
+  h += "#ifndef " + guard + "\n#define " + guard +
+       "\n\n#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
+  h += "typedef " + real + " PFX_real;\n\n";
+  h += fmt::format("#define PFX_TS {} /* sample time, s */\n", m.Literal(controller.Ts()));
+  h += fmt::format("#define PFX_STATE_BYTES {} /* sizeof(PFX_state) with 4-byte int */\n",
+                   result.ram_bytes);
+  if (m.qp_solver_) {
+    h += "\n/* QP status (PFX_state.qp.status). */\n#define PFX_QP_SOLVED 0\n"
+         "#define PFX_QP_INFEASIBLE 1\n#define PFX_QP_MAX_ITERATIONS_REACHED 2\n";
+  }
+  h += "\n" + qp_struct + "typedef struct {\n" + state_body + "} PFX_state;\n\n";
+  h += R"C(/* Back to rest at u = 0, y = 0: PFX_reset(s, 0, 0). */
+void PFX_init(PFX_state* s);
+/* Back to rest at an operating point: input u0 applied long enough for the
+   output to settle at y0. */
+void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0);
+/* One control step: set-point and measured output at the current sample;
+   returns the input to hold over the next period (within the limits). */
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement);
+/* The input actually applied after the last step, when a later layer changed
+   it (actuator saturation): the controller takes it as its own. */
+void PFX_applied(PFX_state* s, PFX_real u);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
+)C";
+
+  // Source.
+  std::string c;
+  c += fmt::format("/* {0}.c: {1}\n * Generated by pneumid codegen ({2} precision). */\n", name,
+                   result.description, real);
+  c += fmt::format("#include \"{}.h\"\n\n#include <math.h>\n#include <string.h>\n\n", name);
+  c += fmt::format("#define PFX_ZERO {}\n#define PFX_ONE {}\n#define PFX_THOUSAND {}\n",
+                   m.Literal(0.0), m.Literal(1.0), m.Literal(1e3));
+  c += "#define PFX_INF ((PFX_real)INFINITY)\n";
+  c += fmt::format("#define PFX_EPSILON {}\n",
+                   is_float ? m.Literal(std::numeric_limits<float>::epsilon())
+                            : m.Literal(std::numeric_limits<double>::epsilon()));
+  c += is_float ? "#define PFX_FABS fabsf\n#define PFX_HYPOT hypotf\n"
+                : "#define PFX_FABS fabs\n#define PFX_HYPOT hypot\n";
+  c += "#define PFX_ISFINITE(x) isfinite(x)\n\n";
+  c += m.constants_ + "\n";
+  if (m.dot_) c += std::string(internal::kCDot).substr(1) + "\n";
+  if (m.dot_strided_) c += std::string(internal::kCDotStrided).substr(1) + "\n";
+  if (m.gemv_col_) c += std::string(internal::kCGemvCol).substr(1) + "\n";
+  if (m.qp_solver_) {
+    c += std::string(internal::kCGemvRow).substr(1) + "\n";
+    c += std::string(internal::kCTriangular).substr(1) + "\n";
+    c += std::string(internal::kCQp).substr(1) + "\n";
+  }
+  c += m.code_;
+  c += "\nvoid PFX_init(PFX_state* s) { PFX_reset(s, PFX_ZERO, PFX_ZERO); }\n";
+  // The step uses PFX_ISFINITE only in some controllers; keep every macro used.
+  result.header = WithPrefix(h, name, m.macros_);
+  result.source = WithPrefix(c, name, m.macros_);
+
+  // README.
+  result.readme = fmt::format(
+      R"(# {0}: generated controller
+
+{1}, generated by `pneumid codegen` in {2} precision.
+
+Files: `{0}.h` (interface), `{0}.c` (implementation). C99; no dynamic memory,
+no library beyond `<math.h>` and `<string.h>` (link with `-lm`). All state is
+in `{0}_state`, which the caller owns: the code is re-entrant, and several
+controllers can run side by side.
+
+```c
+#include "{0}.h"
+
+static {0}_state ctrl;          /* {3} bytes of RAM */
+
+void control_init(void) {{ {0}_init(&ctrl); }}   /* or {0}_reset(&ctrl, u0, y0) */
+
+/* Every {4} s: */
+{0}_real control_step({0}_real setpoint, {0}_real y) {{
+  {0}_real u = {0}_step(&ctrl, setpoint, y);
+  /* If the actuator applies another value (saturation): {0}_applied(&ctrl, u_applied); */
+  return u;
+}}
+```
+
+| function | what |
+|---|---|
+| `{0}_init(s)` | reset at rest, u = 0, y = 0 |
+| `{0}_reset(s, u0, y0)` | reset at an operating point: u0 applied long enough for y to settle at y0 |
+| `{0}_step(s, r, y)` | one sample: set-point r, measurement y -> input u within the limits |
+| `{0}_applied(s, u)` | the input actually applied (anti-windup), when it differs from the returned one |
+
+Sample time: `{7}_TS` = {4} s. State: `sizeof({0}_state)` = `{7}_STATE_BYTES` = {3} bytes;
+constant tables: {5} bytes.
+{6}
+The arithmetic follows pneumid's library controller step by step (same
+formulas, same order of the sums), so that the double-precision module
+reproduces the library's inputs to rounding.
+)",
+      name, result.description, real, result.ram_bytes, controller.Ts(), result.const_bytes,
+      result.constrained
+          ? fmt::format(
+                "\nConstrained: every step may solve a dense QP (Goldfarb-Idnani dual active "
+                "set, warm-started) with an iteration cap; `s->qp.status` is `{1}_QP_SOLVED`, "
+                "`{1}_QP_INFEASIBLE` or `{1}_QP_MAX_ITERATIONS_REACHED`, `s->qp.iterations` the "
+                "work done; a step whose QP fails applies the clipped unconstrained move and "
+                "counts it in `s->qp_failures` (reset by `{0}_reset`).\n",
+                name, internal::Upper(name))
+          : std::string(),
+      internal::Upper(name));
+  return result;
+}
+
+std::vector<std::string> WriteCodegenFiles(const CodegenResult& result,
+                                           const std::string& directory) {
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  if (ec)
+    throw DataError(fmt::format("{}: cannot create the directory: {}", directory, ec.message()));
+  const std::filesystem::path dir(directory);
+  std::vector<std::string> paths;
+  const std::pair<std::string, const std::string*> files[] = {
+      {result.prefix + ".h", &result.header},
+      {result.prefix + ".c", &result.source},
+      {"README.md", &result.readme},
+  };
+  for (const auto& [file, text] : files) {
+    if (text->empty()) continue;
+    const std::string path = (dir / file).string();
+    std::ofstream out(path, std::ios::binary);
+    out << *text;
+    out.close();
+    if (!out) throw DataError(fmt::format("{}: cannot write", path));
+    paths.push_back(path);
+  }
+  return paths;
+}
+
+}  // namespace pneumid
