@@ -19,6 +19,7 @@
 #include "pneumid/common/enum_names.hpp"
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/gpc.hpp"
+#include "pneumid/control/inverse_map_controller.hpp"
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
 
@@ -789,6 +790,11 @@ CodegenResult GenerateC(const Controller& controller, const CodegenOptions& opti
     result.type = ControllerType::kMpc;
     result.constrained = mpc->constrained();
     GenerateMpc(*mpc, m);
+  } else if (dynamic_cast<const InverseMapController*>(&controller)) {
+    PNEUMID_CHECK(false,
+                  "code generation does not support a controller behind an input map (--input-map "
+                  "or a Hammerstein model) yet: '{}'",
+                  controller.Describe());
   } else {
     PNEUMID_CHECK(false, "code generation supports the dmc, gpc, pid and mpc controllers, not '{}'",
                   controller.Describe());

@@ -56,6 +56,9 @@ moves=$("$TMP/paper/run")
 # Bad input.
 expect_error "ram budget" "above the budget of 1000 bytes" codegen "${common[@]}" --controller dmc \
   --max-ram 1000 -o "$TMP/x"
+echo '{"u": [0, 10, 100], "y": [0, 0, 150]}' > "$TMP/map.json"
+expect_error "input map" "does not support a controller behind an input map" codegen "${common[@]}" \
+  --controller mpc --input-map "$TMP/map.json" -o "$TMP/x"
 expect_error "precision" "precision" codegen "${common[@]}" --controller dmc --precision half -o "$TMP/x"
 expect_error "prefix" "not a C identifier" codegen "${common[@]}" --controller dmc --prefix "a-b" -o "$TMP/x"
 expect_error "controller" "controller" codegen "${common[@]}" --controller lqr -o "$TMP/x"
