@@ -16,12 +16,15 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <memory>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/gpc.hpp"
+#include "pneumid/control/inverse_map_controller.hpp"
+#include "pneumid/control/mpc.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 
@@ -56,6 +59,38 @@ void BM_DmcUnconstrainedStep(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_DmcUnconstrainedStep);
+
+// The cost the inverse static map adds to a controller step (issue target:
+// <= 0.2 us): the same unconstrained MPC alone (arg 0) and behind the inverse
+// of a 21-knot S-shaped map (arg 1), on the same lag plant.
+void BM_InverseMapStep(benchmark::State& state) {
+  std::vector<double> u, y;
+  for (int i = 0; i <= 20; ++i) {
+    u.push_back(5.0 * i);
+    const double x = (5.0 * i - 50.0) / 15.0;
+    y.push_back(i <= 2 ? 0.0 : 140.0 / (1.0 + std::exp(-x)));
+  }
+  const StaticMap map(u, y);
+  MpcOptions o;
+  o.P = 126;
+  o.M = 5;
+  o.lambda = 1.0;
+  auto mpc = std::make_unique<MpcController>(PaperFopdtModel(), 0.01, o);
+  std::unique_ptr<Controller> c;
+  if (state.range(0) == 1)
+    c = std::make_unique<InverseMapController>(std::move(mpc), map);
+  else
+    c = std::move(mpc);
+  double yk = 0.0, uk = 0.0;
+  long k = 0;
+  for (auto _ : state) {
+    const double r = (k++ / 200) % 2 ? 100.0 : 20.0;
+    uk = c->Update(r, yk);
+    yk = 0.96 * yk + 0.04 * (state.range(0) == 1 ? map.Evaluate(uk) : 1.6 * uk);
+    benchmark::DoNotOptimize(uk);
+  }
+}
+BENCHMARK(BM_InverseMapStep)->Arg(0)->Arg(1);
 
 void BM_GpcStep(benchmark::State& state) {
   GpcOptions o;
