@@ -21,7 +21,6 @@
 #include "command.hpp"
 #include "controller_options.hpp"
 #include "output_options.hpp"
-#include "validators.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/spec.hpp"
 #include "pneumid/control/closed_loop.hpp"
@@ -31,6 +30,7 @@
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/report/figures.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -149,8 +149,8 @@ std::string ControllerLabel(const BuiltController& b) {
     return fmt::format("PID {} (Kc={:.3g}, Ti={:.3g} s, Td={:.3g} s)", ToString(b.pid_rule),
                        b.pid_gains.Kc, b.pid_gains.Ti, b.pid_gains.Td);
   }
-  return fmt::format("{} {} (P={}, M={}, lambda={:.3g})", TypeName(b.type), ToString(b.tuning.rule),
-                     b.tuning.P, b.tuning.M, b.tuning.lambda);
+  return fmt::format("{} {} (P={}, M={}, lambda={:.3g})", TypeName(b.type), b.Label(), b.tuning.P,
+                     b.tuning.M, b.tuning.lambda);
 }
 
 // Output and input (units of the plant: force N or position m and duty % for
@@ -167,8 +167,9 @@ void WritePlot(const std::string& path, const std::vector<Run>& runs, const Cont
                                             : "Output y";
   options.labels.input = in.unit == "%" ? "Duty cycle u [%]" : "Input u";
   options.title = fmt::format("{} on {} (model {}, Ts = {:g} s)", TypeName(runs[0].built.type),
-                              plant_spec, c.model, c.Ts);
-  if (!c.load_steps.empty()) options.disturbance_time = ParseLoadStep("--load-step", c.load_steps[0]).at;
+                              PlotLiteral(plant_spec), PlotLiteral(c.model), c.Ts);
+  if (!c.load_steps.empty())
+    options.disturbance_time = ParseLoadStep("--load-step", c.load_steps[0]).at;
   std::vector<ClosedLoopTrace> traces;
   for (const Run& r : runs) traces.push_back({ControllerLabel(r.built), r.result.y, r.result.u});
   ClosedLoopFigure(runs[0].result.t, runs[0].result.r, traces, options).Save(path);
@@ -183,7 +184,8 @@ void Execute(const ControlCli& c) {
   cl.duration = c.duration;
   cl.noise_std = c.noise;
   cl.seed = c.seed;
-  for (const std::string& l : c.load_steps) cl.load_steps.push_back(ParseLoadStep("--load-step", l));
+  for (const std::string& l : c.load_steps)
+    cl.load_steps.push_back(ParseLoadStep("--load-step", l));
   PlantOptions po;
   po.seed = c.seed;
   const std::string plant_spec = c.plant.empty() ? c.model : c.plant;
@@ -262,11 +264,15 @@ const Registrar reg(
       app.add_option("--duration", c->duration, "Simulated time in s")
           ->required()
           ->check(Positive());
-      app.add_option("--u-min", c->controller.limits.u_min, "Lower input limit (default: the plant's input range, IPA 0 % duty)");
-      app.add_option("--u-max", c->controller.limits.u_max, "Upper input limit (default: the plant's input range, IPA 100 % duty)");
+      app.add_option("--u-min", c->controller.limits.u_min,
+                     "Lower input limit (default: the plant's input range, IPA 0 % duty)");
+      app.add_option("--u-max", c->controller.limits.u_max,
+                     "Upper input limit (default: the plant's input range, IPA 100 % duty)");
       app.add_option("--du-max", c->controller.limits.du_max, "Largest input change per sample");
-      app.add_option("--y-min", c->controller.y_min, "Soft lower output bound (with --constrained)");
-      app.add_option("--y-max", c->controller.y_max, "Soft upper output bound (with --constrained)");
+      app.add_option("--y-min", c->controller.y_min,
+                     "Soft lower output bound (with --constrained)");
+      app.add_option("--y-max", c->controller.y_max,
+                     "Soft upper output bound (with --constrained)");
       app.add_option("--noise", c->noise, "Measurement noise standard deviation (output units)")
           ->check(NonNegative());
       app.add_option("--seed", c->seed, "Noise seed")->capture_default_str();
@@ -275,7 +281,8 @@ const Registrar reg(
       app.add_option("--t-filter", c->controller.t_filter,
                      "GPC observer polynomial T: 1, A, or coefficients '1 -0.8'")
           ->capture_default_str();
-      app.add_option("--tau-c", c->controller.tau_c, "PID closed-loop time constant in s (0 = rule default)")
+      app.add_option("--tau-c", c->controller.tau_c,
+                     "PID closed-loop time constant in s (0 = rule default)")
           ->check(NonNegative());
       app.add_flag("--json", c->json, "Print the metrics as JSON");
       AddPlotOption(app, c->plot, "set-point, output and input with units");

@@ -58,7 +58,8 @@ ControllerSpec WithModelInputMap(ControllerSpec spec, const std::string& model_s
 }
 
 std::string BuiltController::Label() const {
-  return type == ControllerType::kPid ? "pid" : ToString(tuning.rule);
+  if (type == ControllerType::kPid) return "pid";
+  return auto_summary.empty() ? ToString(tuning.rule) : "auto";
 }
 
 std::string BuiltController::Summary() const {

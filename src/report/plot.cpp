@@ -356,6 +356,16 @@ std::string PlainText(const std::string& s) {
 
 std::string DescribeFigure(const Figure& figure);
 
+std::string PlotLiteral(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char ch : text) {
+    out += ch;
+    if (ch == '#') out += '#';
+  }
+  return out;
+}
+
 namespace {
 
 // Accessible text: <title> and <desc> after the opening <svg ...> tag (cairo
@@ -426,7 +436,7 @@ Color PaletteColor(int i) {
 }
 
 Curve& Axes::AddLine(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label,
-                      LineStyle style) {
+                     LineStyle style) {
   CheckXY(x, y, "Axes::AddLine");
   Curve s;
   s.x = x;

@@ -100,6 +100,16 @@ TEST(PlotTest, InMemorySvgCarriesLabelsAndUniqueIds) {
   EXPECT_GT(ids, 0u);
 }
 
+TEST(PlotTest, PlotLiteralDoublesTheEscapeCharacter) {
+  EXPECT_EQ(PlotLiteral("models.json#fit-p1d"), "models.json##fit-p1d");
+  EXPECT_EQ(PlotLiteral("##"), "####");
+  EXPECT_EQ(PlotLiteral("no escape"), "no escape");
+  // The figure's plain-text description shows the literal text again.
+  Figure fig(1);
+  fig.title = PlotLiteral("MPC (model a.json#fit-p1d)");
+  EXPECT_THAT(DescribeFigure(fig), ::testing::HasSubstr("MPC (model a.json#fit-p1d)"));
+}
+
 TEST(PlotTest, LogAxisAndSingleSubplot) {
   Eigen::VectorXd w = Eigen::VectorXd::LinSpaced(100, -1.0, 3.0);
   w = w.unaryExpr([](double e) { return std::pow(10.0, e); });

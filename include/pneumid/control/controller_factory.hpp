@@ -108,7 +108,8 @@ struct BuiltController {
   /// Rule "auto": the auto-tuner's message (what it met or why not).
   std::string auto_summary;
 
-  /// "pid" for a PID, else the tuning rule's name (as in a comparison table).
+  /// "pid" for a PID, "auto" for settings tuned to specifications, else the
+  /// tuning rule's name (as in a comparison table).
   std::string Label() const;
   /// One line stating the design: the rule with P, M, lambda and its formula,
   /// or the PID rule, the FOPDT it used and the gains.

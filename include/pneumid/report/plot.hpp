@@ -107,7 +107,7 @@ struct Axes {
   /// Adds a line. Throws InvalidArgument when x and y differ in length or are
   /// empty. Returns the new series for further styling.
   Curve& AddLine(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label = {},
-                  LineStyle style = LineStyle::kSolid);
+                 LineStyle style = LineStyle::kSolid);
   /// Adds a zero-order-hold staircase (sampled inputs). Same checks as AddLine.
   Curve& AddStairs(const Eigen::VectorXd& x, const Eigen::VectorXd& y, std::string label = {});
   /// Adds a horizontal reference line (dashed by default).
@@ -157,6 +157,11 @@ class Figure {
   std::vector<Axes> axes_;
   FigureOptions options_;
 };
+
+/// `text` for a title, label or legend entry, with PLplot's escape character
+/// '#' doubled, so that user text such as "models.json#fit-p1d" is drawn as
+/// written (a lone '#' starts an escape: #u superscript, #f font, ...).
+std::string PlotLiteral(const std::string& text);
 
 /// Plain-text description of a figure (title, axis labels, legend entries),
 /// one item per line; used for the SVG <desc> element and the HTML alt text.
