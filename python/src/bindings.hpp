@@ -16,6 +16,7 @@ void BindExtras(pybind11::module_& m);
 void BindUncertainty(pybind11::module_& m);
 /// calibrate() and the IPA parameter helpers.
 void BindCalibration(pybind11::module_& m);
+void BindNonlinear(pybind11::module_& m);
 
 /// Throws InvalidArgument (Python: pneumid.InvalidArgument, a ValueError)
 /// "function: argument is empty (...)" when an array argument has no elements.

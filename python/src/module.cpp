@@ -65,4 +65,5 @@ PYBIND11_MODULE(pneumid, m) {
   pneumid::python::BindExtras(m);
   pneumid::python::BindUncertainty(m);
   pneumid::python::BindCalibration(m);
+  pneumid::python::BindNonlinear(m);
 }
