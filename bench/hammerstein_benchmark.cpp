@@ -76,6 +76,17 @@ void BM_StaticMap60s(benchmark::State& state) {
 }
 BENCHMARK(BM_StaticMap60s)->Unit(benchmark::kMicrosecond);
 
+// The inverse of the IPA's steady map, as a compensator calls it every sample.
+void BM_StaticMapInverse(benchmark::State& state) {
+  static const pneumid::StaticMap f = pneumid::FitStaticMap(IpaRecord().u, IpaRecord().y, kTs).map;
+  double y = 0.0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(f.Inverse(y));
+    y = y > 190.0 ? 0.0 : y + 0.37;
+  }
+}
+BENCHMARK(BM_StaticMapInverse);
+
 }  // namespace
 
 BENCHMARK_MAIN();
