@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <optional>
 #include <iostream>
+#include <optional>
 #include <type_traits>
 #include <variant>
 
@@ -20,11 +20,11 @@
 #include "command.hpp"
 #include "data_options.hpp"
 #include "output_options.hpp"
-#include "progress.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
 #include "pneumid/report/plot.hpp"
+#include "progress.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -150,11 +150,11 @@ void Run(const IdentifyArgs& args) {
   IdentificationSummary summary;
   {
     ProgressBar bar("identify", args.progress || StderrIsTerminal());
-    summary = IdentifyModels(
-        methods, data, args.request, options, validation ? &*validation : nullptr,
-        [&bar](std::size_t done, std::size_t total, const std::string& method) {
-          bar(static_cast<double>(done) / static_cast<double>(total), method);
-        });
+    summary =
+        IdentifyModels(methods, data, args.request, options, validation ? &*validation : nullptr,
+                       [&bar](std::size_t done, std::size_t total, const std::string& method) {
+                         bar(static_cast<double>(done) / static_cast<double>(total), method);
+                       });
   }
   for (const auto& [method, reason] : summary.failures)
     std::cerr << fmt::format("pneumid identify: {} failed: {}\n", method, reason);
@@ -223,12 +223,10 @@ void Run(const IdentifyArgs& args) {
     for (const std::string& note : m.notes) std::cout << fmt::format("{:<16} note: {}\n", "", note);
   }
   const IdentifiedModel& best = models.front();
-  std::cout << fmt::format("best: {} ({:.2f} % {}fit){}\n", best.method, RankScore(best),
-                           held_out ? "validation " : "",
-                           best.flags.empty()
-                               ? ""
-                               : fmt::format("; every model is flagged, {} least severely",
-                                             best.method));
+  std::cout << fmt::format(
+      "best: {} ({:.2f} % {}fit){}\n", best.method, RankScore(best), held_out ? "validation " : "",
+      best.flags.empty() ? ""
+                         : fmt::format("; every model is flagged, {} least severely", best.method));
   if (!summary.failures.empty())
     std::cout << fmt::format("failed: {}\n", [&] {
       std::vector<std::string> f;
@@ -281,6 +279,8 @@ static Registrar reg(
                      "hammerstein, wiener: knots of the static map, spread over the input range")
           ->capture_default_str()
           ->check(CLI::Range(2, 1000));
+      app.add_flag("--monotone-map", args->nonlinear.block.monotone_map,
+                   "hammerstein: keep the input map monotone (invertible)");
       app.add_option("--settle", args->nonlinear.static_map.settle_fraction,
                      "static-map: fraction of each constant-input segment averaged (its end)")
           ->capture_default_str()

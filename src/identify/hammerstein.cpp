@@ -11,6 +11,7 @@
 #include "ceres_logging.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/arx.hpp"
+#include "pneumid/identify/static_map_fit.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {
@@ -70,14 +71,20 @@ void SimulateUnitGain(const T* p, const Layout& l, const std::vector<T>& v, std:
 }
 
 // Simulation errors y - yhat of the Hammerstein model.
+// With `monotone` (sign +-1) the map parameters are alpha_1 and the square
+// roots of the increments: alpha_j = alpha_{j-1} + monotone * q_j^2.
 struct HammersteinError {
   Layout l;
   const Eigen::VectorXd* y;
   std::vector<Tent> tents;  // of u(t)
+  double monotone = 0.0;
   template <typename T>
   bool operator()(T const* const* params, T* residuals) const {
     const T* p = params[0];
-    const T* alpha = p + l.map_offset();
+    std::vector<T> values(p + l.map_offset(), p + l.map_offset() + l.m);
+    if (monotone != 0.0)
+      for (int j = 1; j < l.m; ++j) values[j] = values[j - 1] + monotone * values[j] * values[j];
+    const T* alpha = values.data();
     std::vector<T> v(tents.size()), x;
     for (std::size_t t = 0; t < tents.size(); ++t)
       v[t] = (1.0 - tents[t].w) * alpha[tents[t].j] + tents[t].w * alpha[tents[t].j + 1];
@@ -361,9 +368,31 @@ BlockModelResult EstimateHammerstein(const Eigen::VectorXd& u, const Eigen::Vect
   alpha.tail(mm) = (alpha[0] + d.array()).matrix();
   Eigen::VectorXd theta = Normalised(sol.head(l.na), b, alpha, l, /*map_after=*/false, &s.warnings);
 
+  // Monotone map: the start made monotone (PAVA) in the direction of its
+  // trend, then parameterised by squared increments (kept off 0, where their
+  // derivative would vanish).
+  double monotone = 0.0;
+  if (o.monotone_map) {
+    Eigen::Ref<Eigen::VectorXd> a = theta.segment(l.map_offset(), l.m);
+    monotone = a[l.m - 1] >= a[0] ? 1.0 : -1.0;
+    const std::vector<double> pooled =
+        PoolAdjacentViolators(std::vector<double>(a.data(), a.data() + l.m),
+                              std::vector<double>(l.m, 1.0), monotone > 0.0);
+    const double floor =
+        1e-3 * std::sqrt(std::max(std::abs(pooled.back() - pooled.front()), 1e-12));
+    for (int j = l.m - 1; j >= 1; --j)
+      a[j] = std::max(std::sqrt(std::abs(pooled[j] - pooled[j - 1])), floor);
+    a[0] = pooled[0];
+  }
+
   // 2. Output-error refinement.
-  RefineOutputError(std::make_unique<HammersteinError>(HammersteinError{l, &y, std::move(tents)}),
-                    u.size(), o, &theta, &s);
+  RefineOutputError(
+      std::make_unique<HammersteinError>(HammersteinError{l, &y, std::move(tents), monotone}),
+      u.size(), o, &theta, &s);
+  if (monotone != 0.0) {
+    Eigen::Ref<Eigen::VectorXd> a = theta.segment(l.map_offset(), l.m);
+    for (int j = 1; j < l.m; ++j) a[j] = a[j - 1] + monotone * a[j] * a[j];
+  }
   s.num_rows = u.size();
   return Finish(theta, l, Ts, knots, std::move(s), StaticMapExtrapolation::kClamp);
 }

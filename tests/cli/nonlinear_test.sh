@@ -54,6 +54,15 @@ m = {m["method"]: m for m in json.load(open(sys.argv[2]))["models"]}["hammerstei
 assert abs(v["fit_percent"] - m["validation_fit_percent"]) < 1e-6, (v["fit_percent"], m)
 PY
 
+# --monotone-map keeps the Hammerstein input map invertible.
+"$PNEUMID" identify "$dir/est.csv" -m hammerstein --monotone-map --na 3 --nb 3 --nk 1 --knots 21 \
+  --json >"$dir/mono.json"
+"$PY" - "$dir/mono.json" <<'PY' || fail "monotone Hammerstein map"
+import json, sys
+f = json.load(open(sys.argv[1]))["models"][0]["input_map"]
+assert all(b >= a for a, b in zip(f["y"], f["y"][1:])), f["y"]
+PY
+
 # The static map from the staircase part.
 "$PNEUMID" identify "$dir/est.csv" -m static-map --min-segment 1.2 --json >"$dir/map.json"
 "$PY" - "$dir/map.json" <<'PY' || fail "static map"

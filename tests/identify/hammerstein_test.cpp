@@ -65,6 +65,17 @@ TEST(HammersteinTest, RecoversAKnownSystemWithinTwoPercent) {
   ExpectRecovered(r, 0.02);
 }
 
+TEST(HammersteinTest, MonotoneMapRecoversTheSameSystem) {
+  // The true map is increasing: the constrained fit reaches the same optimum.
+  const Dataset d = Recorded("hammerstein");
+  BlockModelOptions o = TrueStructure();
+  o.monotone_map = true;
+  const BlockModelResult r = EstimateHammerstein(d.u(), d.y(), d.SampleTime(), o);
+  EXPECT_EQ(r.summary.termination, Termination::kConvergence) << r.summary.message;
+  EXPECT_TRUE(r.map.IsMonotone());
+  ExpectRecovered(r, 0.02);
+}
+
 TEST(HammersteinTest, SimulatesAsScipy) {
   const Dataset d = Recorded("hammerstein", "y_true");
   const StaticMap f(kKnots, kValues);

@@ -65,6 +65,11 @@ struct BlockModelOptions {
   /// spread evenly over [min u, max u] of the data.
   std::vector<double> knots;
   int num_knots = 11;  ///< >= 2, used when `knots` is empty
+  /// Hammerstein only: keep f monotone (non-decreasing or non-increasing, the
+  /// direction of the initial estimate's trend) for an invertible map: the
+  /// start is made monotone by PAVA and the refinement runs over alpha_1 and
+  /// the square roots of the increments, alpha_j = alpha_{j-1} +- q_j^2.
+  bool monotone_map = false;
   /// Output-error refinement with Ceres after the initial estimate.
   bool refine = true;
   int max_iterations = 100;           ///< Levenberg-Marquardt iterations (>= 1)
