@@ -2,13 +2,14 @@
 //
 // Identifies models of a plant from measured data with the step-response
 // methods (reaction curve, tangent, two-point, SOPDT, PTn, Strejc, areas,
-// process-model fits) and the parametric ones (ARX, ARMAX, OE, BJ, IV4,
-// N4SID, CRA, SPA), and lists them best fit first.
+// process-model fits), the parametric ones (ARX, ARMAX, OE, BJ, IV4,
+// N4SID, CRA, SPA) and the nonlinear ones (static map, Hammerstein, Wiener,
+// NARX), and lists them best fit first.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <optional>
 #include <iostream>
+#include <optional>
 #include <type_traits>
 #include <variant>
 
@@ -19,11 +20,11 @@
 #include "command.hpp"
 #include "data_options.hpp"
 #include "output_options.hpp"
-#include "progress.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
 #include "pneumid/report/plot.hpp"
+#include "progress.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -34,6 +35,7 @@ struct IdentifyArgs {
   std::string methods = "reaction-curve";
   IdentifyRequest request;
   std::string loss = "none";
+  NonlinearOptions nonlinear;
   bool json = false;
   std::string plot;
   std::string output;
@@ -143,15 +145,16 @@ void Run(const IdentifyArgs& args) {
   IdentifyOptions options;
   options.step.fit.loss = RobustLossFromString(args.loss);
   options.split = args.split;
+  options.nonlinear = args.nonlinear;
 
   IdentificationSummary summary;
   {
     ProgressBar bar("identify", args.progress || StderrIsTerminal());
-    summary = IdentifyModels(
-        methods, data, args.request, options, validation ? &*validation : nullptr,
-        [&bar](std::size_t done, std::size_t total, const std::string& method) {
-          bar(static_cast<double>(done) / static_cast<double>(total), method);
-        });
+    summary =
+        IdentifyModels(methods, data, args.request, options, validation ? &*validation : nullptr,
+                       [&bar](std::size_t done, std::size_t total, const std::string& method) {
+                         bar(static_cast<double>(done) / static_cast<double>(total), method);
+                       });
   }
   for (const auto& [method, reason] : summary.failures)
     std::cerr << fmt::format("pneumid identify: {} failed: {}\n", method, reason);
@@ -220,12 +223,10 @@ void Run(const IdentifyArgs& args) {
     for (const std::string& note : m.notes) std::cout << fmt::format("{:<16} note: {}\n", "", note);
   }
   const IdentifiedModel& best = models.front();
-  std::cout << fmt::format("best: {} ({:.2f} % {}fit){}\n", best.method, RankScore(best),
-                           held_out ? "validation " : "",
-                           best.flags.empty()
-                               ? ""
-                               : fmt::format("; every model is flagged, {} least severely",
-                                             best.method));
+  std::cout << fmt::format(
+      "best: {} ({:.2f} % {}fit){}\n", best.method, RankScore(best), held_out ? "validation " : "",
+      best.flags.empty() ? ""
+                         : fmt::format("; every model is flagged, {} least severely", best.method));
   if (!summary.failures.empty())
     std::cout << fmt::format("failed: {}\n", [&] {
       std::vector<std::string> f;
@@ -245,7 +246,8 @@ static Registrar reg(
       app.add_option("-m,--method,--methods", args->methods,
                      "Comma-separated methods, or all: reaction-curve, tangent, smith, "
                      "sundaresan, broida, sopdt, ptn, strejc, areas, fit-p1d, fit-p2d, fit-p2du, "
-                     "fit-p3d, fit-p1di, arx, armax, oe, bj, iv4, n4sid, cra, spa")
+                     "fit-p3d, fit-p1di, arx, armax, oe, bj, iv4, n4sid, cra, spa; nonlinear "
+                     "(not in all): static-map, hammerstein, wiener, narx")
           ->capture_default_str();
       app.add_option("--order", args->request.order, "PTn order n (ptn)")
           ->capture_default_str()
@@ -273,6 +275,31 @@ static Registrar reg(
               return std::string(e.what());
             }
           });
+      app.add_option("--knots", args->nonlinear.block.num_knots,
+                     "hammerstein, wiener: knots of the static map, spread over the input range")
+          ->capture_default_str()
+          ->check(CLI::Range(2, 1000));
+      app.add_flag("--monotone-map", args->nonlinear.block.monotone_map,
+                   "hammerstein: keep the input map monotone (invertible)");
+      app.add_option("--settle", args->nonlinear.static_map.settle_fraction,
+                     "static-map: fraction of each constant-input segment averaged (its end)")
+          ->capture_default_str()
+          ->check(CLI::Range(0.01, 1.0));
+      app.add_option("--min-segment", args->nonlinear.static_map.min_segment_duration,
+                     "static-map: shortest constant-input segment used, s")
+          ->capture_default_str()
+          ->check(CLI::NonNegativeNumber);
+      app.add_option("--degree", args->nonlinear.narx.degree,
+                     "narx: polynomial degree (lags: ny = --na, nu = --nb, delay --nk)")
+          ->capture_default_str()
+          ->check(CLI::Range(1, 3));
+      app.add_option("--max-terms", args->nonlinear.narx.max_terms, "narx: most terms selected")
+          ->capture_default_str()
+          ->check(CLI::Range(1, 1000));
+      app.add_option("--err-tolerance", args->nonlinear.narx.err_tolerance,
+                     "narx: stop when 1 - sum ERR falls below this")
+          ->capture_default_str()
+          ->check(CLI::Range(1e-15, 0.999999));
       app.add_option("--loss", args->loss, "Loss of the fit-* methods: none, huber, cauchy")
           ->capture_default_str();
       app.add_flag("--json", args->json,

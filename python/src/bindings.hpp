@@ -18,6 +18,7 @@ void BindUncertainty(pybind11::module_& m);
 void BindCalibration(pybind11::module_& m);
 /// generate_c() and write_c() (embedded C code generation).
 void BindCodegen(pybind11::module_& m);
+void BindNonlinear(pybind11::module_& m);
 
 /// Throws InvalidArgument (Python: pneumid.InvalidArgument, a ValueError)
 /// "function: argument is empty (...)" when an array argument has no elements.

@@ -12,9 +12,9 @@
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/identify.hpp"
 #include "pneumid/identify/initial_state.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
-#include "pneumid/identify/identify.hpp"
 #include "pneumid/identify/step_analysis.hpp"
 #include "pneumid/identify/step_methods.hpp"
 #include "pneumid/report/figures.hpp"
@@ -131,6 +131,24 @@ void BindIdentify(py::module_& m) {
           },
           "Parameter covariance {'names': [...], 'matrix': ndarray} (names of params, e.g. "
           "a1, b1), or None (model_uncertainty: step_response_std, bode_std).")
+      .def_property_readonly(
+          "input_map",
+          [](const IdentifiedModel& r) -> py::object {
+            return r.input_map ? py::cast(*r.input_map) : py::none();
+          },
+          "StaticMap of a static-map or Hammerstein model, or None.")
+      .def_property_readonly(
+          "output_map",
+          [](const IdentifiedModel& r) -> py::object {
+            return r.output_map ? py::cast(*r.output_map) : py::none();
+          },
+          "StaticMap of a Wiener model, or None.")
+      .def_property_readonly(
+          "narx",
+          [](const IdentifiedModel& r) -> py::object {
+            return r.narx ? JsonToPython(ToJson(*r.narx)) : py::none();
+          },
+          "NARX model {'terms', 'theta', 'err', ...} (narx.hpp), or None.")
       .def(
           "to_dict", [](const IdentifiedModel& r) { return JsonToPython(ToJson(r)); },
           "The JSON form of `pneumid identify --json`.")
@@ -143,7 +161,8 @@ void BindIdentify(py::module_& m) {
   m.def(
       "identify",
       [](const std::string& method, const Dataset& data, int input, int output, int order, int na,
-         int nb, int nk, int nc, int nd, int nf, bool feedthrough, const std::string& n4sid_weight) {
+         int nb, int nk, int nc, int nd, int nf, bool feedthrough,
+         const std::string& n4sid_weight) {
         IdentifyRequest r = MakeRequest(input, output, order, na, nb, nk, nc, nd, nf);
         r.feedthrough = feedthrough;
         r.n4sid_weight = SubspaceWeightingFromString(n4sid_weight);
@@ -162,8 +181,8 @@ void BindIdentify(py::module_& m) {
       "preprocess",
       [](const Dataset& data, const std::string& window, double resample, bool remove_initial,
          const std::string& detrend, const std::string& filter, int decimate) {
-        const PreprocessOptions o = PythonPreprocessOptions(window, resample, remove_initial,
-                                                            detrend, filter, decimate);
+        const PreprocessOptions o =
+            PythonPreprocessOptions(window, resample, remove_initial, detrend, filter, decimate);
         PreprocessRecord record;
         Dataset out;
         {
@@ -183,13 +202,12 @@ void BindIdentify(py::module_& m) {
       [](const std::vector<std::string>& methods, const Dataset& data, int input, int output,
          int order, int na, int nb, int nk, int nc, int nd, int nf, double split,
          std::optional<Dataset> validation, const std::string& window, double resample,
-         bool remove_initial, const std::string& detrend, const std::string& filter,
-         int decimate) {
+         bool remove_initial, const std::string& detrend, const std::string& filter, int decimate) {
         const IdentifyRequest r = MakeRequest(input, output, order, na, nb, nk, nc, nd, nf);
         IdentifyOptions o;
         o.split = split;
-        const PreprocessOptions p = PythonPreprocessOptions(window, resample, remove_initial,
-                                                            detrend, filter, decimate);
+        const PreprocessOptions p =
+            PythonPreprocessOptions(window, resample, remove_initial, detrend, filter, decimate);
         IdentificationSummary s;
         {
           py::gil_scoped_release release;
@@ -209,10 +227,10 @@ void BindIdentify(py::module_& m) {
                                                     : py::cast(s.models.front().method),
                         "termination"_a = ToString(s.termination), "message"_a = s.message);
       },
-      "methods"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3,
-      "nb"_a = 3, "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3, "split"_a = 0.0,
-      "validation"_a = py::none(), "window"_a = "", "resample"_a = 0.0,
-      "remove_initial"_a = false, "detrend"_a = "none", "filter"_a = "", "decimate"_a = 1,
+      "methods"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3, "nb"_a = 3,
+      "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3, "split"_a = 0.0, "validation"_a = py::none(),
+      "window"_a = "", "resample"_a = 0.0, "remove_initial"_a = false, "detrend"_a = "none",
+      "filter"_a = "", "decimate"_a = 1,
       "Runs several methods as `pneumid identify -m` does: each fails alone, models are "
       "flagged and ranked (unflagged first; by validation fit with `split` or `validation` "
       "data). Returns {'models': [IdentifiedModel, best first], 'failures': [{'method', "

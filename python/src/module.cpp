@@ -66,4 +66,5 @@ PYBIND11_MODULE(pneumid, m) {
   pneumid::python::BindUncertainty(m);
   pneumid::python::BindCalibration(m);
   pneumid::python::BindCodegen(m);
+  pneumid::python::BindNonlinear(m);
 }

@@ -25,8 +25,8 @@ std::vector<double> Numbers(const nlohmann::json& a, const std::string& key) {
 ParamValue ParamFromJson(const nlohmann::json& v, const std::string& key) {
   if (v.is_number_integer()) return v.get<int>();
   if (v.is_number()) return v.get<double>();
-  PNEUMID_CHECK(v.is_array(), "parameter '{}': expected a number or an array, got a JSON {}",
-                key, v.type_name());
+  PNEUMID_CHECK(v.is_array(), "parameter '{}': expected a number or an array, got a JSON {}", key,
+                v.type_name());
   if (!v.empty() && v[0].is_array()) {
     std::vector<std::vector<double>> rows;
     for (const auto& row : v) {
@@ -119,6 +119,9 @@ nlohmann::json ToJson(const IdentifiedModel& model) {
     }
     j["covariance"] = {{"names", model.covariance->names}, {"matrix", std::move(rows)}};
   }
+  if (model.input_map) j["input_map"] = ToJson(*model.input_map);
+  if (model.output_map) j["output_map"] = ToJson(*model.output_map);
+  if (model.narx) j["narx"] = ToJson(*model.narx);
   return j;
 }
 
@@ -162,20 +165,24 @@ IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
                   Excerpt(j.at("termination").dump()));
     m.termination = TerminationFromString(j.at("termination").get<std::string>());
   }
-  m.validation_fit_percent = number("validation_fit_percent",
-                                    std::numeric_limits<double>::quiet_NaN());
+  m.validation_fit_percent =
+      number("validation_fit_percent", std::numeric_limits<double>::quiet_NaN());
   if (j.contains("flags")) {
     PNEUMID_CHECK(j.at("flags").is_array(), "'flags' must be an array, got {}",
                   Excerpt(j.at("flags").dump()));
     for (const nlohmann::json& f : j.at("flags")) {
       PNEUMID_CHECK(f.is_object() && f.contains("flag") && f.at("flag").is_string(),
                     "each element of 'flags' needs a string 'flag', got {}", Excerpt(f.dump()));
-      m.flags.push_back({ModelFlagFromString(f.at("flag").get<std::string>()),
-                         f.value("reason", std::string())});
+      m.flags.push_back(
+          {ModelFlagFromString(f.at("flag").get<std::string>()), f.value("reason", std::string())});
     }
   }
-  if (j.contains("preprocessing")) m.preprocessing = PreprocessRecordFromJson(j.at("preprocessing"));
+  if (j.contains("preprocessing"))
+    m.preprocessing = PreprocessRecordFromJson(j.at("preprocessing"));
   if (j.contains("covariance")) m.covariance = CovarianceFromJson(j.at("covariance"));
+  if (j.contains("input_map")) m.input_map = StaticMapFromJson(j.at("input_map"));
+  if (j.contains("output_map")) m.output_map = StaticMapFromJson(j.at("output_map"));
+  if (j.contains("narx")) m.narx = NarxModelFromJson(j.at("narx"));
   return m;
 }
 

@@ -12,19 +12,22 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
+#include "pneumid/identify/nonlinear.hpp"
 #include "pneumid/identify/parametric.hpp"
 #include "pneumid/identify/validation.hpp"
 
 namespace pneumid {
 
 bool IdentifyOptions::IsValid(std::string* error) const {
-  if (!step.IsValid(error) || !quality.IsValid(error)) return false;
+  if (!step.IsValid(error) || !quality.IsValid(error) || !nonlinear.IsValid(error)) return false;
   if (!(split == 0.0 || (split > 0.0 && split < 1.0))) {
-    if (error) *error = fmt::format("IdentifyOptions::split must be 0 (none) or in (0, 1), got {}", split);
+    if (error)
+      *error = fmt::format("IdentifyOptions::split must be 0 (none) or in (0, 1), got {}", split);
     return false;
   }
   if (num_threads < 0) {
-    if (error) *error = fmt::format("IdentifyOptions::num_threads must be >= 0, got {}", num_threads);
+    if (error)
+      *error = fmt::format("IdentifyOptions::num_threads must be >= 0, got {}", num_threads);
     return false;
   }
   return true;
@@ -41,8 +44,17 @@ const std::vector<std::string>& IdentifyMethodNames() {
 
 bool IsIdentifyMethod(const std::string& name) {
   const auto& names = IdentifyMethodNames();
-  return std::find(names.begin(), names.end(), name) != names.end();
+  return std::find(names.begin(), names.end(), name) != names.end() || IsNonlinearMethod(name);
 }
+
+namespace {
+
+std::string ValidMethodList() {
+  return fmt::format("{}, {}", fmt::join(IdentifyMethodNames(), ", "),
+                     fmt::join(NonlinearMethodNames(), ", "));
+}
+
+}  // namespace
 
 std::vector<std::string> ParseMethodList(const std::string& list) {
   std::vector<std::string> out;
@@ -56,7 +68,7 @@ std::vector<std::string> ParseMethodList(const std::string& list) {
       continue;
     }
     PNEUMID_CHECK(IsIdentifyMethod(item), "unknown method '{}' (valid: {}, or all)", item,
-                  fmt::join(IdentifyMethodNames(), ", "));
+                  ValidMethodList());
     add(item);
   }
   PNEUMID_CHECK(!out.empty(), "the method list needs at least one method name, got '{}'", list);
@@ -68,8 +80,8 @@ IdentifiedModel Identify(const std::string& method, const Dataset& data,
   data.RequireNumericScale();
   if (IsStepMethod(method)) return IdentifyStepMethod(method, data, request, options.step);
   if (IsParametricMethod(method)) return IdentifyParametric(method, data, request);
-  PNEUMID_CHECK(false, "unknown method '{}' (valid: {})", method,
-                fmt::join(IdentifyMethodNames(), ", "));
+  if (IsNonlinearMethod(method)) return IdentifyNonlinear(method, data, request, options.nonlinear);
+  PNEUMID_CHECK(false, "unknown method '{}' (valid: {})", method, ValidMethodList());
   return {};
 }
 
@@ -108,22 +120,20 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
   std::string why;
   PNEUMID_CHECK(!methods.empty(), "IdentifyModels needs at least one method");
   for (const std::string& m : methods)
-    PNEUMID_CHECK(IsIdentifyMethod(m), "unknown method '{}' (valid: {})", m,
-                  fmt::join(IdentifyMethodNames(), ", "));
+    PNEUMID_CHECK(IsIdentifyMethod(m), "unknown method '{}' (valid: {})", m, ValidMethodList());
   PNEUMID_CHECK(request.IsValid(&why), "invalid identify request: {}", why);
   PNEUMID_CHECK(options.IsValid(&why), "{}", why);
   PNEUMID_CHECK(request.input < data.num_inputs() && request.output < data.num_outputs(),
                 "input column {} / output column {} do not exist (the data{} have {} input(s) "
                 "and {} output(s))",
-                request.input, request.output,
-                data.source().empty() ? "" : " of " + data.source(), data.num_inputs(),
-                data.num_outputs());
+                request.input, request.output, data.source().empty() ? "" : " of " + data.source(),
+                data.num_inputs(), data.num_outputs());
   PNEUMID_CHECK(validation == nullptr || options.split == 0.0,
                 "give either held-out validation data or a split fraction ({}), not both",
                 options.split);
   if (validation != nullptr) {
-    const std::string vsrc = validation->source().empty() ? "the validation data"
-                                                          : validation->source();
+    const std::string vsrc =
+        validation->source().empty() ? "the validation data" : validation->source();
     PNEUMID_CHECK(SameChannels(validation->input_channels(), data.input_channels()) &&
                       SameChannels(validation->output_channels(), data.output_channels()),
                   "{} have the channels inputs {} outputs {}, the estimation data inputs {} "
@@ -132,10 +142,10 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
                   ChannelNames(validation->output_channels()), ChannelNames(data.input_channels()),
                   ChannelNames(data.output_channels()));
     validation->RequireUniform();
-    PNEUMID_CHECK(std::abs(validation->SampleTime() - data.SampleTime()) <=
-                      1e-6 * data.SampleTime(),
-                  "{} are sampled at {} s, the estimation data at {} s", vsrc,
-                  validation->SampleTime(), data.SampleTime());
+    PNEUMID_CHECK(
+        std::abs(validation->SampleTime() - data.SampleTime()) <= 1e-6 * data.SampleTime(),
+        "{} are sampled at {} s, the estimation data at {} s", vsrc, validation->SampleTime(),
+        data.SampleTime());
   }
 
   // The estimation part, and the held-out samples [score_from, N) of `scored`.
@@ -166,8 +176,7 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
         IdentifiedModel m = Identify(methods[i], estimation, request, options);
         m.flags = AssessModel(m, estimation, request.input, request.output, options.quality);
         if (scored != nullptr) {
-          const FitMetrics f =
-              EvaluateModel(m, *scored, request.input, request.output, score_from);
+          const FitMetrics f = EvaluateModel(m, *scored, request.input, request.output, score_from);
           m.validation_fit_percent = f.fit_percent;
         }
         results[i] = std::move(m);

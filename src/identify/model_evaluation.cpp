@@ -11,6 +11,7 @@
 #include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/initial_state.hpp"
+#include "pneumid/identify/nonlinear.hpp"
 #include "pneumid/identify/parametric_model.hpp"
 #include "pneumid/identify/residual_analysis.hpp"
 #include "pneumid/lti/conversion.hpp"
@@ -58,6 +59,7 @@ TransferFunction FormOnDataGrid(const IdentifiedModel& model, const Dataset& dat
 }  // namespace
 
 Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input) {
+  if (IsNonlinearModel(model)) return SimulateNonlinear(model, data, input, 0);
   const TransferFunction g = FormOnDataGrid(model, data, input);
   const Eigen::VectorXd du = (data.u(input).array() - model.u0).matrix();
   return (Lsim(g, du, data.SampleTime()).array() + model.y0).matrix();
@@ -78,6 +80,13 @@ InitialCondition InitialConditionFromString(const std::string& name) {
 
 Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input,
                               int output, InitialCondition initial) {
+  if (IsNonlinearModel(model)) {
+    PNEUMID_CHECK(initial == InitialCondition::kZero,
+                  "the initial-state estimate is for linear models; the {} model '{}' starts "
+                  "at rest (initial condition zero)",
+                  model.structure, model.method);
+    return SimulateNonlinear(model, data, input, output);
+  }
   if (initial == InitialCondition::kZero) return SimulateModel(model, data, input);
   PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
                 "output column {} does not exist (the data have {} output(s))", output,
@@ -92,6 +101,8 @@ Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data,
 
 FitMetrics EvaluateModel(const IdentifiedModel& model, const Dataset& data, int input, int output,
                          Eigen::Index score_from) {
+  if (IsNonlinearModel(model))
+    return ScoreSimulation(data, output, SimulateNonlinear(model, data, input, output), score_from);
   return ScoreSimulation(data, output, SimulateModel(model, data, input), score_from);
 }
 
@@ -178,7 +189,8 @@ std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Datas
   const bool noise_model = IsPolynomial(model) && model.structure != "OE";
   Eigen::VectorXd yhat;
   if (!noise_model || !std::isfinite(model.fit_percent)) {
-    yhat = SimulateModel(model, data, input);
+    yhat = IsNonlinearModel(model) ? SimulateNonlinear(model, data, input, output)
+                                   : SimulateModel(model, data, input);
     if (!yhat.allFinite()) {
       flags.push_back({ModelFlag::kNotFinite, "the simulated output is not finite"});
       return flags;

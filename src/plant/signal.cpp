@@ -158,6 +158,50 @@ class PrbsSignal final : public Signal {
   mutable std::vector<std::uint8_t> bits_;
 };
 
+// Multi-level pseudo-random signal: in clock period k (from `at` on) the
+// level index is SplitMix64(seed + (k + 1) * 0x9E3779B97F4A7C15) mod levels
+// [1], i.e. independent, uniformly distributed levels
+//   low + (high - low) i / (levels - 1),  i = 0 .. levels - 1,
+// computed directly for any k (no state, the same on every platform).
+// [1] G. L. Steele, D. Lea, C. H. Flood, Fast splittable pseudorandom number
+//     generators, OOPSLA 2014 (the SplitMix64 finalizer).
+class PrbsLevelsSignal final : public Signal {
+ public:
+  PrbsLevelsSignal(double low, double high, int levels, double clock, std::uint64_t seed, double at,
+                   Shaping s)
+      : low_(low), high_(high), levels_(levels), clock_(clock), seed_(seed), at_(at), s_(s) {}
+  double operator()(double t) const override {
+    if (!Reached(t, at_)) return s_.Apply(low_);
+    const double pos = std::max(EdgeFloor((t - at_) / clock_), 0.0);
+    PNEUMID_CHECK(pos < 9007199254740992.0,
+                  "signal '{}': t = {} s is {:g} clock periods of {} s, beyond the exact "
+                  "integers of a double (2^53)",
+                  ToString(), t, pos, clock_);
+    return s_.Apply(Level(static_cast<std::uint64_t>(pos)));
+  }
+  std::string ToString() const override {
+    return "prbs-levels:low=" + Num(low_) + ",high=" + Num(high_) +
+           ",levels=" + std::to_string(levels_) + ",clock=" + Num(clock_) +
+           ",seed=" + std::to_string(seed_) + ",at=" + Num(at_) + s_.Suffix();
+  }
+
+ private:
+  double Level(std::uint64_t k) const {
+    std::uint64_t z = seed_ + (k + 1) * 0x9E3779B97F4A7C15ULL;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    z ^= z >> 31;
+    const auto i = static_cast<double>(z % static_cast<std::uint64_t>(levels_));
+    return low_ + (high_ - low_) * i / static_cast<double>(levels_ - 1);
+  }
+  double low_, high_;
+  int levels_;
+  double clock_;
+  std::uint64_t seed_;
+  double at_;
+  Shaping s_;
+};
+
 class ChirpSignal final : public Signal {
  public:
   ChirpSignal(double from, double to, double f0, double f1, double at, double duration, Shaping s)
@@ -254,11 +298,11 @@ std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
   const std::string_view trimmed = Trim(spec_in);
   PNEUMID_CHECK(!trimmed.empty(), "empty signal spec (expected e.g. 'step:from=0,to=1,at=1')");
   const std::string kind = ToLower(Trim(trimmed.substr(0, trimmed.find(':'))));
-  static const std::set<std::string> kinds = {"step",  "staircase", "multistep", "prbs",
-                                              "chirp", "ramp",      "file"};
+  static const std::set<std::string> kinds = {"step",        "staircase", "multistep", "prbs",
+                                              "prbs-levels", "chirp",     "ramp",      "file"};
   PNEUMID_CHECK(kinds.count(kind) != 0,
                 "signal '{}': unknown kind '{}' (expected step, staircase, multistep, prbs, "
-                "chirp, ramp or file)",
+                "prbs-levels, chirp, ramp or file)",
                 trimmed, kind);
   Spec p("signal", trimmed, {.has_kind = true, .has_head = kind == "file"});
   const std::string& spec = p.text();
@@ -298,6 +342,22 @@ std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
     p.Finish();
     out = std::make_unique<PrbsSignal>(low, high, order, clock, static_cast<std::uint64_t>(seed_d),
                                        at, s);
+  } else if (kind == "prbs-levels") {
+    double low = p.Number("low", 0.0);
+    double high = p.Number("high", 1.0);
+    double levels_d = p.Number("levels", 5.0);
+    PNEUMID_CHECK(levels_d == std::floor(levels_d) && levels_d >= 2 && levels_d <= 1000,
+                  "signal '{}': levels must be an integer in 2..1000, got {}", spec, levels_d);
+    double clock = p.Number("clock");
+    PNEUMID_CHECK(clock > 0.0, "signal '{}': clock must be positive, got {}", spec, clock);
+    double seed_d = p.Number("seed", 1.0);
+    PNEUMID_CHECK(seed_d == std::floor(seed_d) && seed_d >= 0 && seed_d <= 9007199254740992.0,
+                  "signal '{}': seed must be an integer in 0..2^53, got {}", spec, seed_d);
+    double at = p.Number("at", 0.0);
+    Shaping s = TakeShaping(p);
+    p.Finish();
+    out = std::make_unique<PrbsLevelsSignal>(low, high, static_cast<int>(levels_d), clock,
+                                             static_cast<std::uint64_t>(seed_d), at, s);
   } else if (kind == "chirp") {
     double from = p.Number("from");
     double to = p.Number("to");
@@ -343,6 +403,12 @@ std::string SignalSyntaxHelp() {
                                         (N = 2..32, period 2^N-1 clock periods of C seconds,
                                         seed = initial register 1..2^N-1, default all ones;
                                         same taps as scipy.signal.max_len_seq), repeated
+  prbs-levels:low=A,high=B,levels=L,clock=C[,seed=S][,at=T]
+                                        multi-level pseudo-random signal: in each clock
+                                        period of C seconds one of L equally spaced levels
+                                        from A to B (L = 2..1000, default 5), independent
+                                        and uniformly drawn from seed S (default 1; the same
+                                        on every run and platform); A before T
   chirp:from=A,to=B,f0=F0,f1=F1[,at=T][,duration=D]
                                         sine between A and B, frequency swept linearly from
                                         F0 to F1 over D seconds (default 10), (A+B)/2 outside

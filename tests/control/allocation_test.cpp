@@ -2,6 +2,7 @@
 // QDMC's QP solve) must not touch the heap. Counted by replacing the global
 // operator new for this test program.
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <new>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/lti/static_map.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -109,6 +111,22 @@ TEST(AllocationTest, GpcAndPidStepsDoNotAllocate) {
   p.limits.u_max = 1.0;
   PidController pid(0.01, p);
   EXPECT_EQ(AllocationsDuringUpdates(pid), 0);
+}
+
+// A compensator calls the actuator map's inverse every sample (in front of a
+// linear controller): Evaluate and Inverse are binary searches without heap use.
+TEST(AllocationTest, StaticMapEvaluateAndInverseDoNotAllocate) {
+  const StaticMap f({0, 10, 20, 40, 60, 82, 88, 100}, {0, 0, 18.7, 39, 79.8, 130, 193.2, 193.2});
+  double acc = 0.0;
+  g_allocations = 0;
+  g_counting = true;
+  for (int k = 0; k < 1000; ++k) {
+    acc += f.Inverse(-10.0 + 0.21 * k);  // below, inside and above the output range
+    acc += f.Evaluate(-5.0 + 0.11 * k);
+  }
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_TRUE(std::isfinite(acc));
 }
 
 }  // namespace

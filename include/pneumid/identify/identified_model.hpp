@@ -21,7 +21,9 @@
 #include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/data/preprocess.hpp"
+#include "pneumid/identify/narx.hpp"
 #include "pneumid/identify/subspace.hpp"
+#include "pneumid/lti/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
@@ -127,13 +129,19 @@ struct IdentifiedModel {
   /// full covariance is not finite); none for
   /// the graphical, subspace and correlation methods.
   std::optional<ParameterCovariance> covariance;
+  /// Nonlinear parts (nonlinear.hpp; absent for linear models): the input map
+  /// f of a Hammerstein model or a static map (yhat from f(u) through
+  /// `discrete`), the output map of a Wiener model, a polynomial NARX model.
+  std::optional<StaticMap> input_map;
+  std::optional<StaticMap> output_map;
+  std::optional<NarxModel> narx;
 };
 
 /// Options shared by every method of `pneumid identify`.
 struct IdentifyRequest {
-  int input = 0;   ///< input column
-  int output = 0;  ///< output column
-  int order = 2;   ///< PTn / Strejc order n
+  int input = 0;               ///< input column
+  int output = 0;              ///< output column
+  int order = 2;               ///< PTn / Strejc order n
   int na = 3, nb = 3, nk = 1;  ///< polynomial orders
   int nc = 1, nd = 1, nf = 3;  ///< ARMAX/BJ/OE orders
   bool feedthrough = false;    ///< n4sid: estimate the D term (subspace.hpp)

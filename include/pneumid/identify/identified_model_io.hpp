@@ -8,7 +8,13 @@
 //    "discrete": {...}                         (polynomial models only)
 //    "fit_percent": 97.1, "iae": 0.8, "notes": [...]   (notes only when any)
 //    "covariance": {"names": ["a1", "b1"], "matrix": [[...], [...]]}
-//                                              (only when known; model_uncertainty.hpp)}
+//                                              (only when known; model_uncertainty.hpp)
+//    "input_map": {"u": [...], "y": [...], "extrapolation": "clamp"}
+//                                              (static-map, hammerstein; lti/static_map.hpp)
+//    "output_map": {...}                       (wiener)
+//    "narx": {"ny", "nu", "nk", "degree", "Ts", "terms", "theta", "err"}
+//                                              (narx; identify/narx.hpp)}
+// The nonlinear keys are optional: files without them read as before.
 //
 // The keys are a file format read back by `pneumid step/bode/control --model
 // FILE` (lti/model_io.hpp reads "tf") and `pneumid validate` (the polynomial

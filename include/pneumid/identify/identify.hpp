@@ -8,6 +8,9 @@
 //   fit-p1d fit-p2d fit-p2du fit-p3d        step_methods.hpp (process models
 //   fit-p1di                                fitted by Ceres, any input)
 //   arx armax oe bj iv4 n4sid cra spa       parametric.hpp (black-box)
+//   static-map hammerstein wiener narx      nonlinear.hpp (not in `all`: they
+//                                           need a staircase / multi-level
+//                                           experiment, a step test has two levels)
 //
 // Every method returns an IdentifiedModel (identified_model.hpp) scored on the
 // data it was identified from (fit_percent, iae).
@@ -23,6 +26,7 @@
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/nonlinear.hpp"
 #include "pneumid/identify/step_methods.hpp"
 
 namespace pneumid {
@@ -34,6 +38,9 @@ struct IdentifyOptions {
   StepMethodOptions step;
   /// Flags that rank a model after the trusted ones (IdentifyModels).
   ModelQualityOptions quality;
+  /// Settings of static-map, hammerstein, wiener and narx (their orders are
+  /// the request's na, nb, nk).
+  NonlinearOptions nonlinear;
   /// Held-out split for IdentifyModels: the first `split` fraction of the
   /// samples estimates, the rest validates (models simulated over the whole
   /// record, scored on the rest). 0 (default) = no split; else in (0, 1).
@@ -44,16 +51,17 @@ struct IdentifyOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// Every method name, step-response methods first, in the order of the table
-/// above (the order `all` expands to).
+/// The linear method names, step-response methods first, in the order of the
+/// table above (the order `all` expands to). The nonlinear methods are
+/// NonlinearMethodNames() (nonlinear.hpp).
 const std::vector<std::string>& IdentifyMethodNames();
 
-/// True when `name` is one of IdentifyMethodNames().
+/// True when `name` is one of IdentifyMethodNames() or NonlinearMethodNames().
 bool IsIdentifyMethod(const std::string& name);
 
 /// Method names from a comma-separated list such as "arx, ptn" or "all"
-/// (every method). Blanks around names are ignored; a repeated name is kept
-/// once, at its first position.
+/// (every linear method, IdentifyMethodNames()). Blanks around names are ignored; a repeated name
+/// is kept once, at its first position.
 /// @throws InvalidArgument naming an unknown method, or for an empty list.
 std::vector<std::string> ParseMethodList(const std::string& list);
 

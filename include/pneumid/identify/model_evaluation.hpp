@@ -7,6 +7,10 @@
 // with (u0, y0) the model's operating point (IdentifiedModel::u0, y0) and G
 // its discrete form when it has one (polynomial, state-space and FIR models),
 // otherwise its continuous transfer function under a zero-order hold.
+// Nonlinear models (static map, Hammerstein, Wiener, NARX) are simulated by
+// SimulateNonlinear (nonlinear.hpp): the linear part at rest at the first
+// input sample, a NARX model from its first measured outputs (output column 0
+// in the three-argument SimulateModel, `output` elsewhere).
 // Fit: fit = 100 (1 - ||y - yhat|| / ||y - mean(y)||) (fit_metrics.hpp) over
 // the scored samples; with held-out data that continue the estimation record
 // (a split), the model is simulated over the whole record and scored on the

@@ -1,0 +1,117 @@
+// The steady-state input-output map of a plant from a staircase (or a slow
+// ramp) experiment, as a monotone piecewise-linear StaticMap
+// (lti/static_map.hpp). Method `static-map` of `pneumid identify`.
+//
+// Staircase ([1] sec. 13.2, static gain from steady states):
+//   1. segments of constant input: runs of samples whose input differs from
+//      the run's first by at most `level_tolerance`; runs shorter than
+//      `min_segment_duration` (not settled: PRBS bits, pulses) are skipped;
+//   2. the steady output of a segment is the mean of y over its last
+//      `settle_fraction` (the first part is the transient);
+//   3. segments at the same level (within `level_tolerance`) are merged, the
+//      means weighted by their sample counts: levels u_i, values ybar_i, weights w_i;
+//   4. monotone by the pool-adjacent-violators algorithm (PAVA, [2]): the
+//      weighted least-squares non-decreasing (or non-increasing, by the sign
+//      of the least-squares slope of ybar against u) sequence closest to ybar;
+//      pooled levels share one value, so a dead zone or a saturation measured
+//      with noise comes out flat;
+//   5. optional smoothing: `smoothing_passes` passes of the weights
+//      [1 2 1]/4 over the interior values (ends kept), then PAVA again.
+// The knots are the levels u_i, the values the result of 4-5.
+//
+// Slow ramp (quasi-static: the ramp must be slow against the plant's time
+// constants): the input range is cut into `ramp_bins` equal bins; each
+// non-empty bin gives the knot (mean u, mean y), then steps 4-5.
+//
+// [1] L. Ljung, System Identification: Theory for the User, 2nd ed., 1999.
+// [2] M. Ayer, H. D. Brunk, G. M. Ewing, W. T. Reid, E. Silverman, An empirical
+//     distribution function for sampling with incomplete information, Ann.
+//     Math. Statist. 26 (1955) 641-647; R. E. Barlow et al., Statistical
+//     Inference under Order Restrictions, Wiley, 1972, ch. 1.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pneumid/common/termination.hpp"
+#include "pneumid/data/dataset.hpp"
+#include "pneumid/lti/static_map.hpp"
+
+namespace pneumid {
+
+/// Which experiment the data are.
+enum class StaticMapSource {
+  kAuto,       ///< "auto": staircase when >= 2 settled levels, else a monotone ramp
+  kStaircase,  ///< "staircase": segments of constant input
+  kRamp,       ///< "ramp": a slow ramp, binned
+};
+std::string ToString(StaticMapSource s);
+/// Inverse of ToString. @throws InvalidArgument listing the valid names.
+StaticMapSource StaticMapSourceFromString(const std::string& name);
+
+struct StaticMapFitOptions {
+  StaticMapSource source = StaticMapSource::kAuto;
+  /// Fraction of each segment, at its end, averaged for the steady output;
+  /// in (0, 1]. Default 0.5.
+  double settle_fraction = 0.5;
+  /// Constant-input segments shorter than this (s) are skipped; >= 0.
+  /// Default 1 s.
+  double min_segment_duration = 1.0;
+  /// Input values within this (input units) of each other are one level;
+  /// >= 0. Default 1e-6.
+  double level_tolerance = 1e-6;
+  /// Make the map monotone (PAVA); default true.
+  bool monotone = true;
+  /// Passes of the [1 2 1]/4 smoother (>= 0, default 0).
+  int smoothing_passes = 0;
+  /// Bins of a ramp (>= 2, default 20).
+  int ramp_bins = 20;
+  /// How the map extrapolates (default clamp: saturated beyond the levels).
+  StaticMapExtrapolation extrapolation = StaticMapExtrapolation::kClamp;
+  bool IsValid(std::string* error) const;
+};
+
+struct StaticMapFitSummary {
+  StaticMapSource source = StaticMapSource::kStaircase;  ///< what was used
+  int segments_used = 0;     ///< settled segments (staircase) or filled bins (ramp)
+  int segments_skipped = 0;  ///< constant-input runs too short to settle
+  int levels_pooled = 0;     ///< levels merged by PAVA into a neighbour's value
+  /// Largest |value - level mean| that PAVA and smoothing introduced (output units).
+  double max_adjustment = 0.0;
+  Termination termination = Termination::kConvergence;
+  std::string message;
+  /// One line: "static-map convergence: staircase, 11 levels, 2 pooled (max change 0.8)".
+  std::string BriefReport() const;
+};
+
+struct StaticMapFitResult {
+  StaticMap map;
+  /// The measured steady states before PAVA / smoothing, with their weights
+  /// (samples averaged), sorted by level.
+  std::vector<double> level_u, level_y, weight;
+  StaticMapFitSummary summary;
+};
+
+/// Fits the map from input u and output y sampled every Ts seconds.
+/// @throws InvalidArgument for invalid options, sizes that differ, fewer than
+///         2 samples, non-finite values, or data from which no map follows:
+///         an input that never leaves one operating point (naming the level
+///         and the input range), fewer than 2 settled levels of a staircase
+///         (naming the levels and segment lengths found), a ramp source on an
+///         input that is not monotone.
+StaticMapFitResult FitStaticMap(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
+                                const StaticMapFitOptions& options = {});
+/// As above for input column `input` and output column `output` of `data`
+/// (uniformly sampled).
+StaticMapFitResult FitStaticMap(const Dataset& data, int input = 0, int output = 0,
+                                const StaticMapFitOptions& options = {});
+
+/// The weighted least-squares non-decreasing (`increasing`) or non-increasing
+/// sequence closest to `values` (PAVA [2]), weights > 0.
+/// @throws InvalidArgument for sizes that differ or a weight <= 0.
+std::vector<double> PoolAdjacentViolators(const std::vector<double>& values,
+                                          const std::vector<double>& weights, bool increasing);
+
+}  // namespace pneumid

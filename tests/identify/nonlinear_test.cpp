@@ -1,0 +1,97 @@
+// The nonlinear methods through the identification entry point: dispatch by
+// name, not in `all`, the model file round trip (maps and NARX terms), the
+// simulation used by validate, and the errors for unsuitable data.
+#include "pneumid/identify/nonlinear.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/data/load.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/identify.hpp"
+#include "pneumid/identify/model_evaluation.hpp"
+#include "step_test_util.hpp"
+
+namespace pneumid {
+namespace {
+
+using ::testing::Contains;
+using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::ThrowsMessage;
+
+Dataset Recorded(const std::string& name) {
+  return LoadDataset(std::string(PNEUMID_SOURCE_DIR) + "/tests/identify/data/" + name + ".csv");
+}
+
+TEST(NonlinearMethodsTest, AreIdentifyMethodsButNotInAll) {
+  for (const std::string& m : NonlinearMethodNames()) {
+    EXPECT_TRUE(IsIdentifyMethod(m)) << m;
+    EXPECT_THAT(ParseMethodList("all"), Not(Contains(m)));
+  }
+  EXPECT_THAT(ParseMethodList("arx,hammerstein"), ::testing::ElementsAre("arx", "hammerstein"));
+  EXPECT_THAT(
+      [] { ParseMethodList("hammerstien"); },
+      ThrowsMessage<InvalidArgument>(HasSubstr("spa, static-map, hammerstein, wiener, narx")));
+}
+
+TEST(NonlinearMethodsTest, ModelsRoundTripThroughTheModelFile) {
+  const Dataset h = Recorded("hammerstein");
+  IdentifyRequest r;
+  r.na = 2;
+  r.nb = 2;
+  r.nk = 1;
+  IdentifyOptions o;
+  o.nonlinear.block.num_knots = 6;  // the true knots 0, 20, .., 100
+  for (const std::string method : {"hammerstein", "wiener", "narx"}) {
+    SCOPED_TRACE(method);
+    const IdentifiedModel m = Identify(method, h, r, o);
+    EXPECT_EQ(m.method, method);
+    const IdentifiedModel back = IdentifiedModelFromJson(nlohmann::json::parse(ToJson(m).dump()));
+    EXPECT_TRUE(IsNonlinearModel(back));
+    EXPECT_EQ(back.input_map, m.input_map);
+    EXPECT_EQ(back.output_map, m.output_map);
+    ASSERT_EQ(back.narx.has_value(), m.narx.has_value());
+    const Eigen::VectorXd y1 = SimulateModel(m, h), y2 = SimulateModel(back, h);
+    EXPECT_LT((y1 - y2).cwiseAbs().maxCoeff(), 1e-6 * (1.0 + y1.cwiseAbs().maxCoeff()));
+    EXPECT_NEAR(EvaluateModel(back, h).fit_percent, m.fit_percent, 1e-6);
+    EXPECT_FALSE(m.notes.empty());
+  }
+  const IdentifiedModel ham = Identify("hammerstein", h, r, o);
+  EXPECT_EQ(ham.structure, "Hammerstein");
+  ASSERT_TRUE(ham.input_map.has_value());
+  EXPECT_GT(ham.fit_percent, 98.0);  // noise std 0.2 on a 10..128 output
+  EXPECT_THAT(ham.notes[0], HasSubstr("input map f(u): monotone increasing, 6 knots"));
+  EXPECT_THAT([&] { SimulateModel(ham, h, 0, 0, InitialCondition::kEstimate); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("initial-state estimate is for linear")));
+  const IdentifiedModel narx = Identify("narx", Recorded("narx"), r, o);
+  EXPECT_THAT(narx.notes[0], HasSubstr("selected terms: "));
+}
+
+TEST(NonlinearMethodsTest, StaticMapOfAStaircaseAndErrorsOnAStepTest) {
+  Eigen::VectorXd u(1000);
+  for (Eigen::Index k = 0; k < 1000; ++k) u[k] = 10.0 * static_cast<double>(k / 200);
+  const Eigen::VectorXd y = (2.0 * u.array() + 1.0).matrix();
+  const IdentifiedModel m = Identify("static-map", Dataset::FromUniform(0.01, u, y));
+  ASSERT_TRUE(m.input_map.has_value());
+  EXPECT_EQ(m.input_map->u(), (std::vector<double>{0, 10, 20, 30, 40}));
+  EXPECT_NEAR(m.fit_percent, 100.0, 1e-9);  // a static plant is its map
+  // One step: two levels, a map of two knots; a constant input: an error.
+  const Dataset flat =
+      Dataset::FromUniform(0.01, Eigen::VectorXd::Constant(300, 5.0), Eigen::VectorXd::Ones(300));
+  EXPECT_THAT([&] { Identify("static-map", flat); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("never leaves one operating point")));
+  EXPECT_THAT([&] { Identify("hammerstein", flat); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("never leaves one operating point")));
+  // `all` on a plain step test runs no nonlinear method.
+  const IdentificationSummary s =
+      IdentifyModels(ParseMethodList("all"), testing::LoadSynthetic("fopdt"));
+  for (const IdentifiedModel& model : s.models) EXPECT_FALSE(IsNonlinearModel(model));
+}
+
+}  // namespace
+}  // namespace pneumid
