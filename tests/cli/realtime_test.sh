@@ -8,6 +8,9 @@ cleanup() {  # called by lib.sh on exit
 }
 
 start_server() {  # start_server [extra flags]; sets SERVER_PID and PORT
+  # Empty the file here, not in the background job's redirection: that runs in the
+  # child and can come after the loop below has read the previous server's port.
+  : > "$TMP/server.txt"
   "$PNEUMID" plant-server --plant ipa --port 0 "$@" > "$TMP/server.txt" 2>&1 &
   SERVER_PID=$!
   for _ in $(seq 50); do
