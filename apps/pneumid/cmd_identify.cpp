@@ -247,7 +247,7 @@ static Registrar reg(
                      "Comma-separated methods, or all: reaction-curve, tangent, smith, "
                      "sundaresan, broida, sopdt, ptn, strejc, areas, fit-p1d, fit-p2d, fit-p2du, "
                      "fit-p3d, fit-p1di, arx, armax, oe, bj, iv4, n4sid, cra, spa; nonlinear "
-                     "(not in all): static-map, hammerstein, wiener, narx")
+                     "(not in all): static-map, hammerstein, wiener, narx, affine-narx")
           ->capture_default_str();
       app.add_option("--order", args->request.order, "PTn order n (ptn)")
           ->capture_default_str()
@@ -275,8 +275,10 @@ static Registrar reg(
               return std::string(e.what());
             }
           });
-      app.add_option("--knots", args->nonlinear.block.num_knots,
-                     "hammerstein, wiener: knots of the static map, spread over the input range")
+      app.add_option(
+             "--knots", args->nonlinear.block.num_knots,
+             "hammerstein, wiener, affine-narx: knots of the static map, spread over the input "
+             "range")
           ->capture_default_str()
           ->check(CLI::Range(2, 1000));
       app.add_flag("--monotone-map", args->nonlinear.block.monotone_map,
@@ -290,7 +292,9 @@ static Registrar reg(
           ->capture_default_str()
           ->check(CLI::NonNegativeNumber);
       app.add_option("--degree", args->nonlinear.narx.degree,
-                     "narx: polynomial degree (lags: ny = --na, nu = --nb, delay --nk)")
+                     "narx: polynomial degree (lags: ny = --na, nu = --nb, delay --nk); "
+                     "affine-narx: degree "
+                     "of its a(y) and b(y)")
           ->capture_default_str()
           ->check(CLI::Range(1, 3));
       app.add_option("--max-terms", args->nonlinear.narx.max_terms, "narx: most terms selected")

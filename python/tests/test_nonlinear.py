@@ -57,7 +57,7 @@ def test_fit_static_map_of_a_staircase():
 
 
 def test_identify_hammerstein_and_wiener_recover_the_system():
-    assert pneumid.nonlinear_methods() == ["static-map", "hammerstein", "wiener", "narx"]
+    assert pneumid.nonlinear_methods() == ["static-map", "hammerstein", "wiener", "narx", "affine-narx"]
     assert "hammerstein" not in pneumid.identify_methods()
     u = levels(5)
     f = np.interp(u, KNOTS, VALUES)

@@ -322,12 +322,18 @@ NarxResult EstimateNarx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, doub
   s.loss = m.y_scale * m.y_scale * (target - S * theta).squaredNorm() / static_cast<double>(rows);
   s.message = fmt::format("FROLS: {} of {} candidate terms, stopped: {}", chosen.size(), M, stop);
   result.one_step_fit_percent = NrmseFit(target, (S * theta).eval());
-  const Eigen::VectorXd sim = m.Simulate(u, y);
-  result.simulation_fit_percent = sim.allFinite()
-                                      ? NrmseFit(y.tail(rows).eval(), sim.tail(rows).eval())
-                                      : -std::numeric_limits<double>::infinity();
-  if (!sim.allFinite()) s.warnings.push_back("the free-run simulation diverges");
+  result.simulation_fit_percent = NarxSimulationFit(m, u, y, rows, &s.warnings);
   return result;
+}
+
+double NarxSimulationFit(const NarxModel& m, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                         Eigen::Index rows, std::vector<std::string>* warnings) {
+  const Eigen::VectorXd sim = m.Simulate(u, y);
+  if (!sim.allFinite()) {
+    if (warnings) warnings->push_back("the free-run simulation diverges");
+    return -std::numeric_limits<double>::infinity();
+  }
+  return NrmseFit(y.tail(rows).eval(), sim.tail(rows).eval());
 }
 
 }  // namespace pneumid

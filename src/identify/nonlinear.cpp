@@ -66,7 +66,8 @@ bool NonlinearOptions::IsValid(std::string* error) const {
 }
 
 const std::vector<std::string>& NonlinearMethodNames() {
-  static const std::vector<std::string> names = {"static-map", "hammerstein", "wiener", "narx"};
+  static const std::vector<std::string> names = {"static-map", "hammerstein", "wiener", "narx",
+                                                 "affine-narx"};
   return names;
 }
 
@@ -121,6 +122,27 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
     SetLinearPart(r.linear, &m);
     m.notes.push_back(MapNote(hammerstein ? "input map f(u)" : "output map f(x)", r.map));
     AddSummary(r.summary, &m);
+  } else if (method == "affine-narx") {
+    AffineNarxOptions o;
+    o.degree = options.narx.degree;
+    o.nk = std::max(1, request.nk);
+    o.knots = options.block.knots;
+    o.num_knots = options.block.num_knots;
+    const AffineNarxResult r = EstimateAffineNarx(u, y, Ts, o);
+    m.structure = "input-affine NARX";
+    m.narx = r.narx;
+    m.input_map = r.map;
+    m.discrete = TransferFunction::Discrete({1.0}, {1.0}, Ts);
+    m.tf = TransferFunction();
+    m.params = {
+        {"degree", o.degree}, {"nk", o.nk}, {"knots", static_cast<int>(r.map.size())}, {"Ts", Ts}};
+    m.notes.push_back(MapNote("input map f(u)", r.map));
+    m.notes.push_back(r.narx.Equation() + " (u: the mapped input f(u))");
+    m.notes.push_back(fmt::format("{}; one-step fit {:.2f} %, simulation fit {:.2f} %",
+                                  r.summary.message, r.one_step_fit_percent,
+                                  r.simulation_fit_percent));
+    for (const std::string& w : r.summary.warnings) m.notes.push_back(w);
+    m.termination = r.summary.termination;
   } else {  // narx
     NarxOptions o = options.narx;
     o.ny = request.na;
@@ -172,6 +194,8 @@ Eigen::VectorXd SimulateNonlinear(const IdentifiedModel& model, const Dataset& d
                   "a NARX simulation starts from the measured output: output column {} does "
                   "not exist (the data have {} output(s))",
                   output, data.num_outputs());
+    // affine-narx: the NARX runs on the mapped input f(u).
+    if (model.input_map) return model.narx->Simulate(model.input_map->Evaluate(u), data.y(output));
     return model.narx->Simulate(u, data.y(output));
   }
   PNEUMID_CHECK(model.discrete.has_value(),

@@ -73,6 +73,14 @@ const nlohmann::json& SelectModelJson(const nlohmann::json& j, const std::string
 TransferFunction FromModelJson(const nlohmann::json& j_in, const std::string& where,
                                const std::string& select) {
   const nlohmann::json& j = SelectModelJson(j_in, where, select);
+  PNEUMID_CHECK(!j.contains("narx"),
+                "{}: the model{} is a NARX model, which has no transfer function; a "
+                "controller or a linear simulation needs a linear, static-map or Hammerstein "
+                "model",
+                where,
+                j.contains("method") && j.at("method").is_string()
+                    ? " '" + j.at("method").get<std::string>() + "'"
+                    : std::string());
   // An identified discrete model whose continuous form is only the bilinear
   // (tustin) approximation (no zoh equivalent: a pole on the negative real
   // axis) is used as identified: the tustin form is biproper and its step
@@ -240,6 +248,11 @@ std::optional<StaticMap> ParseModelInputMap(const std::string& spec) {
   try {
     if (IsBareStaticMap(j)) return StaticMapFromJson(j);
     const nlohmann::json& m = SelectModelJson(j, path, select);
+    if (m.contains("narx"))
+      throw DataError(
+          fmt::format("{}: a NARX model's input_map is not the plant's static map; "
+                      "use a static-map or Hammerstein model",
+                      path));
     if (m.contains("input_map")) return StaticMapFromJson(m.at("input_map"));
   } catch (const InvalidArgument& e) {
     throw DataError(fmt::format("{}: {}", path, e.what()));

@@ -123,4 +123,9 @@ struct NarxResult {
 NarxResult EstimateNarx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
                         const NarxOptions& options = {});
 
+/// NRMSE fit (%) of the model's free run (Simulate(u, y)) over the last
+/// `rows` samples of y; -infinity, with a warning added, when it diverges.
+double NarxSimulationFit(const NarxModel& m, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                         Eigen::Index rows, std::vector<std::string>* warnings);
+
 }  // namespace pneumid

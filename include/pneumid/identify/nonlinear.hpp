@@ -4,13 +4,15 @@
 //   hammerstein  input map + linear dynamics (hammerstein.hpp), orders na, nb, nk
 //   wiener       linear dynamics + output map (hammerstein.hpp), orders na, nb, nk
 //   narx         polynomial NARX by FROLS (narx.hpp): ny = na, nu = nb, delay nk
+//   affine-narx  input-affine first-order NARX with an input map (affine_narx.hpp):
+//                degree of narx, knots of hammerstein, delay nk
 //
 // They are not part of `--method all` (identify.hpp): a plain step test has
 // two input levels, from which no map follows, and the fits would only fail.
 //
 // An IdentifiedModel of these methods carries its nonlinear part in the
 // optional members input_map (static-map, hammerstein), output_map (wiener)
-// or narx; `discrete` is the linear part G of unit static gain (static-map:
+// or narx (affine-narx: narx and input_map, the NARX in f(u)); `discrete` is the linear part G of unit static gain (static-map:
 // G = 1, no dynamics), `tf` its continuous (zoh d2c) form when it exists. The
 // operating point is u0 = y0 = 0 (the maps hold the offsets). SimulateModel
 // (model_evaluation.hpp) simulates them as SimulateNonlinear below.
@@ -22,6 +24,7 @@
 #include <Eigen/Core>
 
 #include "pneumid/data/dataset.hpp"
+#include "pneumid/identify/affine_narx.hpp"
 #include "pneumid/identify/hammerstein.hpp"
 #include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/narx.hpp"
@@ -40,7 +43,7 @@ struct NonlinearOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// "static-map", "hammerstein", "wiener", "narx".
+/// "static-map", "hammerstein", "wiener", "narx", "affine-narx".
 const std::vector<std::string>& NonlinearMethodNames();
 bool IsNonlinearMethod(const std::string& name);
 
