@@ -1,4 +1,4 @@
-// Polynomial NARX models with term selection by forward regression with
+// Polynomial NARX models (lti/narx_model.hpp) with term selection by forward regression with
 // orthogonal least squares (FROLS) and the error reduction ratio (ERR),
 // method `narx` of `pneumid identify` (Billings [1] ch. 3, Chen, Billings and
 // Luo [2]).
@@ -48,43 +48,9 @@
 #include <nlohmann/json.hpp>
 
 #include "pneumid/identify/parametric_model.hpp"
+#include "pneumid/lti/narx_model.hpp"
 
 namespace pneumid {
-
-/// One monomial: regressor indices in non-decreasing order, r < ny for
-/// y(t-1-r), r >= ny for u(t-nk-(r-ny)); empty = the constant 1.
-using NarxTerm = std::vector<int>;
-
-struct NarxModel {
-  int ny = 1, nu = 1, nk = 1, degree = 2;
-  double Ts = 1.0;
-  /// Normalisation (see above): u enters as (u - u_offset) / u_scale, y as y / y_scale.
-  double u_offset = 0.0, u_scale = 1.0, y_scale = 1.0;
-  std::vector<NarxTerm> terms;
-  std::vector<double> theta;  ///< one per term
-  std::vector<double> err;    ///< ERR of each term when it was selected (fraction of y'y)
-  /// First sample with a complete regressor, max(ny, nk + nu - 1).
-  int FirstSample() const;
-  /// "1", "y(t-1)", "y(t-2)^2", "u(t-1)*y(t-2)".
-  std::string TermName(const NarxTerm& term) const;
-  /// "y(t) = 0.5 y(t-1) - 0.16 y(t-2)^2 + ..." with 4 significant digits, in
-  /// the normalised signals.
-  std::string Equation() const;
-  /// One-step-ahead predictions for t >= FirstSample() (the measured output
-  /// before); y and u of equal length.
-  /// @throws InvalidArgument for lengths that differ.
-  Eigen::VectorXd Predict(const Eigen::VectorXd& y, const Eigen::VectorXd& u) const;
-  /// Free-run simulation (see above); y supplies the first FirstSample() outputs.
-  /// @throws InvalidArgument for lengths that differ or fewer samples than FirstSample().
-  Eigen::VectorXd Simulate(const Eigen::VectorXd& u, const Eigen::VectorXd& y) const;
-  bool operator==(const NarxModel&) const = default;
-};
-
-/// The JSON form above.
-nlohmann::json ToJson(const NarxModel& m);
-/// Inverse of ToJson(const NarxModel&).
-/// @throws InvalidArgument naming the missing or malformed key or term.
-NarxModel NarxModelFromJson(const nlohmann::json& j);
 
 struct NarxOptions {
   int ny = 2;      ///< output lags (>= 0)

@@ -1,0 +1,73 @@
+// A polynomial NARX model (Billings [1] eq. 2.58): its terms, coefficients,
+// normalisation, one-step prediction, free-run simulation and JSON form. The
+// estimator (term selection by FROLS) is identify/narx.hpp.
+//
+// Model:
+//   y(t) = sum_i theta_i p_i(t) + e(t),
+// each term p_i a product of at most `degree` regressors from
+//   y(t-1) .. y(t-ny),  u(t-nk) .. u(t-nk-nu+1),
+// or the constant 1. The signals enter normalised: the input as
+// (u - u_offset) / u_scale, the output as y / y_scale; terms and theta refer
+// to the normalised signals, and the model multiplies its output by y_scale.
+//
+// Simulation (free run): yhat(t) from the model with yhat in place of y; the
+// first FirstSample() outputs are taken from the measured output (the model's
+// past before it can predict).
+//
+// JSON form: {"ny": 2, "nu": 2, "nk": 1, "degree": 2, "Ts": 0.01,
+//   "terms": ["1", "y(t-1)", "y(t-2)^2", "u(t-1)*y(t-1)"], "theta": [...], "err": [...],
+//   "u_offset": 50, "u_scale": 50, "y_scale": 193}  (the last three optional: 0, 1, 1).
+//
+// [1] S. A. Billings, Nonlinear System Identification: NARMAX Methods in the
+//     Time, Frequency, and Spatio-Temporal Domains, Wiley, 2013.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+namespace pneumid {
+
+/// One monomial: regressor indices in non-decreasing order, r < ny for
+/// y(t-1-r), r >= ny for u(t-nk-(r-ny)); empty = the constant 1.
+using NarxTerm = std::vector<int>;
+
+struct NarxModel {
+  int ny = 1, nu = 1, nk = 1, degree = 2;
+  double Ts = 1.0;
+  /// Normalisation (see above): u enters as (u - u_offset) / u_scale, y as y / y_scale.
+  double u_offset = 0.0, u_scale = 1.0, y_scale = 1.0;
+  std::vector<NarxTerm> terms;
+  std::vector<double> theta;  ///< one per term
+  std::vector<double> err;    ///< ERR of each term when it was selected (fraction of y'y)
+  /// First sample with a complete regressor, max(ny, nk + nu - 1).
+  int FirstSample() const;
+  /// "1", "y(t-1)", "y(t-2)^2", "u(t-1)*y(t-2)".
+  std::string TermName(const NarxTerm& term) const;
+  /// "y(t) = 0.5 y(t-1) - 0.16 y(t-2)^2 + ..." with 4 significant digits, in
+  /// the normalised signals.
+  std::string Equation() const;
+  /// One-step-ahead predictions for t >= FirstSample() (the measured output
+  /// before); y and u of equal length.
+  /// @throws InvalidArgument for lengths that differ.
+  Eigen::VectorXd Predict(const Eigen::VectorXd& y, const Eigen::VectorXd& u) const;
+  /// Free-run simulation (see above); y supplies the first FirstSample() outputs.
+  /// @throws InvalidArgument for lengths that differ or fewer samples than FirstSample().
+  Eigen::VectorXd Simulate(const Eigen::VectorXd& u, const Eigen::VectorXd& y) const;
+  /// Value of regressor r (see NarxTerm) at time t, normalised.
+  double Regressor(int r, Eigen::Index t, const Eigen::VectorXd& y, const Eigen::VectorXd& u) const;
+  /// Value of the monomial `term` at time t (1 for the constant).
+  double TermValue(const NarxTerm& term, Eigen::Index t, const Eigen::VectorXd& y,
+                   const Eigen::VectorXd& u) const;
+  bool operator==(const NarxModel&) const = default;
+};
+
+/// The JSON form above.
+nlohmann::json ToJson(const NarxModel& m);
+/// Inverse of ToJson(const NarxModel&).
+/// @throws InvalidArgument naming the missing or malformed key or term.
+NarxModel NarxModelFromJson(const nlohmann::json& j);
+
+}  // namespace pneumid
