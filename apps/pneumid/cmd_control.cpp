@@ -178,7 +178,7 @@ void WritePlot(const std::string& path, const std::vector<Run>& runs, const Cont
 void Execute(const ControlCli& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   PNEUMID_CHECK(c.duration > 0.0, "--duration must be positive, got {}", c.duration);
-  const TransferFunction model = ParseModelSpec(c.model);
+  const TransferFunction model = ParseControllerModel(c.model);
   auto setpoint = ParseSignal(c.setpoint);
   ClosedLoopOptions cl;
   cl.duration = c.duration;

@@ -64,7 +64,7 @@ void Run(const RunOptions& o, CLI::App& app) {
 
   const IoSpec spec = ParseIoSpec(config.io);
   const double Ts = config.loop.period;
-  const TransferFunction model = ParseModelSpec(o.model);
+  const TransferFunction model = ParseControllerModel(o.model);
   InputLimits limits;
   limits.u_min = s.u_min;
   limits.u_max = s.u_max;

@@ -53,8 +53,30 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
 }
 
 ControllerSpec WithModelInputMap(ControllerSpec spec, const std::string& model_spec) {
+  if (std::optional<NarxWithMap> n = ParseModelNarx(model_spec)) {
+    PNEUMID_CHECK(!spec.input_map,
+                  "{}: a NARX model brings its own input map; --input-map does not apply",
+                  model_spec);
+    spec.narx_model = InputAffineNarx(n->narx, n->input_map);
+    return spec;
+  }
   if (!spec.input_map) spec.input_map = ParseModelInputMap(model_spec);
   return spec;
+}
+
+TransferFunction ParseControllerModel(const std::string& model_spec) {
+  const std::optional<NarxWithMap> n = ParseModelNarx(model_spec);
+  if (!n) return ParseModelSpec(model_spec);
+  const InputAffineNarx m(n->narx, n->input_map);
+  double lo = n->input_map ? n->input_map->u_min() : 0.0;
+  double hi = n->input_map ? n->input_map->u_max() : 1.0;
+  const double mid = 0.5 * (lo + hi), h = 0.01 * (hi - lo);
+  const double y0 = m.SteadyOutput(mid - h), y1 = m.SteadyOutput(mid + h, y0);
+  const double K = (y1 - y0) / (2.0 * h);
+  const double tau = m.TypicalTimeConstant(mid - h, mid + h);
+  PNEUMID_CHECK(std::isfinite(K) && std::isfinite(tau) && tau > 0.0,
+                "{}: the NARX model has no stable steady state at u = {:g}", model_spec, mid);
+  return TransferFunction::Fopdt(K, tau, 0.0);
 }
 
 std::string BuiltController::Label() const {
@@ -122,6 +144,30 @@ BuiltController WithInverseMap(const ControllerSpec& spec, Make make) {
   return b;
 }
 
+// The controller of `spec` designed on the reference model of its NARX
+// model's linearization, behind the linearization.
+BuiltController WithNarxLinearization(const ControllerSpec& spec, double Ts) {
+  const InputAffineNarx& narx = *spec.narx_model;
+  PNEUMID_CHECK(!spec.input_map,
+                "a NARX model brings its own input map; --input-map does not apply");
+  PNEUMID_CHECK(std::abs(Ts - narx.Ts()) <= 1e-9 * narx.Ts(),
+                "the NARX model was identified at Ts = {} s; the controller runs at {} s",
+                narx.Ts(), Ts);
+  const double tau = ReferenceTimeConstant(narx, spec.limits, spec.narx_options);
+  ControllerSpec inner = spec;
+  inner.narx_model.reset();
+  inner.limits = NarxInnerLimits(narx, spec.limits);
+  // --rule auto without a response time: the actuator's typical speed (the
+  // fastest robust design on H trusts the linearization more than a fitted
+  // model deserves at the ends of the range).
+  if (inner.auto_tune && !std::isfinite(inner.auto_options.response_time))
+    inner.auto_options.response_time = tau;
+  BuiltController b = MakeController(TransferFunction::Fopdt(1.0, tau, 0.0), Ts, inner);
+  b.controller =
+      std::make_unique<NarxLinearizingController>(std::move(b.controller), narx, tau, spec.limits);
+  return b;
+}
+
 // `model` scaled to a unit static gain: behind the inverse map the map holds
 // the actuator's gain and the linear part only the dynamics.
 TransferFunction UnitGain(const TransferFunction& model) {
@@ -137,6 +183,7 @@ TransferFunction UnitGain(const TransferFunction& model) {
 
 BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec) {
+  if (spec.narx_model) return WithNarxLinearization(spec, Ts);
   if (spec.input_map) {
     const TransferFunction g = UnitGain(model);
     return WithInverseMap(spec, [&](const ControllerSpec& s) { return MakeController(g, Ts, s); });
@@ -174,6 +221,7 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
 }
 
 BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec_in) {
+  if (spec_in.narx_model) return WithNarxLinearization(spec_in, model.Ts());
   if (spec_in.input_map) {
     const PredictionModel unit(UnitGain(model.model()), model.Ts());
     return WithInverseMap(spec_in,

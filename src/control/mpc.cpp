@@ -349,8 +349,8 @@ double MpcController::Update(double setpoint, double measurement) {
       g_.head(M).noalias() = Gz_ * z_post_;
       g_.head(M) += Gu_ * u_prev_ + Gr_ * setpoint + Gs_ * us;
       if (soft_output_) g_(M) = options_.slack_linear_weight;
-      internal::FillMoveQpBounds(u_rows_, lim, u_prev_, options_.y_min, options_.y_max, free_, M,
-                                 P, lb_, ub_);
+      internal::FillMoveQpBounds(u_rows_, lim, u_prev_, options_.y_min, options_.y_max, free_, M, P,
+                                 lb_, ub_);
       const QpSummary& s = qp_->Solve(g_, lb_, ub_, lbx_, ubx_);
       if (s.status == QpStatus::kSolved) {
         moves_ = qp_->x().head(M);

@@ -166,7 +166,8 @@ nlohmann::ordered_json TuningResult::ToJson() const {
     j["lambda_formula"] = number(lambda_formula);
     j["P_unrounded"] = P_unrounded;
     j["tau_used"] = tau_used;
-    j["fopdt"] = {{"K", fopdt.K}, {"tau", fopdt.tau}, {"theta", fopdt.theta}, {"method", fopdt.method}};
+    j["fopdt"] = {
+        {"K", fopdt.K}, {"tau", fopdt.tau}, {"theta", fopdt.theta}, {"method", fopdt.method}};
   }
   j["Ts"] = Ts;
   j["formula"] = formula;

@@ -94,6 +94,13 @@ TransferFunction FromModelJson(const nlohmann::json& j_in, const std::string& wh
   return TransferFunctionFromJson(j);
 }
 
+// An error in the model file `path`: the message with the file's name in
+// front, unless it starts with it already.
+DataError InFile(const std::string& path, const InvalidArgument& e) {
+  const std::string what = e.what();
+  return DataError(what.rfind(path + ":", 0) == 0 ? what : fmt::format("{}: {}", path, what));
+}
+
 // The JSON of the model file `spec` (FILE.json[#method]), its path and the
 // method selected.
 nlohmann::json ReadModelFile(const std::string& spec, std::string* path_out,
@@ -153,7 +160,7 @@ TransferFunction ParseFile(const std::string& spec) {
   try {
     return FromModelJson(j, path, select);
   } catch (const InvalidArgument& e) {
-    throw DataError(fmt::format("{}: {}", path, e.what()));
+    throw InFile(path, e);
   }
 }
 
@@ -237,37 +244,69 @@ TransferFunction TransferFunctionFromJson(const nlohmann::json& j) {
                           Eigen::Map<const Eigen::VectorXd>(den.data(), den.size()), Ts, delay);
 }
 
-std::optional<StaticMap> ParseModelInputMap(const std::string& spec) {
+namespace {
+
+// The path of a model file spec FILE[#method] (FILE without the selection).
+std::string SpecPath(const std::string& spec) {
+  const std::size_t hash = spec.rfind('#');
+  return hash == std::string::npos ? spec : spec.substr(0, hash);
+}
+
+// The JSON of the model file `spec` when it names a regular file (built-in
+// and inline specs do not): the file's JSON, its path and the method selected.
+std::optional<nlohmann::json> ReadModelFileIfAny(const std::string& spec, std::string* path,
+                                                 std::string* select) {
   std::error_code ec;
-  std::string path = spec;
-  if (const std::size_t hash = spec.rfind('#'); hash != std::string::npos)
-    path = spec.substr(0, hash);
-  if (path.empty() || !std::filesystem::is_regular_file(path, ec)) return std::nullopt;
-  std::string select;
-  const nlohmann::json j = ReadModelFile(spec, &path, &select);
+  const std::string p = SpecPath(spec);
+  if (p.empty() || !std::filesystem::is_regular_file(p, ec)) return std::nullopt;
+  return ReadModelFile(spec, path, select);
+}
+
+}  // namespace
+
+std::optional<StaticMap> ParseModelInputMap(const std::string& spec) {
+  std::string path, select;
+  const std::optional<nlohmann::json> j = ReadModelFileIfAny(spec, &path, &select);
+  if (!j) return std::nullopt;
   try {
-    if (IsBareStaticMap(j)) return StaticMapFromJson(j);
-    const nlohmann::json& m = SelectModelJson(j, path, select);
-    if (m.contains("narx"))
-      throw DataError(
-          fmt::format("{}: a NARX model's input_map is not the plant's static map; "
-                      "use a static-map or Hammerstein model",
-                      path));
+    if (IsBareStaticMap(*j)) return StaticMapFromJson(*j);
+    const nlohmann::json& m = SelectModelJson(*j, path, select);
+    if (m.contains("narx")) return std::nullopt;  // its map feeds the NARX
     if (m.contains("input_map")) return StaticMapFromJson(m.at("input_map"));
   } catch (const InvalidArgument& e) {
-    throw DataError(fmt::format("{}: {}", path, e.what()));
+    throw InFile(path, e);
   }
   return std::nullopt;
 }
 
+std::optional<NarxWithMap> ParseModelNarx(const std::string& spec) {
+  std::string path, select;
+  const std::optional<nlohmann::json> j = ReadModelFileIfAny(spec, &path, &select);
+  if (!j || IsBareStaticMap(*j)) return std::nullopt;
+  try {
+    const nlohmann::json& m = SelectModelJson(*j, path, select);
+    if (!m.contains("narx")) return std::nullopt;
+    NarxWithMap n{NarxModelFromJson(m.at("narx")), std::nullopt};
+    if (m.contains("input_map")) n.input_map = StaticMapFromJson(m.at("input_map"));
+    return n;
+  } catch (const InvalidArgument& e) {
+    throw InFile(path, e);
+  }
+}
+
 StaticMap ReadStaticMap(const std::string& spec) {
   std::error_code ec;
-  std::string path = spec;
-  if (const std::size_t hash = spec.rfind('#'); hash != std::string::npos)
-    path = spec.substr(0, hash);
+  const std::string path = SpecPath(spec);
   if (!std::filesystem::exists(path, ec))
     throw DataError(
         fmt::format("{}: cannot open static map file: {}", path, std::strerror(ENOENT)));
+  if (std::filesystem::is_directory(path, ec))
+    throw DataError(fmt::format("{}: is a directory, not a static map file", path));
+  if (ParseModelNarx(spec))
+    throw DataError(
+        fmt::format("{}: a NARX model's input map is not the plant's static map; "
+                    "use a static-map or Hammerstein model",
+                    spec));
   const std::optional<StaticMap> map = ParseModelInputMap(spec);
   if (!map)
     throw DataError(fmt::format(

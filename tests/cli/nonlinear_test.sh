@@ -56,9 +56,31 @@ v = json.loads(sys.argv[1])
 m = {m["method"]: m for m in json.load(open(sys.argv[2]))["models"]}["affine-narx"]
 assert abs(v["fit_percent"] - m["validation_fit_percent"]) < 1e-6, (v["fit_percent"], m)
 PY
-expect_error "NARX as a controller's model" "is a NARX model, which has no transfer function" \
-  control --controller mpc --model "$dir/models.json#affine-narx" --plant ipa --duration 1 \
-  --setpoint step:from=0,to=40
+expect_error "NARX model as a plant" "is a NARX model, which has no transfer function" \
+  simulate --plant "$dir/models.json#affine-narx" --input step:from=0,to=40 --duration 1
+
+# The MPC behind the affine NARX's input-output linearization holds across the
+# force range: staircase 10 -> 40 -> 80 -> 120 -> 60 -> 20 N on the twin,
+# overshoot <= 5 % and settling <= 0.5 s after every step.
+"$PNEUMID" control --controller mpc --rule auto --model "$dir/models.json#affine-narx" --plant ipa \
+  --Ts 0.01 --setpoint "staircase:levels=10 40 80 120 60 20,dwell=2" --duration 12 --json \
+  >"$dir/narx_loop.json" || fail "control with the affine NARX model"
+"$PY" - "$dir/narx_loop.json" <<'PY' || fail "closed loop with the affine NARX model"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert "behind a NARX linearization" in j["controller"], j["controller"]
+steps = j["steps"]
+assert [(s["from"], s["to"]) for s in steps] == [(10, 40), (40, 80), (80, 120), (120, 60), (60, 20)], steps
+for s in steps:
+    assert s["overshoot_percent"] <= 5.0 and s["settled"] and s["settling_time"] <= 0.5, s
+assert 0.0 <= j["u_min"] and j["u_max"] <= 100.0, j
+PY
+expect_error "--input-map beside a NARX model" "brings its own input map" \
+  control --controller mpc --model "$dir/models.json#affine-narx" --input-map "$dir/models.json#hammerstein" \
+  --plant ipa --setpoint step:from=0,to=40 --duration 1
+expect_error "NARX model as --input-map" "is not the plant's static map" \
+  control --controller mpc --model fopdt-paper --input-map "$dir/models.json#affine-narx" \
+  --plant ipa --setpoint step:from=0,to=40 --duration 1
 
 # validate reads the maps back and simulates them as identify scored them.
 out="$("$PNEUMID" validate "$dir/models.json#hammerstein" "$dir/val.csv" --json)"

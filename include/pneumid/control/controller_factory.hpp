@@ -25,6 +25,7 @@
 #include "pneumid/control/auto_tuning.hpp"
 #include "pneumid/control/controller.hpp"
 #include "pneumid/control/mpc.hpp"
+#include "pneumid/control/narx_linearizing_controller.hpp"
 #include "pneumid/control/pid.hpp"
 #include "pneumid/control/prediction_model.hpp"
 #include "pneumid/control/tuning.hpp"
@@ -54,6 +55,12 @@ struct ControllerSpec {
   /// InnerLimits(f, limits), and runs behind f's inverse
   /// (inverse_map_controller.hpp); `limits` stay the limits on u.
   std::optional<StaticMap> input_map;
+  /// An input-affine NARX model of the actuator (an affine-narx model file):
+  /// the controller is designed on the reference model of its linearization
+  /// and runs behind it (narx_linearizing_controller.hpp); `limits` stay the
+  /// limits on u. Excludes input_map (the model brings its own).
+  std::optional<InputAffineNarx> narx_model;
+  NarxLinearizingOptions narx_options;  ///< the reference model's time constant
 };
 
 /// Controller settings as a user states them (command line, configuration,
@@ -95,8 +102,17 @@ TuningRule InferTuningRule(const std::string& rule, int P, int M, double lambda)
 /// @throws DataError naming the file of an input map that cannot be read.
 ControllerSpec ToControllerSpec(const ControllerSettings& settings);
 /// `spec` with the input map of the model file `model_spec` (a Hammerstein
-/// model's, lti/model_io.hpp ParseModelInputMap) when it has none yet.
+/// model's, lti/model_io.hpp ParseModelInputMap) when it has none yet, or
+/// with its NARX model (narx_model, lti/model_io.hpp ParseModelNarx).
+/// @throws InvalidArgument for a NARX model together with an input map, or a
+/// NARX model a controller cannot use (InputAffineNarx).
 ControllerSpec WithModelInputMap(ControllerSpec spec, const std::string& model_spec);
+/// The transfer function of a controller's --model: ParseModelSpec, or for a
+/// NARX model file its linearization (gain and time constant) at the steady
+/// state in the middle of its input map's range, a nominal description only:
+/// the controller itself uses the NARX model (WithModelInputMap).
+/// @throws as ParseModelSpec and ParseModelNarx.
+TransferFunction ParseControllerModel(const std::string& model_spec);
 
 struct BuiltController {
   std::unique_ptr<Controller> controller;

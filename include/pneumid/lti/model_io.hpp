@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pneumid/lti/narx_model.hpp"
 #include "pneumid/lti/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
@@ -33,13 +34,26 @@ TransferFunction ParseModelSpec(const std::string& spec);
 /// The static input map of a model file spec: the "input_map" of the selected
 /// model (a static-map or Hammerstein model written by `pneumid identify`),
 /// or the file itself when it is a static map {"u": [...], "y": [...]}
-/// (StaticMapFromJson). std::nullopt for built-in and inline specs and for
-/// models without an input map.
+/// (StaticMapFromJson). std::nullopt for built-in and inline specs, for
+/// models without an input map and for NARX models (whose map feeds the NARX:
+/// ParseModelNarx).
 /// @throws DataError naming the file for an unreadable file or an invalid map.
 std::optional<StaticMap> ParseModelInputMap(const std::string& spec);
 /// ParseModelInputMap, required: @throws DataError naming the file when it
 /// holds no static map.
 StaticMap ReadStaticMap(const std::string& spec);
+
+/// A NARX model of a model file with its input map (affine-narx models carry
+/// one; lti/narx_model.hpp).
+struct NarxWithMap {
+  NarxModel narx;
+  std::optional<StaticMap> input_map;
+};
+/// The NARX model of a model file spec (the "narx" of the selected model,
+/// with its "input_map" when present); std::nullopt for built-in and inline
+/// specs and models without one.
+/// @throws DataError naming the file for an unreadable file or an invalid model.
+std::optional<NarxWithMap> ParseModelNarx(const std::string& spec);
 
 /// {"num", "den", "Ts", "delay"} with a monic denominator.
 nlohmann::json ToJson(const TransferFunction& g);
