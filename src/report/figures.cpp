@@ -10,6 +10,7 @@
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
 #include "pneumid/identify/model_uncertainty.hpp"
+#include "pneumid/identify/nonlinear.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {
@@ -65,8 +66,8 @@ bool StepFigureOptions::IsValid(std::string* error) const {
   if (!(dt >= 0.0) || !std::isfinite(dt))
     return fail(fmt::format("StepFigureOptions::dt must be >= 0, got {}", dt));
   if (!(confidence >= 0.0) || !std::isfinite(confidence))
-    return fail(fmt::format("StepFigureOptions::confidence must be >= 0 standard deviations, got {}",
-                            confidence));
+    return fail(fmt::format(
+        "StepFigureOptions::confidence must be >= 0 standard deviations, got {}", confidence));
   if (t_final > 0.0 && dt > 0.0 && t_final / dt > 1e7)
     return fail(
         fmt::format("StepFigureOptions: t_final / dt = {} samples is too many", t_final / dt));
@@ -110,10 +111,10 @@ Figure ResponseFigure(const char* what, ResponseFunction response,
   for (const auto& m : models) {
     const TimeResponse r = response(m.model, t_final, m.model.IsDiscrete() ? 0.0 : options.dt);
     if (options.confidence > 0.0 && m.identified && response == &Step)
-      AddConfidenceBand(ax, m, r.t, r.y * options.amplitude,
-                        StepResponseStd(*m.identified, r.t, FormOf(m)) *
-                            std::abs(options.amplitude),
-                        options.confidence, PaletteColor(k));
+      AddConfidenceBand(
+          ax, m, r.t, r.y * options.amplitude,
+          StepResponseStd(*m.identified, r.t, FormOf(m)) * std::abs(options.amplitude),
+          options.confidence, PaletteColor(k));
     Curve& s = ax.AddLine(r.t, r.y * options.amplitude, m.label);
     s.color = PaletteColor(k++);
     if (m.model.IsDiscrete()) s.stairs = true;
@@ -157,7 +158,10 @@ Figure ModelComparisonFigure(const Dataset& data, const std::vector<NamedModel>&
   const bool fit_defined = (y.array() != y[0]).any();
   for (const auto& m : models) {
     Eigen::VectorXd yhat;
-    if (std::isfinite(m.u0) && std::isfinite(m.y0)) {
+    if (m.identified && IsNonlinearModel(*m.identified)) {
+      // The maps and NARX terms, not the linear part alone.
+      yhat = SimulateModel(*m.identified, data, options.input);
+    } else if (std::isfinite(m.u0) && std::isfinite(m.y0)) {
       IdentifiedModel im;
       im.tf = m.model;
       im.u0 = m.u0;
@@ -178,6 +182,33 @@ Figure ModelComparisonFigure(const Dataset& data, const std::vector<NamedModel>&
     in.ylabel = options.labels.input;
     in.AddStairs(t, data.u(options.input), "input");
     in.legend = LegendPosition::kNone;
+  }
+  return fig;
+}
+
+Figure StaticMapFigure(const std::vector<NamedStaticMap>& maps, const SignalLabels& labels,
+                       const std::string& title) {
+  PNEUMID_CHECK(!maps.empty(), "a static map figure needs at least one map");
+  const bool any_normalised =
+      std::any_of(maps.begin(), maps.end(), [](const NamedStaticMap& m) { return m.normalised; });
+  const bool any_plain =
+      std::any_of(maps.begin(), maps.end(), [](const NamedStaticMap& m) { return !m.normalised; });
+  Figure fig(any_normalised && any_plain ? 2 : 1);
+  fig.title = title;
+  int k = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const bool normalised = pass == 1;
+    if (normalised ? !any_normalised : !any_plain) continue;
+    Axes& ax = fig.axes(normalised && any_plain ? 1 : 0);
+    ax.xlabel = labels.input;
+    ax.ylabel = normalised ? "f(u) (normalised, 0..1)" : "f(u): " + labels.output;
+    for (const NamedStaticMap& m : maps) {
+      if (m.normalised != normalised) continue;
+      const Eigen::VectorXd u = Eigen::VectorXd::LinSpaced(201, m.map.u_min(), m.map.u_max());
+      Curve& c = ax.AddLine(u, m.map.Evaluate(u), m.label);
+      c.color = PaletteColor(k++);
+    }
+    ax.legend = LegendPosition::kBottomRight;
   }
   return fig;
 }

@@ -11,6 +11,7 @@
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
+#include "pneumid/identify/nonlinear.hpp"
 #include "pneumid/identify/step_analysis.hpp"
 #include "pneumid/report/figures.hpp"
 #include "pneumid/report/html.hpp"
@@ -94,7 +95,8 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
 
   ReportSummary summary;
   {
-    const IdentificationSummary ids = IdentifyModels(options.methods, data, options.request, {}, nullptr, options.progress);
+    const IdentificationSummary ids =
+        IdentifyModels(options.methods, data, options.request, {}, nullptr, options.progress);
     summary.models = ids.models;
     summary.failures = ids.failures;
     if (options.preprocessing)
@@ -158,7 +160,8 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
     Table mt;
     mt.caption = "Fit to the data (model simulated on the measured input)";
     mt.header = {"method", "NRMSE fit [%]", "IAE [" + (yc.unit.empty() ? "" : yc.unit + " ") + "s]",
-                 "RMSE",   "max |error|",   "flags", "notes"};
+                 "RMSE",   "max |error|",   "flags",
+                 "notes"};
     for (const auto& m : summary.models) {
       FitMetrics fm;
       fm.fit_percent = m.fit_percent;
@@ -190,22 +193,33 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
     // leave out models flagged unstable, not finite or with a Nyquist pole,
     // whose responses are not the plant's (and would set the axes).
     std::vector<NamedModel> named, trusted;
-    std::vector<std::string> left_out;
+    std::vector<std::string> left_out, nonlinear;
+    std::vector<NamedStaticMap> maps;
     for (const auto& m : summary.models) {
       NamedModel nm{m.method + " (" + m.structure + ")", m.discrete ? *m.discrete : m.tf, m.u0,
                     m.y0};
-      if (options.confidence > 0.0) nm.identified = std::make_shared<const IdentifiedModel>(m);
+      // The comparison simulates nonlinear models as they are; the bands need it too.
+      if (options.confidence > 0.0 || IsNonlinearModel(m))
+        nm.identified = std::make_shared<const IdentifiedModel>(m);
       named.push_back(nm);
-      if (RankGroup(m) < 2) {
+      if (m.input_map) maps.push_back({m.method, *m.input_map, m.narx.has_value()});
+      if (IsNonlinearModel(m)) {
+        nonlinear.push_back(m.method);  // no single step or frequency response
+      } else if (RankGroup(m) < 2) {
         trusted.push_back(nm);
       } else {
         left_out.push_back(m.method);
       }
     }
-    const std::string left_out_text =
-        left_out.empty() ? ""
-                         : fmt::format(" Left out (flagged, see the fit table): {}.",
-                                       fmt::join(left_out, ", "));
+    std::string left_out_text =
+        left_out.empty()
+            ? ""
+            : fmt::format(" Left out (flagged, see the fit table): {}.", fmt::join(left_out, ", "));
+    if (!nonlinear.empty())
+      left_out_text += fmt::format(
+          " Not drawn: the nonlinear models ({}), whose responses depend on the operating "
+          "point (their static maps are drawn below).",
+          fmt::join(nonlinear, ", "));
     doc.AddHeading("Figures");
     ComparisonFigureOptions co;
     co.labels = labels;
@@ -229,9 +243,10 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
     so.confidence = options.confidence;
     const std::string band_text =
         options.confidence > 0.0
-            ? fmt::format(" Shaded: \u00b1{:g} standard deviations of the models with a parameter "
-                          "covariance (first-order propagation).",
-                          options.confidence)
+            ? fmt::format(
+                  " Shaded: \u00b1{:g} standard deviations of the models with a parameter "
+                  "covariance (first-order propagation).",
+                  options.confidence)
             : "";
     if (!trusted.empty()) {
       doc.AddFigure(StepResponseFigure(trusted, so),
@@ -239,6 +254,13 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
                                 Num(du), band_text, left_out_text));
       doc.AddFigure(BodeFigure(trusted, Eigen::VectorXd(), "Bode diagram", options.confidence),
                     "Frequency responses of the models." + band_text + left_out_text);
+    }
+
+    if (!maps.empty()) {
+      doc.AddFigure(StaticMapFigure(maps, labels, "Static input maps"),
+                    "The models' static input maps f(u): the steady output of a static-map "
+                    "model, the input nonlinearity of a Hammerstein model (both in output "
+                    "units), the valves' open fraction of an input-affine NARX (0..1).");
     }
 
     // Residuals of the best model (the first of the ranking).

@@ -10,9 +10,9 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/closed_loop.hpp"
-#include "pneumid/data/preprocess.hpp"
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/tuning.hpp"
+#include "pneumid/data/preprocess.hpp"
 #include "pneumid/identify/identify.hpp"
 #include "pneumid/lti/conversion.hpp"
 #include "pneumid/lti/model_io.hpp"
@@ -114,9 +114,10 @@ bool PaperOptions::IsValid(std::string* error) const {
                             loop_duration));
   if (loop_levels.size() < 2) return fail("PaperOptions::loop_levels needs at least 2 levels");
   if (!prbs.empty() && !(prbs_skip >= 0.0 && prbs_skip + 100 * Ts <= prbs_duration))
-    return fail(fmt::format("PaperOptions::prbs_skip must be in [0, prbs_duration - 100 Ts], "
-                            "got {}",
-                            prbs_skip));
+    return fail(
+        fmt::format("PaperOptions::prbs_skip must be in [0, prbs_duration - 100 Ts], "
+                    "got {}",
+                    prbs_skip));
   if (!prbs.empty() && !(prbs_duration >= 100 * Ts && prbs_duration <= 3600.0))
     return fail(fmt::format("PaperOptions::prbs_duration must be in [100 Ts, 3600] s, got {}",
                             prbs_duration));
@@ -297,7 +298,7 @@ PaperResult RunPaper(const PaperOptions& o) {
           Close(gd.DcGain(), 1.59796, 0.02) ? "within 2 % of Eq. 5" : kTwinNote);
       row(S2, tag + "discrete poles", "0.95685, -0.17407 ± 0.18062j (Eq. 5)", Roots(poles),
           std::abs(dominant_real - 0.95685) <= 0.01 ? "dominant pole within 0.01 of Eq. 5's"
-                                                   : kTwinNote);
+                                                    : kTwinNote);
       row(S2, tag + "zoh continuous equivalent", "exists (Eq. 6)",
           negative_real ? "none: a pole on the negative real axis" : "exists",
           negative_real ? "PWM ripple aliased onto the Nyquist frequency gives a pole near z = -1"
@@ -340,10 +341,9 @@ PaperResult RunPaper(const PaperOptions& o) {
                     "is ill-determined; with a PWM ripple aliased to the Nyquist frequency it "
                     "sits near z = -1) has no real logarithm, so no zoh equivalent exists; the "
                     "bilinear (tustin) map gives the continuous form; the PRBS ARX above has one"
-        : arx->tf.IsContinuous()
-            ? kSimulatorNote
-            : "a discrete pole on the negative real axis has no real "
-              "logarithm, so there is no zoh continuous equivalent");
+        : arx->tf.IsContinuous() ? kSimulatorNote
+                                 : "a discrete pole on the negative real axis has no real "
+                                   "logarithm, so there is no zoh continuous equivalent");
   }
 
   // Section 4: FOPDT.
@@ -363,8 +363,7 @@ PaperResult RunPaper(const PaperOptions& o) {
     }
     row(S4, "Kp = dy/du", "1.6 (129 / 81.39 = 1.585)", G(K, 4),
         Close(K, 1.585, 0.03) ? "" : kSimulatorNote);
-    const double t63 =
-        fopdt->params.contains("t63") ? fopdt->params.Scalar("t63") : tau + theta;
+    const double t63 = fopdt->params.contains("t63") ? fopdt->params.Scalar("t63") : tau + theta;
     row(S4, "t63 (time to 63.2 % after the step)", "0.245 s", G(t63, 4) + " s",
         std::abs(t63 - 0.245) <= o.Ts ? "within one sample" : kSimulatorNote);
     row(S4, "tau", "0.245 s (= t63, theta ~ 0)", G(tau, 4) + " s",
@@ -421,10 +420,9 @@ PaperResult RunPaper(const PaperOptions& o) {
   if (fopdt) {
     try {
       const double K = fopdt->params.Scalar("K");
-      const double t63 =
-          fopdt->params.contains("t63")
-              ? fopdt->params.Scalar("t63")
-              : fopdt->params.Scalar("tau") + fopdt->params.Scalar("theta");
+      const double t63 = fopdt->params.contains("t63")
+                             ? fopdt->params.Scalar("t63")
+                             : fopdt->params.Scalar("tau") + fopdt->params.Scalar("theta");
       control_model = TransferFunction::Fopdt(K, t63, 0.001);
       TuningOptions to;
       to.rule = TuningRule::kShridharCooper;

@@ -75,6 +75,19 @@ for s in steps:
     assert s["overshoot_percent"] <= 5.0 and s["settled"] and s["settling_time"] <= 0.5, s
 assert 0.0 <= j["u_min"] and j["u_max"] <= 100.0, j
 PY
+# The report draws nonlinear models as they are (maps and NARX, not their
+# linear parts) and their static maps as a figure of their own.
+"$PNEUMID" report "$dir/est.csv" --methods arx,hammerstein,affine-narx -o "$dir/rep" >/dev/null ||
+  fail "report with nonlinear models"
+"$PY" - "$dir/rep" <<'PY' || fail "report of nonlinear models"
+import json, re, sys
+html = open(sys.argv[1] + "/report.html").read()
+models = {m["method"]: m for m in json.load(open(sys.argv[1] + "/models.json"))["models"]}
+assert "Static input maps" in html
+for method in ("hammerstein", "affine-narx"):
+    drawn = re.findall(re.escape(method) + r" \([^)]*\) \(fit ([0-9.]+) %\)", html)
+    assert drawn and abs(float(drawn[0]) - models[method]["fit_percent"]) < 0.06, (method, drawn)
+PY
 expect_error "--input-map beside a NARX model" "brings its own input map" \
   control --controller mpc --model "$dir/models.json#affine-narx" --input-map "$dir/models.json#hammerstein" \
   --plant ipa --setpoint step:from=0,to=40 --duration 1

@@ -33,6 +33,7 @@
 
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/step_methods.hpp"
+#include "pneumid/lti/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 #include "pneumid/report/plot.hpp"
 
@@ -105,11 +106,27 @@ struct ComparisonFigureOptions {
   int input = 0, output = 0;  ///< dataset channels
 };
 
-/// Data and models simulated on its input on one time axis (Figure 5).
+/// Data and models simulated on its input on one time axis (Figure 5);
+/// a model with an `identified` nonlinear model (maps, NARX) is simulated
+/// as that model.
 /// @throws InvalidArgument when `models` is empty, the channels do not exist,
 ///         or SimulateOnData throws.
 Figure ModelComparisonFigure(const Dataset& data, const std::vector<NamedModel>& models,
                              const ComparisonFigureOptions& options = {});
+
+/// A model's static input map, labelled; `normalised` for maps scaled to
+/// 0..1 (an input-affine NARX's valve map) rather than in output units.
+struct NamedStaticMap {
+  std::string label;
+  StaticMap map;
+  bool normalised = false;
+};
+
+/// The static maps f(u) over their input ranges: maps in output units on one
+/// axes, normalised maps on a second when there are both.
+/// @throws InvalidArgument when `maps` is empty.
+Figure StaticMapFigure(const std::vector<NamedStaticMap>& maps, const SignalLabels& labels = {},
+                       const std::string& title = "Static maps");
 
 /// Normalized residual correlations (MATLAB `resid`).
 struct ResidualCorrelation {
