@@ -20,6 +20,13 @@ start_server() {  # start_server [extra flags]; sets SERVER_PID and PORT
   done
   die "plant-server did not start: $(cat "$TMP/server.txt")"
 }
+wait_rows() {  # wait_rows FILE N: until FILE holds N data rows (at most 20 s)
+  for _ in $(seq 200); do
+    [ -f "$1" ] && [ "$(data_rows "$1")" -ge "$2" ] && return 0
+    sleep 0.1
+  done
+  fail "$1: fewer than $2 rows after 20 s"
+}
 stop_server() {
   kill -INT "$SERVER_PID"; wait "$SERVER_PID"; SERVER_PID=""
 }
@@ -106,7 +113,8 @@ tail -1 "$TMP/range.csv" | grep -q ',sensor-out-of-range$' || fail "range fault 
 "$PNEUMID" run --controller pid --model fopdt-paper --io sim --duration 60 --no-realtime \
   --max-overruns -1 --log "$TMP/int.csv" > "$TMP/int.out" 2>&1 &
 RUN_PID=$!
-sleep 1.5
+wait_rows "$TMP/int.csv" 1  # running (its handlers installed), also on a loaded machine
+sleep 0.5
 kill -INT $RUN_PID
 wait $RUN_PID
 rc=$?
@@ -119,7 +127,8 @@ grep -q "^# stop: stopped: stopped by signal 2 (Interrupt) after $rows samples" 
 "$PNEUMID" run --controller pid --model fopdt-paper --io sim --duration 60 --no-realtime \
   --max-overruns -1 --log "$TMP/kill.csv" > /dev/null 2>&1 &
 RUN_PID=$!
-sleep 3
+wait_rows "$TMP/kill.csv" 1  # the first flush (1 s) has come
+sleep 2
 kill -9 $RUN_PID
 wait $RUN_PID 2>/dev/null
 rows=$(data_rows "$TMP/kill.csv")
