@@ -1,0 +1,40 @@
+# The page of `pneumid app` (web/): built with npm (vite) into
+# ${CMAKE_BINARY_DIR}/web (index.html + assets/), which the server reads in the
+# build tree; installed to share/pneumid/web. Needs npm and web/node_modules
+# (scripts/setup runs `npm ci` in web/); without them the page is not built.
+set(PNEUMID_WEB_SOURCE_DIR ${CMAKE_CURRENT_SOURCE_DIR}/web)
+set(PNEUMID_WEB_OUTPUT_DIR ${CMAKE_BINARY_DIR}/web)
+find_program(PNEUMID_NPM npm)
+if(PNEUMID_NPM AND EXISTS ${PNEUMID_WEB_SOURCE_DIR}/node_modules)
+  file(GLOB _web_sources CONFIGURE_DEPENDS
+       ${PNEUMID_WEB_SOURCE_DIR}/src/*
+       ${PNEUMID_WEB_SOURCE_DIR}/index.html
+       ${PNEUMID_WEB_SOURCE_DIR}/package.json
+       ${PNEUMID_WEB_SOURCE_DIR}/package-lock.json
+       ${PNEUMID_WEB_SOURCE_DIR}/vite.config.ts)
+  set(_web_stamp ${CMAKE_BINARY_DIR}/web.stamp)
+  add_custom_command(
+    OUTPUT ${_web_stamp}
+    COMMAND ${PNEUMID_NPM} run --silent build -- --outDir ${PNEUMID_WEB_OUTPUT_DIR}
+    COMMAND ${CMAKE_COMMAND} -E touch ${_web_stamp}
+    DEPENDS ${_web_sources}
+    WORKING_DIRECTORY ${PNEUMID_WEB_SOURCE_DIR}
+    COMMENT "Building the page of pneumid app into ${PNEUMID_WEB_OUTPUT_DIR}"
+    VERBATIM)
+  add_custom_target(pneumid_web ALL DEPENDS ${_web_stamp})
+  install(DIRECTORY ${PNEUMID_WEB_OUTPUT_DIR}/
+          DESTINATION ${CMAKE_INSTALL_DATADIR}/pneumid/web)
+else()
+  message(STATUS "pneumid app: npm or web/node_modules not found (run scripts/setup); "
+                 "the page (web/) is not built")
+endif()
+
+# End-to-end test of the page in Chromium (tests/app/browser_test.sh). It
+# fails, naming what is missing, without node, web/node_modules or chromium.
+if(PNEUMID_BUILD_TESTS)
+  add_test(NAME app.browser
+           COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tests/app/browser_test.sh
+                   $<TARGET_FILE:pneumid_cli>
+           WORKING_DIRECTORY ${CMAKE_BINARY_DIR})
+  set_tests_properties(app.browser PROPERTIES LABELS "app" TIMEOUT 300)
+endif()
