@@ -41,6 +41,7 @@ const state = {
   control: null as any,
   controlCount: 0, // closed-loop redraws done
   controlLatency: [] as number[], // ms from the change to the redraw, per redraw
+  controlIdle: true, // no change waits for its closed-loop redraw
   tune: null as any,
   run: { state: 'idle', samples: 0, points: 0, frames: 0, summary: null as any },
 };
@@ -78,15 +79,17 @@ function fmt(v: unknown, digits = 4): string {
   return String(v);
 }
 
-function debounce(fn: () => void, ms: number): () => void {
+function debounce(fn: () => void, ms: number): (() => void) & { pending: () => boolean } {
   let timer: number | undefined;
-  return () => {
+  const f = () => {
     if (timer !== undefined) clearTimeout(timer);
     timer = window.setTimeout(() => {
       timer = undefined;
       fn();
     }, ms);
   };
+  f.pending = () => timer !== undefined;
+  return f;
 }
 
 function download(blob: Blob, name: string): void {
@@ -427,10 +430,12 @@ let controlSeq = 0;
 let controlAbort: AbortController | null = null;
 const debouncedControl = debounce(() => void runControl(), 30);
 const debouncedTune = debounce(() => void runTune(), 150);
+const controlTimerPending = () => debouncedControl.pending();
 
 function scheduleControl(): void {
   if (!pendingSince) pendingSince = performance.now();
   if (!state.model) return;
+  state.controlIdle = false;
   $('control-state').textContent = 'simulating …';
   debouncedControl();
   debouncedTune();
@@ -456,12 +461,14 @@ async function runControl(): Promise<void> {
     state.controlLatency.push(latency);
     state.controlCount++;
     document.body.dataset.controlCount = String(state.controlCount);
+    state.controlIdle = !controlTimerPending();
     $('control-state').textContent =
       `${res.controller ?? ''} on ${res.plant ?? ''}: server ${(t1 - t0).toFixed(0)} ms, ` +
       `drawn ${(t2 - t1).toFixed(0)} ms, change to redraw ${latency.toFixed(0)} ms`;
   } catch (e) {
     if (seq !== controlSeq) return;
     pendingSince = 0;
+    state.controlIdle = !controlTimerPending();
     $('control-state').textContent = '';
     showError('control-error', e);
   }
@@ -661,7 +668,7 @@ async function startRun(): Promise<void> {
   body.io = ($('io') as HTMLInputElement).value.trim() || 'sim';
   live = { t: [], r: [], y: [], u: [], stride: 1, skip: 0 };
   state.run = { state: 'starting', samples: 0, points: 0, frames: 0, summary: null };
-  $('run-summary').hidden = true;
+  $('run-details').hidden = true;
   setRunState('starting', 'starting …');
   try {
     await call('POST', '/api/run/start', { body });
@@ -729,7 +736,7 @@ function finishRun(summary: any, how: string): void {
     if (summary.compute_p99_us !== undefined) parts.push(`compute p99 ${fmt(summary.compute_p99_us)} µs`);
     if (summary.overruns !== undefined) parts.push(`${summary.overruns} overruns`);
     $('run-summary').textContent = JSON.stringify(summary, null, 2);
-    $('run-summary').hidden = false;
+    $('run-details').hidden = false;
   }
   setRunState(how === 'running' ? 'finished' : how, parts.join(', '));
 }
