@@ -52,5 +52,6 @@ done
 [ -n "$URL" ] || die "pneumid app did not print its address: $(head -c 2000 "$TMP/app.txt")"
 echo "pneumid app at $URL"
 
-node "$SRC/web/tests/e2e.mjs" "$URL" "$TMP/control.json" || fail "the page's end-to-end test (web/tests/e2e.mjs)"
+cp "$ROOT/demo.csv" "$TMP/upload.csv"
+node "$SRC/web/tests/e2e.mjs" "$URL" "$TMP/control.json" "$TMP/upload.csv" || fail "the page's end-to-end test (web/tests/e2e.mjs)"
 finish

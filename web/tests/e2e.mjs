@@ -1,11 +1,12 @@
 // End-to-end test of the page of `pneumid app` in Chromium (playwright-core).
 //
-//   node e2e.mjs URL EXPECTED_CONTROL.json
+//   node e2e.mjs URL EXPECTED_CONTROL.json [UPLOAD.csv]
 //
 // URL is the address `pneumid app` printed (with ?token=), EXPECTED_CONTROL.json
 // what `pneumid control --controller mpc --rule auto --model MODELS.json#fit-p1d
 // --plant ipa --Ts 0.01 --setpoint step:from=0,to=40,at=0.5 --duration 10 --json`
-// printed for the same data (the root holds demo.csv). With PNEUMID_SCREENSHOTS=DIR
+// printed for the same data (the root holds demo.csv); UPLOAD.csv, when given,
+// is uploaded through the page first. With PNEUMID_SCREENSHOTS=DIR
 // a screenshot of each stage is written to DIR/app-{data,identification,controller,run}.png.
 // Exit status 0 when every check passed.
 import fs from 'node:fs';
@@ -13,7 +14,7 @@ import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
-const [url, expectedFile] = process.argv.slice(2);
+const [url, expectedFile, uploadFile] = process.argv.slice(2);
 if (!url || !expectedFile) {
   console.error('usage: node e2e.mjs URL EXPECTED_CONTROL.json');
   process.exit(2);
@@ -84,6 +85,17 @@ try {
     await page.waitForSelector('#files li[data-name="demo.csv"]', { timeout: 5000 });
   });
 
+  if (uploadFile) {
+    await step('upload a data file', async () => {
+      await page.setInputFiles('#upload', uploadFile);
+      await page.waitForFunction((n) => window.pneumid.data && window.pneumid.data.name.includes(n),
+        path.basename(uploadFile), { timeout: 15000 });
+      const d = await page.evaluate(() => ({ samples: window.pneumid.data.samples, columns: window.pneumid.data.columns }));
+      if (!(d.samples > 0)) fail(`uploaded ${uploadFile}: ${d.samples} samples`);
+      log(`uploaded: ${d.samples} samples, columns ${d.columns.join(', ')}`);
+    });
+  }
+
   await step('open demo.csv', async () => {
     await page.click('#files li[data-name="demo.csv"]');
     await page.waitForFunction(() => window.pneumid.data && window.pneumid.data.name.includes('demo.csv'), null, { timeout: 15000 });
@@ -136,6 +148,15 @@ try {
     log(`${compared} metrics equal to 1e-9: ` + cells.map(([k, v]) => `${k}=${v}`).join(', '));
     await page.waitForSelector('#control-plot canvas');
     await page.waitForSelector('#control-u-plot canvas');
+  });
+
+  await step('an API error is shown', async () => {
+    await page.fill('#setpoint', 'nonsense:x=1');
+    await page.waitForSelector('#control-error:not([hidden])', { timeout: 30000 });
+    log('error shown: ' + (await page.textContent('#control-error')).trim());
+    await page.fill('#setpoint', 'step:from=0,to=40,at=0.5');
+    await page.waitForSelector('#control-error[hidden]', { state: 'attached', timeout: 30000 });
+    await page.waitForFunction(() => window.pneumid.controlIdle, null, { timeout: 30000 });
   });
 
   await step('slider to redraw latency (10 s at 100 Hz)', async () => {
@@ -211,7 +232,8 @@ try {
 } catch {
   // reported by step()
 } finally {
-  if (consoleErrors.length) console.error('browser console errors:\n  ' + consoleErrors.join('\n  '));
+  // (the error check provokes one 4xx answer on purpose)
+  if (failures && consoleErrors.length) console.error('browser console errors:\n  ' + consoleErrors.join('\n  '));
   await browser.close();
 }
 
