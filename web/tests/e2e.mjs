@@ -227,6 +227,20 @@ try {
     log(`model JSON: ${mf.models.length} models; controller TOML: ${toml.split('\n').length} lines`);
   });
 
+  await step('stop a run', async () => {
+    await page.fill('#run-duration', '20');
+    const t0 = Date.now();
+    await page.click('#run-start');
+    await page.waitForFunction(() => window.pneumid.run.points > 0, null, { timeout: 10000 });
+    await page.click('#run-stop');
+    await page.waitForFunction(() => ['finished', 'stopped', 'failed'].includes(document.getElementById('run-state').dataset.state), null, { timeout: 10000 });
+    const r = await page.evaluate(() => ({ samples: window.pneumid.run.samples, state: document.getElementById('run-state').dataset.state, text: document.getElementById('run-state').textContent }));
+    log(`stopped after ${Date.now() - t0} ms: ${r.text}`);
+    if (r.state !== 'stopped') fail(`the run ended ${r.state}, expected stopped`);
+    if (r.samples >= 2000) fail(`the stopped run streamed ${r.samples} samples`);
+    await page.fill('#run-duration', '3');
+  });
+
   const errs = await visibleErrors();
   if (errs.length) fail('errors shown on the page: ' + errs.join(' | '));
 } catch {
