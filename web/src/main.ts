@@ -112,7 +112,8 @@ async function listFiles(dir: string): Promise<void> {
   try {
     const res = await call<{ dir: string; entries: { name: string; type: string; size?: number }[] }>(
       'GET', '/api/files?dir=' + encodeURIComponent(dir));
-    state.dir = res.dir ?? dir;
+    // the root is "" (the server may say ".")
+    state.dir = (res.dir ?? dir).replace(/^\.\/?/, '').replace(/\/$/, '');
     $('files-dir').textContent = '/' + state.dir;
     const ul = $('files');
     ul.innerHTML = '';
@@ -199,7 +200,7 @@ function setData(ds: DataSet): void {
       o.value = o.textContent = c;
       sel.appendChild(o);
     }
-    sel.value = ds[key];
+    sel.value = columnOf(ds, ds[key], key);
   }
   $('data-info').innerHTML = '';
   const b = document.createElement('strong');
@@ -207,19 +208,35 @@ function setData(ds: DataSet): void {
   $('data-info').append(b, ` — ${ds.samples} samples, Ts = ${fmt(ds.Ts)} s` +
     (ds.decimated ? `, drawn at ${ds.signals.t.length} points` : ''));
   $('data-info').classList.remove('muted');
+  const yName = ($('col-y') as HTMLSelectElement).value || ds.y;
+  const uName = ($('col-u') as HTMLSelectElement).value || ds.u;
   dataPlot.draw({
     title: 'Data: ' + ds.name,
-    ylabel: ds.y,
-    y2label: ds.u,
+    ylabel: yName,
+    y2label: uName,
     series: [
-      { label: 'y: ' + ds.y, color: COLORS[0] },
-      { label: 'u: ' + ds.u, color: COLORS[1], scale: 'y2' },
+      { label: 'output ' + yName, color: COLORS[0] },
+      { label: 'input ' + uName, color: COLORS[1], scale: 'y2' },
     ],
   }, [ds.signals.t, ds.signals.y, ds.signals.u]);
   ($('identify') as HTMLButtonElement).disabled = false;
   ($('export-report') as HTMLButtonElement).disabled = false;
   $('identify-state').textContent = '';
   document.body.dataset.data = ds.id;
+}
+
+// The header name of the column a spec names: the name itself, the name
+// without its unit ("y" for "y [N]"), or a 0-based index.
+function columnOf(ds: DataSet, spec: string | undefined, key: 't' | 'u' | 'y'): string {
+  const cols = ds.columns;
+  if (spec !== undefined && spec !== null) {
+    if (cols.includes(spec)) return spec;
+    const bare = (c: string) => c.replace(/\s*[\[(].*[\])]\s*$/, '').trim();
+    const byBare = cols.find((c) => bare(c) === spec);
+    if (byBare) return byBare;
+    if (/^\d+$/.test(spec) && Number(spec) < cols.length) return cols[Number(spec)];
+  }
+  return cols[{ t: 0, u: 1, y: 2 }[key]] ?? cols[0] ?? '';
 }
 
 function onColumnsChange(): void {
@@ -366,7 +383,7 @@ function showIdentify(res: IdentifyResult): void {
     const ydata = interp(state.data.signals.t, state.data.signals.y, r.t);
     identifyPlot.draw({
       title: 'Model responses to the data\'s input',
-      ylabel: state.data.y,
+      ylabel: ($('col-y') as HTMLSelectElement).value || state.data.y,
       series: [
         { label: 'data', color: '#495057', width: 2.5 },
         ...methods.map((m, i) => ({ label: m, color: COLORS[(i + 1) % COLORS.length], dash: i % 2 ? [6, 3] : undefined })),

@@ -55,6 +55,7 @@ page.on('pageerror', (e) => consoleErrors.push('page error: ' + e.message));
 
 async function shot(section, name) {
   if (!shots) return;
+  await page.evaluate(() => document.activeElement?.blur());
   fs.mkdirSync(shots, { recursive: true });
   const file = path.join(shots, `app-${name}.png`);
   await page.locator('section#' + section).screenshot({ path: file });
@@ -102,6 +103,8 @@ try {
     await page.waitForSelector('#data-plot canvas');
     const samples = await page.evaluate(() => window.pneumid.data.samples);
     if (samples !== 401) fail(`demo.csv: ${samples} samples, expected 401`);
+    const cols = await page.$$eval('#col-t, #col-u, #col-y', (els) => els.map((e) => e.value));
+    if (JSON.stringify(cols) !== JSON.stringify(['t [s]', 'u [%]', 'y [N]'])) fail(`column pickers show ${cols}`);
   });
   await shot('data', 'data');
 
