@@ -358,7 +358,8 @@ nlohmann::json AppApi::AddDataSet(DataSet set) {
                   {"y", d.num_outputs() > 0 ? Decimate(d.y(0)) : nlohmann::json::array()}};
   j["decimated"] = Stride(d.size()) > 1;
   std::lock_guard lock(mutex_);
-  data_[set.id] = std::make_shared<const DataSet>(std::move(set));
+  const std::string id = set.id;
+  data_[id] = std::make_shared<const DataSet>(std::move(set));
   return j;
 }
 
@@ -628,6 +629,7 @@ Response AppApi::RunStart(const nlohmann::json& b) {
   if (Get(b, "noise", noise)) o.rt.noise = noise;
   std::string safe_state;
   if (Get(b, "safe_state", safe_state)) config.safety.safe_state = SafeStateFromString(safe_state);
+  Get(b, "max_overruns", config.safety.max_overruns);
   const IoSpec io = ParseIoSpec(config.io);
   // The simulator needs no real-time priority (nor the server's memory locked).
   config.loop.realtime = io.kind != IoKind::kSim;
@@ -691,6 +693,7 @@ Response AppApi::ExportController(const nlohmann::json& b) {
   Get(b, "u_min", config.safety.u_min);
   Get(b, "u_max", config.safety.u_max);
   Get(b, "rate_max", config.safety.rate_max);
+  Get(b, "max_overruns", config.safety.max_overruns);
   ParseIoSpec(config.io);
   std::string error;
   PNEUMID_CHECK(config.loop.IsValid(&error), "{}", error);
@@ -739,10 +742,10 @@ Response AppApi::ExportController(const nlohmann::json& b) {
                       nlohmann::json(config.loop.period).dump(),
                       nlohmann::json(config.loop.duration).dump());
   toml += fmt::format("\n[io]\nbackend = {}\nplant = {}\n", q(config.io), q(config.plant));
-  toml += fmt::format("\n[safety]\nu_min = {}\nu_max = {}\nrate_max = {}\n",
+  toml += fmt::format("\n[safety]\nu_min = {}\nu_max = {}\nrate_max = {}\nmax_overruns = {}\n",
                       nlohmann::json(config.safety.u_min).dump(),
                       nlohmann::json(config.safety.u_max).dump(),
-                      nlohmann::json(config.safety.rate_max).dump());
+                      nlohmann::json(config.safety.rate_max).dump(), config.safety.max_overruns);
   ParseRealtimeConfig(toml, "controller.toml");  // what `run --config` will read
   Response r;
   r.content_type = "text/plain; charset=utf-8";

@@ -3,7 +3,9 @@
 #include <sys/socket.h>
 #include <sys/time.h>
 
+#include <chrono>
 #include <condition_variable>
+#include <limits>
 #include <set>
 
 #include <fmt/format.h>
@@ -158,13 +160,31 @@ struct HttpServer::Impl {
     http::write(socket, res, ec);
   }
 
+  // After refusing a body: says it is done sending and reads what the client
+  // still sends for a moment, so that closing does not reset the connection
+  // (a reset would discard the answer before the client reads it).
+  static void Drain(tcp::socket& socket) {
+    beast::error_code ec;
+    socket.shutdown(tcp::socket::shutdown_send, ec);
+    timeval tv{0, 200000};
+    ::setsockopt(socket.native_handle(), SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+    const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+    std::vector<char> sink(64 * 1024);
+    while (std::chrono::steady_clock::now() < end) {
+      socket.read_some(net::buffer(sink), ec);
+      if (ec) break;
+    }
+  }
+
   void Session(tcp::socket socket) {
     beast::error_code ec;
     beast::flat_buffer buffer;
     for (;;) {
       http::request_parser<http::string_body> parser;
       parser.header_limit(64 * 1024);
-      parser.body_limit(options.upload_limit);
+      // The limit is set once the path is known (a larger Content-Length would fail
+      // read_header itself, without an answer).
+      parser.body_limit(std::numeric_limits<std::uint64_t>::max());
       http::read_header(socket, buffer, parser, ec);
       if (ec) break;
       const auto& head = parser.get();
@@ -194,13 +214,15 @@ struct HttpServer::Impl {
       };
       if (parser.content_length() && *parser.content_length() > limit) {
         Write(socket, too_large(*parser.content_length()), head.version(), false, ec);
-        break;
+        Drain(socket);
+        return;
       }
       parser.body_limit(limit);
       if (!parser.is_done()) http::read(socket, buffer, parser, ec);
       if (ec == http::error::body_limit) {
         Write(socket, too_large(std::nullopt), head.version(), false, ec);
-        break;
+        Drain(socket);
+        return;
       }
       if (ec) break;
       auto req = parser.release();
