@@ -14,7 +14,7 @@ if(PNEUMID_NPM AND EXISTS ${PNEUMID_WEB_SOURCE_DIR}/node_modules)
        ${PNEUMID_WEB_SOURCE_DIR}/vite.config.ts)
   set(_web_stamp ${CMAKE_BINARY_DIR}/web.stamp)
   add_custom_command(
-    OUTPUT ${_web_stamp}
+    OUTPUT ${_web_stamp} ${PNEUMID_WEB_OUTPUT_DIR}/index.html
     COMMAND ${PNEUMID_NPM} run --silent build -- --outDir ${PNEUMID_WEB_OUTPUT_DIR}
     COMMAND ${CMAKE_COMMAND} -E touch ${_web_stamp}
     DEPENDS ${_web_sources}
@@ -22,8 +22,9 @@ if(PNEUMID_NPM AND EXISTS ${PNEUMID_WEB_SOURCE_DIR}/node_modules)
     COMMENT "Building the page of pneumid app into ${PNEUMID_WEB_OUTPUT_DIR}"
     VERBATIM)
   add_custom_target(pneumid_web ALL DEPENDS ${_web_stamp})
+  # OPTIONAL: a tree built without the target pneumid_web still installs
   install(DIRECTORY ${PNEUMID_WEB_OUTPUT_DIR}/
-          DESTINATION ${CMAKE_INSTALL_DATADIR}/pneumid/web)
+          DESTINATION ${CMAKE_INSTALL_DATADIR}/pneumid/web OPTIONAL)
 else()
   message(STATUS "pneumid app: npm or web/node_modules not found (run scripts/setup); "
                  "the page (web/) is not built")
