@@ -81,6 +81,13 @@ void Serve(const AppCli& c) {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  // A handler (never run: the signals stay blocked) so that signals a parent
+  // shell set to be ignored (background jobs ignore SIGINT) still reach sigwait.
+  struct sigaction sa {};
+  sa.sa_handler = [](int) {};
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
 
   app::AppOptions options;
   options.root = root;

@@ -291,9 +291,9 @@ if expect(s, a, 200, "run stop") and a.get("termination") != "stopped":
 s, a = call("GET", "/api/run/status")
 if a.get("state") != "stopped":
     fail(f"status after stop: {a}")
-# a run going on when the server is told to stop (SIGTERM below)
+# a run going on when the server is told to stop (SIGINT below)
 s, a = call("POST", "/api/run/start", dict(run, duration=30))
-expect(s, a, 200, "run start before SIGTERM")
+expect(s, a, 200, "run start before SIGINT")
 sys.exit(1 if failures else 0)
 EOF
 
@@ -305,11 +305,28 @@ if [ -s "$TMP/controller.toml" ]; then
     --json > "$TMP/run_config.json" || fail "run --config the exported TOML: $(cat "$TMP/run_config.json")"
 fi
 
-# SIGTERM with a run going on: the run stops, the server exits 0
+# SIGINT (Ctrl-C) with a run going on: the run stops, the server exits 0
+kill -INT "$APP_PID"
+rc=0
+wait "$APP_PID" || rc=$?
+APP_PID=""
+[ "$rc" -eq 0 ] || fail "pneumid app exit status after SIGINT: $rc: $(cat "$TMP/app.txt")"
+grep -q "stopping" "$TMP/app.txt" || fail "pneumid app did not say it stops: $(cat "$TMP/app.txt")"
+
+# SIGTERM ends it too
+: > "$TMP/app.txt"
+"$PNEUMID" app --port 0 --root "$ROOT" > "$TMP/app.txt" 2>&1 &
+APP_PID=$!
+for _ in $(seq 100); do
+  grep -q "^pneumid app: serving .*token=[0-9a-f]\{32\}" "$TMP/app.txt" && break
+  sleep 0.1
+done
+grep -q "^pneumid app: serving .*token=[0-9a-f]\{32\}" "$TMP/app.txt" ||
+  fail "no address with a 32-digit random token: $(cat "$TMP/app.txt")"
 kill -TERM "$APP_PID"
 rc=0
 wait "$APP_PID" || rc=$?
 APP_PID=""
-[ "$rc" -eq 0 ] || fail "pneumid app exit status after SIGTERM: $rc: $(cat "$TMP/app.txt")"
+[ "$rc" -eq 0 ] || fail "pneumid app exit status after SIGTERM: $rc"
 
 finish

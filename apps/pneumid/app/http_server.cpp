@@ -218,6 +218,10 @@ struct HttpServer::Impl {
         return;
       }
       parser.body_limit(limit);
+      if (!parser.is_done() && beast::iequals(head[http::field::expect], "100-continue")) {
+        http::response<http::empty_body> go_on{http::status::continue_, head.version()};
+        http::write(socket, go_on, ec);
+      }
       if (!parser.is_done()) http::read(socket, buffer, parser, ec);
       if (ec == http::error::body_limit) {
         Write(socket, too_large(std::nullopt), head.version(), false, ec);
