@@ -415,7 +415,10 @@ const controlUPlot = new TimePlot($('control-u-plot'));
 let explicitFromSliders = false; // the sliders hold values the user set
 let responseTimeSet = false;
 
+// lambda: the rule's value exactly until the (logarithmic) slider moves
+let lambdaExact: number | null = null;
 function lambdaValue(): number {
+  if (lambdaExact !== null) return lambdaExact;
   const v = Math.pow(10, Number(($('lambda') as HTMLInputElement).value));
   return Number(v.toPrecision(3));
 }
@@ -531,6 +534,7 @@ function drawControl(res: any): void {
     if (typeof s.M === 'number') setSlider('M', s.M, String(s.M));
     if (typeof s.lambda === 'number' && s.lambda > 0) setSlider('lambda', Math.log10(s.lambda), fmt(s.lambda, 3));
     else if (typeof s.lambda === 'number') $('lambda-out').textContent = fmt(s.lambda, 3);
+    if (typeof s.lambda === 'number') lambdaExact = s.lambda;
   }
 }
 
@@ -582,7 +586,20 @@ function reviewText(t: any): string {
   return lines.join('\n') || JSON.stringify(t, null, 2);
 }
 
+// gpc has no rule auto; pid has no horizons (its rules give Kc, Ti, Td)
+function controllerChoices(): void {
+  const ctl = ($('ctl') as HTMLSelectElement).value;
+  const rule = $('rule') as HTMLSelectElement;
+  const auto = rule.querySelector<HTMLOptionElement>('option[value=auto]')!;
+  auto.disabled = ctl === 'gpc';
+  if (ctl === 'gpc' && rule.value === 'auto') rule.value = 'shridhar-cooper';
+  for (const id of ['P', 'M', 'lambda']) ($(id) as HTMLInputElement).disabled = ctl === 'pid';
+  ($('rt') as HTMLInputElement).disabled = ctl === 'gpc';
+}
+
 function bindController(): void {
+  $('ctl').addEventListener('change', controllerChoices);
+  controllerChoices();
   for (const id of ['ctl', 'rule', 'plant']) $(id).addEventListener('change', () => {
     if (id === 'rule') explicitFromSliders = ($('rule') as HTMLSelectElement).value === 'explicit' && explicitFromSliders;
     scheduleControl();
@@ -592,6 +609,7 @@ function bindController(): void {
     $(id).addEventListener('input', () => {
       pendingSince = performance.now();
       explicitFromSliders = true;
+      if (id === 'lambda') lambdaExact = null;
       ($('rule') as HTMLSelectElement).value = 'explicit';
       $('P-out').textContent = ($('P') as HTMLInputElement).value;
       $('M-out').textContent = ($('M') as HTMLInputElement).value;
