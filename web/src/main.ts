@@ -798,7 +798,10 @@ function bindExport(): void {
   $('export-controller').addEventListener('click', async () => {
     clearError('export-error');
     try {
-      const text = await call<string>('POST', '/api/export/controller', { body: controllerBody(), as: 'text' });
+      const body = controllerBody();
+      body.io = ($('io') as HTMLInputElement).value.trim() || 'sim';
+      body.duration = Number(($('run-duration') as HTMLInputElement).value);
+      const text = await call<string>('POST', '/api/export/controller', { body, as: 'text' });
       download(new Blob([text], { type: 'text/plain' }), 'controller.toml');
     } catch (e) {
       showError('export-error', e);

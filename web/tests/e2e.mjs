@@ -220,14 +220,18 @@ try {
     if (rows.length < 250) fail(`run log: ${rows.length} lines`);
   });
 
-  await step('export the model JSON and the controller TOML', async () => {
+  await step('export the model JSON, the controller TOML and the report', async () => {
     const [m] = await Promise.all([page.waitForEvent('download', { timeout: 10000 }), page.click('#export-model')]);
     const mf = JSON.parse(fs.readFileSync(await m.path(), 'utf8'));
     if (!Array.isArray(mf.models) || !mf.models.some((x) => x.method === 'fit-p1d')) fail('model JSON lacks fit-p1d');
     const [c] = await Promise.all([page.waitForEvent('download', { timeout: 20000 }), page.click('#export-controller')]);
     const toml = fs.readFileSync(await c.path(), 'utf8');
     if (!toml.trim()) fail('controller TOML is empty');
-    log(`model JSON: ${mf.models.length} models; controller TOML: ${toml.split('\n').length} lines`);
+    if (!/\[io\][^[]*backend = "sim"/.test(toml)) fail('controller TOML lacks [io] backend = "sim"');
+    const [h] = await Promise.all([page.waitForEvent('download', { timeout: 60000 }), page.click('#export-report')]);
+    const html = fs.readFileSync(await h.path(), 'utf8');
+    if (!/^<!DOCTYPE html>/i.test(html.trim())) fail('the HTML report is not HTML: ' + html.slice(0, 80));
+    log(`model JSON: ${mf.models.length} models; controller TOML: ${toml.split('\n').length} lines; report: ${html.length} bytes`);
   });
 
   await step('stop a run', async () => {
