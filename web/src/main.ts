@@ -37,6 +37,7 @@ const state = {
   dataSource: null as { path?: string; file?: File } | null,
   identify: null as IdentifyResult | null,
   identifyMethods: [] as string[],
+  identifyDetrend: 'none',
   model: '' as string, // method of the chosen model
   control: null as any,
   controlCount: 0, // closed-loop redraws done
@@ -299,6 +300,7 @@ async function identify(): Promise<void> {
     });
     state.identify = res;
     state.identifyMethods = methods;
+    state.identifyDetrend = ($('detrend') as HTMLSelectElement).value;
     const ms = performance.now() - t0;
     const nfail = Array.isArray(res.failures) ? res.failures.length : 0;
     $('identify-state').textContent = `${res.models.length} models in ${(ms / 1000).toFixed(2)} s` +
@@ -380,18 +382,40 @@ function showIdentify(res: IdentifyResult): void {
   const r = res.responses;
   if (r && Array.isArray(r.t) && state.data) {
     const methods = res.models.map((m) => m.method).filter((m) => Array.isArray(r[m]));
-    const ydata = interp(state.data.signals.t, state.data.signals.y, r.t);
+    // the responses are in the coordinates of the identification: the data
+    // drawn with them is detrended the same way (over the window's points)
+    const detrend = state.identifyDetrend;
+    const ydata = detrendData(interp(state.data.signals.t, state.data.signals.y, r.t), r.t, detrend);
     identifyPlot.draw({
       title: 'Model responses to the data\'s input',
-      ylabel: ($('col-y') as HTMLSelectElement).value || state.data.y,
+      ylabel: (($('col-y') as HTMLSelectElement).value || state.data.y) + (detrend !== 'none' ? ` (detrended, ${detrend})` : ''),
       series: [
-        { label: 'data', color: '#495057', width: 2.5 },
+        { label: detrend !== 'none' ? 'data (detrended)' : 'data', color: '#495057', width: 2.5 },
         ...methods.map((m, i) => ({ label: m, color: COLORS[(i + 1) % COLORS.length], dash: i % 2 ? [6, 3] : undefined })),
       ],
     }, [r.t, ydata, ...methods.map((m) => r[m])]);
   }
   ($('export-model') as HTMLButtonElement).disabled = !res.model_file;
   chooseModel(best);
+}
+
+function detrendData(y: (number | null)[], t: number[], how: string): (number | null)[] {
+  if (how !== 'constant' && how !== 'linear') return y;
+  let n = 0, st = 0, sy = 0, stt = 0, sty = 0;
+  y.forEach((v, i) => {
+    if (v === null) return;
+    n++; st += t[i]; sy += v; stt += t[i] * t[i]; sty += t[i] * v;
+  });
+  if (n === 0) return y;
+  let a = sy / n, b = 0;
+  if (how === 'linear' && n > 1) {
+    const d = n * stt - st * st;
+    if (d !== 0) {
+      b = (n * sty - st * sy) / d;
+      a = (sy - b * st) / n;
+    }
+  }
+  return y.map((v, i) => (v === null ? null : v - a - b * t[i]));
 }
 
 function chooseModel(method: string): void {
