@@ -179,7 +179,7 @@ Response AppApi::Handle(const Request& request) {
 
 Response AppApi::Route(const Request& req) {
   const std::string& p = req.path;
-  const bool get = req.method == "GET" || req.method == "HEAD";
+  const bool get = req.method == "GET";
   const bool post = req.method == "POST";
   auto body = [&req] {
     if (req.body.empty()) return nlohmann::json::object();
