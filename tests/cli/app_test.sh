@@ -12,6 +12,7 @@ check_help app --port --host --root --open --assets --token
 
 ROOT="$TMP/root"
 mkdir -p "$ROOT/sub"
+ln -s /etc "$ROOT/link"
 "$PNEUMID" simulate --plant ipa --input step:from=0.61,to=82,at=1.0 --duration 4 --Ts 0.01 \
   --seed 1 -o "$ROOT/demo.csv" > /dev/null || die "simulate the demo step test"
 (cd "$ROOT" && "$PNEUMID" identify demo.csv -m reaction-curve,arx,fit-p1d -o models.json \
@@ -99,6 +100,8 @@ s, a = call("POST", "/api/data/open", {"path": "/etc/passwd"})
 expect(s, a, 403, "open an absolute path outside the root")
 s, a = call("GET", "/api/files?dir=..")
 expect(s, a, 403, "list the root's parent")
+s, a = call("POST", "/api/data/open", {"path": "link/passwd"})
+expect(s, a, 403, "open through a symbolic link that leaves the root")
 s, a = call("POST", "/api/control", {"model": "../x.json", "setpoint": "step:to=1", "duration": 1})
 expect(s, a, 403, "a model file outside the root")
 
@@ -313,16 +316,52 @@ APP_PID=""
 [ "$rc" -eq 0 ] || fail "pneumid app exit status after SIGINT: $rc: $(cat "$TMP/app.txt")"
 grep -q "stopping" "$TMP/app.txt" || fail "pneumid app did not say it stops: $(cat "$TMP/app.txt")"
 
-# SIGTERM ends it too
+# The page from --assets, with the cookie that lets its assets load; SIGTERM ends it
+mkdir -p "$TMP/web/assets"
+echo '<!doctype html><script type="module" src="./assets/app.js"></script>' > "$TMP/web/index.html"
+echo 'console.log("pneumid");' > "$TMP/web/assets/app.js"
+echo 'top-secret-content' > "$TMP/web/secret.txt"
 : > "$TMP/app.txt"
-"$PNEUMID" app --port 0 --root "$ROOT" > "$TMP/app.txt" 2>&1 &
+"$PNEUMID" app --port 0 --root "$ROOT" --assets "$TMP/web" > "$TMP/app.txt" 2>&1 &
 APP_PID=$!
+URL=""
 for _ in $(seq 100); do
-  grep -q "^pneumid app: serving .*token=[0-9a-f]\{32\}" "$TMP/app.txt" && break
+  URL=$(grep -o 'http://127\.0\.0\.1:[0-9]*/?token=[0-9a-f]\{32\}$' "$TMP/app.txt")
+  [ -n "$URL" ] && break
   sleep 0.1
 done
-grep -q "^pneumid app: serving .*token=[0-9a-f]\{32\}" "$TMP/app.txt" ||
-  fail "no address with a 32-digit random token: $(cat "$TMP/app.txt")"
+[ -n "$URL" ] || fail "no address with a 32-digit random token: $(cat "$TMP/app.txt")"
+if [ -n "$URL" ]; then
+  $PY - "$URL" << 'PYEOF' || fail "page and assets (above)"
+import sys, urllib.error, urllib.request
+base, token = sys.argv[1].split("/?token=")
+bad = 0
+def get(path, headers=None):
+    try:
+        with urllib.request.urlopen(urllib.request.Request(base + path, headers=headers or {})) as r:
+            return r.status, r.read().decode(), r.headers
+    except urllib.error.HTTPError as e:
+        return e.code, e.read().decode(), e.headers
+def check(ok, msg):
+    global bad
+    if not ok:
+        print("FAIL: " + msg, file=sys.stderr)
+        bad += 1
+s, body, headers = get("/?token=" + token)
+cookie = headers.get("Set-Cookie", "")
+check(s == 200 and "./assets/app.js" in body and "HttpOnly" in cookie,
+      f"GET /: {s} {body[:100]} cookie {cookie}")
+jar = {"Cookie": cookie.split(";")[0]}
+s, body, headers = get("/assets/app.js", jar)
+check(s == 200 and "pneumid" in body and "javascript" in headers.get("Content-Type", ""),
+      f"an asset with the cookie: {s} {body[:100]}")
+s, body, _ = get("/assets/app.js")
+check(s == 403, f"an asset without a token: {s}")
+s, body, _ = get("/assets/%2e%2e/secret.txt", jar)
+check(s == 403 and "top-secret-content" not in body, f"a file outside the assets folder: {s} {body[:100]}")
+sys.exit(1 if bad else 0)
+PYEOF
+fi
 kill -TERM "$APP_PID"
 rc=0
 wait "$APP_PID" || rc=$?
