@@ -9,7 +9,7 @@ import crypto from 'node:crypto';
 import { execFile, spawn } from 'node:child_process';
 
 const argv = process.argv.slice(2);
-const PNEUMID = argv[0];
+const PNEUMID = path.resolve(argv[0]);
 const opt = (k, d) => { const i = argv.indexOf(k); return i >= 0 ? argv[i + 1] : d; };
 const ROOT = path.resolve(opt('--root', '.'));
 const TOKEN = opt('--token', 'T');
@@ -198,15 +198,17 @@ async function handle(req, res, url, body) {
   if (p === '/api/export/controller') {
     const q = b();
     res.writeHead(200, { 'Content-Type': 'text/plain' });
-    return res.end(`[controller]\ntype = "${q.controller}"\nrule = "${q.rule}"\n`);
+    return res.end(`[loop]\nperiod = ${q.Ts ?? 0.01}\nduration = ${q.duration ?? 10}\n\n[io]\nbackend = "${q.io ?? 'sim'}"\n`);
   }
   if (p === '/api/export/report') {
     const q = b();
     const ds = datasets.get(q.data);
-    const out = path.join(TMP, 'report.html');
+    if (!ds) return json(404, { error: `data: no data set ${q.data}` });
+    const out = path.join(TMP, 'report');
     await cli(['report', ds.file, '-m', q.methods.join(','), '-o', out]);
+    const html = fs.readdirSync(out).find((f) => f.endsWith('.html'));
     res.writeHead(200, { 'Content-Type': 'text/html' });
-    return res.end(fs.readFileSync(out));
+    return res.end(fs.readFileSync(path.join(out, html)));
   }
   return json(404, { error: 'no such path ' + p });
 }
