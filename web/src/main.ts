@@ -725,6 +725,8 @@ async function startRun(): Promise<void> {
   const body = controllerBody();
   body.duration = Number(($('run-duration') as HTMLInputElement).value);
   body.io = ($('io') as HTMLInputElement).value.trim() || 'sim';
+  const maxOverruns = ($('max-overruns') as HTMLInputElement).value.trim();
+  if (maxOverruns !== '') body.max_overruns = Number(maxOverruns);
   live = { t: [], r: [], y: [], u: [], stride: 1, skip: 0 };
   state.run = { state: 'starting', samples: 0, points: 0, frames: 0, summary: null };
   $('run-details').hidden = true;
