@@ -304,7 +304,17 @@ async function identify(): Promise<void> {
     const ms = performance.now() - t0;
     const nfail = Array.isArray(res.failures) ? res.failures.length : 0;
     $('identify-state').textContent = `${res.models.length} models in ${(ms / 1000).toFixed(2)} s` +
-      (nfail ? `, ${nfail} failed: ` + res.failures!.map((f: any) => f.method ? `${f.method} (${f.message ?? f.reason ?? ''})` : JSON.stringify(f)).join('; ') : '');
+      (nfail ? `, ${nfail} failed` : '');
+    const warn = $('identify-failures');
+    warn.innerHTML = '';
+    for (const f of (res.failures ?? []) as any[]) {
+      const li = document.createElement('li');
+      const b = document.createElement('strong');
+      b.textContent = f.method ?? '';
+      li.append(b, ' ' + (f.message ?? f.reason ?? f.error ?? (f.method ? '' : JSON.stringify(f))));
+      warn.appendChild(li);
+    }
+    warn.hidden = nfail === 0;
     showIdentify(res);
   } catch (e) {
     $('identify-state').textContent = '';
