@@ -22,6 +22,17 @@ command -v node >/dev/null 2>&1 || die "node not found (Node.js; scripts/setup i
 [ -x "${PNEUMID_CHROMIUM:-/usr/bin/chromium}" ] ||
   die "${PNEUMID_CHROMIUM:-/usr/bin/chromium} not found (Debian package chromium; scripts/setup installs it)"
 
+if [ -z "${PNEUMID_APP_MOCK:-}" ]; then
+  WEB="$(dirname "$PNEUMID")/web"
+  [ -f "$WEB/index.html" ] || die "$WEB/index.html not found: the page is not built (it needs npm and \
+web/node_modules when CMake configures: run scripts/setup, then cmake and the target pneumid_web)"
+  for f in "$SRC"/web/src/* "$SRC/web/index.html"; do
+    [ "$f" -nt "$WEB/index.html" ] && fail "$f is newer than $WEB/index.html: rebuild the page (target pneumid_web)"
+  done
+fi
+# the page's TypeScript type-checks
+(cd "$SRC/web" && node_modules/.bin/tsc --noEmit -p .) || fail "web/src does not type-check (tsc)"
+
 ROOT="$TMP/root"
 mkdir -p "$ROOT"
 "$PNEUMID" simulate --plant ipa --input step:from=0.61,to=82,at=1.0 --duration 4 --Ts 0.01 \

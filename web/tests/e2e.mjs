@@ -86,6 +86,17 @@ try {
     await page.waitForSelector('#files li[data-name="demo.csv"]', { timeout: 5000 });
   });
 
+  await step('a page without the token says so', async () => {
+    const p2 = await context.newPage();
+    const u = new URL(url);
+    u.search = '';
+    await p2.goto(u.toString());
+    await p2.waitForSelector('#global-error:not([hidden])', { timeout: 10000 });
+    const text = await p2.textContent('#global-error');
+    if (!/token/.test(text)) fail('the error without a token does not name it: ' + text);
+    await p2.close();
+  });
+
   if (uploadFile) {
     await step('upload a data file', async () => {
       await page.setInputFiles('#upload', uploadFile);
