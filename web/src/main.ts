@@ -43,6 +43,7 @@ const state = {
   controlCount: 0, // closed-loop redraws done
   controlLatency: [] as number[], // ms from the change to the redraw, per redraw
   controlIdle: true, // no change waits for its closed-loop redraw
+  controlTimings: [] as { server: number; draw: number }[], // ms of the request and of the redraw
   tune: null as any,
   run: { state: 'idle', samples: 0, points: 0, frames: 0, summary: null as any },
 };
@@ -513,6 +514,7 @@ async function runControl(): Promise<void> {
     const latency = t2 - (pendingSince || t0);
     pendingSince = 0;
     state.controlLatency.push(latency);
+    state.controlTimings.push({ server: t1 - t0, draw: t2 - t1 });
     state.controlCount++;
     document.body.dataset.controlCount = String(state.controlCount);
     state.controlIdle = !controlTimerPending();

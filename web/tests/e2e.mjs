@@ -187,16 +187,17 @@ try {
         }
         // until the frame with the new plot is painted
         await new Promise((r) => requestAnimationFrame(() => r()));
-        return { total: performance.now() - t0, page: window.pneumid.controlLatency.at(-1) };
+        return { total: performance.now() - t0, page: window.pneumid.controlLatency.at(-1), ...window.pneumid.controlTimings.at(-1) };
       }, P);
       lat.push(ms);
     }
-    const tot = lat.map((x) => x.total).sort((a, b) => a - b);
-    const pg = lat.map((x) => x.page).sort((a, b) => a - b);
+    const sorted = (k) => lat.map((x) => x[k]).sort((a, b) => a - b);
+    const tot = sorted('total'), pg = sorted('page');
     const med = (a) => a[Math.floor(a.length / 2)];
     log(`slider to redraw latency over ${tot.length} moves of P: median ${med(tot).toFixed(1)} ms, ` +
       `max ${tot.at(-1).toFixed(1)} ms (to the painted frame, with the 30 ms debounce); ` +
-      `change to plot updated: median ${med(pg).toFixed(1)} ms`);
+      `change to plot updated: median ${med(pg).toFixed(1)} ms, of which the request (POST /api/control, ` +
+      `1000 samples) ${med(sorted('server')).toFixed(1)} ms and the redraw ${med(sorted('draw')).toFixed(1)} ms`);
     const rule = await page.$eval('#rule', (e) => e.value);
     if (rule !== 'explicit') fail(`moving P left the rule at ${rule}, expected explicit`);
     // back to the rule auto for the run
