@@ -5,7 +5,17 @@
 set(PNEUMID_WEB_SOURCE_DIR ${CMAKE_CURRENT_SOURCE_DIR}/web)
 set(PNEUMID_WEB_OUTPUT_DIR ${CMAKE_BINARY_DIR}/web)
 find_program(PNEUMID_NPM npm)
-if(PNEUMID_NPM AND EXISTS ${PNEUMID_WEB_SOURCE_DIR}/node_modules)
+find_program(PNEUMID_NODE node)
+set(_node_version "")
+if(PNEUMID_NODE)
+  execute_process(COMMAND ${PNEUMID_NODE} --version OUTPUT_VARIABLE _node_version
+                  OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+  string(REGEX REPLACE "^v" "" _node_version "${_node_version}")
+endif()
+if(PNEUMID_NPM AND _node_version VERSION_LESS 20.19)
+  # vite 8 needs Node.js 20.19 or newer
+  message(STATUS "pneumid app: node ${_node_version} is older than 20.19; the page (web/) is not built")
+elseif(PNEUMID_NPM AND EXISTS ${PNEUMID_WEB_SOURCE_DIR}/node_modules)
   file(GLOB _web_sources CONFIGURE_DEPENDS
        ${PNEUMID_WEB_SOURCE_DIR}/src/*
        ${PNEUMID_WEB_SOURCE_DIR}/index.html

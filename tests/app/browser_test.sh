@@ -8,7 +8,7 @@
 #   bash tests/app/browser_test.sh build/pneumid
 #
 # PNEUMID_SCREENSHOTS=DIR writes a screenshot of each stage to DIR/app-*.png
-# (docs/img holds them).
+# (docs/img holds them); PNEUMID_CHROMIUM=PATH uses another Chromium.
 source "$(dirname "${BASH_SOURCE[0]}")/../cli/lib.sh" "$@"
 
 SERVER_PID=""
@@ -17,6 +17,8 @@ cleanup() {
 }
 
 command -v node >/dev/null 2>&1 || die "node not found (Node.js; scripts/setup installs it)"
+node -e 'process.exit(Number(process.versions.node.split(".")[0]) >= 20 ? 0 : 1)' ||
+  die "node $(node --version) is too old: the page and its test need Node.js 20 or newer"
 [ -d "$SRC/web/node_modules/playwright-core" ] ||
   die "$SRC/web/node_modules/playwright-core not found (run scripts/setup, or npm ci in web/)"
 [ -x "${PNEUMID_CHROMIUM:-/usr/bin/chromium}" ] ||
