@@ -28,6 +28,8 @@ const METRIC_KEYS: [string, string][] = [
   ['u_min', 'u min'],
   ['u_max', 'u max'],
   ['settled', 'settled'],
+  ['load_peak_deviation', 'load: peak deviation'],
+  ['load_recovery_time', 'load: recovery time [s]'],
 ];
 
 // State of the page, also exposed as window.pneumid for scripts and tests.
@@ -477,6 +479,12 @@ function controllerBody(): Record<string, unknown> {
   body.Ts = Number(($('Ts') as HTMLInputElement).value);
   body.setpoint = ($('setpoint') as HTMLInputElement).value.trim();
   body.duration = Number(($('duration') as HTMLInputElement).value);
+  const load = ($('load-step') as HTMLInputElement).value.trim();
+  if (load) body.load_step = load;
+  for (const [id, key] of [['u-min', 'u_min'], ['u-max', 'u_max']]) {
+    const v = ($(id) as HTMLInputElement).value.trim();
+    if (v !== '') body[key] = Number(v);
+  }
   return body;
 }
 
@@ -640,7 +648,7 @@ function bindController(): void {
     if (id === 'rule') explicitFromSliders = ($('rule') as HTMLSelectElement).value === 'explicit' && explicitFromSliders;
     scheduleControl();
   });
-  for (const id of ['setpoint', 'duration', 'Ts']) $(id).addEventListener('input', scheduleControl);
+  for (const id of ['setpoint', 'duration', 'Ts', 'load-step', 'u-min', 'u-max']) $(id).addEventListener('input', scheduleControl);
   for (const id of ['P', 'M', 'lambda']) {
     $(id).addEventListener('input', () => {
       pendingSince = performance.now();
