@@ -496,8 +496,8 @@ const debouncedTune = debounce(() => void runTune(), 150);
 const controlTimerPending = () => debouncedControl.pending();
 
 function scheduleControl(): void {
-  if (!pendingSince) pendingSince = performance.now();
   if (!state.model) return;
+  if (!pendingSince) pendingSince = performance.now();
   state.controlIdle = false;
   $('control-state').textContent = 'simulating …';
   debouncedControl();
@@ -651,7 +651,7 @@ function bindController(): void {
   for (const id of ['setpoint', 'duration', 'Ts', 'load-step', 'u-min', 'u-max']) $(id).addEventListener('input', scheduleControl);
   for (const id of ['P', 'M', 'lambda']) {
     $(id).addEventListener('input', () => {
-      pendingSince = performance.now();
+      if (state.model) pendingSince = performance.now();
       explicitFromSliders = true;
       if (id === 'lambda') lambdaExact = null;
       ($('rule') as HTMLSelectElement).value = 'explicit';
@@ -662,7 +662,7 @@ function bindController(): void {
     });
   }
   $('rt').addEventListener('input', () => {
-    pendingSince = performance.now();
+    if (state.model) pendingSince = performance.now();
     responseTimeSet = true;
     ($('rule') as HTMLSelectElement).value = 'auto';
     explicitFromSliders = false;
