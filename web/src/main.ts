@@ -827,7 +827,9 @@ async function stopRun(): Promise<void> {
     const summary = await call('POST', '/api/run/stop');
     if (state.run.state === 'running') finishRun(summary?.summary ?? summary ?? null, 'stopped');
   } catch (e) {
-    showError('run-error', e);
+    // 409: no run to stop (it ended meanwhile): the status says how
+    if (e instanceof ApiError && e.status === 409) void pollStatus(true);
+    else showError('run-error', e);
   }
 }
 
