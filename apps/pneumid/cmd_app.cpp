@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <random>
 #include <string>
 #include <thread>
@@ -97,6 +98,12 @@ void Serve(const AppCli& c) {
   if (mkdtemp(work.data()) == nullptr)
     throw DataError(fmt::format("cannot create a temporary folder {}", work));
   options.work = work;
+  // Removed on every way out (the uploads, models and logs of the session).
+  const std::unique_ptr<const std::string, void (*)(const std::string*)> remove_work(
+      &work, [](const std::string* w) {
+        std::error_code e;
+        fs::remove_all(*w, e);
+      });
   // Model specs and other relative names resolve under the root.
   fs::current_path(root);
 
@@ -126,7 +133,6 @@ void Serve(const AppCli& c) {
   if (c.open) OpenBrowser(url);
   server.Run();
   waiter.join();
-  fs::remove_all(work, ec);
 }
 
 const Registrar reg(

@@ -273,8 +273,15 @@ HttpServer::HttpServer(ServerOptions options, Handler handler, WebSocketHandler 
   impl_->websocket = std::move(websocket);
   const auto& o = impl_->options;
   beast::error_code ec;
-  const auto address = net::ip::make_address(o.host, ec);
-  if (ec) throw DataError(fmt::format("--host {}: not an IP address ({})", o.host, ec.message()));
+  auto address = net::ip::make_address(o.host, ec);
+  if (ec) {  // a name, e.g. localhost: its first address
+    tcp::resolver resolver(impl_->ioc);
+    const auto found = resolver.resolve(o.host, "", ec);
+    if (ec || found.empty())
+      throw DataError(fmt::format("--host {}: not an address or a known name ({})", o.host,
+                                  ec ? ec.message() : "no address"));
+    address = found.begin()->endpoint().address();
+  }
   const tcp::endpoint endpoint(address, static_cast<unsigned short>(o.port));
   auto& acc = impl_->acceptor;
   acc.open(endpoint.protocol(), ec);
