@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "command_json.hpp"
 #include "controller_options.hpp"
 #include "output_options.hpp"
 #include "pneumid/common/check.hpp"
@@ -35,27 +36,7 @@
 namespace pneumid::cli {
 namespace {
 
-struct ControlCli {
-  ControllerSettings controller;  // --controller, --rule, --P, ..., --u-min, --t-filter, --tau-c
-  std::string model;
-  std::string plant;
-  double Ts = 0.01;
-  std::string setpoint;
-  double duration = 0.0;
-  double noise = 0.0;
-  std::uint64_t seed = 1;
-  std::vector<std::string> load_steps;
-  bool json = false;
-  std::string plot;
-  std::string output;
-  bool compare_given = false;
-  std::string compare;
-};
-
-struct Run {
-  BuiltController built;
-  ClosedLoopResult result;
-};
+using Run = ControlRun;
 
 nlohmann::ordered_json RunJson(const Run& run) {
   nlohmann::ordered_json j;
@@ -175,7 +156,9 @@ void WritePlot(const std::string& path, const std::vector<Run>& runs, const Cont
   ClosedLoopFigure(runs[0].result.t, runs[0].result.r, traces, options).Save(path);
 }
 
-void Execute(const ControlCli& c) {
+}  // namespace
+
+std::vector<ControlRun> SimulateControl(const ControlCli& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   PNEUMID_CHECK(c.duration > 0.0, "--duration must be positive, got {}", c.duration);
   const TransferFunction model = ParseControllerModel(c.model);
@@ -228,15 +211,23 @@ void Execute(const ControlCli& c) {
   }
   if (!c.output.empty()) WriteCsv(c.output, runs);
   if (!c.plot.empty()) WritePlot(c.plot, runs, c, plant_spec);
+  return runs;
+}
+
+nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs) {
+  if (runs.size() == 1) return RunJson(runs[0]);
+  nlohmann::ordered_json j;
+  j["compare"] = nlohmann::json::array();
+  for (const Run& r : runs) j["compare"].push_back(RunJson(r));
+  return j;
+}
+
+namespace {
+
+void Execute(const ControlCli& c) {
+  const std::vector<Run> runs = SimulateControl(c);
   if (c.json) {
-    if (runs.size() == 1) {
-      std::cout << RunJson(runs[0]).dump(2) << "\n";
-    } else {
-      nlohmann::ordered_json j;
-      j["compare"] = nlohmann::json::array();
-      for (const Run& r : runs) j["compare"].push_back(RunJson(r));
-      std::cout << j.dump(2) << "\n";
-    }
+    std::cout << ControlJson(runs).dump(2) << "\n";
     return;
   }
   PrintTable(runs);

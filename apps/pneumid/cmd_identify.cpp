@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "command_json.hpp"
 #include "data_options.hpp"
 #include "output_options.hpp"
 #include "pneumid/common/check.hpp"
@@ -28,21 +29,6 @@
 
 namespace pneumid::cli {
 namespace {
-
-struct IdentifyArgs {
-  DataOptions data;
-  PreprocessArgs preprocess;
-  std::string methods = "reaction-curve";
-  IdentifyRequest request;
-  std::string loss = "none";
-  NonlinearOptions nonlinear;
-  bool json = false;
-  std::string plot;
-  std::string output;
-  std::string validation;  ///< held-out data file (same column options)
-  double split = 0.0;
-  bool progress = false;
-};
 
 // "K=1.6 a=[1 -0.6 0.2] A=[[0.9] [0.1]] t=[200 values]": numbers with 4
 // significant digits, arrays of more than 8 values by their size.
@@ -122,49 +108,39 @@ std::string FlagNames(const IdentifiedModel& m) {
   return names.empty() ? "-" : fmt::format("{}", fmt::join(names, ","));
 }
 
-void Run(const IdentifyArgs& args) {
+}  // namespace
+
+IdentifyOutcome IdentifyData(const IdentifyArgs& args, const Dataset& raw,
+                             const Dataset* validation_raw, const IdentifyProgress& progress) {
   std::string why;
   PNEUMID_CHECK(args.request.IsValid(&why), "{}", why);
-  PNEUMID_CHECK(args.validation.empty() || args.split == 0.0,
+  PNEUMID_CHECK(validation_raw == nullptr || args.split == 0.0,
                 "--validation and --split exclude each other: give held-out data as a file or "
                 "as a fraction of DATA");
   PNEUMID_CHECK(args.split == 0.0 || (args.split > 0.0 && args.split < 1.0),
                 "--split must be a fraction in (0, 1), e.g. 0.7, got {}", args.split);
   const std::vector<std::string> methods = ParseMethodList(args.methods);
   const PreprocessOptions prep = ToPreprocessOptions(args.preprocess);
-  PreprocessRecord record;
-  const Dataset data = Preprocess(LoadFromOptions(args.data), prep, &record);
+  IdentifyOutcome out;
+  out.data = Preprocess(raw, prep, &out.record);
   std::optional<Dataset> validation;
-  if (!args.validation.empty()) {
-    DataOptions v = args.data;
-    v.path = args.validation;
-    // The validation data get the estimation data's preprocessing, with the
-    // offsets measured on the estimation data (not re-estimated).
-    validation.emplace(ApplyRecorded(LoadFromOptions(v), record));
-  }
+  // The validation data get the estimation data's preprocessing, with the
+  // offsets measured on the estimation data (not re-estimated).
+  if (validation_raw) validation.emplace(ApplyRecorded(*validation_raw, out.record));
   IdentifyOptions options;
   options.step.fit.loss = RobustLossFromString(args.loss);
   options.split = args.split;
   options.nonlinear = args.nonlinear;
-
-  IdentificationSummary summary;
-  {
-    ProgressBar bar("identify", args.progress || StderrIsTerminal());
-    summary =
-        IdentifyModels(methods, data, args.request, options, validation ? &*validation : nullptr,
-                       [&bar](std::size_t done, std::size_t total, const std::string& method) {
-                         bar(static_cast<double>(done) / static_cast<double>(total), method);
-                       });
-  }
-  for (const auto& [method, reason] : summary.failures)
-    std::cerr << fmt::format("pneumid identify: {} failed: {}\n", method, reason);
-  if (summary.models.empty()) throw DataError(summary.message);
-  if (!record.IsIdentity())
-    for (IdentifiedModel& m : summary.models) m.preprocessing = record;
+  out.summary = IdentifyModels(methods, out.data, args.request, options,
+                               validation ? &*validation : nullptr, progress);
+  IdentificationSummary& summary = out.summary;
+  if (summary.models.empty()) return out;
+  if (!out.record.IsIdentity())
+    for (IdentifiedModel& m : summary.models) m.preprocessing = out.record;
   const std::vector<IdentifiedModel>& models = summary.models;
   const bool held_out = summary.validation_samples > 0;
 
-  nlohmann::json j;
+  nlohmann::json& j = out.json;
   j["models"] = nlohmann::json::array();
   for (const IdentifiedModel& m : models) j["models"].push_back(ToJson(m));
   j["best"] = models.front().method;
@@ -176,6 +152,37 @@ void Run(const IdentifyArgs& args) {
     j["failures"].push_back({{"method", method}, {"reason", reason}});
   j["termination"] = ToString(summary.termination);
   j["message"] = summary.message;
+  return out;
+}
+
+namespace {
+
+void Run(const IdentifyArgs& args) {
+  std::optional<Dataset> validation_raw;
+  if (!args.validation.empty()) {
+    DataOptions v = args.data;
+    v.path = args.validation;
+    validation_raw.emplace(LoadFromOptions(v));
+  }
+  IdentifyOutcome outcome;
+  {
+    ProgressBar bar("identify", args.progress || StderrIsTerminal());
+    outcome =
+        IdentifyData(args, LoadFromOptions(args.data), validation_raw ? &*validation_raw : nullptr,
+                     [&bar](std::size_t done, std::size_t total, const std::string& method) {
+                       bar(static_cast<double>(done) / static_cast<double>(total), method);
+                     });
+  }
+  for (const auto& [method, reason] : outcome.summary.failures)
+    std::cerr << fmt::format("pneumid identify: {} failed: {}\n", method, reason);
+  if (outcome.summary.models.empty()) throw DataError(outcome.summary.message);
+  const Dataset& data = outcome.data;
+  const PreprocessRecord& record = outcome.record;
+  const IdentificationSummary& summary = outcome.summary;
+  const std::vector<IdentifiedModel>& models = summary.models;
+  const bool held_out = summary.validation_samples > 0;
+  const std::optional<Dataset>& validation = validation_raw;
+  const nlohmann::json& j = outcome.json;
   if (!args.output.empty()) WriteJsonFile(j, args.output);
   if (!args.plot.empty()) WritePlot(args.plot, data, args.request, models);
 

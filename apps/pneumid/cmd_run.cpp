@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "command_json.hpp"
 #include "controller_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/closed_loop.hpp"
@@ -31,17 +32,6 @@
 namespace pneumid::cli {
 namespace {
 
-struct RunOptions {
-  ControllerSettings controller;  // --controller, --rule, --P, --M, --lambda, ...
-  std::string model = "fopdt-paper";
-  std::string setpoint = "step:from=0,to=100,at=0.5";
-  RealtimeOptions rt;  // --io, --config, --plant, --Ts, --duration, --log, --json, ...
-  std::optional<double> u_min, u_max, rate_max, y_min, y_max;
-  std::optional<int> frozen_samples;
-  bool offline = false;
-  std::vector<std::string> load_steps;
-};
-
 // The control area's settings and factory (controller_factory.hpp).
 BuiltController BuildController(const RunOptions& o, const TransferFunction& model, double Ts,
                                 const InputLimits& limits) {
@@ -50,8 +40,9 @@ BuiltController BuildController(const RunOptions& o, const TransferFunction& mod
   return MakeController(model, Ts, WithModelInputMap(ToControllerSpec(c), o.model));
 }
 
-void Run(const RunOptions& o, CLI::App& app) {
-  RealtimeConfig config = ResolveRealtimeConfig(o.rt, app);
+}  // namespace
+
+void ApplySafetyFlags(const RunOptions& o, RealtimeConfig& config) {
   auto& s = config.safety;
   if (o.u_min) s.u_min = *o.u_min;
   if (o.u_max) s.u_max = *o.u_max;
@@ -61,6 +52,11 @@ void Run(const RunOptions& o, CLI::App& app) {
   if (o.frozen_samples) s.frozen_samples = *o.frozen_samples;
   std::string error;
   PNEUMID_CHECK(s.IsValid(&error), "invalid safety settings: {}", error);
+}
+
+RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
+                       SpscRingBuffer<LogRecord>* live) {
+  const auto& s = config.safety;
 
   const IoSpec spec = ParseIoSpec(config.io);
   const double Ts = config.loop.period;
@@ -87,6 +83,7 @@ void Run(const RunOptions& o, CLI::App& app) {
   so.loop = config.loop;
   so.safety = s;
   so.log = config.log;
+  so.log.live = live;
   so.log_path = o.rt.log;
   if (IsMatPath(o.rt.log)) so.log.format = LogFormat::kMat;
   so.keep_records = true;
@@ -124,17 +121,39 @@ void Run(const RunOptions& o, CLI::App& app) {
     offline = ref.metrics.ToJson();
   }
 
+  RunOutcome out;
+  out.summary = sum;
+  out.controller = controller_text;
+  out.io = io->Describe();
+  out.log_rows = res.log_rows;
+  out.metrics = metrics;
+  out.offline = offline;
+  nlohmann::json& j = out.json;
+  j = sum.ToJson();
+  j["controller"] = controller_text;
+  j["io"] = out.io;
+  j["log"] = o.rt.log;
+  j["log_rows"] = res.log_rows;
+  j["metrics"] = metrics;
+  if (o.offline) j["offline_metrics"] = offline;
+  return out;
+}
+
+namespace {
+
+void Run(const RunOptions& o, CLI::App& app) {
+  RealtimeConfig config = ResolveRealtimeConfig(o.rt, app);
+  ApplySafetyFlags(o, config);
+  const RunOutcome out = RunRealtime(o, config);
+  const LoopSummary& sum = out.summary;
+  const std::string& controller_text = out.controller;
+  const nlohmann::json& metrics = out.metrics;
+  const nlohmann::json& offline = out.offline;
+  const RunOutcome& res = out;
   if (o.rt.json) {
-    nlohmann::json j = sum.ToJson();
-    j["controller"] = controller_text;
-    j["io"] = io->Describe();
-    j["log"] = o.rt.log;
-    j["log_rows"] = res.log_rows;
-    j["metrics"] = metrics;
-    if (o.offline) j["offline_metrics"] = offline;
-    std::cout << j.dump(2) << "\n";
+    std::cout << out.json.dump(2) << "\n";
   } else {
-    std::cout << fmt::format("{} on {}\n{}\n{}\n{}\n", controller_text, io->Describe(), sum.message,
+    std::cout << fmt::format("{} on {}\n{}\n{}\n{}\n", controller_text, out.io, sum.message,
                              sum.timing.BriefReport(), sum.scheduling);
     auto line = [](const char* name, const nlohmann::json& mj) {
       if (mj.is_null()) return std::string();

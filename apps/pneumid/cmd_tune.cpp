@@ -20,36 +20,17 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "validators.hpp"
+#include "command_json.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/auto_tuning.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
 
-struct TuneCli {
-  std::string model;
-  double Ts = 0.0;
-  std::string rule = "shridhar-cooper";
-  int M = 0;
-  int P = 0;
-  double lambda = std::numeric_limits<double>::quiet_NaN();
-  int tau_digits = 2;
-  bool json = false;
-  // --rule auto
-  std::string controller;
-  double response_time = std::numeric_limits<double>::quiet_NaN();
-  std::string measure;
-  double overshoot = std::numeric_limits<double>::quiet_NaN();
-  double aggressiveness = std::numeric_limits<double>::quiet_NaN();
-  double u_min = -std::numeric_limits<double>::infinity();
-  double u_max = std::numeric_limits<double>::infinity();
-  double du_max = std::numeric_limits<double>::infinity();
-};
-
-void RunAuto(const TuneCli& c, const TransferFunction& model) {
+AutoTuneResult Auto(const TuneCli& c, const TransferFunction& model) {
   PNEUMID_CHECK(c.P == 0 && std::isnan(c.lambda),
                 "--rule auto chooses P and lambda itself; drop --P/--lambda");
   AutoTuneOptions o;
@@ -62,7 +43,11 @@ void RunAuto(const TuneCli& c, const TransferFunction& model) {
   o.limits.u_max = c.u_max;
   o.limits.du_max = c.du_max;
   o.M = c.M;
-  const AutoTuneResult r = AutoTune(model, c.Ts, o);
+  return AutoTune(model, c.Ts, o);
+}
+
+void RunAuto(const TuneCli& c, const TransferFunction& model) {
+  const AutoTuneResult r = Auto(c, model);
   if (c.json) {
     std::cout << r.ToJson().dump(2) << "\n";
     return;
@@ -70,13 +55,8 @@ void RunAuto(const TuneCli& c, const TransferFunction& model) {
   std::cout << r.FullReport();
 }
 
-void Run(const TuneCli& c) {
-  PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
-  const TransferFunction model = ParseModelSpec(c.model);
-  if (c.rule == "auto") {
-    RunAuto(c, model);
-    return;
-  }
+// The settings of a rule other than auto.
+TuningResult Conventional(const TuneCli& c, const TransferFunction& model) {
   PNEUMID_CHECK(c.controller.empty() && std::isnan(c.response_time) && c.measure.empty() &&
                     std::isnan(c.overshoot) && std::isnan(c.aggressiveness) &&
                     std::isinf(c.u_min) && std::isinf(c.u_max) && std::isinf(c.du_max),
@@ -88,7 +68,17 @@ void Run(const TuneCli& c) {
   o.P = c.P;
   o.lambda = c.lambda;
   o.tau_significant_digits = c.tau_digits;
-  const TuningResult r = Tune(model, c.Ts, o);
+  return Tune(model, c.Ts, o);
+}
+
+void Run(const TuneCli& c) {
+  PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
+  const TransferFunction model = ParseModelSpec(c.model);
+  if (c.rule == "auto") {
+    RunAuto(c, model);
+    return;
+  }
+  const TuningResult r = Conventional(c, model);
   if (c.json) {
     std::cout << r.ToJson().dump(2) << "\n";
     return;
@@ -105,6 +95,17 @@ void Run(const TuneCli& c) {
   }
   std::cout << "formula: " << r.formula << "\n";
 }
+
+}  // namespace
+
+nlohmann::ordered_json TuneJson(const TuneCli& c) {
+  PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
+  const TransferFunction model = ParseModelSpec(c.model);
+  if (c.rule == "auto") return Auto(c, model).ToJson();
+  return Conventional(c, model).ToJson();
+}
+
+namespace {
 
 const Registrar reg(
     "tune", "Horizons and move suppression (P, M, lambda) of DMC/GPC from a model",

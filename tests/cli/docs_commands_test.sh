@@ -24,7 +24,7 @@ ALIASES = {"--sample-time": "--Ts", "--period": "--Ts", "--methods": "--method",
            "--save": "-o"}
 PLACEHOLDER = re.compile(r"(^|[\s=,:])(DATA|MODEL|DIR|FILE|PLANT|SIGNAL|ADDR|HOST|PORT|SPEC|"
                          r"RULE|TS|N|K|X|T|C|S|Y|D|Q|M\d)(\b|$)")
-NOT_RUN = re.compile(r"udp://|comedi|plant-server")
+NOT_RUN = re.compile(r"udp://|comedi|plant-server|pneumid app\b")
 
 
 def commands(path):

@@ -87,6 +87,24 @@ TEST(LogWriter, FullBufferDropsAndCountsInsteadOfBlocking) {
   EXPECT_EQ(w.written() + w.dropped(), 100000);
 }
 
+TEST(LogWriter, LiveRingGetsACopyOfEachRecordAndDropsWhenFull) {
+  const std::string path = TempPath("writer_live.csv");
+  SpscRingBuffer<LogRecord> live(8);
+  LogWriterOptions o;
+  o.live = &live;
+  LogWriter w(path, {}, o);
+  for (int k = 0; k < 20; ++k) w.Push(Rec(k));  // nobody drains: the ring fills up
+  w.Close();
+  EXPECT_EQ(w.written(), 20);  // the log is not affected
+  EXPECT_EQ(w.dropped(), 0);
+  ASSERT_EQ(live.size(), live.capacity());
+  LogRecord r;
+  for (std::size_t k = 0; k < live.capacity(); ++k) {
+    ASSERT_TRUE(live.TryPop(&r));
+    EXPECT_EQ(r.k, static_cast<std::int64_t>(k));  // the first ones, in order
+  }
+}
+
 TEST(LogWriter, MatFileHoldsTheColumns) {
   const std::string path = TempPath("writer.mat");
   LogWriterOptions o;

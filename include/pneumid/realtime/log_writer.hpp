@@ -77,6 +77,11 @@ struct LogWriterOptions {
   double flush_interval = 1.0;     ///< seconds between flushes to the OS
   /// Also keep every record in memory (writer thread) for records() after Close().
   bool keep_in_memory = false;
+  /// Also offer every record to this ring buffer (not owned; may be null), e.g. for
+  /// live plots: Push() copies the record into it from the loop thread without
+  /// blocking or allocating, and drops it (uncounted) when the ring is full. Its
+  /// single consumer must keep draining it while the writer lives.
+  SpscRingBuffer<LogRecord>* live = nullptr;
   bool IsValid(std::string* error) const;
 };
 
@@ -96,6 +101,7 @@ class LogWriter {
   /// full the record is dropped and counted.
   void Push(const LogRecord& r) noexcept {
     if (!ring_.TryPush(r)) dropped_.fetch_add(1, std::memory_order_relaxed);
+    if (options_.live != nullptr) options_.live->TryPush(r);
   }
   /// Stops the writer thread after draining every queued record, fills in the
   /// reserved `timing` and `stop` header lines, flushes and fsyncs.

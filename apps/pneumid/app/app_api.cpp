@@ -1,0 +1,784 @@
+#include "app_api.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "../command_json.hpp"
+#include "../data_options.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/common/version.hpp"
+#include "pneumid/data/load.hpp"
+#include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/signal.hpp"
+#include "pneumid/realtime/io_backend.hpp"
+#include "pneumid/realtime/realtime_config.hpp"
+#include "pneumid/report/identification_report.hpp"
+
+namespace pneumid::app {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr Eigen::Index kMaxPoints = 2000;  // signals sent for drawing
+
+// An error with its HTTP status.
+struct HttpError : std::runtime_error {
+  HttpError(int s, const std::string& message) : std::runtime_error(message), status(s) {}
+  int status;
+};
+
+Response JsonResponse(const nlohmann::ordered_json& j, int status = 200) {
+  Response r;
+  r.status = status;
+  r.body = j.dump();
+  return r;
+}
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw DataError(fmt::format("{}: cannot open", path.string()));
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string ContentType(const fs::path& path) {
+  const std::string ext = path.extension().string();
+  if (ext == ".html") return "text/html; charset=utf-8";
+  if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
+  if (ext == ".css") return "text/css; charset=utf-8";
+  if (ext == ".json" || ext == ".map") return "application/json";
+  if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".png") return "image/png";
+  if (ext == ".ico") return "image/x-icon";
+  if (ext == ".woff2") return "font/woff2";
+  if (ext == ".woff") return "font/woff";
+  return "application/octet-stream";
+}
+
+bool IsDataFile(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext == ".csv" || ext == ".txt" || ext == ".tsv" || ext == ".dat" || ext == ".mat";
+}
+
+// True when `path` lies inside `dir` (both canonical).
+bool Inside(const fs::path& path, const fs::path& dir) {
+  auto p = path.begin();
+  for (auto d = dir.begin(); d != dir.end(); ++d, ++p) {
+    if (d->empty()) continue;  // a trailing separator
+    if (p == path.end() || *p != *d) return false;
+  }
+  return true;
+}
+
+// The indices drawn: every k-th sample so that at most kMaxPoints remain.
+Eigen::Index Stride(Eigen::Index n) {
+  return std::max<Eigen::Index>(1, (n + kMaxPoints - 1) / kMaxPoints);
+}
+
+nlohmann::json Decimate(const Eigen::VectorXd& v) {
+  nlohmann::json out = nlohmann::json::array();
+  const Eigen::Index step = Stride(v.size());
+  for (Eigen::Index k = 0; k < v.size(); k += step) out.push_back(v[k]);
+  return out;
+}
+
+// Optional fields of a request body, with their type checked.
+template <typename T>
+bool Get(const nlohmann::json& body, const char* key, T& out) {
+  if (!body.contains(key) || body[key].is_null()) return false;
+  try {
+    out = body[key].get<T>();
+  } catch (const nlohmann::json::exception&) {
+    throw HttpError(400, fmt::format("field '{}' has the wrong type: {}", key, body[key].dump()));
+  }
+  return true;
+}
+
+// The first line of a CSV-like file that is not a comment, split at its delimiter.
+std::vector<std::string> CsvColumns(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    char delim = ',';
+    for (char c : {',', ';', '\t'})
+      if (line.find(c) != std::string::npos) {
+        delim = c;
+        break;
+      }
+    if (line.find(delim) == std::string::npos) delim = ' ';
+    std::vector<std::string> cols;
+    std::stringstream s(line);
+    std::string item;
+    while (std::getline(s, item, delim)) {
+      const auto a = item.find_first_not_of(" \"");
+      const auto b = item.find_last_not_of(" \"");
+      if (a != std::string::npos) cols.push_back(item.substr(a, b - a + 1));
+    }
+    return cols;
+  }
+  return {};
+}
+
+std::string ShellQuote(const std::string& s) {
+  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                        "0123456789_-./=,:+#") == std::string::npos)
+    return s;
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+const char* kNoPage = R"(<!doctype html>
+<html><head><meta charset="utf-8"><title>pneumid app</title></head>
+<body style="font-family: sans-serif; max-width: 40em; margin: 3em auto">
+<h1>pneumid app</h1>
+<p>The front end was not built: build the project with npm installed (the page is
+built into <code>web/</code> beside the program), or give its folder with
+<code>--assets DIR</code>.</p>
+<p>The HTTP JSON API works without it: see <code>docs/app.md</code>, e.g.
+<code>GET /api/version</code>.</p>
+</body></html>
+)";
+
+}  // namespace
+
+AppApi::AppApi(AppOptions options)
+    : options_(std::move(options)), run_((options_.work / "run.csv").string()) {}
+
+AppApi::~AppApi() { Shutdown(); }
+
+void AppApi::Shutdown() {
+  shutting_down_ = true;
+  run_.Stop();
+}
+
+Response AppApi::Handle(const Request& request) {
+  try {
+    return Route(request);
+  } catch (const HttpError& e) {
+    return ErrorResponse(e.status, e.what());
+  } catch (const nlohmann::json::exception& e) {
+    return ErrorResponse(400, fmt::format("invalid JSON: {}", e.what()));
+  } catch (const InvalidArgument& e) {
+    return ErrorResponse(400, e.what());
+  } catch (const DataError& e) {
+    return ErrorResponse(422, e.what());
+  } catch (const std::exception& e) {
+    return ErrorResponse(500, e.what());
+  }
+}
+
+Response AppApi::Route(const Request& req) {
+  const std::string& p = req.path;
+  const bool get = req.method == "GET";
+  const bool post = req.method == "POST";
+  auto body = [&req] {
+    if (req.body.empty()) return nlohmann::json::object();
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(req.body);
+    } catch (const nlohmann::json::exception& e) {
+      throw HttpError(400, fmt::format("the request body is not JSON: {}", e.what()));
+    }
+    if (!j.is_object()) throw HttpError(400, "the request body must be a JSON object");
+    return j;
+  };
+  auto method_check = [&](bool ok, const char* allowed) {
+    if (!ok) throw HttpError(405, fmt::format("{} takes {}, not {}", p, allowed, req.method));
+  };
+  if (p == "/" || p == "/index.html") {
+    method_check(get, "GET");
+    return Page();
+  }
+  if (p.rfind("/assets/", 0) == 0) {
+    method_check(get, "GET");
+    return Asset(p.substr(8));
+  }
+  if (p == "/api/version") {
+    method_check(get, "GET");
+    return JsonResponse({{"version", Version()}, {"root", options_.root.string()}});
+  }
+  if (p == "/api/files") {
+    method_check(get, "GET");
+    return JsonResponse(Files(req));
+  }
+  if (p == "/api/data/open") {
+    method_check(post, "POST");
+    return JsonResponse(OpenData(body()));
+  }
+  if (p == "/api/data/upload") {
+    method_check(post, "POST");
+    return JsonResponse(Upload(req));
+  }
+  if (p == "/api/identify") {
+    method_check(post, "POST");
+    return JsonResponse(Identify(body()));
+  }
+  if (p == "/api/tune") {
+    method_check(post, "POST");
+    return JsonResponse(Tune(body()));
+  }
+  if (p == "/api/control") {
+    method_check(post, "POST");
+    return JsonResponse(Control(body()));
+  }
+  if (p == "/api/run/start") {
+    method_check(post, "POST");
+    return RunStart(body());
+  }
+  if (p == "/api/run/status") {
+    method_check(get, "GET");
+    return JsonResponse(run_.Status());
+  }
+  if (p == "/api/run/stop") {
+    method_check(post, "POST");
+    nlohmann::json summary = run_.Stop();
+    if (summary.is_null()) throw HttpError(409, "no real-time run has been started");
+    return JsonResponse(summary);
+  }
+  if (p == "/api/run/log") {
+    method_check(get, "GET");
+    if (!run_.HasLog()) throw HttpError(404, "no real-time run has been started");
+    Response r;
+    r.content_type = "text/csv";
+    r.body = ReadFile(run_.LogPath());
+    return r;
+  }
+  if (p == "/api/run/stream")
+    throw HttpError(400, "/api/run/stream is a WebSocket: connect with an Upgrade request");
+  if (p == "/api/export/controller") {
+    method_check(post, "POST");
+    return ExportController(body());
+  }
+  if (p == "/api/export/report") {
+    method_check(post, "POST");
+    return ExportReport(body());
+  }
+  throw HttpError(404, fmt::format("no such path: {}", p));
+}
+
+// ---------------------------------------------------------------- page, assets
+
+Response AppApi::Page() {
+  Response r;
+  r.content_type = "text/html; charset=utf-8";
+  // The page's scripts and styles are loaded without the query: the cookie
+  // carries the token for them (HttpOnly, same site only).
+  r.headers.emplace_back("Set-Cookie", fmt::format("pneumid_token={}; Path=/; HttpOnly; "
+                                                   "SameSite=Strict",
+                                                   options_.token));
+  const fs::path index = options_.assets / "index.html";
+  std::error_code ec;
+  r.body = fs::is_regular_file(index, ec) ? ReadFile(index) : std::string(kNoPage);
+  return r;
+}
+
+Response AppApi::Asset(const std::string& rel) {
+  std::error_code ec;
+  const fs::path dir = fs::weakly_canonical(options_.assets / "assets", ec);
+  if (ec || !fs::is_directory(dir)) throw HttpError(404, "the front end was not built");
+  const fs::path file = fs::weakly_canonical(dir / rel, ec);
+  if (ec || !Inside(file, dir)) throw HttpError(403, fmt::format("{} is outside the assets", rel));
+  if (!fs::is_regular_file(file, ec)) throw HttpError(404, fmt::format("no such asset: {}", rel));
+  Response r;
+  r.content_type = ContentType(file);
+  r.body = ReadFile(file);
+  return r;
+}
+
+// ---------------------------------------------------------------- files and data
+
+fs::path AppApi::Confine(const std::string& path) const {
+  if (path.empty()) return options_.root;
+  std::error_code ec;
+  const fs::path given(path);
+  const fs::path full =
+      fs::weakly_canonical(given.is_absolute() ? given : options_.root / given, ec);
+  if (ec || !Inside(full, options_.root))
+    throw HttpError(403, fmt::format("{} is outside the root {}", path, options_.root.string()));
+  return full;
+}
+
+nlohmann::json AppApi::Files(const Request& req) {
+  const auto it = req.query.find("dir");
+  const std::string rel = it == req.query.end() ? "" : it->second;
+  const fs::path dir = Confine(rel);
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw HttpError(404, fmt::format("{}: not a folder", rel));
+  std::vector<nlohmann::json> dirs, files;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.empty() || name[0] == '.') continue;
+    std::error_code e2;
+    if (e.is_directory(e2)) {
+      dirs.push_back({{"name", name}, {"type", "dir"}, {"size", nullptr}});
+    } else if (e.is_regular_file(e2) && IsDataFile(e.path())) {
+      files.push_back({{"name", name}, {"type", "file"}, {"size", e.file_size(e2)}});
+    }
+  }
+  auto by_name = [](const nlohmann::json& a, const nlohmann::json& b) {
+    return a["name"].get<std::string>() < b["name"].get<std::string>();
+  };
+  std::sort(dirs.begin(), dirs.end(), by_name);
+  std::sort(files.begin(), files.end(), by_name);
+  nlohmann::json j;
+  j["dir"] = fs::relative(dir, options_.root).generic_string();
+  j["entries"] = nlohmann::json::array();
+  for (auto& d : dirs) j["entries"].push_back(std::move(d));
+  for (auto& f : files) j["entries"].push_back(std::move(f));
+  return j;
+}
+
+nlohmann::json AppApi::AddDataSet(DataSet set) {
+  const Dataset& d = set.data;
+  nlohmann::json j;
+  {
+    std::lock_guard lock(mutex_);
+    set.id = fmt::format("d{}", next_data_++);
+  }
+  j["id"] = set.id;
+  j["name"] = set.name;
+  j["columns"] = set.columns;
+  j["t"] = set.t;
+  j["u"] = set.u;
+  j["y"] = set.y;
+  j["samples"] = d.size();
+  j["Ts"] = d.size() >= 2 ? nlohmann::json(d.MedianSampleInterval()) : nlohmann::json(nullptr);
+  j["signals"] = {{"t", Decimate(d.time())},
+                  {"u", d.num_inputs() > 0 ? Decimate(d.u(0)) : nlohmann::json::array()},
+                  {"y", d.num_outputs() > 0 ? Decimate(d.y(0)) : nlohmann::json::array()}};
+  j["decimated"] = Stride(d.size()) > 1;
+  std::lock_guard lock(mutex_);
+  const std::string id = set.id;
+  data_[id] = std::make_shared<const DataSet>(std::move(set));
+  return j;
+}
+
+nlohmann::json AppApi::OpenData(const nlohmann::json& body) {
+  std::string path;
+  if (!Get(body, "path", path) || path.empty()) throw HttpError(400, "field 'path' is missing");
+  const fs::path file = Confine(path);
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) throw HttpError(404, fmt::format("{}: no such file", path));
+  cli::DataOptions o;
+  o.path = file.string();
+  Get(body, "t", o.time_col);
+  Get(body, "u", o.input_col);
+  Get(body, "y", o.output_col);
+  DataSet set;
+  set.name = path;
+  set.path = o.path;
+  set.t = o.time_col;
+  set.u = o.input_col;
+  set.y = o.output_col;
+  set.data = cli::LoadFromOptions(o);
+  set.columns = DataFormatFromPath(o.path) == DataFormat::kMat
+                    ? std::vector<std::string>{o.time_col, o.input_col, o.output_col}
+                    : CsvColumns(file);
+  return AddDataSet(std::move(set));
+}
+
+nlohmann::json AppApi::Upload(const Request& req) {
+  const auto it = req.query.find("name");
+  std::string name =
+      it == req.query.end() ? "upload.csv" : fs::path(it->second).filename().string();
+  if (name.empty() || name[0] == '.') name = "upload.csv";
+  if (!IsDataFile(name))
+    throw HttpError(400, fmt::format("{}: a data file is .csv, .txt, .tsv, .dat or .mat", name));
+  int n;
+  {
+    std::lock_guard lock(mutex_);
+    n = next_file_++;
+  }
+  const fs::path dir = options_.work / fmt::format("upload{}", n);
+  fs::create_directories(dir);
+  const fs::path file = dir / name;
+  {
+    std::ofstream out(file, std::ios::binary);
+    out.write(req.body.data(), static_cast<std::streamsize>(req.body.size()));
+    if (!out) throw DataError(fmt::format("{}: cannot store the upload", name));
+  }
+  cli::DataOptions o;
+  o.path = file.string();
+  auto q = [&](const char* key, std::string& out) {
+    if (auto i = req.query.find(key); i != req.query.end() && !i->second.empty()) out = i->second;
+  };
+  q("t", o.time_col);
+  q("u", o.input_col);
+  q("y", o.output_col);
+  DataSet set;
+  set.name = name;
+  set.path = o.path;
+  set.t = o.time_col;
+  set.u = o.input_col;
+  set.y = o.output_col;
+  set.data = cli::LoadFromOptions(o);
+  set.columns = DataFormatFromPath(o.path) == DataFormat::kMat
+                    ? std::vector<std::string>{o.time_col, o.input_col, o.output_col}
+                    : CsvColumns(file);
+  return AddDataSet(std::move(set));
+}
+
+std::shared_ptr<const AppApi::DataSet> AppApi::FindDataSet(const nlohmann::json& id,
+                                                           const char* field) const {
+  if (!id.is_string()) throw HttpError(400, fmt::format("field '{}' must be a data set id", field));
+  std::lock_guard lock(mutex_);
+  const auto it = data_.find(id.get<std::string>());
+  if (it == data_.end())
+    throw HttpError(404, fmt::format("{}: no data set {} (open or upload it first)", field,
+                                     id.get<std::string>()));
+  return it->second;
+}
+
+// ---------------------------------------------------------------- identify
+
+nlohmann::json AppApi::Identify(const nlohmann::json& body) {
+  if (!body.contains("data")) throw HttpError(400, "field 'data' is missing");
+  const auto set = FindDataSet(body["data"], "data");
+  std::shared_ptr<const DataSet> validation;
+  if (body.contains("validation") && !body["validation"].is_null())
+    validation = FindDataSet(body["validation"], "validation");
+  cli::IdentifyArgs args;
+  if (body.contains("methods")) {
+    const auto& m = body["methods"];
+    if (m.is_string()) {
+      args.methods = m.get<std::string>();
+    } else if (m.is_array() && !m.empty()) {
+      std::vector<std::string> names;
+      for (const auto& x : m) {
+        if (!x.is_string()) throw HttpError(400, "field 'methods' must list method names");
+        names.push_back(x.get<std::string>());
+      }
+      args.methods = fmt::format("{}", fmt::join(names, ","));
+    } else {
+      throw HttpError(400, "field 'methods' must be a list of method names");
+    }
+  }
+  Get(body, "detrend", args.preprocess.detrend);
+  Get(body, "window", args.preprocess.window);
+  Get(body, "order", args.request.order);
+  Get(body, "na", args.request.na);
+  Get(body, "nb", args.request.nb);
+  Get(body, "nk", args.request.nk);
+  cli::IdentifyOutcome out =
+      cli::IdentifyData(args, set->data, validation ? &validation->data : nullptr);
+  if (out.summary.models.empty()) throw HttpError(422, out.summary.message);
+  nlohmann::json j = out.json;
+  nlohmann::json responses;
+  responses["t"] = Decimate(out.data.time());
+  for (const IdentifiedModel& m : out.summary.models) {
+    try {
+      const Eigen::VectorXd yhat = SimulateModel(m, out.data, 0);
+      responses[m.method] = Decimate(yhat);
+    } catch (const std::exception&) {
+      responses[m.method] = nullptr;  // cannot be simulated on these data
+    }
+  }
+  j["responses"] = std::move(responses);
+  j["model_file"] = out.json;
+  return j;
+}
+
+// ---------------------------------------------------------------- controllers
+
+std::string AppApi::FileSpec(const std::string& spec) const {
+  // A spec naming a file (FILE.json[#method], FILE.toml) is read only under the root.
+  const std::string file = spec.substr(0, spec.find('#'));
+  const auto ends = [&](const char* ext) {
+    const std::string e(ext);
+    return file.size() > e.size() && file.compare(file.size() - e.size(), e.size(), e) == 0;
+  };
+  if (ends(".json") || ends(".toml") || file.find('/') != std::string::npos) Confine(file);
+  return spec;
+}
+
+std::string AppApi::ModelSpec(const nlohmann::json& model) {
+  if (model.is_string()) return FileSpec(model.get<std::string>());
+  if (!model.is_object())
+    throw HttpError(400, "field 'model' must be a model spec or a model object");
+  // A model object (an entry of a model file): read as a model file of one model.
+  int n;
+  {
+    std::lock_guard lock(mutex_);
+    n = next_file_++;
+  }
+  const fs::path file = options_.work / fmt::format("model{}.json", n);
+  std::ofstream out(file);
+  out << nlohmann::json{{"models", nlohmann::json::array({model})}}.dump(2) << "\n";
+  if (!out) throw DataError("cannot store the model");
+  return file.string();
+}
+
+namespace {
+
+// The controller settings of a request (the command line's names).
+void ReadControllerSettings(const nlohmann::json& b, ControllerSettings& s) {
+  Get(b, "controller", s.controller);
+  Get(b, "rule", s.rule);
+  Get(b, "P", s.P);
+  Get(b, "M", s.M);
+  Get(b, "lambda", s.lambda);
+  Get(b, "constrained", s.constrained);
+  Get(b, "pid_rule", s.pid_rule);
+  Get(b, "tau_c", s.tau_c);
+  Get(b, "t_filter", s.t_filter);
+  Get(b, "disturbance", s.disturbance);
+  Get(b, "response_time", s.response_time);
+  Get(b, "overshoot", s.overshoot);
+  Get(b, "aggressiveness", s.aggressiveness);
+  Get(b, "du_max", s.limits.du_max);
+  Get(b, "y_min", s.y_min);
+  Get(b, "y_max", s.y_max);
+}
+
+std::vector<std::string> LoadSteps(const nlohmann::json& b) {
+  std::vector<std::string> out;
+  if (!b.contains("load_step") || b["load_step"].is_null()) return out;
+  const auto& l = b["load_step"];
+  if (l.is_string()) {
+    if (!l.get<std::string>().empty()) out.push_back(l.get<std::string>());
+  } else if (l.is_array()) {
+    for (const auto& x : l)
+      if (x.is_string()) out.push_back(x.get<std::string>());
+  } else {
+    throw HttpError(400, "field 'load_step' must be \"at=T,size=D\" or a list of them");
+  }
+  return out;
+}
+
+nlohmann::json Trace(const ClosedLoopResult& r) {
+  return {{"t", Decimate(r.t)}, {"r", Decimate(r.r)}, {"y", Decimate(r.y)}, {"u", Decimate(r.u)}};
+}
+
+}  // namespace
+
+nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
+  cli::TuneCli c;
+  if (!b.contains("model")) throw HttpError(400, "field 'model' is missing");
+  c.model = ModelSpec(b["model"]);
+  c.Ts = 0.01;
+  Get(b, "Ts", c.Ts);
+  Get(b, "rule", c.rule);
+  if (c.rule.empty()) c.rule = "shridhar-cooper";
+  Get(b, "M", c.M);
+  Get(b, "P", c.P);
+  Get(b, "lambda", c.lambda);
+  if (c.rule == "auto") {
+    Get(b, "controller", c.controller);
+    Get(b, "response_time", c.response_time);
+    Get(b, "overshoot", c.overshoot);
+    Get(b, "aggressiveness", c.aggressiveness);
+    Get(b, "u_min", c.u_min);
+    Get(b, "u_max", c.u_max);
+    Get(b, "du_max", c.du_max);
+  }
+  return cli::TuneJson(c);
+}
+
+nlohmann::ordered_json AppApi::Control(const nlohmann::json& b) {
+  cli::ControlCli c;
+  if (!b.contains("model")) throw HttpError(400, "field 'model' is missing");
+  c.model = ModelSpec(b["model"]);
+  ReadControllerSettings(b, c.controller);
+  Get(b, "u_min", c.controller.limits.u_min);
+  Get(b, "u_max", c.controller.limits.u_max);
+  if (Get(b, "plant", c.plant)) FileSpec(c.plant);
+  Get(b, "Ts", c.Ts);
+  if (!Get(b, "setpoint", c.setpoint)) throw HttpError(400, "field 'setpoint' is missing");
+  if (!Get(b, "duration", c.duration)) throw HttpError(400, "field 'duration' is missing");
+  PNEUMID_CHECK(c.duration > 0.0, "duration must be positive, got {}", c.duration);
+  Get(b, "noise", c.noise);
+  Get(b, "seed", c.seed);
+  c.load_steps = LoadSteps(b);
+  const std::vector<cli::ControlRun> runs = cli::SimulateControl(c);
+  nlohmann::ordered_json j = cli::ControlJson(runs);
+  j["trace"] = Trace(runs.front().result);
+  return j;
+}
+
+// ---------------------------------------------------------------- real-time run
+
+Response AppApi::RunStart(const nlohmann::json& b) {
+  if (run_.Running())
+    return ErrorResponse(409, "a real-time run is going on (POST /api/run/stop ends it)");
+  cli::RunOptions o;
+  if (b.contains("model")) o.model = ModelSpec(b["model"]);
+  ReadControllerSettings(b, o.controller);
+  Get(b, "setpoint", o.setpoint);
+  o.load_steps = LoadSteps(b);
+  double u = 0.0;
+  if (Get(b, "u_min", u)) o.u_min = u;
+  if (Get(b, "u_max", u)) o.u_max = u;
+  if (Get(b, "rate_max", u)) o.rate_max = u;
+  RealtimeConfig config;
+  Get(b, "io", config.io);
+  if (Get(b, "plant", config.plant)) FileSpec(config.plant);
+  Get(b, "Ts", config.loop.period);
+  Get(b, "duration", config.loop.duration);
+  Get(b, "seed", o.rt.seed);
+  double noise = 0.0;
+  if (Get(b, "noise", noise)) o.rt.noise = noise;
+  std::string safe_state;
+  if (Get(b, "safe_state", safe_state)) config.safety.safe_state = SafeStateFromString(safe_state);
+  Get(b, "max_overruns", config.safety.max_overruns);
+  const IoSpec io = ParseIoSpec(config.io);
+  // The simulator needs no real-time priority (nor the server's memory locked).
+  config.loop.realtime = io.kind != IoKind::kSim;
+  std::string error;
+  PNEUMID_CHECK(config.loop.IsValid(&error), "{}", error);
+  cli::ApplySafetyFlags(o, config);
+  // Errors in the settings answer here rather than in the run's status.
+  ParseModelSpec(o.model);
+  ParseSignal(o.setpoint);
+  if (!run_.Start(std::move(o), std::move(config)))
+    return ErrorResponse(409, "a real-time run is going on (POST /api/run/stop ends it)");
+  return JsonResponse({{"state", "running"}});
+}
+
+void AppApi::Stream(const Request& req, const std::function<bool(const std::string&)>& send) {
+  if (req.path != "/api/run/stream") {
+    send(nlohmann::json{{"error", fmt::format("no WebSocket at {}", req.path)}}.dump());
+    return;
+  }
+  std::uint64_t run_id = 0;
+  std::size_t sent = 0;
+  auto idle_since = std::chrono::steady_clock::now();
+  while (!shutting_down_) {
+    LiveRun::Update u = run_.Since(run_id, sent);
+    if (u.run_id != run_id) {
+      run_id = u.run_id;
+      sent = 0;
+    }
+    if (!u.samples.empty()) {
+      nlohmann::json t = nlohmann::json::array(), r = t, y = t, uu = t;
+      for (const LogRecord& rec : u.samples) {
+        t.push_back(rec.t);
+        r.push_back(rec.r);
+        y.push_back(rec.y);
+        uu.push_back(rec.u);
+      }
+      sent += u.samples.size();
+      if (!send(nlohmann::json{{"t", t}, {"r", r}, {"y", y}, {"u", uu}}.dump())) return;
+      idle_since = std::chrono::steady_clock::now();
+    }
+    if (u.ended) {
+      send(nlohmann::json{{"done", true}, {"summary", u.summary}}.dump());
+      return;
+    }
+    if (std::chrono::steady_clock::now() - idle_since > std::chrono::seconds(2)) {
+      if (!send("")) return;  // a ping: has the page gone?
+      idle_since = std::chrono::steady_clock::now();
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+// ---------------------------------------------------------------- exports
+
+Response AppApi::ExportController(const nlohmann::json& b) {
+  RealtimeConfig config;
+  Get(b, "io", config.io);
+  Get(b, "plant", config.plant);
+  Get(b, "Ts", config.loop.period);
+  Get(b, "duration", config.loop.duration);
+  Get(b, "u_min", config.safety.u_min);
+  Get(b, "u_max", config.safety.u_max);
+  Get(b, "rate_max", config.safety.rate_max);
+  Get(b, "max_overruns", config.safety.max_overruns);
+  ParseIoSpec(config.io);
+  std::string error;
+  PNEUMID_CHECK(config.loop.IsValid(&error), "{}", error);
+  PNEUMID_CHECK(config.safety.IsValid(&error), "{}", error);
+
+  // The controller goes on the command line (the configuration holds the loop,
+  // backend and safety settings).
+  std::string cmd = "pneumid run --config controller.toml";
+  std::string model_note;
+  if (b.contains("model") && b["model"].is_string()) {
+    cmd += " --model " + ShellQuote(FileSpec(b["model"].get<std::string>()));
+  } else if (b.contains("model") && b["model"].is_object()) {
+    cmd += " --model model.json";
+    model_note = "# model.json: {\"models\": [" + b["model"].dump() + "]}\n";
+  }
+  auto flag = [&](const char* key, const char* name) {
+    if (!b.contains(key) || b[key].is_null()) return;
+    const auto& v = b[key];
+    if (v.is_boolean()) {
+      if (v.get<bool>()) cmd += fmt::format(" --{}", name);
+    } else {
+      cmd += fmt::format(" --{} {}", name,
+                         ShellQuote(v.is_string() ? v.get<std::string>() : v.dump()));
+    }
+  };
+  flag("controller", "controller");
+  flag("rule", "rule");
+  flag("P", "P");
+  flag("M", "M");
+  flag("lambda", "lambda");
+  flag("response_time", "response-time");
+  flag("overshoot", "overshoot");
+  flag("aggressiveness", "aggressiveness");
+  flag("constrained", "constrained");
+  flag("pid_rule", "pid-rule");
+  flag("disturbance", "disturbance");
+  flag("setpoint", "setpoint");
+  for (const std::string& l : LoadSteps(b)) cmd += " --load-step " + ShellQuote(l);
+
+  const auto q = [](const std::string& s) { return nlohmann::json(s).dump(); };
+  std::string toml;
+  toml += "# Real-time configuration written by `pneumid app`; run the controller with\n";
+  toml += "#   " + cmd + "\n";
+  toml += model_note;
+  toml += fmt::format("\n[loop]\nperiod = {}\nduration = {}\n",
+                      nlohmann::json(config.loop.period).dump(),
+                      nlohmann::json(config.loop.duration).dump());
+  toml += fmt::format("\n[io]\nbackend = {}\nplant = {}\n", q(config.io), q(config.plant));
+  toml += fmt::format("\n[safety]\nu_min = {}\nu_max = {}\nrate_max = {}\nmax_overruns = {}\n",
+                      nlohmann::json(config.safety.u_min).dump(),
+                      nlohmann::json(config.safety.u_max).dump(),
+                      nlohmann::json(config.safety.rate_max).dump(), config.safety.max_overruns);
+  ParseRealtimeConfig(toml, "controller.toml");  // what `run --config` will read
+  Response r;
+  r.content_type = "text/plain; charset=utf-8";
+  r.body = toml;
+  return r;
+}
+
+Response AppApi::ExportReport(const nlohmann::json& b) {
+  if (!b.contains("data")) throw HttpError(400, "field 'data' is missing");
+  const auto set = FindDataSet(b["data"], "data");
+  ReportOptions o;
+  if (b.contains("methods")) {
+    if (!b["methods"].is_array()) throw HttpError(400, "field 'methods' must be a list");
+    o.methods.clear();
+    for (const auto& m : b["methods"])
+      if (m.is_string()) o.methods.push_back(m.get<std::string>());
+  }
+  o.title = fmt::format("Identification report: {}", set->name);
+  o.commands = {fmt::format("pneumid report {} --method {} --output-dir report",
+                            ShellQuote(set->name), fmt::join(o.methods, ","))};
+  std::string error;
+  PNEUMID_CHECK(o.IsValid(&error), "{}", error);
+  int n;
+  {
+    std::lock_guard lock(mutex_);
+    n = next_file_++;
+  }
+  const fs::path dir = options_.work / fmt::format("report{}", n);
+  const ReportSummary s = WriteIdentificationReport(set->data, o, dir.string());
+  Response r;
+  r.content_type = "text/html; charset=utf-8";
+  r.body = ReadFile(s.html_path);
+  return r;
+}
+
+}  // namespace pneumid::app

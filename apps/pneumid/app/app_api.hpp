@@ -1,0 +1,78 @@
+// The HTTP JSON API of `pneumid app` (docs/app.md): the page and its assets,
+// data sets kept in memory by id, identification, tuning, closed-loop
+// simulation, the real-time run with its live stream, and the exports. The
+// answers are the JSON that the command line prints (command_json.hpp).
+#pragma once
+
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "http_server.hpp"
+#include "live_run.hpp"
+#include "pneumid/data/dataset.hpp"
+
+namespace pneumid::app {
+
+struct AppOptions {
+  std::filesystem::path root;    ///< canonical; files are read only below it
+  std::filesystem::path assets;  ///< the built page (index.html, assets/); may not exist
+  std::filesystem::path work;    ///< the server's own temporary folder
+  std::string token;
+};
+
+class AppApi {
+ public:
+  explicit AppApi(AppOptions options);
+  ~AppApi();
+
+  /// Answers one request (never throws: errors become {"error": ...}).
+  Response Handle(const Request& request);
+  /// GET /api/run/stream: the live samples of the run as text frames.
+  void Stream(const Request& request, const std::function<bool(const std::string&)>& send);
+  /// Stops a run going on (the plant to its safe state) and ends the streams.
+  void Shutdown();
+
+ private:
+  struct DataSet {
+    std::string id, name, path;
+    std::vector<std::string> columns;
+    std::string t, u, y;
+    Dataset data;
+  };
+
+  Response Route(const Request& request);
+  Response Page();
+  Response Asset(const std::string& path);
+  nlohmann::json Files(const Request& request);
+  nlohmann::json OpenData(const nlohmann::json& body);
+  nlohmann::json Upload(const Request& request);
+  nlohmann::json Identify(const nlohmann::json& body);
+  nlohmann::ordered_json Tune(const nlohmann::json& body);
+  nlohmann::ordered_json Control(const nlohmann::json& body);
+  Response RunStart(const nlohmann::json& body);
+  Response ExportController(const nlohmann::json& body);
+  Response ExportReport(const nlohmann::json& body);
+
+  nlohmann::json AddDataSet(DataSet set);
+  std::shared_ptr<const DataSet> FindDataSet(const nlohmann::json& id, const char* field) const;
+  std::filesystem::path Confine(const std::string& path) const;
+  std::string ModelSpec(const nlohmann::json& model);
+  std::string FileSpec(const std::string& spec) const;
+
+  AppOptions options_;
+  mutable std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<const DataSet>> data_;
+  int next_data_ = 1;
+  int next_file_ = 1;
+  LiveRun run_;
+  std::atomic<bool> shutting_down_{false};
+};
+
+}  // namespace pneumid::app

@@ -1,0 +1,155 @@
+// The results of `control`, `tune`, `identify` and `run` as data and JSON,
+// shared by those commands (their --json output) and by `pneumid app` (its
+// HTTP API answers with the same JSON). The structs hold the commands'
+// options; each function does the command's work without printing.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "data_options.hpp"
+#include "pneumid/control/closed_loop.hpp"
+#include "pneumid/control/controller_factory.hpp"
+#include "pneumid/identify/identify.hpp"
+#include "pneumid/realtime/log_writer.hpp"
+#include "pneumid/realtime/realtime_config.hpp"
+#include "pneumid/realtime/realtime_loop.hpp"
+#include "pneumid/realtime/spsc_ring_buffer.hpp"
+#include "realtime_options.hpp"
+
+namespace pneumid::cli {
+
+// ---------------------------------------------------------------- control
+
+struct ControlCli {
+  ControllerSettings controller;  // --controller, --rule, --P, ..., --u-min, --t-filter, --tau-c
+  std::string model;
+  std::string plant;
+  double Ts = 0.01;
+  std::string setpoint;
+  double duration = 0.0;
+  double noise = 0.0;
+  std::uint64_t seed = 1;
+  std::vector<std::string> load_steps;
+  bool json = false;
+  std::string plot;
+  std::string output;
+  bool compare_given = false;
+  std::string compare;
+};
+
+/// One closed-loop simulation of `control`.
+struct ControlRun {
+  BuiltController built;
+  ClosedLoopResult result;
+};
+
+/// The simulations of `control` (one, or one per rule with --compare), after
+/// writing -o and --plot when given.
+/// @throws InvalidArgument / DataError for invalid settings or an unreadable model.
+std::vector<ControlRun> SimulateControl(const ControlCli& c);
+
+/// What `control --json` prints for these runs.
+nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs);
+
+// ---------------------------------------------------------------- tune
+
+struct TuneCli {
+  std::string model;
+  double Ts = 0.0;
+  std::string rule = "shridhar-cooper";
+  int M = 0;
+  int P = 0;
+  double lambda = std::numeric_limits<double>::quiet_NaN();
+  int tau_digits = 2;
+  bool json = false;
+  // --rule auto
+  std::string controller;
+  double response_time = std::numeric_limits<double>::quiet_NaN();
+  std::string measure;
+  double overshoot = std::numeric_limits<double>::quiet_NaN();
+  double aggressiveness = std::numeric_limits<double>::quiet_NaN();
+  double u_min = -std::numeric_limits<double>::infinity();
+  double u_max = std::numeric_limits<double>::infinity();
+  double du_max = std::numeric_limits<double>::infinity();
+};
+
+/// What `tune --json` prints. @throws InvalidArgument as `tune` does.
+nlohmann::ordered_json TuneJson(const TuneCli& c);
+
+// ---------------------------------------------------------------- identify
+
+struct IdentifyArgs {
+  DataOptions data;
+  PreprocessArgs preprocess;
+  std::string methods = "reaction-curve";
+  IdentifyRequest request;
+  std::string loss = "none";
+  NonlinearOptions nonlinear;
+  bool json = false;
+  std::string plot;
+  std::string output;
+  std::string validation;  ///< held-out data file (same column options)
+  double split = 0.0;
+  bool progress = false;
+};
+
+struct IdentifyOutcome {
+  Dataset data;  ///< after preprocessing
+  PreprocessRecord record;
+  IdentificationSummary summary;  ///< models with the preprocessing record
+  /// The model file: what `identify --json` prints and `-o FILE` writes.
+  nlohmann::json json;
+};
+
+/// Identifies the models of `raw` (loaded data, preprocessed here as
+/// args.preprocess says; `validation_raw` gets the same preprocessing).
+/// `progress` (may be empty) is called as IdentifyModels does.
+/// When no model could be identified, summary.models is empty (the reason in
+/// summary.message and failures) and json is null.
+/// @throws InvalidArgument for invalid settings.
+IdentifyOutcome IdentifyData(const IdentifyArgs& args, const Dataset& raw,
+                             const Dataset* validation_raw,
+                             const IdentifyProgress& progress = nullptr);
+
+// ---------------------------------------------------------------- run
+
+struct RunOptions {
+  ControllerSettings controller;  // --controller, --rule, --P, --M, --lambda, ...
+  std::string model = "fopdt-paper";
+  std::string setpoint = "step:from=0,to=100,at=0.5";
+  RealtimeOptions rt;  // --io, --config, --plant, --Ts, --duration, --log, --json, ...
+  std::optional<double> u_min, u_max, rate_max, y_min, y_max;
+  std::optional<int> frozen_samples;
+  bool offline = false;
+  std::vector<std::string> load_steps;
+};
+
+struct RunOutcome {
+  LoopSummary summary;
+  std::string controller;  ///< the controller's description
+  std::string io;          ///< the backend's description
+  std::int64_t log_rows = 0;
+  nlohmann::json metrics;  ///< closed-loop metrics, null unless the run completed
+  nlohmann::json offline;  ///< --offline metrics, or null
+  /// What `run --json` prints.
+  nlohmann::json json;
+};
+
+/// `run`'s safety settings: the configuration's with the flags applied.
+/// @throws InvalidArgument for invalid settings.
+void ApplySafetyFlags(const RunOptions& o, RealtimeConfig& config);
+
+/// Runs the loop of `run` with `config` (ResolveRealtimeConfig and
+/// ApplySafetyFlags applied). `live` (may be null) receives a copy of every
+/// logged record from the loop thread (LogWriterOptions::live).
+/// @throws InvalidArgument / DataError as RunSession does (before the run).
+RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
+                       SpscRingBuffer<LogRecord>* live = nullptr);
+
+}  // namespace pneumid::cli

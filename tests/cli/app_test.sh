@@ -1,0 +1,371 @@
+#!/usr/bin/env bash
+# CLI tests of `pneumid app`: the HTTP JSON API of docs/app.md through Python's
+# standard library (urllib, a socket for the oversized upload and the WebSocket).
+# Usage: bash app_test.sh /path/to/pneumid   (cwd: a scratch/build directory)
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+APP_PID=""
+cleanup() {  # called by lib.sh on exit
+  if [ -n "$APP_PID" ]; then kill "$APP_PID" 2>/dev/null; wait "$APP_PID" 2>/dev/null; fi
+}
+
+check_help app --port --host --root --open --assets --token
+
+ROOT="$TMP/root"
+mkdir -p "$ROOT/sub"
+ln -s /etc "$ROOT/link"
+"$PNEUMID" simulate --plant ipa --input step:from=0.61,to=82,at=1.0 --duration 4 --Ts 0.01 \
+  --seed 1 -o "$ROOT/demo.csv" > /dev/null || die "simulate the demo step test"
+(cd "$ROOT" && "$PNEUMID" identify demo.csv -m reaction-curve,arx,fit-p1d -o models.json \
+  > /dev/null) || die "identify -o models.json"
+(cd "$ROOT" && "$PNEUMID" control --controller dmc --model 'models.json#arx' --plant ipa \
+  --Ts 0.01 --setpoint step:from=0,to=80,at=0.5 --duration 3 --load-step at=2,size=-10 \
+  --json > "$TMP/control_cli.json") || fail "control --json"
+(cd "$ROOT" && "$PNEUMID" identify demo.csv -m reaction-curve,arx,fit-p1d --detrend none \
+  --json > "$TMP/identify_cli.json") || fail "identify --json"
+"$PNEUMID" tune --model fopdt-paper --Ts 0.01 --json > "$TMP/tune_cli.json" || fail "tune --json"
+
+# Empty the file before the background job starts (its redirection may come late).
+: > "$TMP/app.txt"
+"$PNEUMID" app --port 0 --root "$ROOT" --assets "$TMP/no-assets" --token secret123 \
+  > "$TMP/app.txt" 2>&1 &
+APP_PID=$!
+URL=""
+for _ in $(seq 100); do
+  URL=$(sed -n 's/^pneumid app: serving.*\(http:\/\/127\.0\.0\.1:[0-9]*\/?token=[0-9a-z]*\).*/\1/p' \
+    "$TMP/app.txt")
+  [ -n "$URL" ] && break
+  sleep 0.1
+done
+[ -n "$URL" ] || die "pneumid app did not print its address: $(cat "$TMP/app.txt")"
+grep -q "token=secret123" <<< "$URL" || fail "the address lacks the token: $URL"
+BASE=${URL%%/\?token=*}
+
+cat > "$TMP/client.py" << 'EOF'
+import base64, json, os, socket, sys, time, urllib.error, urllib.request
+
+base, token, tmp = sys.argv[1], sys.argv[2], sys.argv[3]
+failures = []
+
+def fail(msg):
+    print("FAIL: " + msg, file=sys.stderr)
+    failures.append(msg)
+
+def call(method, path, body=None, headers=None, with_token=True, raw=False):
+    headers = dict(headers or {})
+    if with_token:
+        headers.setdefault("X-Pneumid-Token", token)
+    data = None
+    if body is not None:
+        data = body if isinstance(body, bytes) else json.dumps(body).encode()
+        headers.setdefault("Content-Type", "application/json")
+    req = urllib.request.Request(base + path, data=data, method=method, headers=headers)
+    try:
+        with urllib.request.urlopen(req, timeout=120) as r:
+            status, text = r.status, r.read().decode()
+    except urllib.error.HTTPError as e:
+        status, text = e.code, e.read().decode()
+    if raw:
+        return status, text
+    try:
+        return status, json.loads(text)
+    except ValueError:
+        return status, text
+
+def expect(status, answer, want, what):
+    if status != want:
+        fail(f"{what}: HTTP {status} (expected {want}): {str(answer)[:300]}")
+        return False
+    return True
+
+# --- security: the token on every path, the origin, the root
+for path in ["/", "/assets/index.js", "/api/version"]:
+    s, a = call("GET", path, with_token=False)
+    expect(s, a, 403, f"GET {path} without a token")
+    s, a = call("GET", path, with_token=False, headers={"X-Pneumid-Token": "wrong"})
+    expect(s, a, 403, f"GET {path} with a wrong token")
+s, a = call("GET", "/api/version?token=" + token, with_token=False)
+if expect(s, a, 200, "token as a query parameter") and a.get("version") is None:
+    fail(f"version: {a}")
+s, a = call("GET", "/api/version", headers={"Origin": "http://evil.example"})
+expect(s, a, 403, "a foreign Origin")
+s, a = call("GET", "/api/version", headers={"Origin": base})
+expect(s, a, 200, "the server's own Origin")
+s, a = call("GET", "/", raw=True)
+if expect(s, a, 200, "GET / without assets") and "not built" not in a:
+    fail("GET / without assets does not say the front end was not built")
+s, a = call("POST", "/api/data/open", {"path": "../../etc/passwd"})
+if expect(s, a, 403, "open ../../etc/passwd") and "outside the root" not in a.get("error", ""):
+    fail(f"open ../../etc/passwd: {a}")
+s, a = call("POST", "/api/data/open", {"path": "/etc/passwd"})
+expect(s, a, 403, "open an absolute path outside the root")
+s, a = call("GET", "/api/files?dir=..")
+expect(s, a, 403, "list the root's parent")
+s, a = call("POST", "/api/data/open", {"path": "link/passwd"})
+expect(s, a, 403, "open through a symbolic link that leaves the root")
+s, a = call("POST", "/api/control", {"model": "../x.json", "setpoint": "step:to=1", "duration": 1})
+expect(s, a, 403, "a model file outside the root")
+
+# --- files and data
+s, a = call("GET", "/api/files")
+if expect(s, a, 200, "files"):
+    names = {(e["name"], e["type"]) for e in a["entries"]}
+    if ("demo.csv", "file") not in names or ("sub", "dir") not in names:
+        fail(f"files: {a}")
+s, a = call("POST", "/api/data/open", {"path": "demo.csv"})
+data_id = None
+if expect(s, a, 200, "open demo.csv"):
+    data_id = a["id"]
+    for key in ["name", "columns", "t", "u", "y", "samples", "Ts", "signals"]:
+        if key not in a:
+            fail(f"data set lacks {key}")
+    if a["samples"] != 401 or len(a["signals"]["y"]) != 401:
+        fail(f"data set: {a['samples']} samples, {len(a['signals']['y'])} drawn")
+s, a = call("POST", "/api/data/open", {"path": "missing.csv"})
+expect(s, a, 404, "open a missing file")
+
+# an upload within the limit
+with open(os.path.join(os.path.dirname(tmp + "/"), "root", "demo.csv"), "rb") as f:
+    demo = f.read()
+s, a = call("POST", "/api/data/upload?name=up.csv", demo,
+            headers={"Content-Type": "application/octet-stream"})
+if expect(s, a, 200, "upload") and a.get("samples") != 401:
+    fail(f"upload: {a}")
+
+# a 100 MB upload: refused from its Content-Length, before the body is read
+host, port = base[len("http://"):].split(":")
+sock = socket.create_connection((host, int(port)), timeout=30)
+size = 100 * 1024 * 1024
+sock.sendall((f"POST /api/data/upload?name=big.csv HTTP/1.1\r\nHost: {host}:{port}\r\n"
+              f"X-Pneumid-Token: {token}\r\nContent-Length: {size}\r\n\r\n").encode())
+try:
+    sock.sendall(b"\0" * 65536)
+except OSError:
+    pass
+reply = b""
+while True:
+    try:
+        chunk = sock.recv(65536)
+    except OSError:
+        break
+    if not chunk:
+        break
+    reply += chunk
+sock.close()
+head, _, body = reply.partition(b"\r\n\r\n")
+if not head.startswith(b"HTTP/1.1 413"):
+    fail(f"100 MB upload: {head[:100]!r}")
+elif f"upload of {size} bytes is larger than the 50 MB limit".encode() not in body:
+    fail(f"100 MB upload message: {body[:200]!r}")
+
+# --- identify: the command line's JSON, plus responses and the model file
+methods = ["reaction-curve", "arx", "fit-p1d"]
+s, a = call("POST", "/api/identify", {"data": data_id, "methods": methods, "detrend": "none"})
+if expect(s, a, 200, "identify"):
+    cli = json.load(open(tmp + "/identify_cli.json"))
+    responses = a.pop("responses")
+    model_file = a.pop("model_file")
+    if a != cli:
+        fail("identify: not the JSON of pneumid identify --json")
+    if model_file != cli:
+        fail("identify: model_file differs from pneumid identify --json")
+    for m in methods + ["t"]:
+        if m not in responses or len(responses[m] or []) != 401:
+            fail(f"identify: no response of {m}")
+    arx = next(m for m in model_file["models"] if m["method"] == "arx")
+s, a = call("POST", "/api/identify", {"data": "d99", "methods": methods})
+expect(s, a, 404, "identify an unknown data set")
+
+# --- tune and control: the command line's JSON
+s, a = call("POST", "/api/tune", {"model": "fopdt-paper", "Ts": 0.01})
+if expect(s, a, 200, "tune") and a != json.load(open(tmp + "/tune_cli.json")):
+    fail("tune: not the JSON of pneumid tune --json")
+scenario = {"controller": "dmc", "plant": "ipa", "Ts": 0.01, "duration": 3,
+            "setpoint": "step:from=0,to=80,at=0.5", "load_step": "at=2,size=-10"}
+s, a = call("POST", "/api/control", dict(scenario, model="models.json#arx"))
+if expect(s, a, 200, "control"):
+    trace = a.pop("trace")
+    cli = json.load(open(tmp + "/control_cli.json"))
+    if a != cli:
+        fail(f"control: not the JSON of pneumid control --json:\n{a}\n{cli}")
+    if len(trace["y"]) != len(trace["t"]) or len(trace["t"]) < 300:
+        fail(f"control trace: {len(trace['t'])} points")
+# a model object (an entry of the model file) gives the same metrics
+s, a = call("POST", "/api/control", dict(scenario, model=arx))
+if expect(s, a, 200, "control with a model object"):
+    cli = json.load(open(tmp + "/control_cli.json"))
+    for key in ["iae", "rise_time", "overshoot_percent", "settling_time"]:
+        if a.get(key) != cli.get(key):
+            fail(f"control with a model object: {key} {a.get(key)} != {cli.get(key)}")
+s, a = call("POST", "/api/control", {"model": "fopdt-paper", "duration": 1})
+if expect(s, a, 400, "control without a set point") and "setpoint" not in a.get("error", ""):
+    fail(f"control without a set point: {a}")
+s, a = call("POST", "/api/control", b"{not json")
+expect(s, a, 400, "a body that is not JSON")
+
+# --- exports
+s, a = call("POST", "/api/export/controller", dict(scenario, model="models.json#arx"), raw=True)
+if expect(s, a, 200, "export controller"):
+    open(tmp + "/controller.toml", "w").write(a)
+s, a = call("POST", "/api/export/report", {"data": data_id, "methods": methods}, raw=True)
+if expect(s, a, 200, "export report") and "<html" not in a.lower():
+    fail("export report: not HTML")
+
+# --- real-time run: start, 409, status, live stream, stop, log
+def ws_connect(path):
+    sock = socket.create_connection((host, int(port)), timeout=30)
+    key = base64.b64encode(os.urandom(16)).decode()
+    sock.sendall((f"GET {path}?token={token} HTTP/1.1\r\nHost: {host}:{port}\r\n"
+                  "Upgrade: websocket\r\nConnection: Upgrade\r\n"
+                  f"Sec-WebSocket-Key: {key}\r\nSec-WebSocket-Version: 13\r\n\r\n").encode())
+    buf = b""
+    while b"\r\n\r\n" not in buf:
+        chunk = sock.recv(4096)
+        if not chunk:
+            break
+        buf += chunk
+    head, _, rest = buf.partition(b"\r\n\r\n")
+    return sock, head, rest
+
+def ws_frames(sock, rest):
+    buf = rest
+    def need(n):
+        nonlocal buf
+        while len(buf) < n:
+            chunk = sock.recv(65536)
+            if not chunk:
+                raise EOFError
+            buf += chunk
+    while True:
+        need(2)
+        op, n = buf[0] & 0x0F, buf[1] & 0x7F
+        off = 2
+        if n == 126:
+            need(4); n = int.from_bytes(buf[2:4], "big"); off = 4
+        elif n == 127:
+            need(10); n = int.from_bytes(buf[2:10], "big"); off = 10
+        need(off + n)
+        payload, buf = buf[off:off + n], buf[off + n:]
+        if op == 1:
+            yield json.loads(payload)
+        elif op == 8:
+            return
+
+# (overruns tolerated: the test machine may be busy)
+run = {"controller": "dmc", "model": "fopdt-paper", "io": "sim", "Ts": 0.01, "duration": 1,
+       "setpoint": "step:from=0,to=100,at=0.2", "max_overruns": -1}
+s, a = call("POST", "/api/run/start", run)
+if expect(s, a, 200, "run start") and a.get("state") != "running":
+    fail(f"run start: {a}")
+s, a = call("POST", "/api/run/start", run)
+expect(s, a, 409, "a second run while one is going on")
+s, a = call("GET", "/api/run/status")
+if expect(s, a, 200, "run status") and a.get("state") not in ("running", "finished"):
+    fail(f"run status: {a}")
+sock, head, rest = ws_connect("/api/run/stream")
+if not head.startswith(b"HTTP/1.1 101"):
+    fail(f"stream: no WebSocket: {head[:200]!r}")
+else:
+    samples, summary = 0, None
+    for frame in ws_frames(sock, rest):
+        if frame.get("done"):
+            summary = frame.get("summary")
+            break
+        if len(frame["t"]) != len(frame["y"]):
+            fail("stream: a batch of unequal lengths")
+        samples += len(frame["t"])
+    if summary is None or samples != 100 or summary.get("samples") != 100:
+        fail(f"stream: {samples} samples, summary {summary}")
+sock.close()
+s, a = call("POST", "/api/run/stop")
+if expect(s, a, 200, "run stop") and a.get("termination") != "success":
+    fail(f"run stop after the end: {a}")
+s, a = call("GET", "/api/run/log", raw=True)
+if expect(s, a, 200, "run log"):
+    rows = [l for l in a.splitlines() if l and not l.startswith("#")]
+    if rows[0] != "t,u,y,r,u_ctrl,aux,jitter_us,compute_us,flags,fault" or len(rows) != 101:
+        fail(f"run log: {len(rows)} lines, header {rows[0]}")
+# a longer run stopped early: the plant goes to its safe state
+s, a = call("POST", "/api/run/start", dict(run, duration=30))
+expect(s, a, 200, "run start (30 s)")
+time.sleep(0.5)
+s, a = call("POST", "/api/run/stop")
+if expect(s, a, 200, "run stop") and a.get("termination") != "stopped":
+    fail(f"run stop: {a}")
+s, a = call("GET", "/api/run/status")
+if a.get("state") != "stopped":
+    fail(f"status after stop: {a}")
+# a run going on when the server is told to stop (SIGINT below)
+s, a = call("POST", "/api/run/start", dict(run, duration=30))
+expect(s, a, 200, "run start before SIGINT")
+sys.exit(1 if failures else 0)
+EOF
+
+$PY "$TMP/client.py" "$BASE" secret123 "$TMP" || fail "API checks (above)"
+
+# the exported configuration is one `pneumid run --config` reads
+if [ -s "$TMP/controller.toml" ]; then
+  "$PNEUMID" run --config "$TMP/controller.toml" --model fopdt-paper --fast --duration 0.5 \
+    --json > "$TMP/run_config.json" || fail "run --config the exported TOML: $(cat "$TMP/run_config.json")"
+fi
+
+# SIGINT (Ctrl-C) with a run going on: the run stops, the server exits 0
+kill -INT "$APP_PID"
+rc=0
+wait "$APP_PID" || rc=$?
+APP_PID=""
+[ "$rc" -eq 0 ] || fail "pneumid app exit status after SIGINT: $rc: $(cat "$TMP/app.txt")"
+grep -q "stopping" "$TMP/app.txt" || fail "pneumid app did not say it stops: $(cat "$TMP/app.txt")"
+
+# The page from --assets, with the cookie that lets its assets load; SIGTERM ends it
+mkdir -p "$TMP/web/assets"
+echo '<!doctype html><script type="module" src="./assets/app.js"></script>' > "$TMP/web/index.html"
+echo 'console.log("pneumid");' > "$TMP/web/assets/app.js"
+echo 'top-secret-content' > "$TMP/web/secret.txt"
+: > "$TMP/app.txt"
+"$PNEUMID" app --port 0 --root "$ROOT" --assets "$TMP/web" > "$TMP/app.txt" 2>&1 &
+APP_PID=$!
+URL=""
+for _ in $(seq 100); do
+  URL=$(grep -o 'http://127\.0\.0\.1:[0-9]*/?token=[0-9a-f]\{32\}$' "$TMP/app.txt")
+  [ -n "$URL" ] && break
+  sleep 0.1
+done
+[ -n "$URL" ] || fail "no address with a 32-digit random token: $(cat "$TMP/app.txt")"
+if [ -n "$URL" ]; then
+  $PY - "$URL" << 'PYEOF' || fail "page and assets (above)"
+import sys, urllib.error, urllib.request
+base, token = sys.argv[1].split("/?token=")
+bad = 0
+def get(path, headers=None):
+    try:
+        with urllib.request.urlopen(urllib.request.Request(base + path, headers=headers or {})) as r:
+            return r.status, r.read().decode(), r.headers
+    except urllib.error.HTTPError as e:
+        return e.code, e.read().decode(), e.headers
+def check(ok, msg):
+    global bad
+    if not ok:
+        print("FAIL: " + msg, file=sys.stderr)
+        bad += 1
+s, body, headers = get("/?token=" + token)
+cookie = headers.get("Set-Cookie", "")
+check(s == 200 and "./assets/app.js" in body and "HttpOnly" in cookie,
+      f"GET /: {s} {body[:100]} cookie {cookie}")
+jar = {"Cookie": cookie.split(";")[0]}
+s, body, headers = get("/assets/app.js", jar)
+check(s == 200 and "pneumid" in body and "javascript" in headers.get("Content-Type", ""),
+      f"an asset with the cookie: {s} {body[:100]}")
+s, body, _ = get("/assets/app.js")
+check(s == 403, f"an asset without a token: {s}")
+s, body, _ = get("/assets/%2e%2e/secret.txt", jar)
+check(s == 403 and "top-secret-content" not in body, f"a file outside the assets folder: {s} {body[:100]}")
+sys.exit(1 if bad else 0)
+PYEOF
+fi
+kill -TERM "$APP_PID"
+rc=0
+wait "$APP_PID" || rc=$?
+APP_PID=""
+[ "$rc" -eq 0 ] || fail "pneumid app exit status after SIGTERM: $rc"
+
+finish
