@@ -770,7 +770,10 @@ async function startRun(): Promise<void> {
     }
     state.run.frames++;
     if (m.done) {
-      finishRun(m.summary ?? null, 'finished');
+      // a Stop's end can reach the stream before the Stop's answer: the
+      // summary's termination says how the run ended
+      const t = m.summary?.termination;
+      finishRun(m.summary ?? null, t === 'stopped' ? 'stopped' : t === 'failure' ? 'failed' : 'finished');
       return;
     }
     if (Array.isArray(m.t)) appendLive(m);

@@ -637,7 +637,7 @@ Response AppApi::RunStart(const nlohmann::json& b) {
   PNEUMID_CHECK(config.loop.IsValid(&error), "{}", error);
   cli::ApplySafetyFlags(o, config);
   // Errors in the settings answer here rather than in the run's status.
-  ParseModelSpec(o.model);
+  ParseControllerModel(o.model);
   ParseSignal(o.setpoint);
   if (!run_.Start(std::move(o), std::move(config)))
     return ErrorResponse(409, "a real-time run is going on (POST /api/run/stop ends it)");
