@@ -61,6 +61,7 @@ ControllerSpec WithModelInputMap(ControllerSpec spec, const std::string& model_s
     return spec;
   }
   if (!spec.input_map) spec.input_map = ParseModelInputMap(model_spec);
+  if (!spec.output_map) spec.output_map = ParseModelOutputMap(model_spec);
   return spec;
 }
 
@@ -168,6 +169,17 @@ BuiltController WithNarxLinearization(const ControllerSpec& spec, double Ts) {
   return b;
 }
 
+// The controller of `spec` without its output map, made by `make`, on the
+// output map's inverse.
+template <typename Make>
+BuiltController WithOutputMap(const ControllerSpec& spec, Make make) {
+  ControllerSpec inner = spec;
+  inner.output_map.reset();
+  BuiltController b = make(inner);
+  b.controller = std::make_unique<OutputMapController>(std::move(b.controller), *spec.output_map);
+  return b;
+}
+
 // `model` scaled to a unit static gain: behind the inverse map the map holds
 // the actuator's gain and the linear part only the dynamics.
 TransferFunction UnitGain(const TransferFunction& model) {
@@ -184,6 +196,9 @@ TransferFunction UnitGain(const TransferFunction& model) {
 BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec) {
   if (spec.narx_model) return WithNarxLinearization(spec, Ts);
+  if (spec.output_map)
+    return WithOutputMap(spec,
+                         [&](const ControllerSpec& s) { return MakeController(model, Ts, s); });
   if (spec.input_map) {
     const TransferFunction g = UnitGain(model);
     return WithInverseMap(spec, [&](const ControllerSpec& s) { return MakeController(g, Ts, s); });
@@ -222,6 +237,9 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
 
 BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec_in) {
   if (spec_in.narx_model) return WithNarxLinearization(spec_in, model.Ts());
+  if (spec_in.output_map)
+    return WithOutputMap(spec_in,
+                         [&](const ControllerSpec& s) { return MakeController(model, s); });
   if (spec_in.input_map) {
     const PredictionModel unit(UnitGain(model.model()), model.Ts());
     return WithInverseMap(spec_in,

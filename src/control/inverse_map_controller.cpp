@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -78,6 +79,31 @@ void InverseMapController::Applied(double u) {
 std::string InverseMapController::Describe() const {
   return fmt::format("{} with inverse map ({} knots, u in [{:g}, {:g}])", inner_->Describe(),
                      map_.size(), map_.u_min(), map_.u_max());
+}
+
+StaticMap MonotoneEnvelope(const StaticMap& f, const std::string& what) {
+  std::vector<double> y = f.y();
+  for (std::size_t i = 1; i < y.size(); ++i) y[i] = std::max(y[i], y[i - 1]);
+  PNEUMID_CHECK(y.back() > y.front(),
+                "the {} ({}) does not increase anywhere, so no controller can invert it", what,
+                f.Describe());
+  return StaticMap(f.u(), y, StaticMapExtrapolation::kClamp);
+}
+
+OutputMapController::OutputMapController(std::unique_ptr<Controller> inner,
+                                         const StaticMap& output_map)
+    : inner_(std::move(inner)), map_(MonotoneEnvelope(output_map, "output map")) {
+  PNEUMID_CHECK(inner_ != nullptr, "OutputMapController needs a controller, got null");
+}
+
+void OutputMapController::Reset(double u0, double y0) { inner_->Reset(u0, map_.Inverse(y0)); }
+
+double OutputMapController::Update(double setpoint, double measurement) {
+  return inner_->Update(map_.Inverse(setpoint), map_.Inverse(measurement));
+}
+
+std::string OutputMapController::Describe() const {
+  return fmt::format("{} on the inverse output map ({} knots)", inner_->Describe(), map_.size());
 }
 
 }  // namespace pneumid

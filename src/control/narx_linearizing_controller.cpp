@@ -8,23 +8,13 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/control/inverse_map_controller.hpp"
 
 namespace pneumid {
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// The running maximum of the map's knot values: monotone non-decreasing.
-StaticMap MonotoneEnvelope(const StaticMap& f) {
-  std::vector<double> y = f.y();
-  for (std::size_t i = 1; i < y.size(); ++i) y[i] = std::max(y[i], y[i - 1]);
-  PNEUMID_CHECK(y.back() > y.front(),
-                "the NARX model's input map ({}) does not increase anywhere: no input moves "
-                "the output up, so no controller can be formed",
-                f.Describe());
-  return StaticMap(f.u(), y, StaticMapExtrapolation::kClamp);
-}
 
 // The input range the model's default time constant and the inner limits use.
 bool InputRange(const std::optional<StaticMap>& map, const InputLimits& limits, double* lo,
@@ -74,7 +64,7 @@ InputAffineNarx::InputAffineNarx(const NarxModel& narx, std::optional<StaticMap>
   }
   PNEUMID_CHECK(std::any_of(gain_.begin(), gain_.end(), [](double g) { return g != 0.0; }),
                 "the NARX model has no input term: the input does not move its output");
-  if (map_) envelope_ = MonotoneEnvelope(*map_);
+  if (map_) envelope_ = MonotoneEnvelope(*map_, "NARX model's input map");
 }
 
 double InputAffineNarx::Poly(const std::vector<double>& c, double y) const {

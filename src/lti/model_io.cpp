@@ -279,6 +279,19 @@ std::optional<StaticMap> ParseModelInputMap(const std::string& spec) {
   return std::nullopt;
 }
 
+std::optional<StaticMap> ParseModelOutputMap(const std::string& spec) {
+  std::string path, select;
+  const std::optional<nlohmann::json> j = ReadModelFileIfAny(spec, &path, &select);
+  if (!j || IsBareStaticMap(*j)) return std::nullopt;
+  try {
+    const nlohmann::json& m = SelectModelJson(*j, path, select);
+    if (m.contains("output_map")) return StaticMapFromJson(m.at("output_map"));
+  } catch (const InvalidArgument& e) {
+    throw InFile(path, e);
+  }
+  return std::nullopt;
+}
+
 std::optional<NarxWithMap> ParseModelNarx(const std::string& spec) {
   std::string path, select;
   const std::optional<nlohmann::json> j = ReadModelFileIfAny(spec, &path, &select);

@@ -60,6 +60,10 @@ struct ControllerSpec {
   /// and runs behind it (narx_linearizing_controller.hpp); `limits` stay the
   /// limits on u. Excludes input_map (the model brings its own).
   std::optional<InputAffineNarx> narx_model;
+  /// The output map g of a Wiener or Hammerstein-Wiener model y = g(G ...):
+  /// the controller is designed on the rest of the model and takes set point
+  /// and measurement through g's inverse (OutputMapController).
+  std::optional<StaticMap> output_map;
   NarxLinearizingOptions narx_options;  ///< the reference model's time constant
 };
 
@@ -102,8 +106,9 @@ TuningRule InferTuningRule(const std::string& rule, int P, int M, double lambda)
 /// @throws DataError naming the file of an input map that cannot be read.
 ControllerSpec ToControllerSpec(const ControllerSettings& settings);
 /// `spec` with the input map of the model file `model_spec` (a Hammerstein
-/// model's, lti/model_io.hpp ParseModelInputMap) when it has none yet, or
-/// with its NARX model (narx_model, lti/model_io.hpp ParseModelNarx).
+/// model's, lti/model_io.hpp ParseModelInputMap) when it has none yet, its
+/// output map (a Wiener model's, ParseModelOutputMap), or its NARX model
+/// (narx_model, lti/model_io.hpp ParseModelNarx).
 /// @throws InvalidArgument for a NARX model together with an input map, or a
 /// NARX model a controller cannot use (InputAffineNarx).
 ControllerSpec WithModelInputMap(ControllerSpec spec, const std::string& model_spec);

@@ -73,4 +73,41 @@ class InverseMapController : public Controller {
   double v_ = 0.0;
 };
 
+/// A linear controller on the linear part of a Wiener plant y = g(x),
+/// x = G u (an identified Wiener or Hammerstein-Wiener model): the set point
+/// and the measurement go through the inverse of the output map g,
+///   u_k = inner.Update(g^-1(r_k), g^-1(y_k)),
+/// so that the inner controller, designed on G, sees x. g^-1 inverts the
+/// monotone envelope of g (the running maximum of its knot values: a fitted
+/// map can dip where the output hardly moves); beyond g's range the inverse
+/// holds the end of its input range. The input and its limits are the
+/// inner controller's.
+class OutputMapController : public Controller {
+ public:
+  /// @throws InvalidArgument for a null controller or a map that does not
+  /// increase anywhere.
+  OutputMapController(std::unique_ptr<Controller> inner, const StaticMap& output_map);
+
+  void Reset(double u0 = 0.0, double y0 = 0.0) override;
+  /// Allocates no memory.
+  double Update(double setpoint, double measurement) override;
+  void Applied(double u) override { inner_->Applied(u); }
+  double Ts() const override { return inner_->Ts(); }
+  /// The inner controller's description + " on the inverse output map (N knots)".
+  std::string Describe() const override;
+
+  const Controller& inner() const { return *inner_; }
+  /// The monotone envelope of the output map that is inverted.
+  const StaticMap& map() const { return map_; }
+
+ private:
+  std::unique_ptr<Controller> inner_;
+  StaticMap map_;
+};
+
+/// The running maximum of a map's knot values (non-decreasing), as the
+/// inverses of fitted maps use it.
+/// @throws InvalidArgument naming `what` when the envelope is constant.
+StaticMap MonotoneEnvelope(const StaticMap& f, const std::string& what);
+
 }  // namespace pneumid

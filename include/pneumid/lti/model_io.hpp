@@ -39,6 +39,11 @@ TransferFunction ParseModelSpec(const std::string& spec);
 /// ParseModelNarx).
 /// @throws DataError naming the file for an unreadable file or an invalid map.
 std::optional<StaticMap> ParseModelInputMap(const std::string& spec);
+/// The static output map of a model file spec: the "output_map" of the
+/// selected model (a Wiener or Hammerstein-Wiener model); std::nullopt
+/// otherwise (built-in and inline specs, models without one).
+/// @throws DataError naming the file for an unreadable file or an invalid map.
+std::optional<StaticMap> ParseModelOutputMap(const std::string& spec);
 /// ParseModelInputMap, required: @throws DataError naming the file when it
 /// holds no static map.
 StaticMap ReadStaticMap(const std::string& spec);
