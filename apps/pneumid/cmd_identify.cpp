@@ -4,7 +4,7 @@
 // methods (reaction curve, tangent, two-point, SOPDT, PTn, Strejc, areas,
 // process-model fits), the parametric ones (ARX, ARMAX, OE, BJ, IV4,
 // N4SID, CRA, SPA) and the nonlinear ones (static map, Hammerstein, Wiener,
-// NARX), and lists them best fit first.
+// Hammerstein-Wiener, NARX), and lists them best fit first.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -254,7 +254,7 @@ static Registrar reg(
                      "Comma-separated methods, or all: reaction-curve, tangent, smith, "
                      "sundaresan, broida, sopdt, ptn, strejc, areas, fit-p1d, fit-p2d, fit-p2du, "
                      "fit-p3d, fit-p1di, arx, armax, oe, bj, iv4, n4sid, cra, spa; nonlinear "
-                     "(not in all): static-map, hammerstein, wiener, narx, affine-narx")
+                     "(not in all): static-map, hammerstein, wiener, hw, narx, affine-narx")
           ->capture_default_str();
       app.add_option("--order", args->request.order, "PTn order n (ptn)")
           ->capture_default_str()
@@ -284,8 +284,8 @@ static Registrar reg(
           });
       app.add_option(
              "--knots", args->nonlinear.block.num_knots,
-             "hammerstein, wiener, affine-narx: knots of the static map, spread over the input "
-             "range")
+             "hammerstein, wiener, hw, affine-narx: knots of the static map, spread over the "
+             "input range (hw: as many for the output map, over the range of G f(u))")
           ->capture_default_str()
           ->check(CLI::Range(2, 1000));
       app.add_flag("--monotone-map", args->nonlinear.block.monotone_map,

@@ -136,13 +136,13 @@ void BindIdentify(py::module_& m) {
           [](const IdentifiedModel& r) -> py::object {
             return r.input_map ? py::cast(*r.input_map) : py::none();
           },
-          "StaticMap of a static-map or Hammerstein model, or None.")
+          "StaticMap of a static-map, Hammerstein or Hammerstein-Wiener model, or None.")
       .def_property_readonly(
           "output_map",
           [](const IdentifiedModel& r) -> py::object {
             return r.output_map ? py::cast(*r.output_map) : py::none();
           },
-          "StaticMap of a Wiener model, or None.")
+          "StaticMap of a Wiener or Hammerstein-Wiener model, or None.")
       .def_property_readonly(
           "narx",
           [](const IdentifiedModel& r) -> py::object {

@@ -1,5 +1,5 @@
 """Nonlinear identification from Python: StaticMap against numpy, fit_static_map,
-and identify('hammerstein' | 'wiener' | 'narx') on systems simulated here
+and identify('hammerstein' | 'wiener' | 'hw' | 'narx') on systems simulated here
 with scipy."""
 import numpy as np
 import pytest
@@ -57,7 +57,8 @@ def test_fit_static_map_of_a_staircase():
 
 
 def test_identify_hammerstein_and_wiener_recover_the_system():
-    assert pneumid.nonlinear_methods() == ["static-map", "hammerstein", "wiener", "narx", "affine-narx"]
+    assert pneumid.nonlinear_methods() == ["static-map", "hammerstein", "wiener", "hw", "narx",
+                                          "affine-narx"]
     assert "hammerstein" not in pneumid.identify_methods()
     u = levels(5)
     f = np.interp(u, KNOTS, VALUES)
@@ -72,6 +73,10 @@ def test_identify_hammerstein_and_wiener_recover_the_system():
     x = sig.lfilter(B, A, u - u[0]) + u[0]
     w = pneumid.identify("wiener", dataset(u, np.interp(x, KNOTS, VALUES)), na=2, nb=2, nk=1)
     assert w.output_map is not None and w.fit_percent > 99.5
+    # A Wiener system is a Hammerstein-Wiener one with the identity input map.
+    hw = pneumid.identify("hw", dataset(u, np.interp(x, KNOTS, VALUES)), na=2, nb=2, nk=1)
+    assert hw.structure == "Hammerstein-Wiener"
+    assert hw.input_map is not None and hw.output_map is not None and hw.fit_percent > 99.0
 
 
 def test_identify_narx_selects_terms():

@@ -70,6 +70,27 @@ void SimulateUnitGain(const T* p, const Layout& l, const std::vector<T>& v, std:
   }
 }
 
+// The input map through the tents of u: v(t) = (1 - w) alpha_j + w alpha_{j+1}.
+template <typename T>
+std::vector<T> MapThroughTents(const T* alpha, const std::vector<Tent>& tents) {
+  std::vector<T> v(tents.size());
+  for (std::size_t t = 0; t < tents.size(); ++t)
+    v[t] = (1.0 - tents[t].w) * alpha[tents[t].j] + tents[t].w * alpha[tents[t].j + 1];
+  return v;
+}
+
+// The output map with values beta on the knots at x, flat beyond them; inside
+// it is linear in x on the segment (derivatives with respect to x as well).
+template <typename T>
+T OutputMap(const std::vector<double>& knots, const T* beta, const T& x) {
+  const double xv = Value(x);
+  if (xv <= knots.front()) return beta[0];
+  if (xv >= knots.back()) return beta[knots.size() - 1];
+  const Tent h = TentAt(knots, xv);
+  const T w = (x - knots[h.j]) / (knots[h.j + 1] - knots[h.j]);
+  return (1.0 - w) * beta[h.j] + w * beta[h.j + 1];
+}
+
 // Simulation errors y - yhat of the Hammerstein model.
 // With `monotone` (sign +-1) the map parameters are alpha_1 and the square
 // roots of the increments: alpha_j = alpha_{j-1} + monotone * q_j^2.
@@ -84,11 +105,8 @@ struct HammersteinError {
     std::vector<T> values(p + l.map_offset(), p + l.map_offset() + l.m);
     if (monotone != 0.0)
       for (int j = 1; j < l.m; ++j) values[j] = values[j - 1] + monotone * values[j] * values[j];
-    const T* alpha = values.data();
-    std::vector<T> v(tents.size()), x;
-    for (std::size_t t = 0; t < tents.size(); ++t)
-      v[t] = (1.0 - tents[t].w) * alpha[tents[t].j] + tents[t].w * alpha[tents[t].j + 1];
-    SimulateUnitGain(p, l, v, &x);
+    std::vector<T> x;
+    SimulateUnitGain(p, l, MapThroughTents(values.data(), tents), &x);
     for (std::size_t t = 0; t < tents.size(); ++t)
       residuals[t] = (*y)[static_cast<Eigen::Index>(t)] - x[t];
     return true;
@@ -104,24 +122,38 @@ struct WienerError {
   template <typename T>
   bool operator()(T const* const* params, T* residuals) const {
     const T* p = params[0];
-    const T* beta = p + l.map_offset();
     std::vector<T> v(static_cast<std::size_t>(u->size())), x;
     for (std::size_t t = 0; t < v.size(); ++t) v[t] = T((*u)[static_cast<Eigen::Index>(t)]);
     SimulateUnitGain(p, l, v, &x);
-    for (std::size_t t = 0; t < v.size(); ++t) {
-      const Tent h = TentAt(knots, Value(x[t]));
-      // Inside the knots the map is linear in x on the segment; beyond them flat.
-      T f;
-      if (Value(x[t]) <= knots.front()) {
-        f = beta[0];
-      } else if (Value(x[t]) >= knots.back()) {
-        f = beta[l.m - 1];
-      } else {
-        const T w = (x[t] - knots[h.j]) / (knots[h.j + 1] - knots[h.j]);
-        f = (1.0 - w) * beta[h.j] + w * beta[h.j + 1];
-      }
-      residuals[t] = (*y)[static_cast<Eigen::Index>(t)] - f;
-    }
+    for (std::size_t t = 0; t < v.size(); ++t)
+      residuals[t] =
+          (*y)[static_cast<Eigen::Index>(t)] - OutputMap(knots, p + l.map_offset(), x[t]);
+    return true;
+  }
+};
+
+// Simulation errors of the Hammerstein-Wiener model. The map parameters are
+// the inner values f(c_2), .., f(c_{m-1}) of the input map (its end values
+// are fixed: f(c_1) = c_1, f(c_m) = c_m), then the m values of the output map
+// on `out_knots`.
+struct HwError {
+  Layout l;  // l.m = (m - 2) + m map parameters
+  const Eigen::VectorXd* y;
+  std::vector<Tent> tents;  // of u(t) on the input knots
+  std::vector<double> in_knots, out_knots;
+  template <typename T>
+  bool operator()(T const* const* params, T* residuals) const {
+    const T* p = params[0];
+    const std::size_t m = in_knots.size();
+    std::vector<T> alpha(m);
+    alpha.front() = T(in_knots.front());
+    alpha.back() = T(in_knots.back());
+    for (std::size_t j = 1; j + 1 < m; ++j) alpha[j] = p[l.map_offset() + j - 1];
+    std::vector<T> x;
+    SimulateUnitGain(p, l, MapThroughTents(alpha.data(), tents), &x);
+    const T* beta = p + l.map_offset() + (m - 2);
+    for (std::size_t t = 0; t < tents.size(); ++t)
+      residuals[t] = (*y)[static_cast<Eigen::Index>(t)] - OutputMap(out_knots, beta, x[t]);
     return true;
   }
 };
@@ -171,8 +203,9 @@ void RefineOutputError(std::unique_ptr<Functor> functor, Eigen::Index n, const B
     s->warnings.push_back(fmt::format("not converged after {} iterations", o.max_iterations));
 }
 
+// `two_maps`: Hammerstein-Wiener, m - 2 free input-map values and m output-map values.
 void CheckSignals(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
-                  const BlockModelOptions& o, const char* what) {
+                  const BlockModelOptions& o, const char* what, bool two_maps = false) {
   std::string why;
   PNEUMID_CHECK(o.IsValid(&why), "{}", why);
   PNEUMID_CHECK(u.size() == y.size(), "{}: the input has {} samples, the output {}", what, u.size(),
@@ -180,7 +213,7 @@ void CheckSignals(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
   PNEUMID_CHECK(u.allFinite() && y.allFinite(), "{}: the data hold non-finite values", what);
   const int m = o.knots.empty() ? o.num_knots : static_cast<int>(o.knots.size());
-  const int np = o.na + o.nb - 1 + m;
+  const int np = o.na + o.nb - 1 + (two_maps ? 2 * m - 2 : m);
   PNEUMID_CHECK(u.size() >= 2 * np,
                 "{}: {} samples are too few for {} parameters (na = {}, nb = {}, {} knots)", what,
                 u.size(), np, o.na, o.nb, m);
@@ -190,10 +223,11 @@ void CheckSignals(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
                 what, u[0]);
 }
 
-// The knots: given, or spread evenly over the input range; knots whose tent
-// holds no sample are dropped (their value would be undetermined).
+// The knots: given, or spread evenly over the range of u; knots whose tent
+// holds no sample are dropped (their value would be undetermined). `name`
+// names the signal in the warnings.
 std::vector<double> Knots(const Eigen::VectorXd& u, const BlockModelOptions& o,
-                          std::vector<std::string>* warnings) {
+                          std::vector<std::string>* warnings, const char* name = "u") {
   std::vector<double> c = o.knots;
   if (c.empty()) {
     const Eigen::VectorXd k = Eigen::VectorXd::LinSpaced(o.num_knots, u.minCoeff(), u.maxCoeff());
@@ -211,7 +245,7 @@ std::vector<double> Knots(const Eigen::VectorXd& u, const BlockModelOptions& o,
       if (support[j] < 1e-9) empty = j;
     if (empty == c.size() || c.size() <= 2) break;
     warnings->push_back(
-        fmt::format("knot u = {:g} dropped: no input sample within its neighbours", c[empty]));
+        fmt::format("knot {} = {:g} dropped: no sample within its neighbours", name, c[empty]));
     c.erase(c.begin() + static_cast<std::ptrdiff_t>(empty));
   }
   return c;
@@ -239,15 +273,20 @@ PolynomialModel LinearPart(const Eigen::VectorXd& theta, const Layout& l, double
   return g;
 }
 
-BlockModelResult Finish(const Eigen::VectorXd& theta, const Layout& l, double Ts,
-                        const std::vector<double>& knots, EstimationSummary s,
-                        StaticMapExtrapolation extrapolation) {
+// The map through the knots with the n values of theta from `offset`.
+StaticMap MapOf(const std::vector<double>& knots, const Eigen::VectorXd& theta,
+                Eigen::Index offset) {
+  const Eigen::VectorXd v = theta.segment(offset, static_cast<Eigen::Index>(knots.size()));
+  return StaticMap(knots, std::vector<double>(v.data(), v.data() + v.size()),
+                   StaticMapExtrapolation::kClamp);
+}
+
+BlockModelResult Finish(const Eigen::VectorXd& theta, const Layout& l, double Ts, StaticMap map,
+                        EstimationSummary s) {
   BlockModelResult r;
   r.linear = LinearPart(theta, l, Ts);
   r.linear.noise_variance = s.loss;
-  const Eigen::VectorXd values = theta.segment(l.map_offset(), l.m);
-  r.map = StaticMap(knots, std::vector<double>(values.data(), values.data() + values.size()),
-                    extrapolation);
+  r.map = std::move(map);
   s.num_parameters = l.size();
   if (!r.linear.ToTransferFunction().IsStable())
     s.warnings.push_back("the linear part is unstable");
@@ -394,7 +433,7 @@ BlockModelResult EstimateHammerstein(const Eigen::VectorXd& u, const Eigen::Vect
     for (int j = 1; j < l.m; ++j) a[j] = a[j - 1] + monotone * a[j] * a[j];
   }
   s.num_rows = u.size();
-  return Finish(theta, l, Ts, knots, std::move(s), StaticMapExtrapolation::kClamp);
+  return Finish(theta, l, Ts, MapOf(knots, theta, l.map_offset()), std::move(s));
 }
 
 BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
@@ -422,7 +461,63 @@ BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd&
   RefineOutputError(std::make_unique<WienerError>(WienerError{l, &y, &u, knots}), u.size(), o,
                     &theta, &s);
   s.num_rows = u.size();
-  return Finish(theta, l, Ts, knots, std::move(s), StaticMapExtrapolation::kClamp);
+  return Finish(theta, l, Ts, MapOf(knots, theta, l.map_offset()), std::move(s));
+}
+
+BlockModelResult EstimateHammersteinWiener(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                                           double Ts, const BlockModelOptions& o) {
+  CheckSignals(u, y, Ts, o, "Hammerstein-Wiener", /*two_maps=*/true);
+  // Start: the Hammerstein model (f_H, G), its map moved to the input units.
+  BlockModelOptions ho = o;
+  ho.monotone_map = false;
+  const BlockModelResult h = EstimateHammerstein(u, y, Ts, ho);
+  EstimationSummary s;
+  s.warnings = h.summary.warnings;
+  const std::vector<double>& in_knots = h.map.u();
+  const auto m = static_cast<int>(in_knots.size());
+  const double f1 = h.map.y().front(), fm = h.map.y().back();
+  const double c1 = in_knots.front(), cm = in_knots.back();
+  PNEUMID_CHECK(std::abs(fm - f1) > 1e-12 * std::max(std::abs(f1), std::abs(fm)),
+                "Hammerstein-Wiener: the initial input map has the same value {:g} at both end "
+                "knots u = {:g} and u = {:g}; the normalisation f(c_1) = c_1, f(c_m) = c_m needs "
+                "an input map that changes over the input range",
+                f1, c1, cm);
+  const double scale = (cm - c1) / (fm - f1);
+  std::vector<double> f(m);
+  for (int j = 0; j < m; ++j) f[j] = c1 + scale * (h.map.y()[j] - f1);
+  f.front() = c1;
+  f.back() = cm;
+
+  // x = G f(u); the output map's knots over its range, values fitted on (x, y).
+  const Layout l{o.na, o.nb, o.nk, 2 * m - 2};
+  Eigen::VectorXd theta(l.size());
+  theta.head(l.na) = h.linear.a.tail(l.na);
+  theta.segment(l.na, l.nb - 1) = h.linear.b[0].segment(l.nk, l.nb - 1);
+  for (int j = 1; j + 1 < m; ++j) theta[l.map_offset() + j - 1] = f[j];
+  std::vector<Tent> tents(static_cast<std::size_t>(u.size()));
+  for (Eigen::Index t = 0; t < u.size(); ++t)
+    tents[static_cast<std::size_t>(t)] = TentAt(in_knots, u[t]);
+  std::vector<double> x;
+  SimulateUnitGain(theta.data(), l, MapThroughTents(f.data(), tents), &x);
+  const Eigen::VectorXd xv = Eigen::Map<const Eigen::VectorXd>(x.data(), u.size());
+  BlockModelOptions go = o;
+  go.knots.clear();
+  go.num_knots = m;
+  const std::vector<double> out_knots = Knots(xv, go, &s.warnings, "x");
+  theta.conservativeResize(l.na + l.nb - 1 + (m - 2) + static_cast<Eigen::Index>(out_knots.size()));
+  theta.tail(static_cast<Eigen::Index>(out_knots.size())) = FitMapValues(out_knots, xv, y);
+  const Layout lj{o.na, o.nb, o.nk, m - 2 + static_cast<int>(out_knots.size())};
+
+  // Joint output-error refinement of G and both maps.
+  RefineOutputError(
+      std::make_unique<HwError>(HwError{lj, &y, std::move(tents), in_knots, out_knots}), u.size(),
+      o, &theta, &s);
+  s.num_rows = u.size();
+  Eigen::VectorXd fv(m);
+  fv << c1, theta.segment(lj.map_offset(), m - 2), cm;
+  BlockModelResult r = Finish(theta, lj, Ts, MapOf(in_knots, fv, 0), std::move(s));
+  r.output_map = MapOf(out_knots, theta, lj.map_offset() + m - 2);
+  return r;
 }
 
 namespace {

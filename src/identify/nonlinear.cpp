@@ -42,6 +42,14 @@ void SetLinearPart(const PolynomialModel& g, IdentifiedModel* m) {
                {"Ts", g.Ts}};
 }
 
+BlockModelOptions BlockOptions(const IdentifyRequest& request, const NonlinearOptions& options) {
+  BlockModelOptions o = options.block;
+  o.na = request.na;
+  o.nb = std::max(1, request.nb);
+  o.nk = request.nk;
+  return o;
+}
+
 void AddSummary(const EstimationSummary& s, IdentifiedModel* m) {
   m->termination = s.termination;
   m->notes.push_back(
@@ -66,8 +74,8 @@ bool NonlinearOptions::IsValid(std::string* error) const {
 }
 
 const std::vector<std::string>& NonlinearMethodNames() {
-  static const std::vector<std::string> names = {"static-map", "hammerstein", "wiener", "narx",
-                                                 "affine-narx"};
+  static const std::vector<std::string> names = {"static-map", "hammerstein", "wiener",
+                                                 "hw",         "narx",        "affine-narx"};
   return names;
 }
 
@@ -110,10 +118,7 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
     m.notes.push_back(MapNote("map", r.map));
     m.notes.push_back(r.summary.BriefReport());
   } else if (method == "hammerstein" || method == "wiener") {
-    BlockModelOptions o = options.block;
-    o.na = request.na;
-    o.nb = std::max(1, request.nb);
-    o.nk = request.nk;
+    const BlockModelOptions o = BlockOptions(request, options);
     const bool hammerstein = method == "hammerstein";
     const BlockModelResult r =
         hammerstein ? EstimateHammerstein(u, y, Ts, o) : EstimateWiener(u, y, Ts, o);
@@ -121,6 +126,15 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
     (hammerstein ? m.input_map : m.output_map) = r.map;
     SetLinearPart(r.linear, &m);
     m.notes.push_back(MapNote(hammerstein ? "input map f(u)" : "output map f(x)", r.map));
+    AddSummary(r.summary, &m);
+  } else if (method == "hw") {
+    const BlockModelResult r = EstimateHammersteinWiener(u, y, Ts, BlockOptions(request, options));
+    m.structure = "Hammerstein-Wiener";
+    m.input_map = r.map;
+    m.output_map = r.output_map;
+    SetLinearPart(r.linear, &m);
+    m.notes.push_back(MapNote("input map f(u)", r.map));
+    m.notes.push_back(MapNote("output map g(x)", *r.output_map));
     AddSummary(r.summary, &m);
   } else if (method == "affine-narx") {
     AffineNarxOptions o;

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# pneumid identify -m static-map|hammerstein|wiener|narx on the IPA twin: one
+# pneumid identify -m static-map|hammerstein|wiener|hw|narx on the IPA twin: one
 # 60 s experiment (staircase 0..100 % in 5 % steps for 30 s, then a
 # multi-level PRBS for 30 s), validated on another experiment; the model file
 # keeps the maps and NARX terms and `validate` simulates them.
@@ -27,13 +27,13 @@ experiment "staircase:levels=0 25 55 85 45 15 65 95 35 5,dwell=2" \
 
 help="$("$PNEUMID" identify --help)"
 grep -q "hammerstein" <<<"$help" || fail "--help lacks the nonlinear methods"
-"$PNEUMID" identify "$dir/est.csv" -m arx,oe,fit-p1d,hammerstein,wiener,narx,affine-narx --na 2 --nb 2 \
+"$PNEUMID" identify "$dir/est.csv" -m arx,oe,fit-p1d,hammerstein,wiener,hw,narx,affine-narx --na 2 --nb 2 \
   --nk 1 --nf 2 --knots 21 --max-terms 15 --validation "$dir/val.csv" -o "$dir/models.json" \
   >"$dir/table.txt"
 grep -q "input map f(u): .*21 knots" "$dir/table.txt" || fail "no map knots printed: $(cat "$dir/table.txt")"
 grep -q "selected terms: " "$dir/table.txt" || fail "no NARX terms printed"
 "$PY" - "$dir/models.json" <<'PY' || fail "validation fits"
-import json, sys
+import json, math, sys
 models = {m["method"]: m for m in json.load(open(sys.argv[1]))["models"]}
 fit = {k: m["validation_fit_percent"] for k, m in models.items()}
 print(" ".join(f"{k}={v:.1f}" for k, v in sorted(fit.items())))
@@ -42,20 +42,26 @@ nonlinear = max(fit["hammerstein"], fit["wiener"], fit["narx"], fit["affine-narx
 assert linear <= 80.0, fit
 assert nonlinear >= 90.0 and nonlinear - linear >= 12.0, fit
 assert fit["affine-narx"] >= 90.0, fit  # fills faster than it vents: only it reaches 90 %
+assert math.isfinite(fit["hw"]) and fit["hw"] > linear, fit
+hw = models["hw"]
+assert len(hw["input_map"]["u"]) == 21 and len(hw["output_map"]["u"]) == 21, hw
 assert len(models["hammerstein"]["input_map"]["u"]) == 21
 assert "output_map" in models["wiener"] and "narx" in models["narx"]
 assert "narx" in models["affine-narx"] and len(models["affine-narx"]["input_map"]["u"]) == 21
 PY
 
-# validate simulates the affine NARX (map, then NARX) as identify scored it;
+# validate simulates the affine NARX (map, then NARX) and the
+# Hammerstein-Wiener model (input map, G, output map) as identify scored them;
 # a controller refuses a NARX model with a clear message.
-out="$("$PNEUMID" validate "$dir/models.json#affine-narx" "$dir/val.csv" --json)"
-"$PY" - "$out" "$dir/models.json" <<'PY' || fail "validate of the affine NARX"
+for method in affine-narx hw; do
+  out="$("$PNEUMID" validate "$dir/models.json#$method" "$dir/val.csv" --json)"
+  "$PY" - "$out" "$dir/models.json" "$method" <<'PY' || fail "validate of $method"
 import json, sys
 v = json.loads(sys.argv[1])
-m = {m["method"]: m for m in json.load(open(sys.argv[2]))["models"]}["affine-narx"]
+m = {m["method"]: m for m in json.load(open(sys.argv[2]))["models"]}[sys.argv[3]]
 assert abs(v["fit_percent"] - m["validation_fit_percent"]) < 1e-6, (v["fit_percent"], m)
 PY
+done
 expect_error "NARX model as a plant" "is a NARX model, which has no transfer function" \
   simulate --plant "$dir/models.json#affine-narx" --input step:from=0,to=40 --duration 1
 

@@ -10,13 +10,18 @@ noise (seeded); y_true is the noise-free output.
 
 Run from the repository root:
     /usr/bin/python3 tests/identify/gen_nonlinear_systems.py
-writes tests/identify/data/{hammerstein,wiener,narx}.csv (columns t,u,y,y_true).
+writes tests/identify/data/{hammerstein,wiener,hw,narx}.csv (columns t,u,y,y_true).
 
 Hammerstein and Wiener: the static map f through the knots U_KNOTS with values
 F_VALUES (linear between knots, held beyond them) and the unit-gain linear part
     G(q) = (B1 q^-1 + B2 q^-2) / (1 + A1 q^-1 + A2 q^-2),  Ts = 0.01 s,
 started in steady state at the first input sample:
     Hammerstein y = f(u0) + G (f(u) - f(u0));  Wiener y = f(u0 + G (u - u0)).
+Hammerstein-Wiener (hw.csv): y = g(x), x = f_in(u0) + G (f_in(u) - f_in(u0)) with
+the same G, the input map f_in through U_KNOTS with values HW_IN_VALUES (end
+values equal to the end knots: pneumid's normalisation) and the output map g
+through HW_OUT_KNOTS with values HW_OUT_VALUES; the input starts with 0 and 100
+held 150 samples each, so that x covers [0, 100]; noise std 0.2.
 NARX (Billings 2013, sec. 3.7 style polynomial model, u scaled to [-1, 1]
 as u/50 - 1):
     y(t) = -0.605 y(t-1) - 0.163 y(t-2)^2 + 0.588 v(t-1) - 0.240 v(t-2) + e(t),
@@ -37,6 +42,9 @@ A1, A2 = -1.7, 0.72  # poles 0.9 and 0.8
 B1 = 0.012
 B2 = (1.0 + A1 + A2) - B1  # unit static gain: B(1) = A(1) = 0.02
 N = 4000
+HW_IN_VALUES = np.array([0.0, 6.0, 24.0, 55.0, 85.0, 100.0])
+HW_OUT_KNOTS = np.array([0.0, 20.0, 40.0, 60.0, 80.0, 100.0])
+HW_OUT_VALUES = np.array([5.0, 40.0, 68.0, 88.0, 101.0, 108.0])
 
 
 def levels(seed, n, grid=False):
@@ -91,6 +99,13 @@ def main():
     u = levels(21, N)
     write("wiener", u, f(unit_gain_from_rest(u)), 0.2, 22,
           "Wiener: same f and G as hammerstein.csv; noise std 0.2 (gen_nonlinear_systems.py)")
+
+    u = np.concatenate([np.zeros(150), np.full(150, 100.0), levels(41, N - 300)])
+    x = unit_gain_from_rest(np.interp(u, U_KNOTS, HW_IN_VALUES))
+    write("hw", u, np.interp(x, HW_OUT_KNOTS, HW_OUT_VALUES), 0.2, 42,
+          "Hammerstein-Wiener: f_in knots {} values {}, g knots {} values {}; G as hammerstein.csv;"
+          " noise std 0.2 (gen_nonlinear_systems.py)".format(
+              list(U_KNOTS), list(HW_IN_VALUES), list(HW_OUT_KNOTS), list(HW_OUT_VALUES)))
 
     u = levels(31, 2000, grid=True)
     v = u / 50.0 - 1.0

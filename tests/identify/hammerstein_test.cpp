@@ -1,4 +1,4 @@
-// Hammerstein and Wiener estimation on recorded data of known systems
+// Hammerstein, Wiener and Hammerstein-Wiener estimation on recorded data of known systems
 // (gen_nonlinear_systems.py beside this file, simulated with scipy): the
 // parameters are recovered within 2 %, the simulations match scipy's, and bad
 // input is rejected with the offending values.
@@ -104,6 +104,62 @@ TEST(WienerTest, RecoversAKnownSystemWithinTwoPercent) {
   EXPECT_EQ(r.summary.termination, Termination::kConvergence) << r.summary.message;
   EXPECT_NEAR(r.summary.loss, 0.04, 0.004);
   ExpectRecovered(r, 0.02);
+}
+
+// The Hammerstein-Wiener system of gen_nonlinear_systems.py (hw.csv): the
+// same G, input map through kKnots (end values = end knots, as normalised).
+const std::vector<double> kHwIn = {0, 6, 24, 55, 85, 100};
+const std::vector<double> kHwOutKnots = {0, 20, 40, 60, 80, 100};
+const std::vector<double> kHwOut = {5, 40, 68, 88, 101, 108};
+
+TEST(HammersteinWienerTest, RecoversAKnownSystemWithinAFewPercent) {
+  const Dataset d = Recorded("hw");
+  const BlockModelResult r =
+      EstimateHammersteinWiener(d.u(), d.y(), d.SampleTime(), TrueStructure());
+  EXPECT_EQ(r.summary.termination, Termination::kConvergence) << r.summary.message;
+  EXPECT_LT(r.summary.loss, r.summary.initial_loss);
+  EXPECT_NEAR(r.summary.loss, 0.04, 0.004);  // noise std 0.2
+  EXPECT_EQ(r.summary.num_parameters, 2 + 1 + 4 + 6);
+  const double rel = 0.03;
+  EXPECT_NEAR(r.linear.a[1], kA1, rel * std::abs(kA1));
+  EXPECT_NEAR(r.linear.a[2], kA2, rel * std::abs(kA2));
+  EXPECT_NEAR(r.linear.b[0][1], kB1, rel * kB1);
+  EXPECT_NEAR(r.linear.b[0][2], kB2, rel * kB2);
+  EXPECT_NEAR(r.linear.ToTransferFunction().DcGain(), 1.0, 1e-9);
+  // The input map at its knots: the ends fixed by the normalisation.
+  ASSERT_EQ(r.map.u(), kKnots);
+  EXPECT_EQ(r.map.y().front(), 0.0);
+  EXPECT_EQ(r.map.y().back(), 100.0);
+  for (std::size_t j = 1; j + 1 < kKnots.size(); ++j)
+    EXPECT_NEAR(r.map.y()[j], kHwIn[j], 0.03 * 100.0) << "input knot " << kKnots[j];
+  // The output map at its knots (spread over the range of x = [0, 100]).
+  ASSERT_TRUE(r.output_map.has_value());
+  const StaticMap g_true(kHwOutKnots, kHwOut);
+  ASSERT_EQ(r.output_map->size(), 6U);
+  EXPECT_NEAR(r.output_map->u().front(), 0.0, 1e-6);
+  EXPECT_NEAR(r.output_map->u().back(), 100.0, 1e-3);
+  for (std::size_t j = 0; j < r.output_map->size(); ++j)
+    EXPECT_NEAR(r.output_map->y()[j], g_true.Evaluate(r.output_map->u()[j]), 0.03 * 108.0)
+        << "output knot " << r.output_map->u()[j];
+  // The model simulates the noise-free output closely.
+  const Dataset clean = Recorded("hw", "y_true");
+  const Eigen::VectorXd yhat =
+      SimulateWiener(r.linear.ToTransferFunction(), *r.output_map, r.map.Evaluate(clean.u()));
+  const Eigen::VectorXd e = yhat - clean.y();
+  EXPECT_LT(std::sqrt(e.squaredNorm() / static_cast<double>(e.size())), 0.2);
+  EXPECT_LT(e.cwiseAbs().maxCoeff(), 1.0);
+}
+
+TEST(HammersteinWienerTest, RejectsBadInput) {
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(500, 30.0);
+  const Eigen::VectorXd y = Eigen::VectorXd::Random(500);
+  EXPECT_THAT([&] { EstimateHammersteinWiener(u, y, 0.01); },
+              ThrowsMessage<InvalidArgument>(HasSubstr(
+                  "Hammerstein-Wiener: the input never leaves one operating point (u = 30")));
+  // Two maps of 11 knots: 9 + 11 free map values besides the 3 of G.
+  EXPECT_THAT(
+      [&] { EstimateHammersteinWiener(u.head(30), y.head(30), 0.01); },
+      ThrowsMessage<InvalidArgument>(HasSubstr("30 samples are too few for 23 parameters")));
 }
 
 TEST(HammersteinTest, SpreadsKnotsOverTheInputRangeAndDropsEmptyOnes) {

@@ -36,7 +36,7 @@ TEST(NonlinearMethodsTest, AreIdentifyMethodsButNotInAll) {
   EXPECT_THAT(ParseMethodList("arx,hammerstein"), ::testing::ElementsAre("arx", "hammerstein"));
   EXPECT_THAT(
       [] { ParseMethodList("hammerstien"); },
-      ThrowsMessage<InvalidArgument>(HasSubstr("spa, static-map, hammerstein, wiener, narx")));
+      ThrowsMessage<InvalidArgument>(HasSubstr("spa, static-map, hammerstein, wiener, hw, narx")));
 }
 
 TEST(NonlinearMethodsTest, ModelsRoundTripThroughTheModelFile) {
@@ -47,7 +47,7 @@ TEST(NonlinearMethodsTest, ModelsRoundTripThroughTheModelFile) {
   r.nk = 1;
   IdentifyOptions o;
   o.nonlinear.block.num_knots = 6;  // the true knots 0, 20, .., 100
-  for (const std::string method : {"hammerstein", "wiener", "narx"}) {
+  for (const std::string method : {"hammerstein", "wiener", "hw", "narx"}) {
     SCOPED_TRACE(method);
     const IdentifiedModel m = Identify(method, h, r, o);
     EXPECT_EQ(m.method, method);
@@ -68,6 +68,12 @@ TEST(NonlinearMethodsTest, ModelsRoundTripThroughTheModelFile) {
   EXPECT_THAT(ham.notes[0], HasSubstr("input map f(u): monotone increasing, 6 knots"));
   EXPECT_THAT([&] { SimulateModel(ham, h, 0, 0, InitialCondition::kEstimate); },
               ThrowsMessage<InvalidArgument>(HasSubstr("initial-state estimate is for linear")));
+  const IdentifiedModel hw = Identify("hw", Recorded("hw"), r, o);
+  EXPECT_EQ(hw.structure, "Hammerstein-Wiener");
+  ASSERT_TRUE(hw.input_map.has_value() && hw.output_map.has_value());
+  EXPECT_GT(hw.fit_percent, 98.0);
+  EXPECT_THAT(hw.notes[0], HasSubstr("input map f(u): monotone increasing, 6 knots"));
+  EXPECT_THAT(hw.notes[1], HasSubstr("output map g(x): monotone increasing, 6 knots"));
   const IdentifiedModel narx = Identify("narx", Recorded("narx"), r, o);
   EXPECT_THAT(narx.notes[0], HasSubstr("selected terms: "));
 }

@@ -1,8 +1,10 @@
-// Block-oriented nonlinear models: a static map and linear dynamics in series
-// ([1] sec. 5.5, [2]). Methods `hammerstein` and `wiener` of `pneumid identify`.
+// Block-oriented nonlinear models: static maps and linear dynamics in series
+// ([1] sec. 5.5, [2]). Methods `hammerstein`, `wiener` and `hw` of
+// `pneumid identify`.
 //
-//   Hammerstein:  v(t) = f(u(t)),  y(t) = G(q) v(t) + e(t)
-//   Wiener:       x(t) = G(q) u(t),  y(t) = f(x(t)) + e(t)
+//   Hammerstein:         v(t) = f(u(t)),  y(t) = G(q) v(t) + e(t)
+//   Wiener:              x(t) = G(q) u(t),  y(t) = f(x(t)) + e(t)
+//   Hammerstein-Wiener:  x(t) = G(q) f(u(t)),  y(t) = g(x(t)) + e(t)
 //
 // with f a piecewise-linear StaticMap (lti/static_map.hpp) through knots
 // c_1 < ... < c_m (given, or spread evenly over the input range) and
@@ -39,6 +41,23 @@
 // the input range); then the same output-error refinement over a, b and the
 // values of f.
 //
+// Hammerstein-Wiener: f (the input map, knots as above) and g (the output
+// map, as many knots spread evenly over the range of x = G f(u) at the start,
+// empty ones dropped) leave, besides the scale of G, an affine transformation
+// of the intermediate signal free (x -> s x + d with f -> s f + d and
+// g(x) -> g((x - d) / s) give the same model). It is fixed by
+//   G(1) = 1,  f(c_1) = c_1,  f(c_m) = c_m,
+// i.e. the input map's end values equal its end knots, so x has the units of
+// u (and the model needs f(c_1) != f(c_m): an input map that changes over the
+// input range). The free parameters are a, b_1..b_{nb-1}, f(c_2), ..,
+// f(c_{m-1}) and the values of g. Start: the Hammerstein estimate (f_H, G),
+// moved to f = c_1 + (c_m - c_1) (f_H - f_H(c_1)) / (f_H(c_m) - f_H(c_1));
+// g is the least-squares piecewise-linear fit of y on x = G f(u); then the
+// output-error refinement over all parameters jointly. `monotone_map` applies
+// to `hammerstein` only (the Hammerstein-Wiener maps are not constrained).
+// Simulation: yhat = g(f(u(0)) + G (f(u) - f(u(0)))), i.e. SimulateWiener on
+// the mapped input f(u).
+//
 // [1] L. Ljung, System Identification: Theory for the User, 2nd ed., 1999.
 // [2] F. Giri, E.-W. Bai (eds.), Block-oriented Nonlinear System
 //     Identification, Springer, 2010.
@@ -46,6 +65,7 @@
 //     Hammerstein-Wiener nonlinear systems, Automatica 34 (1998) 333-338.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,10 +85,10 @@ struct BlockModelOptions {
   /// spread evenly over [min u, max u] of the data.
   std::vector<double> knots;
   int num_knots = 11;  ///< >= 2, used when `knots` is empty
-  /// Hammerstein only: keep f monotone (non-decreasing or non-increasing, the
-  /// direction of the initial estimate's trend) for an invertible map: the
-  /// start is made monotone by PAVA and the refinement runs over alpha_1 and
-  /// the square roots of the increments, alpha_j = alpha_{j-1} +- q_j^2.
+  /// Hammerstein only (not Hammerstein-Wiener): keep f monotone (non-decreasing or non-increasing,
+  /// the direction of the initial estimate's trend) for an invertible map: the start is made
+  /// monotone by PAVA and the refinement runs over alpha_1 and the square roots of the increments,
+  /// alpha_j = alpha_{j-1} +- q_j^2.
   bool monotone_map = false;
   /// Output-error refinement with Ceres after the initial estimate.
   bool refine = true;
@@ -81,7 +101,9 @@ struct BlockModelOptions {
 
 /// A static map and a linear part G of unit static gain (see above).
 struct BlockModelResult {
-  StaticMap map;
+  StaticMap map;  ///< f: the input map (Hammerstein, Hammerstein-Wiener) or output map (Wiener)
+  /// Hammerstein-Wiener only: the output map g (`map` is then the input map f).
+  std::optional<StaticMap> output_map;
   PolynomialModel linear;  ///< structure "OE": a, b (nk leading zeros), nk, Ts
   /// termination, iterations, loss = mean squared simulation error (initial
   /// estimate: initial_loss), warnings (knots without data, ...).
@@ -99,6 +121,11 @@ BlockModelResult EstimateHammerstein(const Eigen::VectorXd& u, const Eigen::Vect
 /// Wiener model; errors as EstimateHammerstein.
 BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
                                 const BlockModelOptions& options = {});
+
+/// Hammerstein-Wiener model y = g(G f(u)) normalised as above; errors as
+/// EstimateHammerstein, and for an initial input map with equal end values.
+BlockModelResult EstimateHammersteinWiener(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                                           double Ts, const BlockModelOptions& options = {});
 
 /// yhat = f(u(0)) + G (f(u) - f(u(0))), G discrete, started at rest.
 /// @throws InvalidArgument for a continuous G.

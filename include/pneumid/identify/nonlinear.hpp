@@ -3,6 +3,8 @@
 //   static-map   steady-state map from a staircase or slow ramp (static_map_fit.hpp)
 //   hammerstein  input map + linear dynamics (hammerstein.hpp), orders na, nb, nk
 //   wiener       linear dynamics + output map (hammerstein.hpp), orders na, nb, nk
+//   hw           Hammerstein-Wiener: input map + linear dynamics + output map
+//                (hammerstein.hpp), orders na, nb, nk
 //   narx         polynomial NARX by FROLS (narx.hpp): ny = na, nu = nb, delay nk
 //   affine-narx  input-affine first-order NARX with an input map (affine_narx.hpp):
 //                degree of narx, knots of hammerstein, delay nk
@@ -11,10 +13,11 @@
 // two input levels, from which no map follows, and the fits would only fail.
 //
 // An IdentifiedModel of these methods carries its nonlinear part in the
-// optional members input_map (static-map, hammerstein), output_map (wiener)
-// or narx (affine-narx: narx and input_map, the NARX in f(u)); `discrete` is the linear part G of unit static gain (static-map:
-// G = 1, no dynamics), `tf` its continuous (zoh d2c) form when it exists. The
-// operating point is u0 = y0 = 0 (the maps hold the offsets). SimulateModel
+// optional members input_map (static-map, hammerstein, hw), output_map
+// (wiener, hw) or narx (affine-narx: narx and input_map, the NARX in f(u));
+// `discrete` is the linear part G of unit static gain (static-map: G = 1, no
+// dynamics), `tf` its continuous (zoh d2c) form when it exists. The operating
+// point is u0 = y0 = 0 (the maps hold the offsets). SimulateModel
 // (model_evaluation.hpp) simulates them as SimulateNonlinear below.
 #pragma once
 
@@ -43,7 +46,7 @@ struct NonlinearOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// "static-map", "hammerstein", "wiener", "narx", "affine-narx".
+/// "static-map", "hammerstein", "wiener", "hw", "narx", "affine-narx".
 const std::vector<std::string>& NonlinearMethodNames();
 bool IsNonlinearMethod(const std::string& name);
 
@@ -62,7 +65,8 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
 
 /// Simulated output of a nonlinear model on `data` (see the module comment
 /// and each estimator's header): Hammerstein / static map
-/// f(u(0)) + G (f(u) - f(u(0))), Wiener f(u(0) + G (u - u(0))), NARX free
+/// f(u(0)) + G (f(u) - f(u(0))), Wiener f(u(0) + G (u - u(0))),
+/// Hammerstein-Wiener g(f(u(0)) + G (f(u) - f(u(0)))), NARX free
 /// run with its first max-lag outputs from output column `output`.
 /// @throws InvalidArgument for a model without nonlinear part, bad columns,
 ///         or a sample time that differs from the model's.
