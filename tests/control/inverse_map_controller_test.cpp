@@ -164,5 +164,46 @@ TEST(InverseMapControllerTest, RejectsAMapWithoutInverseAndBadArguments) {
   EXPECT_THROW(InverseMapController(Mpc({}), SMap(), bad), InvalidArgument);
 }
 
+TEST(OutputMapControllerTest, WienerPlantThroughTheInverseIsTheLinearLoop) {
+  // Plant y = g(x), x = G u, with an increasing output map g (x in input
+  // units, y in N); the inner MPC on G sees x = g^-1(y) and the set point
+  // g^-1(r): every sample equals the linear loop's on x.
+  const StaticMap g({0, 25, 50, 75, 100}, {0, 10, 50, 110, 140});
+  OutputMapController c(Mpc({}), g);
+  auto linear = Mpc({});
+  c.Reset(20.0, g.Evaluate(20.0));
+  linear->Reset(20.0, 20.0);
+  Lag wie{20.0}, lin{20.0};
+  const std::vector<double> r = {30.0, 120.0, 60.0};
+  for (int k = 0; k < 600; ++k) {
+    const double rk = r[static_cast<std::size_t>(k / 200)];
+    const double u = c.Update(rk, g.Evaluate(wie.Output()));
+    const double v = linear->Update(g.Inverse(rk), lin.Output());
+    ASSERT_NEAR(u, v, 1e-9 * (1.0 + std::abs(v))) << "k = " << k;
+    wie.Advance(u);
+    lin.Advance(v);
+  }
+  EXPECT_NEAR(g.Evaluate(wie.Output()), 60.0, 1e-3);
+  EXPECT_THAT(c.Describe(), HasSubstr("on the inverse output map (5 knots)"));
+}
+
+TEST(OutputMapControllerTest, InvertsTheMonotoneEnvelopeAndRefusesAFlatMap) {
+  // A dip (fitted maps have them) is flattened: 8 N maps to the dip's start.
+  const StaticMap dip({0, 10, 20, 100}, {10, 8, 12, 100});
+  OutputMapController c(Mpc({}), dip);
+  EXPECT_NEAR(c.map().Inverse(10.0), 10.0, 1e-12);
+  EXPECT_DOUBLE_EQ(c.map().Evaluate(10.0), 10.0);
+  EXPECT_THAT(
+      [] {
+        OutputMapController(Mpc({}), StaticMap({0, 100}, {5, 1}));
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("output map")));
+  EXPECT_THAT(
+      [] {
+        OutputMapController(nullptr, StaticMap({0, 100}, {0, 1}));
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("got null")));
+}
+
 }  // namespace
 }  // namespace pneumid
