@@ -338,6 +338,20 @@ nlohmann::json AppApi::Files(const Request& req) {
   return j;
 }
 
+nlohmann::json AppApi::LoadDataSet(std::string name, const cli::DataOptions& o) {
+  DataSet set;
+  set.name = std::move(name);
+  set.path = o.path;
+  set.t = o.time_col;
+  set.u = o.input_col;
+  set.y = o.output_col;
+  set.data = cli::LoadFromOptions(o);
+  set.columns = DataFormatFromPath(o.path) == DataFormat::kMat
+                    ? std::vector<std::string>{o.time_col, o.input_col, o.output_col}
+                    : CsvColumns(o.path);
+  return AddDataSet(std::move(set));
+}
+
 nlohmann::json AppApi::AddDataSet(DataSet set) {
   const Dataset& d = set.data;
   nlohmann::json j;
@@ -374,17 +388,7 @@ nlohmann::json AppApi::OpenData(const nlohmann::json& body) {
   Get(body, "t", o.time_col);
   Get(body, "u", o.input_col);
   Get(body, "y", o.output_col);
-  DataSet set;
-  set.name = path;
-  set.path = o.path;
-  set.t = o.time_col;
-  set.u = o.input_col;
-  set.y = o.output_col;
-  set.data = cli::LoadFromOptions(o);
-  set.columns = DataFormatFromPath(o.path) == DataFormat::kMat
-                    ? std::vector<std::string>{o.time_col, o.input_col, o.output_col}
-                    : CsvColumns(file);
-  return AddDataSet(std::move(set));
+  return LoadDataSet(path, o);
 }
 
 nlohmann::json AppApi::Upload(const Request& req) {
@@ -415,17 +419,7 @@ nlohmann::json AppApi::Upload(const Request& req) {
   q("t", o.time_col);
   q("u", o.input_col);
   q("y", o.output_col);
-  DataSet set;
-  set.name = name;
-  set.path = o.path;
-  set.t = o.time_col;
-  set.u = o.input_col;
-  set.y = o.output_col;
-  set.data = cli::LoadFromOptions(o);
-  set.columns = DataFormatFromPath(o.path) == DataFormat::kMat
-                    ? std::vector<std::string>{o.time_col, o.input_col, o.output_col}
-                    : CsvColumns(file);
-  return AddDataSet(std::move(set));
+  return LoadDataSet(name, o);
 }
 
 std::shared_ptr<const AppApi::DataSet> AppApi::FindDataSet(const nlohmann::json& id,

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../data_options.hpp"
 #include "http_server.hpp"
 #include "live_run.hpp"
 #include "pneumid/data/dataset.hpp"
@@ -60,6 +61,8 @@ class AppApi {
   Response ExportController(const nlohmann::json& body);
   Response ExportReport(const nlohmann::json& body);
 
+  /// Loads the data file of `o` (opened or uploaded) as a data set named `name`.
+  nlohmann::json LoadDataSet(std::string name, const cli::DataOptions& o);
   nlohmann::json AddDataSet(DataSet set);
   std::shared_ptr<const DataSet> FindDataSet(const nlohmann::json& id, const char* field) const;
   std::filesystem::path Confine(const std::string& path) const;
