@@ -51,6 +51,9 @@ const std::vector<DoubleKey>& DoubleKeys() {
       {"valves.open_delay", &IpaParameters::open_delay},
       {"valves.close_delay", &IpaParameters::close_delay},
       {"valves.min_pulse_width", &IpaParameters::min_pulse_width},
+      {"valves.tube_conductance", &IpaParameters::tube_conductance},
+      {"valves.tube_critical_ratio", &IpaParameters::tube_critical_ratio},
+      {"valves.manifold_volume", &IpaParameters::manifold_volume},
       {"pwm.frequency", &IpaParameters::pwm_frequency},
       {"mechanics.mass", &IpaParameters::mass},
       {"mechanics.viscous_friction", &IpaParameters::viscous_friction},
@@ -112,6 +115,9 @@ constexpr Range kRanges[] = {
     {"valves.open_delay", "s", 0.0, 0.05, true},  // solenoid valves 0.3..30 ms
     {"valves.close_delay", "s", 0.0, 0.05, true},
     {"valves.min_pulse_width", "s", 0.0, 0.05, true},
+    {"valves.tube_conductance", "m^3/(s Pa)", 0.0, 1e-6, true},  // 0: no tube
+    {"valves.tube_critical_ratio", "", 0.05, 0.6, true},
+    {"valves.manifold_volume", "m^3", 1e-7, 1e-3, true},
     {"pwm.frequency", "Hz", 1.0, 2000.0, true},
     {"mechanics.mass", "kg", 0.01, 1000.0, true},
     {"mechanics.viscous_friction", "N s/m", 0.0, 1e5, true},
@@ -179,8 +185,8 @@ const IpaParameterInfo& FindIpaParameter(const std::string& name) {
     throw InvalidArgument(fmt::format(
         "IPA parameter name '{}' is ambiguous: give it with its section; valid names: {}",
         Excerpt(name), keys));
-  throw InvalidArgument(fmt::format("unknown IPA parameter '{}'; valid names: {}",
-                                    Excerpt(name), keys));
+  throw InvalidArgument(
+      fmt::format("unknown IPA parameter '{}'; valid names: {}", Excerpt(name), keys));
 }
 
 double GetIpaParameter(const IpaParameters& p, const std::string& name) {
@@ -209,8 +215,8 @@ std::string IpaParametersToToml(const IpaParameters& p, const std::string& comme
   for (const auto& sec : sections) {
     out += fmt::format("\n[{}]\n", sec);
     if (sec == "simulation")
-      out += fmt::format("mode = \"{}\"\npwm_mode = \"{}\"\n", ToString(p.mode),
-                         ToString(p.pwm_mode));
+      out +=
+          fmt::format("mode = \"{}\"\npwm_mode = \"{}\"\n", ToString(p.mode), ToString(p.pwm_mode));
     for (const auto& info : IpaParameterTable()) {
       const auto dot = info.key.find('.');
       if (info.key.compare(0, dot, sec) != 0 || dot != sec.size()) continue;

@@ -84,6 +84,7 @@ bool IpaParameters::IsValid(std::string* error) const {
                          Check{inlet_conductance, "valves.inlet_conductance", "m^3/(s Pa)"},
                          Check{exhaust_conductance, "valves.exhaust_conductance", "m^3/(s Pa)"},
                          Check{pwm_frequency, "pwm.frequency", "Hz"},
+                         Check{manifold_volume, "valves.manifold_volume", "m^3"},
                          Check{mass, "mechanics.mass", "kg"},
                          Check{stribeck_velocity, "mechanics.stribeck_velocity", "m/s"},
                          Check{friction_smoothing_velocity, "mechanics.smoothing_velocity", "m/s"},
@@ -97,6 +98,7 @@ bool IpaParameters::IsValid(std::string* error) const {
   for (const Check& c :
        {Check{open_delay, "valves.open_delay", "s"}, Check{close_delay, "valves.close_delay", "s"},
         Check{min_pulse_width, "valves.min_pulse_width", "s"},
+        Check{tube_conductance, "valves.tube_conductance", "m^3/(s Pa)"},
         Check{viscous_friction, "mechanics.viscous_friction", "N s/m"},
         Check{coulomb_friction, "mechanics.coulomb_friction", "N"},
         Check{static_friction, "mechanics.static_friction", "N"},
@@ -116,6 +118,7 @@ bool IpaParameters::IsValid(std::string* error) const {
                             piston_position, stroke));
   for (const Check& c : {Check{inlet_critical_ratio, "valves.inlet_critical_ratio", ""},
                          Check{exhaust_critical_ratio, "valves.exhaust_critical_ratio", ""},
+                         Check{tube_critical_ratio, "valves.tube_critical_ratio", ""},
                          Check{supply_line_critical_ratio, "supply.line_critical_ratio", ""}}) {
     if (!(c.value >= 0.0 && c.value < laminar_ratio))
       return fail(fmt::format("{} must be in [0, valves.laminar_ratio = {}), got {}", c.name,
@@ -189,6 +192,7 @@ void IpaSimulator::Reset() {
         0.0,
         0.0,
         0.0,
+        p_.atmospheric_pressure / kBar,
         p_.atmospheric_pressure / kBar};
   t_ = 0.0;
   dt_ = 1e-4;
@@ -220,6 +224,7 @@ void IpaSimulator::SetState(double p_a, double p_b, double x) {
   if (p_.mode == IpaMode::kPosition) x_[2] = x / kMm;
   x_[3] = 0.0;
   x_[6] = x_[0];
+  x_[7] = x_[0];
   for (double& r : readings_) r = SenseOutput();
   reading_head_ = 0;
 }
@@ -228,6 +233,9 @@ double IpaSimulator::Measure() { return readings_[reading_head_]; }
 
 double IpaSimulator::pressure_a() const { return x_[0] * kBar; }
 double IpaSimulator::pressure_b() const { return x_[1] * kBar; }
+double IpaSimulator::pressure_manifold() const {
+  return (p_.tube_conductance > 0.0 ? x_[7] : x_[0]) * kBar;
+}
 double IpaSimulator::position() const { return x_[2] * kMm; }
 double IpaSimulator::velocity() const { return x_[3]; }
 double IpaSimulator::force() const {
@@ -295,17 +303,27 @@ void IpaSimulator::Rhs(const State& x, State& dxdt, double open_in, double open_
   const double Va = std::max(p_.dead_volume_a + Aa * pos, 0.1 * p_.dead_volume_a);
   const double Vb = std::max(p_.dead_volume_b + Ab * (p_.stroke - pos), 0.1 * p_.dead_volume_b);
 
-  // Chamber A: inlet valve (supply <-> A) and exhaust valve (A <-> atmosphere).
-  double in_a = 0.0, out_a = 0.0;  // mass flows entering / leaving chamber A, kg/s
+  // Valves: inlet (supply <-> valve side) and exhaust (valve side <->
+  // atmosphere). The valve side is chamber A itself or, with a tube, the valve
+  // manifold, which the tube connects to chamber A.
+  const bool tube = p_.tube_conductance > 0.0;
+  const double pv = tube ? x[7] * kBar : pa;
+  double in_v = 0.0, out_v = 0.0;  // mass flows entering / leaving the valve side, kg/s
   if (open_in > 0.0) {
     const double C = p_.inlet_conductance, b = p_.inlet_critical_ratio;
-    in_a += open_in * Iso6358MassFlow(C, b, ps, pa, T, rl);
-    out_a += open_in * Iso6358MassFlow(C, b, pa, ps, T, rl);
+    in_v += open_in * Iso6358MassFlow(C, b, ps, pv, T, rl);
+    out_v += open_in * Iso6358MassFlow(C, b, pv, ps, T, rl);
   }
   if (open_out > 0.0) {
     const double C = p_.exhaust_conductance, b = p_.exhaust_critical_ratio;
-    out_a += open_out * Iso6358MassFlow(C, b, pa, patm, T, rl);
-    in_a += open_out * Iso6358MassFlow(C, b, patm, pa, T, rl);
+    out_v += open_out * Iso6358MassFlow(C, b, pv, patm, T, rl);
+    in_v += open_out * Iso6358MassFlow(C, b, patm, pv, T, rl);
+  }
+  double in_a = in_v, out_a = out_v;  // mass flows entering / leaving chamber A, kg/s
+  if (tube) {
+    const double C = p_.tube_conductance, b = p_.tube_critical_ratio;
+    in_a = Iso6358MassFlow(C, b, pv, pa, T, rl);
+    out_a = Iso6358MassFlow(C, b, pa, pv, T, rl);
   }
   // Chamber B: supply line through the (relieving) regulator.
   const double C = p_.supply_line_conductance, b = p_.supply_line_critical_ratio;
@@ -315,8 +333,14 @@ void IpaSimulator::Rhs(const State& x, State& dxdt, double open_in, double open_
   const double RT = p_.gas_constant * T;
   const double dVa = Aa * v;
   const double dVb = -Ab * v;
-  const double dpa =
-      RT / Va * (p_.alpha_in * in_a - p_.alpha_out * out_a) - p_.alpha * pa * dVa / Va;
+  // The valves' flows carry the charging and discharging coefficients. The
+  // tube's flow joins two volumes of gas at the same temperature: it enters
+  // both with coefficient 1, so it moves p V from one to the other without
+  // creating any (different coefficients on its two ends would pump pressure
+  // up as the gas swings back and forth), and a wide tube gives the response
+  // of the valves on the chamber.
+  const double ka_in = tube ? 1.0 : p_.alpha_in, ka_out = tube ? 1.0 : p_.alpha_out;
+  const double dpa = RT / Va * (ka_in * in_a - ka_out * out_a) - p_.alpha * pa * dVa / Va;
   const double dpb =
       RT / Vb * (p_.alpha_in * in_b - p_.alpha_out * out_b) - p_.alpha * pb * dVb / Vb;
   dxdt[0] = dpa / kBar;
@@ -325,6 +349,9 @@ void IpaSimulator::Rhs(const State& x, State& dxdt, double open_in, double open_
   dxdt[5] = out_a / kGram;
   const double tf = p_.pressure_filter_time_constant;
   dxdt[6] = tf > 0.0 ? (x[0] - x[6]) / tf : 0.0;
+  dxdt[7] = tube ? RT / p_.manifold_volume *
+                       (p_.alpha_in * in_v - p_.alpha_out * out_v + out_a - in_a) / kBar
+                 : 0.0;
   if (!moving) {
     dxdt[2] = 0.0;
     dxdt[3] = 0.0;

@@ -1,10 +1,12 @@
 // Physical checks of the IPA simulator (include/pneumid/plant/ipa_simulator.hpp).
 #include "pneumid/plant/ipa_simulator.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -65,6 +67,7 @@ TEST(Iso6358Test, MatchesTheStandardFormula) {
 
 TEST(IpaSimulatorTest, ChokedFillingFlowEqualsIso6358) {
   IpaParameters p = Quiet();
+  p.tube_conductance = 0.0;  // the inlet valve on the chamber
   p.open_delay = 0.0;
   p.close_delay = 0.0;
   IpaSimulator sim(p, 1e-3);
@@ -144,6 +147,91 @@ TEST(IpaSimulatorTest, MassBalanceHoldsWithMovingPiston) {
   }
   EXPECT_GT(travel, 0.02);  // the piston really moved (m)
   EXPECT_GT(sim.mass_in_a(), 10 * m0);
+}
+
+TEST(IpaSimulatorTest, ValveManifoldAndTubeConserveMassAndEqualize) {
+  // Valves on a manifold of volume V_m, a tube of conductance C_t to chamber A.
+  // The tube moves gas between two volumes at the same temperature: chamber
+  // A's mass p V / (R T) changes by what the tube lets in and out, and with the
+  // valves closed the tube equalizes the two pressures at
+  // p = (p_a V_a + p_m V_m) / (V_a + V_m), whatever the valves' coefficients.
+  IpaParameters p = Quiet();
+  ASSERT_NE(p.alpha_in, p.alpha_out);
+  p.open_delay = p.close_delay = 0.0;
+  p.tube_conductance = 0.05e-8;
+  p.manifold_volume = 10e-6;
+  IpaSimulator sim(p, 1e-3);
+  const double RT = p.gas_constant * p.temperature;
+  const double Va = p.dead_volume_a + p.AreaA() * p.piston_position;
+  const double Vm = p.manifold_volume;
+  const double m0 = sim.chamber_mass_a();
+  EXPECT_NEAR(sim.pressure_manifold(), p.atmospheric_pressure, 1e-9);
+  for (int k = 0; k < 5; ++k) sim.AdvanceValves(true, false);
+  // The manifold fills first; the chamber only through the tube.
+  const double pa1 = sim.pressure_a(), pm1 = sim.pressure_manifold();
+  EXPECT_GT(pm1, pa1 + 2e4);
+  EXPECT_GT(pa1, p.atmospheric_pressure + 100.0);
+  EXPECT_NEAR(sim.chamber_mass_a() - m0, sim.mass_in_a() - sim.mass_out_a(), 1e-6 * m0);
+  for (int k = 0; k < 2000; ++k) sim.AdvanceValves(false, false);
+  const double p_eq = (pa1 * Va + pm1 * Vm) / (Va + Vm);
+  EXPECT_NEAR(sim.pressure_a(), p_eq, 1e-5 * p_eq);
+  EXPECT_NEAR(sim.pressure_manifold(), p_eq, 1e-5 * p_eq);
+  EXPECT_NEAR((sim.pressure_a() * Va + sim.pressure_manifold() * Vm) / RT,
+              (pa1 * Va + pm1 * Vm) / RT, 1e-6 * m0);
+}
+
+TEST(IpaSimulatorTest, WideTubeAndSmallManifoldActLikeValvesOnTheChamber) {
+  // The tube's limit: a conductance far above the valves' and a manifold of
+  // 1 cm^3 (taken from the dead volume) give the response without a tube.
+  IpaParameters direct = Quiet();
+  direct.tube_conductance = 0.0;
+  IpaParameters tube = direct;
+  tube.tube_conductance = 1e-7;
+  tube.manifold_volume = 1e-6;
+  tube.dead_volume_a = direct.dead_volume_a - tube.manifold_volume;
+  IpaSimulator a(direct, 0.01), b(tube, 0.01);
+  double worst = 0.0;
+  for (int k = 0; k < 150; ++k) {
+    const double u = k < 100 ? 60.0 : 0.61;
+    a.Advance(u);
+    b.Advance(u);
+    worst = std::max(worst, std::abs(a.force() - b.force()));
+  }
+  EXPECT_GT(a.force(), -1.0);
+  EXPECT_LT(worst, 1.0);  // N, of about 90 N
+}
+
+TEST(IpaSimulatorTest, TubeSlowsTheVentMoreThanTheFill) {
+  // Venting, all of chamber A's air passes the tube; at a PWM equilibrium the
+  // flow from inlet to exhaust stays in the manifold and the chamber sees only
+  // the difference: the tube delays the vent more than the fill.
+  auto times = [](const IpaParameters& p) {
+    IpaSimulator sim(p, 0.001);
+    double fill = -1.0, vent = -1.0, f_end = 0.0;
+    for (int k = 0; k < 3000; ++k) sim.Advance(60.0);
+    f_end = sim.force();
+    IpaSimulator up(p, 0.001);
+    for (int k = 0; k < 3000 && fill < 0.0; ++k) {
+      up.Advance(60.0);
+      if (up.force() >= 0.5 * f_end) fill = up.time();
+    }
+    for (int k = 0; k < 3000 && vent < 0.0; ++k) {
+      sim.Advance(0.0);
+      if (sim.force() <= 0.5 * f_end) vent = (k + 1) * 0.001;
+    }
+    return std::pair{fill, vent};
+  };
+  IpaParameters direct = Quiet();
+  direct.tube_conductance = 0.0;
+  IpaParameters tube = direct;
+  tube.tube_conductance = 0.3e-8;
+  tube.manifold_volume = 5e-6;
+  const auto [fill0, vent0] = times(direct);
+  const auto [fill1, vent1] = times(tube);
+  ASSERT_GT(fill0, 0.0);
+  ASSERT_GT(vent0, 0.0);
+  EXPECT_GT(vent1 / vent0, 1.3);
+  EXPECT_GT(vent1 / vent0, 1.2 * (fill1 / fill0));
 }
 
 TEST(IpaSimulatorTest, DefaultStepReproducesThePaperForceStep) {

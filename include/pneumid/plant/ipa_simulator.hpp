@@ -98,12 +98,12 @@ struct IpaParameters {
 
   // [cylinder]
   double bore = 0.020248;  ///< m, piston diameter (effective; calibrated)
-  double rod = 0.006;    ///< m, rod diameter (chamber B side)
-  double stroke = 0.10;  ///< m
+  double rod = 0.006;      ///< m, rod diameter (chamber B side)
+  double stroke = 0.10;    ///< m
   double piston_position =
       0.05;  ///< m from the chamber-A end (fixed in force mode, initial otherwise)
   double dead_volume_a = 57.72e-6;  ///< m^3, chamber A ports, manifold and tubing to the valves
-  double dead_volume_b = 10.0e-6;  ///< m^3, chamber B ports and tubing
+  double dead_volume_b = 10.0e-6;   ///< m^3, chamber B ports and tubing
 
   // [supply]
   double supply_pressure = 0.6e6;           ///< Pa gauge, regulated supply
@@ -123,10 +123,17 @@ struct IpaParameters {
   double inlet_critical_ratio = 0.473;     ///< -, b of the inlet valve
   double exhaust_conductance = 0.4829e-8;  ///< m^3/(s Pa), C of the exhaust valve
   double exhaust_critical_ratio = 0.106;   ///< -, b of the exhaust valve
-  double laminar_ratio = 0.999;          ///< -, pressure ratio above which flow is linear in dp
-  double open_delay = 0.0005;            ///< s, command rising edge -> valve open
-  double close_delay = 0.001457;         ///< s, command falling edge -> valve closed
-  double min_pulse_width = 0.0005;       ///< s, shorter command pulses do not open the valve
+  double laminar_ratio = 0.999;            ///< -, pressure ratio above which flow is linear in dp
+  double open_delay = 0.0005;              ///< s, command rising edge -> valve open
+  double close_delay = 0.001457;           ///< s, command falling edge -> valve closed
+  double min_pulse_width = 0.0005;         ///< s, shorter command pulses do not open the valve
+  /// m^3/(s Pa), ISO 6358 C of the tube (and ports) between the valve manifold
+  /// and chamber A; 0: the valves sit on the chamber (no tube, no manifold).
+  double tube_conductance = 0.0;
+  double tube_critical_ratio = 0.3;  ///< -, ISO 6358 b of that tube
+  /// m^3, volume of the valve manifold on the valves' side of the tube (used
+  /// only with a tube; chamber A's own volume is dead_volume_a + A_a x).
+  double manifold_volume = 2.0e-6;
 
   // [pwm]
   double pwm_frequency = 300.0;  ///< Hz (3 periods per 0.01 s sample: no aliased ripple)
@@ -147,11 +154,11 @@ struct IpaParameters {
   /// s, time constant of the first-order low-pass between the chamber-A
   /// pressure and the ADC (transducer bandwidth, RC anti-aliasing filter); 0: none.
   double pressure_filter_time_constant = 0.0;
-  double position_noise = 1.0e-5;      ///< m, standard deviation (position mode)
-  int adc_bits = 16;                   ///< ADC resolution; 0 disables quantization
-  double adc_range = 10.0;             ///< V, bipolar input range +-adc_range
-  int transport_delay_samples = 0;     ///< sample periods between reading and output
-  double force_offset = 0.0;           ///< N added to the force output
+  double position_noise = 1.0e-5;   ///< m, standard deviation (position mode)
+  int adc_bits = 16;                ///< ADC resolution; 0 disables quantization
+  double adc_range = 10.0;          ///< V, bipolar input range +-adc_range
+  int transport_delay_samples = 0;  ///< sample periods between reading and output
+  double force_offset = 0.0;        ///< N added to the force output
 
   // [simulation]
   double relative_tolerance = 1e-6;  ///< odeint error control (states scaled to bar, mm, g)
@@ -254,15 +261,19 @@ class IpaSimulator final : public Plant {
   double rod_force() const;
   /// Gas mass in chamber A by the ideal gas law p V / (R T) (kg).
   double chamber_mass_a() const;
-  /// Mass that has flowed into / out of chamber A through its valves since Reset (kg).
+  /// Pressure in the valve manifold (Pa absolute; equals p_a without a tube).
+  double pressure_manifold() const;
+  /// Mass that has flowed into / out of chamber A since Reset (kg): through its
+  /// valves, or through the tube when there is one.
   double mass_in_a() const;
   double mass_out_a() const;
   /// Number of odeint steps taken since Reset (for benchmarks).
   long long steps() const { return steps_; }
 
   /// Internal state, scaled for the error control: p_a, p_b [bar], x [mm],
-  /// v [m/s], m_in_a, m_out_a [g], sensed p_a after the sensor filter [bar].
-  using State = std::array<double, 7>;
+  /// v [m/s], m_in_a, m_out_a [g], sensed p_a after the sensor filter [bar],
+  /// valve manifold pressure [bar].
+  using State = std::array<double, 8>;
 
  private:
   // Advance, AdvanceValves and Measure do not allocate: the valve event queues
