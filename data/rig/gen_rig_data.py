@@ -10,7 +10,9 @@ duty 0.61 % (chamber vented, inside the valves' dead band), so Eq. 5 is
 driven by u - 0.61 %. Two experiments, noise-free:
   eq5_step.csv   the paper's step: 0.61 -> 82 % at t = 0.5 s, 3 s;
   eq5_prbs.csv   a maximum-length PRBS between 0.61 and 82 % (order 8,
-                 clock 0.05 s, scipy.signal.max_len_seq), from t = 0.5 s, 13.3 s.
+                 clock 0.05 s, scipy.signal.max_len_seq), from t = 0.5 s, 13.3 s;
+  eq5_prbs_long.csv  the same PRBS repeated, from t = 0.5 s to 30 s (the
+                 sequence of pneumid's prbs:low=0.61,high=82,order=8,clock=0.05,at=0.5).
 Columns t [s], u [%] (PWM duty), y [N] (force). Run with /usr/bin/python3
 (numpy, scipy) from this directory; docs/simulator.md ("The default twin")
 uses them with `pneumid calibrate`.
@@ -47,3 +49,8 @@ prbs = np.repeat(np.where(bits > 0, u_high, u_low), clock)
 lead = int(round(t0 / Ts))
 u = np.concatenate([np.full(lead, u_low), prbs, np.full(50, u_low)])
 write("eq5_prbs.csv", u, "PRBS 0.61/82 %%, order %d, clock %g s, from 0.5 s" % (order, clock * Ts))
+
+n_long = 3001
+u_long = np.concatenate([np.full(lead, u_low), np.tile(prbs, 3)])[:n_long]
+write("eq5_prbs_long.csv", u_long,
+      "PRBS 0.61/82 %%, order %d, clock %g s, from 0.5 s, repeated to 30 s" % (order, clock * Ts))
