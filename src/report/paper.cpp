@@ -260,6 +260,7 @@ PaperResult RunPaper(const PaperOptions& o) {
         "coefficients are ill-determined");
   }
   // The twin's PRBS experiment: ARX(3,3,1) from data that excite it richly.
+  bool prbs_has_zoh = false;  // its ARX has no pole on the negative real axis
   if (!o.prbs.empty()) {
     try {
       IpaSimulator ipa(params, o.Ts, o.seed + 1);
@@ -293,6 +294,7 @@ PaperResult RunPaper(const PaperOptions& o) {
       double dominant_real = 0.0;
       for (const auto& p : poles)
         if (std::abs(p) == dominant) dominant_real = p.real();
+      prbs_has_zoh = !negative_real;
       const std::string tag = "ARX(3,3,1) from the twin's PRBS: ";
       row(S2, tag + "experiment", "(the rig's data are not published)",
           fmt::format("{}, {} s (ARX after {} s, means removed), fit {} %", o.prbs,
@@ -348,10 +350,13 @@ PaperResult RunPaper(const PaperOptions& o) {
         "(Eq. 6)",
         arx->tf.IsContinuous() ? arx->tf.Normalized().ToString(5)
                                : "none: a pole on the negative real axis",
-        by_tustin ? "a discrete pole on the negative real axis (from one step the third pole "
-                    "is ill-determined; with a PWM ripple aliased to the Nyquist frequency it "
-                    "sits near z = -1) has no real logarithm, so no zoh equivalent exists; the "
-                    "bilinear (tustin) map gives the continuous form; the PRBS ARX above has one"
+        by_tustin
+            ? std::string("a discrete pole on the negative real axis (from one step the third "
+                          "pole is ill-determined; with a PWM ripple aliased to the Nyquist "
+                          "frequency it sits near z = -1) has no real logarithm, so no zoh "
+                          "equivalent exists; the bilinear (tustin) map gives the continuous "
+                          "form") +
+                  (prbs_has_zoh ? "; the PRBS ARX above has one" : "")
         : arx->tf.IsContinuous() ? kSimulatorNote
                                  : "a discrete pole on the negative real axis has no real "
                                    "logarithm, so there is no zoh continuous equivalent");
