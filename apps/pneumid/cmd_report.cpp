@@ -10,25 +10,16 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "validators.hpp"
 #include "data_options.hpp"
-#include "progress.hpp"
 #include "identified_spec.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/report/identification_report.hpp"
+#include "progress.hpp"
+#include "validators.hpp"
 
 namespace {
-
-std::string ShellQuote(const std::string& s) {
-  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                        "0123456789_-./=,:+") == std::string::npos)
-    return s;
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
 
 std::vector<std::string> SplitComma(const std::string& s) {
   std::vector<std::string> out = pneumid::Split(s, ',');

@@ -34,4 +34,14 @@ std::optional<double> ParseDouble(std::string_view text) {
   return v;
 }
 
+std::string ShellQuote(std::string_view s) {
+  constexpr std::string_view kPlain =
+      "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./=,:+#";
+  if (!s.empty() && s.front() != '#' && s.find_first_not_of(kPlain) == std::string_view::npos)
+    return std::string(s);
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string_view("'\\''") : std::string_view(&c, 1);
+  return out + "'";
+}
+
 }  // namespace pneumid

@@ -15,6 +15,17 @@ using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
+TEST(StringsTest, ShellQuoteGivesOneShellWord) {
+  EXPECT_EQ(ShellQuote("data/step_1.csv"), "data/step_1.csv");
+  EXPECT_EQ(ShellQuote("models.json#arx"), "models.json#arx");  // '#' inside a word
+  EXPECT_EQ(ShellQuote("step:from=0.61,to=82"), "step:from=0.61,to=82");
+  EXPECT_EQ(ShellQuote("#arx"), "'#arx'");  // would start a comment
+  EXPECT_EQ(ShellQuote(""), "''");
+  EXPECT_EQ(ShellQuote("a b"), "'a b'");
+  EXPECT_EQ(ShellQuote("it's"), "'it'\\''s'");
+  EXPECT_EQ(ShellQuote("$HOME;rm"), "'$HOME;rm'");
+}
+
 TEST(StringsTest, TrimSplitParse) {
   EXPECT_EQ(Trim(" \t a b \r\n"), "a b");
   EXPECT_EQ(Trim("   "), "");

@@ -449,6 +449,26 @@ function chooseModel(method: string): void {
 const controlPlot = new TimePlot($('control-plot'));
 const controlUPlot = new TimePlot($('control-u-plot'));
 
+/** A closed loop's set point and output over its controller output, as both
+ *  the design (section 3) and the live run (section 4) show it. */
+function drawLoop(yPlot: TimePlot, uPlot: TimePlot, title: string,
+                  tr: { t: number[]; r: number[]; y: number[]; u: number[] }): void {
+  yPlot.draw({
+    title,
+    ylabel: 'y',
+    series: [
+      { label: 'set point r', color: '#495057', dash: [5, 4] },
+      { label: 'output y', color: COLORS[0], width: 2 },
+    ],
+  }, [tr.t, tr.r, tr.y]);
+  uPlot.draw({
+    title: 'Controller output',
+    ylabel: 'u',
+    height: 180,
+    series: [{ label: 'input u', color: COLORS[1] }],
+  }, [tr.t, tr.u]);
+}
+
 let explicitFromSliders = false; // the sliders hold values the user set
 let responseTimeSet = false;
 
@@ -541,20 +561,7 @@ async function runControl(): Promise<void> {
 function drawControl(res: any): void {
   const tr = res.trace;
   if (tr && Array.isArray(tr.t)) {
-    controlPlot.draw({
-      title: 'Closed loop: set point and output',
-      ylabel: 'y',
-      series: [
-        { label: 'set point r', color: '#495057', dash: [5, 4] },
-        { label: 'output y', color: COLORS[0], width: 2 },
-      ],
-    }, [tr.t, tr.r, tr.y]);
-    controlUPlot.draw({
-      title: 'Controller output',
-      ylabel: 'u',
-      height: 180,
-      series: [{ label: 'input u', color: COLORS[1] }],
-    }, [tr.t, tr.u]);
+    drawLoop(controlPlot, controlUPlot, 'Closed loop: set point and output', tr);
   }
   const tbody = $('metrics').querySelector('tbody')!;
   tbody.innerHTML = '';
@@ -723,16 +730,7 @@ function appendLive(m: { t: number[]; r?: number[]; y: number[]; u: number[] }):
 
 function drawLive(): void {
   liveFrame = 0;
-  runPlot.draw({
-    title: 'Real-time run: set point and output',
-    ylabel: 'y',
-    series: [
-      { label: 'set point r', color: '#495057', dash: [5, 4] },
-      { label: 'output y', color: COLORS[0], width: 2 },
-    ],
-  }, [live.t, live.r, live.y]);
-  runUPlot.draw({ title: 'Controller output', ylabel: 'u', height: 180, series: [{ label: 'input u', color: COLORS[1] }] },
-    [live.t, live.u]);
+  drawLoop(runPlot, runUPlot, 'Real-time run: set point and output', live);
   if (state.run.state === 'running') $('run-state').textContent = runStatusText();
 }
 

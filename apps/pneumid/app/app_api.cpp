@@ -10,6 +10,7 @@
 #include "../command_json.hpp"
 #include "../data_options.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/strings.hpp"
 #include "pneumid/common/version.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
@@ -126,15 +127,6 @@ std::vector<std::string> CsvColumns(const fs::path& path) {
     return cols;
   }
   return {};
-}
-
-std::string ShellQuote(const std::string& s) {
-  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                        "0123456789_-./=,:+#") == std::string::npos)
-    return s;
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
 }
 
 const char* kNoPage = R"(<!doctype html>

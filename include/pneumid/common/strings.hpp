@@ -30,4 +30,10 @@ std::vector<std::string> Split(std::string_view s, char separator);
 /// finiteness where it matters). std::nullopt when `text` is not a number.
 std::optional<double> ParseDouble(std::string_view text);
 
+/// `s` as one word of a POSIX shell command line: unchanged when it holds only
+/// letters, digits and _-./=,:+ (and '#' after its first character, where the
+/// shell does not read it as a comment), else in single quotes with each ' as
+/// '\''. "" -> ''.
+std::string ShellQuote(std::string_view s);
+
 }  // namespace pneumid
