@@ -49,9 +49,10 @@ def test_ipa_step_test_and_reaction_curve():
     ipa = pneumid.make_plant("ipa", 0.01, seed=3)
     d = pneumid.run_experiment(ipa, "step:from=0.61,to=82,at=0.5", 3.0)
     m = pneumid.identify("reaction-curve", d)
-    # the simulator is calibrated to the paper's step test: 0 -> 129 N, t63 = 0.245 s
+    # the simulator is calibrated to Eq. 5's response to the paper's step:
+    # 0 -> 129 N, t63 = 0.2306 s (the paper read 0.245 s off its measured data)
     assert m.params["K"] == pytest.approx(1.585, rel=0.03)
-    assert m.params["t63"] == pytest.approx(0.245, abs=0.01)
+    assert m.params["t63"] == pytest.approx(0.2306, abs=0.01)
 
 
 def test_run_paper_rows():

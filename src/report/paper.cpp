@@ -381,7 +381,11 @@ PaperResult RunPaper(const PaperOptions& o) {
         Close(K, 1.585, 0.03) ? "" : kSimulatorNote);
     const double t63 = fopdt->params.contains("t63") ? fopdt->params.Scalar("t63") : tau + theta;
     row(S4, "t63 (time to 63.2 % after the step)", "0.245 s", G(t63, 4) + " s",
-        std::abs(t63 - 0.245) <= o.Ts ? "within one sample" : kSimulatorNote);
+        std::abs(t63 - 0.245) <= o.Ts ? "within one sample"
+        : std::abs(t63 - 0.2306) <= o.Ts
+            ? "within one sample of Eq. 5's own t63 (0.2306 s, below), to which the twin is "
+              "calibrated; the paper read 0.245 s off its measured data"
+            : kSimulatorNote);
     row(S4, "tau", "0.245 s (= t63, theta ~ 0)", G(tau, 4) + " s",
         std::abs(tau - 0.245) <= o.Ts
             ? "within one sample"
@@ -389,7 +393,7 @@ PaperResult RunPaper(const PaperOptions& o) {
               "the paper takes tau = t63 and theta = 0.001 s");
     row(S4, "theta", "0.001 s", G(theta, 3) + " s",
         "the paper sets theta just above zero on purpose; pneumid reads the departure from the "
-        "baseline off the data (the twin's valve opening delay and PWM latch)");
+        "baseline off the data (the twin's valve delays, PWM latch and sensor lag)");
   }
   try {
     const TransferFunction arx_ct = D2C(paper_arx, DiscretizationMethod::kZoh);

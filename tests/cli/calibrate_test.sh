@@ -80,7 +80,7 @@ check_output "text: experiment" "prbs.csv"
 expect_error "unknown parameter" "unknown IPA parameter 'nosuch'" \
   calibrate "$TMP/prbs.csv" --free bore,nosuch
 expect_error "bounds exclude the start" \
-  "the start value of 'cylinder.bore', 0.020248 m, is outside its bounds 0.03 .. 0.04" \
+  "the start value of 'cylinder.bore', 0.020266 m, is outside its bounds 0.03 .. 0.04" \
   calibrate "$TMP/prbs.csv" --free bore --bound bore=0.03:0.04
 expect_error "empty bounds" "lower < upper" \
   calibrate "$TMP/prbs.csv" --free bore --bound bore=0.03:0.02

@@ -9,7 +9,8 @@ mkdir "$WORK"
 grep -q "paper success" "$WORK/out" || { cat "$WORK/out"; fail "not successful"; }
 # the table holds the paper's numbers next to pneumid's
 grep -q "6.102 s^2 - 91.95 s + 520000" "$WORK/out" || fail "Eq. 6 row missing"
-grep -q "conventional P .* 126 .* 126" "$WORK/out" || fail "P = 126 row missing"
+grep -q "conventional P .* 126 .* 1[0-9][0-9] .*P = round(5 tau'/Ts" "$WORK/out" || fail "conventional P row missing"
+grep -q "P, lambda from the paper's FOPDT (Eq. 2) .* 126, 2.25 .* 126, 2.251" "$WORK/out" || fail "P = 126 row missing"
 for f in fig4 fig5 fig6; do
   for ext in png svg; do
     [ -s "$WORK/figs/$f.$ext" ] || fail "$f.$ext missing"

@@ -114,6 +114,7 @@ TEST(IpaAllocationTest, DelayLineDelaysByTransportDelaySamples) {
   IpaParameters p;
   p.pressure_noise = 0.0;
   p.adc_bits = 0;
+  p.pressure_filter_time_constant = 0.0;  // the sensed force is the chamber's
   p.transport_delay_samples = 3;
   IpaSimulator sim(p, 0.01);
   for (int run = 0; run < 2; ++run) {

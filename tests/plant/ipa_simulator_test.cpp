@@ -28,6 +28,18 @@ IpaParameters Quiet() {
   p.pressure_noise = 0.0;
   p.position_noise = 0.0;
   p.adc_bits = 0;
+  p.pressure_filter_time_constant = 0.0;  // the sensed force is the chamber's
+  return p;
+}
+
+// The twin whose lag is in the chamber (config/ipa_chamber_lag.toml: slow
+// valves on 58 cm^3), quiet: the tube's effects are measured against it.
+IpaParameters QuietChamberLag() {
+  IpaParameters p =
+      LoadIpaParameters(std::string(PNEUMID_SOURCE_DIR) + "/config/ipa_chamber_lag.toml");
+  p.pressure_noise = 0.0;
+  p.position_noise = 0.0;
+  p.adc_bits = 0;
   return p;
 }
 
@@ -183,7 +195,7 @@ TEST(IpaSimulatorTest, ValveManifoldAndTubeConserveMassAndEqualize) {
 TEST(IpaSimulatorTest, WideTubeAndSmallManifoldActLikeValvesOnTheChamber) {
   // The tube's limit: a conductance far above the valves' and a manifold of
   // 1 cm^3 (taken from the dead volume) give the response without a tube.
-  IpaParameters direct = Quiet();
+  IpaParameters direct = QuietChamberLag();
   direct.tube_conductance = 0.0;
   IpaParameters tube = direct;
   tube.tube_conductance = 1e-7;
@@ -221,7 +233,7 @@ TEST(IpaSimulatorTest, TubeSlowsTheVentMoreThanTheFill) {
     }
     return std::pair{fill, vent};
   };
-  IpaParameters direct = Quiet();
+  IpaParameters direct = QuietChamberLag();
   direct.tube_conductance = 0.0;
   IpaParameters tube = direct;
   tube.tube_conductance = 0.3e-8;

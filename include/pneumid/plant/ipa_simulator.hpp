@@ -46,12 +46,12 @@
 //     Control of Machines with Friction, 1991:
 //       F_f = (F_c + (F_s - F_c) exp(-(v/v_s)^2)) tanh(v/v_eps) + b v
 // Sensors: pressure transducer with an optional first-order low-pass (time
-// constant pressure_filter_time_constant: transducer bandwidth and the
-// RC anti-aliasing filter before the ADC), Gaussian noise, 0..full scale -> 0..10 V,
-// read by a bipolar 16-bit ADC over +-10 V (NI PCI-6221: 20 V / 2^16 = 0.305 mV
-// per code), output delayed by transport_delay_samples sample periods.
-// Integration: Boost.Odeint runge_kutta_dopri5 with error control, restarted
-// at every valve switching instant (switching mode) or sample (averaged mode).
+// constant pressure_filter_time_constant: transducer bandwidth, the RC
+// anti-aliasing filter before the ADC, digital smoothing of the PWM ripple), Gaussian noise,
+// 0..full scale -> 0..10 V, read by a bipolar 16-bit ADC over +-10 V (NI PCI-6221: 20 V / 2^16 =
+// 0.305 mV per code), output delayed by transport_delay_samples sample periods. Integration:
+// Boost.Odeint runge_kutta_dopri5 with error control, restarted at every valve switching instant
+// (switching mode) or sample (averaged mode).
 #pragma once
 
 #include <array>
@@ -97,13 +97,13 @@ struct IpaParameters {
   PwmMode pwm_mode = PwmMode::kSwitching;
 
   // [cylinder]
-  double bore = 0.020248;  ///< m, piston diameter (effective; calibrated)
+  double bore = 0.020266;  ///< m, piston diameter (effective; calibrated)
   double rod = 0.006;      ///< m, rod diameter (chamber B side)
   double stroke = 0.10;    ///< m
   double piston_position =
       0.05;  ///< m from the chamber-A end (fixed in force mode, initial otherwise)
-  double dead_volume_a = 57.72e-6;  ///< m^3, chamber A ports, manifold and tubing to the valves
-  double dead_volume_b = 10.0e-6;   ///< m^3, chamber B ports and tubing
+  double dead_volume_a = 10.0e-6;  ///< m^3, chamber A ports, valve manifold and a short tube
+  double dead_volume_b = 10.0e-6;  ///< m^3, chamber B ports and tubing
 
   // [supply]
   double supply_pressure = 0.6e6;           ///< Pa gauge, regulated supply
@@ -119,14 +119,14 @@ struct IpaParameters {
   double alpha = 1.2;           ///< coefficient of the volume-change term [1]
 
   // [valves]  sonic conductance in m^3/(s Pa): 1 dm^3/(s bar) = 1e-8 m^3/(s Pa)
-  double inlet_conductance = 0.1301e-8;    ///< m^3/(s Pa), C of the inlet valve
-  double inlet_critical_ratio = 0.473;     ///< -, b of the inlet valve
-  double exhaust_conductance = 0.4829e-8;  ///< m^3/(s Pa), C of the exhaust valve
-  double exhaust_critical_ratio = 0.106;   ///< -, b of the exhaust valve
-  double laminar_ratio = 0.999;            ///< -, pressure ratio above which flow is linear in dp
-  double open_delay = 0.0005;              ///< s, command rising edge -> valve open
-  double close_delay = 0.001457;           ///< s, command falling edge -> valve closed
-  double min_pulse_width = 0.0005;         ///< s, shorter command pulses do not open the valve
+  double inlet_conductance = 1.05e-8;     ///< m^3/(s Pa), C of the inlet valve
+  double inlet_critical_ratio = 0.473;    ///< -, b of the inlet valve
+  double exhaust_conductance = 3.9e-8;    ///< m^3/(s Pa), C of the exhaust valve
+  double exhaust_critical_ratio = 0.106;  ///< -, b of the exhaust valve
+  double laminar_ratio = 0.999;           ///< -, pressure ratio above which flow is linear in dp
+  double open_delay = 0.0005;             ///< s, command rising edge -> valve open
+  double close_delay = 0.001457;          ///< s, command falling edge -> valve closed
+  double min_pulse_width = 0.0005;        ///< s, shorter command pulses do not open the valve
   /// m^3/(s Pa), ISO 6358 C of the tube (and ports) between the valve manifold
   /// and chamber A; 0: the valves sit on the chamber (no tube, no manifold).
   double tube_conductance = 0.0;
@@ -152,8 +152,10 @@ struct IpaParameters {
   double pressure_noise = 150.0;       ///< Pa, standard deviation of the transducer noise
   double pressure_full_scale = 1.0e6;  ///< Pa gauge at 10 V transducer output
   /// s, time constant of the first-order low-pass between the chamber-A
-  /// pressure and the ADC (transducer bandwidth, RC anti-aliasing filter); 0: none.
-  double pressure_filter_time_constant = 0.0;
+  /// pressure and the ADC (transducer bandwidth, RC anti-aliasing filter,
+  /// digital smoothing of the PWM ripple); 0: none. The default is calibrated
+  /// to the paper's rig (docs/simulator.md, "The default twin").
+  double pressure_filter_time_constant = 0.21564;
   double position_noise = 1.0e-5;   ///< m, standard deviation (position mode)
   int adc_bits = 16;                ///< ADC resolution; 0 disables quantization
   double adc_range = 10.0;          ///< V, bipolar input range +-adc_range
