@@ -13,6 +13,7 @@
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 
 ln -s "$SRC/data" "$TMP/data"
+ln -s "$SRC/config" "$TMP/config"
 "$PY" - "$SRC" "$PNEUMID" "$TMP" <<'PYEOF' || fail "documented commands (see above)"
 import glob, os, re, shlex, subprocess, sys
 
