@@ -310,8 +310,8 @@ TEST_P(CodegenClosedLoopTest, InputsEqualTheLibraryControllers) {
     }
   }
   // float: the unit roundoff (6e-8) amplified by the controllers' recursions;
-  // most stay below 2e-5 of max |u|, GPC with T = A (filter poles at the
-  // plant's, up to 0.955) reaches 1.03e-4 on the default twin.
+  // the others stay below 4e-5 of max |u|, GPC with T = A (filter poles at
+  // the plant's, up to 0.955) reaches 1.03e-4 on the default twin.
   const double tol = p.precision == CodegenPrecision::kDouble ? 1e-12 : 2e-4;
   const double rel = worst / lib.u_range;
   std::printf("[ codegen  ] %-24s %-6s max |u - u_lib| = %.3g (%.3g of max |u|) at step %ld\n",
