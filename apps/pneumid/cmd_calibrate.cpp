@@ -1,6 +1,7 @@
 // pneumid calibrate DATA [DATA ...]: grey-box identification of the IPA
 // simulator's physical parameters from measured experiments (the digital twin
 // of one actuator); writes a parameter TOML for --plant-config / ipa:config=.
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -94,11 +95,13 @@ void Run(const CalibrateArgs& a) {
   options.progress = nullptr;
   // The calibrated twin on the held-out experiments.
   std::vector<double> validation_fit;
+  std::vector<Eigen::VectorXd> validation_sim;
   if (s.termination != Termination::kFailure)
-    for (const auto& d : held_out)
-      validation_fit.push_back(
-          NrmseFit(d.y(0), SimulateIpaOnData(s.parameters, d, options.initial_state,
-                                             options.warmup, options.integration_tolerance)));
+    for (const auto& d : held_out) {
+      validation_sim.push_back(SimulateIpaOnData(s.parameters, d, options.initial_state,
+                                                 options.warmup, options.integration_tolerance));
+      validation_fit.push_back(NrmseFit(d.y(0), validation_sim.back()));
+    }
 
   if (s.termination != Termination::kFailure && !a.output.empty()) {
     std::string comment = fmt::format(
@@ -115,20 +118,34 @@ void Run(const CalibrateArgs& a) {
     if (!out) throw DataError(fmt::format("{}: write failed", a.output));
   }
   if (!a.plot.empty() && !s.experiments.empty()) {
-    const int rows = static_cast<int>(std::min<std::size_t>(3, s.experiments.size()));
-    Figure fig(rows);
+    // One panel per experiment, then the held-out ones: at most four panels.
+    const std::size_t fitted = std::min<std::size_t>(s.experiments.size(), 3);
+    const std::size_t shown_held_out =
+        std::min<std::size_t>(validation_sim.size(), 4 - fitted);
+    Figure fig(static_cast<int>(fitted + shown_held_out));
     fig.title = "IPA twin calibration: measured and simulated output";
-    for (int i = 0; i < rows; ++i) {
-      const auto& e = s.experiments[static_cast<std::size_t>(i)];
-      auto& ax = fig.axes(i);
-      ax.title = fmt::format("{}: fit {:.2f} % (start {:.2f} %)", e.name, e.fit_percent,
-                             e.initial_fit_percent);
+    const std::string ylabel =
+        options.start.mode == IpaMode::kForce ? "Force F [N]" : "Position x [m]";
+    auto panel = [&](std::size_t i, const std::string& title, const Dataset& d,
+                     const Eigen::VectorXd& simulated) {
+      auto& ax = fig.axes(static_cast<int>(i));
+      ax.title = title;
       ax.xlabel = "Time t [s]";
-      ax.ylabel = options.start.mode == IpaMode::kForce ? "Force F [N]" : "Position x [m]";
-      const Dataset& d = experiments[static_cast<std::size_t>(i)].data;
+      ax.ylabel = ylabel;
       ax.AddLine(d.time(), d.y(0), "measured");
-      if (e.simulated.size() == d.size()) ax.AddLine(d.time(), e.simulated, "calibrated twin");
+      if (simulated.size() == d.size()) ax.AddLine(d.time(), simulated, "calibrated twin");
+    };
+    for (std::size_t i = 0; i < fitted; ++i) {
+      const auto& e = s.experiments[i];
+      panel(i,
+            fmt::format("{}: fit {:.2f} % (start {:.2f} %)", e.name, e.fit_percent,
+                        e.initial_fit_percent),
+            experiments[i].data, e.simulated);
     }
+    for (std::size_t i = 0; i < shown_held_out; ++i)
+      panel(fitted + i,
+            fmt::format("{} (held out): fit {:.2f} %", a.validation[i], validation_fit[i]),
+            held_out[i], validation_sim[i]);
     fig.Save(a.plot);
   }
 
