@@ -62,6 +62,9 @@ bool IpaCalibrationOptions::IsValid(std::string* error) const {
   if (!(correlation_threshold > 0.0 && correlation_threshold <= 1.0))
     return fail(
         fmt::format("correlation_threshold must be in (0, 1], got {}", correlation_threshold));
+  if (!(fit_warning_percent >= -1e9 && fit_warning_percent <= 100.0))
+    return fail(fmt::format("fit_warning_percent must be at most 100, got {}",
+                            fit_warning_percent));
   return true;
 }
 
@@ -469,6 +472,13 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
     return out;
   }
   fits(r, false);
+  for (const auto& e : out.experiments)
+    if (e.fit_percent < options.fit_warning_percent)
+      out.warnings.push_back(fmt::format(
+          "{}: the calibrated twin fits it by only {:.2f} % (start {:.2f} %): it does not "
+          "reproduce these data; check their units (u: PWM duty in %, y: force in N or "
+          "position in m), the initial state and the free parameters",
+          e.name, e.fit_percent, e.initial_fit_percent));
   const bool have_j = problem.Jacobian(z.data(), r.data(), J.data());
 
   // Uncertainty and identifiability (header comment).

@@ -243,6 +243,33 @@ TEST(IpaCalibration, BadInputGivesClearErrors) {
   EXPECT_THAT(error_of({{step, "s"}}, threads), HasSubstr("num_threads"));
 }
 
+TEST(IpaCalibration, ATwinThatDoesNotReproduceTheDataIsFlagged) {
+  // The force logged in kN instead of N: the bore cannot shrink the force
+  // 1000 times inside its physical range, so the twin fits badly, and the
+  // summary says so instead of handing over a silently wrong twin.
+  const IpaParameters p;
+  const Dataset step = Simulated(p, kStep, 3.0, 1);
+  const Dataset kilonewton = Dataset::FromUniform(step.SampleTime(), step.u(0),
+                                                  step.y(0) / 1000.0, 0.0, {"u", "%"},
+                                                  {"F", "kN"});
+  IpaCalibrationOptions options;
+  options.free = {"bore", "pressure_filter_time_constant"};
+  const IpaCalibrationSummary bad = CalibrateIpa({{kilonewton, "kn.csv"}}, options);
+  ASSERT_EQ(bad.experiments.size(), 1u);
+  EXPECT_LT(bad.experiments[0].fit_percent, 90.0);
+  EXPECT_THAT(::testing::PrintToString(bad.warnings),
+              HasSubstr("kn.csv: the calibrated twin fits it by only"));
+  EXPECT_THAT(::testing::PrintToString(bad.warnings), HasSubstr("check their units"));
+  // The same record in N: no such warning.
+  const IpaCalibrationSummary good = CalibrateIpa({{step, "n.csv"}}, options);
+  ASSERT_TRUE(IsSuccess(good.termination)) << good.message;
+  EXPECT_GT(good.experiments[0].fit_percent, 99.0);
+  for (const auto& w : good.warnings) EXPECT_THAT(w, ::testing::Not(HasSubstr("fits it by only")));
+  IpaCalibrationOptions invalid = options;
+  invalid.fit_warning_percent = 101.0;
+  EXPECT_THROW(CalibrateIpa({{step, "n.csv"}}, invalid), InvalidArgument);
+}
+
 TEST(IpaCalibration, ProgressIsReportedPerIteration) {
   const IpaParameters p;
   IpaCalibrationOptions options;

@@ -91,6 +91,10 @@ struct IpaCalibrationOptions {
   double parameter_tolerance = 1e-9;   ///< relative step to stop
   int num_threads = 2;                 ///< threads for the Jacobian's simulations
   double correlation_threshold = 0.95; ///< |rho| from which a pair is reported
+  /// A calibrated experiment fitted by less than this NRMSE (%) gets a
+  /// warning: the twin does not reproduce it (units, initial state, free
+  /// parameters or a structure the simulator lacks). Default 90.
+  double fit_warning_percent = 90.0;
   /// Called after every iteration with its number and cost (may be empty).
   std::function<void(int iteration, double cost)> progress;
 
