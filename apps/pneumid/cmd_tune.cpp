@@ -8,7 +8,7 @@
 //       "formula": "..."}
 //   pneumid tune --model fopdt-paper --Ts 0.01 --rule auto [--controller mpc|dmc|pid]
 //                [--response-time T] [--overshoot PCT] [--aggressiveness A]
-//                [--u-min U --u-max U] [--json]
+//                [--u-min U --u-max U] [--plant PLANT] [--json]
 //   -> {"rule": "auto", "controller": "mpc", "P": 126, "M": 5, "lambda": ...,
 //       "predicted": {...}, "robustness": [...], "review": [...],
 //       "termination": "converged", "message": "..."}
@@ -25,6 +25,8 @@
 #include "pneumid/control/auto_tuning.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/actuator.hpp"
+#include "pneumid/plant/plant_factory.hpp"
 #include "validators.hpp"
 
 namespace pneumid::cli {
@@ -42,6 +44,16 @@ AutoTuneResult Auto(const TuneCli& c, const TransferFunction& model) {
   o.limits.u_min = c.u_min;
   o.limits.u_max = c.u_max;
   o.limits.du_max = c.du_max;
+  if (!c.plant.empty()) {
+    // The plant's physical input range (IPA: duty 0..100 %) where --u-min/--u-max
+    // leave it open, as `control --plant` designs: the two give the same settings.
+    const Actuator actuator = PlantActuator(*MakePlant(c.plant, c.Ts));
+    if (!std::isfinite(o.limits.u_min)) o.limits.u_min = actuator.u_min;
+    if (!std::isfinite(o.limits.u_max)) o.limits.u_max = actuator.u_max;
+    PNEUMID_CHECK(o.limits.u_min <= o.limits.u_max,
+                  "--u-min {} is above --u-max {} (the plant's input range is {} .. {})",
+                  o.limits.u_min, o.limits.u_max, actuator.u_min, actuator.u_max);
+  }
   o.M = c.M;
   return AutoTune(model, c.Ts, o);
 }
@@ -59,9 +71,10 @@ void RunAuto(const TuneCli& c, const TransferFunction& model) {
 TuningResult Conventional(const TuneCli& c, const TransferFunction& model) {
   PNEUMID_CHECK(c.controller.empty() && std::isnan(c.response_time) && c.measure.empty() &&
                     std::isnan(c.overshoot) && std::isnan(c.aggressiveness) &&
-                    std::isinf(c.u_min) && std::isinf(c.u_max) && std::isinf(c.du_max),
-                "--controller, --response-time, --measure, --overshoot, --aggressiveness and "
-                "the input limits apply to --rule auto only");
+                    std::isinf(c.u_min) && std::isinf(c.u_max) && std::isinf(c.du_max) &&
+                    c.plant.empty(),
+                "--controller, --response-time, --measure, --overshoot, --aggressiveness, "
+                "the input limits and --plant apply to --rule auto only");
   TuningOptions o;
   o.rule = TuningRuleFromString(c.rule);
   o.M = c.M;
@@ -144,6 +157,9 @@ const Registrar reg(
       app.add_option("--u-min", c->u_min, "auto: lower input limit");
       app.add_option("--u-max", c->u_max, "auto: upper input limit");
       app.add_option("--du-max", c->du_max, "auto: largest input change per sample");
+      app.add_option("--plant", c->plant,
+                     "auto: plant whose physical input range (ipa: duty 0..100 %) sets the "
+                     "limits --u-min/--u-max leave open, as control --plant does");
       app.add_flag("--json", c->json, "Print a JSON object");
       app.callback([c] { Run(*c); });
     });

@@ -77,6 +77,9 @@ struct TuneCli {
   double u_min = -std::numeric_limits<double>::infinity();
   double u_max = std::numeric_limits<double>::infinity();
   double du_max = std::numeric_limits<double>::infinity();
+  /// Plant spec whose physical input range gives the limits --u-min/--u-max
+  /// leave open (as `control --plant` does); empty: none.
+  std::string plant;
 };
 
 /// What `tune --json` prints. @throws InvalidArgument as `tune` does.

@@ -60,4 +60,18 @@ check_json "auto impossible" "j['termination'] == 'spec_not_met' and any(r['chec
 expect_error "auto gpc" "not gpc" tune --rule auto --controller gpc --model fopdt-paper --Ts 0.01
 expect_error "auto knob" "aggressiveness must be in [0, 1]" tune --rule auto --model fopdt-paper --Ts 0.01 --aggressiveness 2
 expect_error "auto flags without auto" "apply to --rule auto only" tune --model fopdt-paper --Ts 0.01 --overshoot 3
+# --plant: the plant's input range bounds the design, as in `control --plant`,
+# so both print the same settings (on the IPA: duty 0..100 %).
+expect_ok "auto with plant" tune --rule auto --model fopdt-paper --Ts 0.01 --plant ipa --json
+cp "$TMP/out" "$TMP/tune_plant.json"
+expect_ok "auto without plant" tune --rule auto --model fopdt-paper --Ts 0.01 --json
+cp "$TMP/out" "$TMP/tune_free.json"
+expect_ok "auto with limits" tune --rule auto --model fopdt-paper --Ts 0.01 --u-min 0 --u-max 100 --json
+check_json "plant range = explicit limits" "j['lambda'] == json.load(open('$TMP/tune_plant.json'))['lambda']"
+check_json "plant range bounds the design" "j['lambda'] != json.load(open('$TMP/tune_free.json'))['lambda']"
+expect_ok "control auto on the plant" control --controller mpc --rule auto --model fopdt-paper --plant ipa --Ts 0.01 --setpoint step:from=0,to=40,at=0.1 --duration 0.5 --json
+check_json "tune --plant = control --plant" "abs(j['settings']['lambda'] / json.load(open('$TMP/tune_plant.json'))['lambda'] - 1) < 1e-9 and j['settings']['P'] == json.load(open('$TMP/tune_plant.json'))['P']"
+expect_error "plant without auto" "apply to --rule auto only" tune --model fopdt-paper --Ts 0.01 --plant ipa
+expect_error "unknown plant" "nosuch" tune --rule auto --model fopdt-paper --Ts 0.01 --plant nosuch
+expect_error "limits outside the plant" "--u-min 50 is above --u-max" tune --rule auto --model fopdt-paper --Ts 0.01 --plant ipa --u-min 50 --u-max 20
 finish

@@ -566,6 +566,9 @@ nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
     Get(b, "u_min", c.u_min);
     Get(b, "u_max", c.u_max);
     Get(b, "du_max", c.du_max);
+    // The loop's plant bounds the design as in /api/control: the review then
+    // describes the controller that runs.
+    if (Get(b, "plant", c.plant)) FileSpec(c.plant);
   }
   return cli::TuneJson(c);
 }
