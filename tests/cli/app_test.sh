@@ -23,6 +23,8 @@ ln -s /etc "$ROOT/link"
 (cd "$ROOT" && "$PNEUMID" identify demo.csv -m reaction-curve,arx,fit-p1d --detrend none \
   --json > "$TMP/identify_cli.json") || fail "identify --json"
 "$PNEUMID" tune --model fopdt-paper --Ts 0.01 --json > "$TMP/tune_cli.json" || fail "tune --json"
+"$PNEUMID" tune --rule auto --model fopdt-paper --Ts 0.01 --plant ipa --json > "$TMP/tune_auto_cli.json" ||
+  fail "tune --rule auto --plant ipa --json"
 
 # Empty the file before the background job starts (its redirection may come late).
 : > "$TMP/app.txt"
@@ -179,6 +181,11 @@ expect(s, a, 404, "identify an unknown data set")
 s, a = call("POST", "/api/tune", {"model": "fopdt-paper", "Ts": 0.01})
 if expect(s, a, 200, "tune") and a != json.load(open(tmp + "/tune_cli.json")):
     fail("tune: not the JSON of pneumid tune --json")
+# the rule auto with the loop's plant: designed within its input range, as tune --plant
+s, a = call("POST", "/api/tune", {"model": "fopdt-paper", "Ts": 0.01, "rule": "auto",
+                                  "plant": "ipa"})
+if expect(s, a, 200, "tune auto") and a != json.load(open(tmp + "/tune_auto_cli.json")):
+    fail("tune auto with a plant: not the JSON of pneumid tune --rule auto --plant ipa --json")
 scenario = {"controller": "dmc", "plant": "ipa", "Ts": 0.01, "duration": 3,
             "setpoint": "step:from=0,to=80,at=0.5", "load_step": "at=2,size=-10"}
 s, a = call("POST", "/api/control", dict(scenario, model="models.json#arx"))
