@@ -80,6 +80,13 @@ std::vector<std::string> DefaultCalibrationParameters(IpaMode mode) {
   return names;
 }
 
+std::vector<std::string> DefaultCalibrationParameters(const IpaParameters& start) {
+  std::vector<std::string> names = DefaultCalibrationParameters(start.mode);
+  if (start.mode == IpaMode::kForce && start.pressure_filter_time_constant > 0.0)
+    names.push_back("sensors.pressure_filter_time_constant");
+  return names;
+}
+
 namespace {
 
 /// The simulator parameters of the calibration's model: noise-free, no ADC
@@ -317,7 +324,7 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
 
   // Free parameters, their ranges and scales.
   std::vector<std::string> keys;
-  for (const auto& name : options.free.empty() ? DefaultCalibrationParameters(options.start.mode)
+  for (const auto& name : options.free.empty() ? DefaultCalibrationParameters(options.start)
                                                 : options.free) {
     const IpaParameterInfo& info = FindIpaParameter(name);
     PNEUMID_CHECK(info.calibratable,

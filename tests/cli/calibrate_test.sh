@@ -33,9 +33,13 @@ for key in parameters experiments termination message validation correlations wa
   check_json "JSON key $key" "'$key' in j" "$TMP/calibrate.json"
 done
 check_json "termination" "j['termination'] == 'convergence'" "$TMP/calibrate.json"
+# the default twin has a sensor filter: its time constant is free by default too
 check_json "default free parameters" "sorted(j['parameters']) == sorted(['cylinder.bore', \
 'valves.inlet_conductance', 'valves.exhaust_conductance', 'valves.inlet_critical_ratio', \
-'valves.exhaust_critical_ratio', 'valves.open_delay'])" "$TMP/calibrate.json"
+'valves.exhaust_critical_ratio', 'valves.open_delay', 'sensors.pressure_filter_time_constant'])" \
+  "$TMP/calibrate.json"
+check_json "filter within 5 %" "abs(j['parameters']['sensors.pressure_filter_time_constant']\
+['value'] / 0.21564 - 1) < 0.05" "$TMP/calibrate.json"
 check_json "bore within 5 %" \
   "abs(j['parameters']['cylinder.bore']['value'] / 0.0212 - 1) < 0.05" "$TMP/calibrate.json"
 check_json "conductances within 5 %" \

@@ -74,7 +74,7 @@ struct IpaCalibrationOptions {
   /// (mode and PWM mode included).
   IpaParameters start;
   /// Names of the free parameters (TOML keys or unique last parts, see
-  /// FindIpaParameter); empty: DefaultCalibrationParameters(start.mode).
+  /// FindIpaParameter); empty: DefaultCalibrationParameters(start).
   std::vector<std::string> free;
   /// Bounds that replace the physical range of a parameter, by name.
   std::map<std::string, std::pair<double, double>> bounds;
@@ -147,6 +147,13 @@ struct IpaCalibrationSummary {
 /// conductance and critical ratio, bore, open delay; position mode adds mass,
 /// viscous and Coulomb friction.
 std::vector<std::string> DefaultCalibrationParameters(IpaMode mode);
+
+/// Free parameters when none are named, for a calibration that starts from
+/// `start`: DefaultCalibrationParameters(start.mode), and in force mode the
+/// sensor filter's time constant when `start` has a sensor filter (> 0; the
+/// default twin's 0.216 s): there it is the dominant lag of the force, which
+/// no valve parameter can stand in for.
+std::vector<std::string> DefaultCalibrationParameters(const IpaParameters& start);
 
 /// The model's output on an experiment's samples: the simulator with
 /// `parameters` (noise-free, no quantization) driven by the data's input.
