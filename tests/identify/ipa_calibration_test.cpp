@@ -39,6 +39,15 @@ IpaParameters ChamberLag() {
   return LoadIpaParameters(std::string(PNEUMID_SOURCE_DIR) + "/config/ipa_chamber_lag.toml");
 }
 
+// Every estimate of `s` within `relative` of the value in `truth`.
+void ExpectEstimatesNear(const IpaCalibrationSummary& s, const IpaParameters& truth,
+                         double relative) {
+  for (const auto& e : s.estimates) {
+    const double truth_value = GetIpaParameter(truth, e.name);
+    EXPECT_NEAR(e.value, truth_value, relative * std::abs(truth_value)) << e.name;
+  }
+}
+
 // Hidden parameter sets drawn from fixed seeds: every default free parameter
 // perturbed (conductances and bore +-20 %, critical ratios 0.2..0.45, open
 // delay 1..3 ms); the data carry the default sensor noise (150 Pa) and the
@@ -115,11 +124,8 @@ TEST_P(DefaultTwinRecovery, RecoversForceScaleSensorLagAndStaticMapWithin5Percen
                    options);
   ASSERT_TRUE(IsSuccess(s.termination)) << s.message;
   ASSERT_EQ(s.estimates.size(), 5u);
-  for (const auto& e : s.estimates) {
-    const double truth_value = GetIpaParameter(truth, e.name);
-    EXPECT_NEAR(e.value, truth_value, 0.05 * std::abs(truth_value)) << e.name;
-    EXPECT_TRUE(e.determined) << e.name;
-  }
+  ExpectEstimatesNear(s, truth, 0.05);
+  for (const auto& e : s.estimates) EXPECT_TRUE(e.determined) << e.name;
   for (const auto& f : s.experiments) EXPECT_GT(f.fit_percent, 99.0) << f.name;
   // A different experiment, held out: multi-level random steps over 10-90 %.
   const Dataset validation = Simulated(
@@ -130,10 +136,12 @@ TEST_P(DefaultTwinRecovery, RecoversForceScaleSensorLagAndStaticMapWithin5Percen
 INSTANTIATE_TEST_SUITE_P(HiddenSeeds, DefaultTwinRecovery, ::testing::Values(5u, 17u, 29u));
 
 TEST(IpaCalibration, DefaultFreeParametersIncludeTheSensorFilterOfATwinThatHasOne) {
-  const std::vector<std::string> valves_and_bore = {
-      "valves.inlet_conductance",    "valves.exhaust_conductance",
-      "valves.inlet_critical_ratio", "valves.exhaust_critical_ratio",
-      "cylinder.bore",               "valves.open_delay"};
+  const std::vector<std::string> valves_and_bore = {"valves.inlet_conductance",
+                                                    "valves.exhaust_conductance",
+                                                    "valves.inlet_critical_ratio",
+                                                    "valves.exhaust_critical_ratio",
+                                                    "cylinder.bore",
+                                                    "valves.open_delay"};
   EXPECT_EQ(DefaultCalibrationParameters(IpaMode::kForce), valves_and_bore);
   EXPECT_EQ(DefaultCalibrationParameters(ChamberLag()), valves_and_bore);  // no filter
   std::vector<std::string> with_filter = valves_and_bore;
@@ -158,24 +166,18 @@ TEST(IpaCalibration, DefaultFreeParametersFitAnActuatorWithAnotherSensorLag) {
   truth.exhaust_conductance = 3.3e-8;
   IpaCalibrationOptions options;
   options.start = start;
-  const IpaCalibrationSummary s =
-      CalibrateIpa({{Simulated(truth, kStep, 3.0, 3), "step"},
-                    {Simulated(truth, kStaircase, 5.0, 4), "staircase"}},
-                   options);
+  const std::vector<CalibrationExperiment> data = {
+      {Simulated(truth, kStep, 3.0, 3), "step"},
+      {Simulated(truth, kStaircase, 5.0, 4), "staircase"}};
+  const IpaCalibrationSummary s = CalibrateIpa(data, options);
   ASSERT_TRUE(IsSuccess(s.termination)) << s.message;
   ASSERT_EQ(s.estimates.size(), 7u);
-  for (const auto& e : s.estimates) {
-    const double truth_value = GetIpaParameter(truth, e.name);
-    EXPECT_NEAR(e.value, truth_value, 0.05 * std::abs(truth_value)) << e.name;
-  }
+  ExpectEstimatesNear(s, truth, 0.05);
   for (const auto& f : s.experiments) EXPECT_GT(f.fit_percent, 99.0) << f.name;
   // The same data with the filter held at the twin's 0.216 s: a poor twin, and flagged.
   options.free = DefaultCalibrationParameters(IpaMode::kForce);
   options.max_iterations = 30;
-  const IpaCalibrationSummary held =
-      CalibrateIpa({{Simulated(truth, kStep, 3.0, 3), "step"},
-                    {Simulated(truth, kStaircase, 5.0, 4), "staircase"}},
-                   options);
+  const IpaCalibrationSummary held = CalibrateIpa(data, options);
   EXPECT_LT(held.experiments[0].fit_percent, 95.0);
   EXPECT_THAT(::testing::PrintToString(held.warnings), HasSubstr("fits it by only"));
 }
@@ -300,9 +302,8 @@ TEST(IpaCalibration, ATwinThatDoesNotReproduceTheDataIsFlagged) {
   // summary says so instead of handing over a silently wrong twin.
   const IpaParameters p;
   const Dataset step = Simulated(p, kStep, 3.0, 1);
-  const Dataset kilonewton = Dataset::FromUniform(step.SampleTime(), step.u(0),
-                                                  step.y(0) / 1000.0, 0.0, {"u", "%"},
-                                                  {"F", "kN"});
+  const Dataset kilonewton = Dataset::FromUniform(step.SampleTime(), step.u(0), step.y(0) / 1000.0,
+                                                  0.0, {"u", "%"}, {"F", "kN"});
   IpaCalibrationOptions options;
   options.free = {"bore", "pressure_filter_time_constant"};
   const IpaCalibrationSummary bad = CalibrateIpa({{kilonewton, "kn.csv"}}, options);
