@@ -23,7 +23,6 @@
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/lti/model_io.hpp"
-#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "validators.hpp"
 
@@ -55,11 +54,9 @@ void Execute(const CodegenCli& c) {
   // As `pneumid control`: the plant's input range (IPA: duty 0..100 %) unless
   // --u-min/--u-max say otherwise.
   ControllerSettings settings = c.controller;
-  if (!c.plant.empty()) {
-    const Actuator actuator = PlantActuator(*MakePlant(c.plant, c.Ts, PlantOptions{}));
-    if (!std::isfinite(settings.limits.u_min)) settings.limits.u_min = actuator.u_min;
-    if (!std::isfinite(settings.limits.u_max)) settings.limits.u_max = actuator.u_max;
-  }
+  if (!c.plant.empty())
+    ApplyPlantInputRange(*MakePlant(c.plant, c.Ts, PlantOptions{}), settings.limits.u_min,
+                         settings.limits.u_max);
   PNEUMID_CHECK(!(settings.limits.u_min > settings.limits.u_max), "--u-min {} is above --u-max {}",
                 settings.limits.u_min, settings.limits.u_max);
   // Options the chosen controller would silently ignore are errors here: the

@@ -27,7 +27,6 @@
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/lti/model_io.hpp"
-#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/report/figures.hpp"
@@ -174,12 +173,8 @@ std::vector<ControlRun> SimulateControl(const ControlCli& c) {
   const std::string plant_spec = c.plant.empty() ? c.model : c.plant;
   // The plant's physical input range (IPA: duty 0..100 %) unless --u-min/--u-max say otherwise.
   ControllerSettings settings = c.controller;
-  const Actuator actuator = PlantActuator(*MakePlant(plant_spec, c.Ts, po));
-  if (!std::isfinite(settings.limits.u_min)) settings.limits.u_min = actuator.u_min;
-  if (!std::isfinite(settings.limits.u_max)) settings.limits.u_max = actuator.u_max;
-  PNEUMID_CHECK(settings.limits.u_min <= settings.limits.u_max,
-                "--u-min {} is above --u-max {} (the plant's input range is {} .. {})",
-                settings.limits.u_min, settings.limits.u_max, actuator.u_min, actuator.u_max);
+  ApplyPlantInputRange(*MakePlant(plant_spec, c.Ts, po), settings.limits.u_min,
+                       settings.limits.u_max);
   cl.actuator.u_min = settings.limits.u_min;
   cl.actuator.u_max = settings.limits.u_max;
   const ControllerSpec base = WithModelInputMap(ToControllerSpec(settings), c.model);

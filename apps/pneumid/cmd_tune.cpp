@@ -21,11 +21,11 @@
 
 #include "command.hpp"
 #include "command_json.hpp"
+#include "controller_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/auto_tuning.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/model_io.hpp"
-#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "validators.hpp"
 
@@ -44,16 +44,9 @@ AutoTuneResult Auto(const TuneCli& c, const TransferFunction& model) {
   o.limits.u_min = c.u_min;
   o.limits.u_max = c.u_max;
   o.limits.du_max = c.du_max;
-  if (!c.plant.empty()) {
-    // The plant's physical input range (IPA: duty 0..100 %) where --u-min/--u-max
-    // leave it open, as `control --plant` designs: the two give the same settings.
-    const Actuator actuator = PlantActuator(*MakePlant(c.plant, c.Ts));
-    if (!std::isfinite(o.limits.u_min)) o.limits.u_min = actuator.u_min;
-    if (!std::isfinite(o.limits.u_max)) o.limits.u_max = actuator.u_max;
-    PNEUMID_CHECK(o.limits.u_min <= o.limits.u_max,
-                  "--u-min {} is above --u-max {} (the plant's input range is {} .. {})",
-                  o.limits.u_min, o.limits.u_max, actuator.u_min, actuator.u_max);
-  }
+  // As `control --plant` designs: the two give the same settings.
+  if (!c.plant.empty())
+    ApplyPlantInputRange(*MakePlant(c.plant, c.Ts), o.limits.u_min, o.limits.u_max);
   o.M = c.M;
   return AutoTune(model, c.Ts, o);
 }

@@ -1,5 +1,10 @@
 #include "controller_options.hpp"
 
+#include <cmath>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/plant/actuator.hpp"
+
 #include "validators.hpp"
 
 namespace pneumid::cli {
@@ -41,6 +46,14 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
                  "disturbance at the plant input), output (on the output) or none")
       ->capture_default_str()
       ->check(CLI::IsMember({"output", "input", "none"}));
+}
+
+void ApplyPlantInputRange(const Plant& plant, double& u_min, double& u_max) {
+  const Actuator actuator = PlantActuator(plant);
+  if (!std::isfinite(u_min)) u_min = actuator.u_min;
+  if (!std::isfinite(u_max)) u_max = actuator.u_max;
+  PNEUMID_CHECK(u_min <= u_max, "--u-min {} is above --u-max {} (the plant's input range is {} .. {})",
+                u_min, u_max, actuator.u_min, actuator.u_max);
 }
 
 }  // namespace pneumid::cli

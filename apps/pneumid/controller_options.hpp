@@ -15,10 +15,17 @@
 #include <CLI/CLI.hpp>
 
 #include "pneumid/control/controller_factory.hpp"
+#include "pneumid/plant/plant.hpp"
 
 namespace pneumid::cli {
 
 /// Adds the options above, writing into `settings`.
 void AddControllerOptions(CLI::App& app, ControllerSettings& settings);
+
+/// Input limits of a design against `plant` (`control`, `tune --plant`,
+/// `codegen --plant`): a limit left open (not finite, no --u-min/--u-max) takes
+/// the plant's physical input range (IPA: duty 0..100 %).
+/// @throws InvalidArgument when u_min > u_max, naming the plant's range.
+void ApplyPlantInputRange(const Plant& plant, double& u_min, double& u_max);
 
 }  // namespace pneumid::cli

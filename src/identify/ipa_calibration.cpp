@@ -62,7 +62,7 @@ bool IpaCalibrationOptions::IsValid(std::string* error) const {
   if (!(correlation_threshold > 0.0 && correlation_threshold <= 1.0))
     return fail(
         fmt::format("correlation_threshold must be in (0, 1], got {}", correlation_threshold));
-  if (!(fit_warning_percent >= -1e9 && fit_warning_percent <= 100.0))
+  if (!(fit_warning_percent <= 100.0))
     return fail(fmt::format("fit_warning_percent must be at most 100, got {}",
                             fit_warning_percent));
   return true;
