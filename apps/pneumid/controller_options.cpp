@@ -52,8 +52,9 @@ void ApplyPlantInputRange(const Plant& plant, double& u_min, double& u_max) {
   const Actuator actuator = PlantActuator(plant);
   if (!std::isfinite(u_min)) u_min = actuator.u_min;
   if (!std::isfinite(u_max)) u_max = actuator.u_max;
-  PNEUMID_CHECK(u_min <= u_max, "--u-min {} is above --u-max {} (the plant's input range is {} .. {})",
-                u_min, u_max, actuator.u_min, actuator.u_max);
+  PNEUMID_CHECK(u_min <= u_max,
+                "--u-min {} is above --u-max {} (the plant's input range is {} .. {})", u_min,
+                u_max, actuator.u_min, actuator.u_max);
 }
 
 }  // namespace pneumid::cli
