@@ -13,6 +13,7 @@
 #include <memory>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
@@ -38,6 +39,11 @@ struct CodegenCli {
   std::string prefix = "pneumid_ctrl";
   std::string output;
   std::size_t max_ram = 0;
+  int qp_max_iterations = -1;
+  double cpu_mhz = 0.0;
+  double period = 0.0;
+  double utilization = 0.5;
+  double cycles_per_instruction = 1.5;
   std::string with_plant;
   bool json = false;
 };
@@ -48,9 +54,17 @@ void Execute(const CodegenCli& c) {
   options.precision = CodegenPrecisionFromString(c.precision);
   options.prefix = c.prefix;
   options.max_ram_bytes = c.max_ram;
+  options.qp_max_iterations = c.qp_max_iterations;
+  options.cpu_mhz = c.cpu_mhz;
+  options.period = c.period;
+  options.utilization = c.utilization;
+  options.cycles_per_instruction = c.cycles_per_instruction;
   std::string error;
   PNEUMID_CHECK(options.IsValid(&error), "--prefix: {}", error);
-  const TransferFunction model = ParseModelSpec(c.model);
+  // The model as `pneumid control` reads it: a Hammerstein, Wiener or
+  // input-affine NARX model file brings its map or linearization, which the
+  // module carries (c_codegen.hpp).
+  const TransferFunction model = ParseControllerModel(c.model);
   // As `pneumid control`: the plant's input range (IPA: duty 0..100 %) unless
   // --u-min/--u-max say otherwise.
   ControllerSettings settings = c.controller;
@@ -71,7 +85,8 @@ void Execute(const CodegenCli& c) {
                 "--y-min/--y-max are soft output bounds of mpc and of dmc with --constrained, "
                 "not of {}",
                 type == "dmc" ? "dmc without --constrained" : type);
-  const BuiltController built = MakeController(model, c.Ts, ToControllerSpec(settings));
+  const BuiltController built =
+      MakeController(model, c.Ts, WithModelInputMap(ToControllerSpec(settings), c.model));
   const CodegenResult result = GenerateC(*built.controller, options);
   std::vector<std::string> paths = WriteCodegenFiles(result, c.output);
   if (!c.with_plant.empty()) {
@@ -95,9 +110,23 @@ void Execute(const CodegenCli& c) {
   }
   std::cout << fmt::format("{} ({} precision)\n", result.description, ToString(options.precision));
   std::cout << fmt::format("design: {}\n", built.Summary());
-  std::cout << fmt::format("state (RAM): {} bytes; constant tables (flash): {} bytes{}\n",
+  std::cout << fmt::format("state (RAM): {} bytes; constant tables: {} bytes{}\n",
                            result.ram_bytes, result.const_bytes,
                            result.constrained ? "; with the embedded QP solver" : "");
+  const RealTimeCertificate& rt = result.certificate;
+  std::cout << fmt::format("worst step: {:.0f} instructions{}{}\n", rt.max_instructions,
+                           rt.qp_max_iterations > 0
+                               ? fmt::format(" with {} QP iterations", rt.qp_max_iterations)
+                               : std::string(),
+                           rt.present ? fmt::format(" = {:.0f} cycles = {:.3g} ms at {:g} MHz, "
+                                                    "budget {:.0f} cycles ({:g} of {:g} ms)",
+                                                    rt.max_cycles, 1e3 * rt.max_time, rt.cpu_mhz,
+                                                    rt.budget_cycles, rt.utilization,
+                                                    1e3 * rt.period)
+                                      : std::string());
+  if (!result.layers.empty())
+    std::cout << fmt::format("layers in front of the {}: {}\n", ToString(result.type),
+                             fmt::join(result.layers, ", "));
   for (const std::string& p : paths) std::cout << "wrote " << p << "\n";
 }
 
@@ -141,6 +170,29 @@ const Registrar reg(
                      "RAM budget in bytes for the controller's state; a larger one is an error "
                      "(0 = none)")
           ->capture_default_str();
+      app.add_option("--qp-max-iterations", c->qp_max_iterations,
+                     "Iteration cap of the constrained controllers' QP in the module "
+                     "(QP_MAX_ITERATIONS, overridable with -D); -1: the design's, 0: 10 (n + "
+                     "finite sides) + 10")
+          ->capture_default_str()
+          ->check(CLI::Range(-1, 1000000));
+      app.add_option("--cpu-mhz", c->cpu_mhz,
+                     "Target clock in MHz for the real-time certificate: the QP's iteration cap "
+                     "becomes the largest whose worst step fits the budget (0: no certificate)")
+          ->capture_default_str()
+          ->check(NonNegative());
+      app.add_option("--period", c->period,
+                     "Control period in s for the certificate (0: --Ts)")
+          ->capture_default_str()
+          ->check(NonNegative());
+      app.add_option("--utilization", c->utilization,
+                     "Fraction of the period the controller may take")
+          ->capture_default_str()
+          ->check(CLI::Range(1e-6, 1.0));
+      app.add_option("--cycles-per-instruction", c->cycles_per_instruction,
+                     "Cycles per instruction assumed on the target (>= 1)")
+          ->capture_default_str()
+          ->check(CLI::Range(1.0, 100.0));
       app.add_option("-o,--output", c->output, "Directory to write NAME.h, NAME.c, README.md into")
           ->required();
       app.add_option("--with-plant", c->with_plant,

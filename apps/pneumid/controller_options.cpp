@@ -46,6 +46,15 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
                  "disturbance at the plant input), output (on the output) or none")
       ->capture_default_str()
       ->check(CLI::IsMember({"output", "input", "none"}));
+  app.add_option("--y-valid-min", s.y_valid_min,
+                 "Lowest measurement a working sensor gives; a sample below it (or NaN/Inf) is a "
+                 "fault: the controller holds its last input and keeps its state (default: any "
+                 "finite value)");
+  app.add_option("--y-valid-max", s.y_valid_max,
+                 "Highest measurement a working sensor gives (see --y-valid-min)");
+  app.add_option("--safe-input", s.safe_input,
+                 "Input applied on a faulty sample instead of holding the last one (e.g. the "
+                 "valves' vented duty)");
 }
 
 void ApplyPlantInputRange(const Plant& plant, double& u_min, double& u_max) {

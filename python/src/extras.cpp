@@ -141,7 +141,33 @@ void BindExtras(py::module_& m) {
   py::class_<Controller>(m, "Controller", "A sampled controller (DMC, GPC, PID, MPC).")
       .def("reset", &Controller::Reset, "u0"_a = 0.0, "y0"_a = 0.0)
       .def("update", &Controller::Update, "setpoint"_a, "measurement"_a,
-           "One control step; returns the input to hold over the next period.")
+           "One control step; returns the input to hold over the next period. A NaN or "
+           "infinite measurement or set-point, or a measurement outside the guard's range, "
+           "leaves the controller's state untouched and returns the last valid input (or the "
+           "guard's safe input); last_fault and fault_count say so.")
+      .def("applied", &Controller::Applied, "u"_a,
+           "The input actually applied after the last update (anti-windup); NaN is ignored.")
+      .def(
+          "set_measurement_guard",
+          [](Controller& c, double y_min, double y_max, double safe_input) {
+            MeasurementGuard g;
+            g.y_min = y_min;
+            g.y_max = y_max;
+            g.safe_input = safe_input;
+            c.SetMeasurementGuard(g);
+          },
+          "y_min"_a = -std::numeric_limits<double>::infinity(),
+          "y_max"_a = std::numeric_limits<double>::infinity(),
+          "safe_input"_a = std::numeric_limits<double>::quiet_NaN(),
+          "Measurements outside [y_min, y_max] are faults; safe_input (NaN: hold the last "
+          "input) is applied on a faulty sample.")
+      .def_property_readonly(
+          "last_fault", [](const Controller& c) { return ToString(c.last_fault()); },
+          "'none', 'measurement-not-finite', 'measurement-out-of-range', "
+          "'setpoint-not-finite' or 'output-not-finite'")
+      .def_property_readonly("fault_count", &Controller::fault_count,
+                             "Faulty samples since the last reset.")
+      .def_property_readonly("last_input", &Controller::last_input)
       .def_property_readonly("Ts", &Controller::Ts)
       .def("describe", &Controller::Describe)
       .def("__repr__", [](const Controller& c) { return "<Controller " + c.Describe() + ">"; });

@@ -92,3 +92,33 @@ def test_make_controller_mpc_by_name():
     u = [c.update(80.0, 0.0) for _ in range(5)]
     assert all(0.0 <= v <= 100.0 for v in u)
     assert u[0] > 0.0
+
+
+@pytest.mark.parametrize("kind", ["dmc", "gpc", "pid", "mpc"])
+def test_nan_measurement_holds_the_input_and_control_resumes(kind):
+    # A NaN or Inf reading neither poisons the controller nor reaches its state:
+    # the input is held, the fault is reported, and the loop recovers.
+    g = pneumid.paper_fopdt_model()
+    c = pneumid.make_controller(g, 0.01, kind, "shridhar-cooper", M=5, u_min=0.0, u_max=100.0)
+    c.set_measurement_guard(y_min=-5.0, y_max=250.0)
+    p = pneumid.make_plant("fopdt-paper", 0.01)
+    c.reset(0.0, 0.0)
+    us, ys, faults = [], [], []
+    for k in range(600):
+        y = p.measure()
+        if 150 <= k < 160:
+            y = float("nan") if k % 2 else float("inf")
+        if 160 <= k < 165:
+            y = -1000.0  # a disconnected sensor, out of the valid range
+        u = c.update(60.0, y)
+        us.append(u)
+        ys.append(p.measure())
+        faults.append(c.last_fault)
+        p.advance(u)
+    assert np.all(np.isfinite(us)) and min(us) >= 0.0 and max(us) <= 100.0
+    assert faults[150] in ("measurement-not-finite",) and faults[162] == "measurement-out-of-range"
+    assert faults[165] == "none" and c.fault_count == 15
+    assert all(u == us[149] for u in us[150:165])
+    assert np.max(np.abs(np.array(ys[215:]) - 60.0)) < 0.5
+    with pytest.raises(ValueError):
+        c.set_measurement_guard(y_min=10.0, y_max=0.0)

@@ -21,6 +21,7 @@
 #include "pneumid/control/gpc.hpp"
 #include "pneumid/control/inverse_map_controller.hpp"
 #include "pneumid/control/mpc.hpp"
+#include "pneumid/control/narx_linearizing_controller.hpp"
 #include "pneumid/control/pid.hpp"
 
 namespace pneumid {
@@ -79,7 +80,15 @@ class Module {
                                    "QP_MAX_ITERATIONS",
                                    "QP_MAX_ITERATIONS_REACHED",
                                    "QP_WARM_START",
-                                   "QP_TOLERANCE"};
+                                   "QP_TOLERANCE",
+                                   "Y_VALID_MIN",
+                                   "Y_VALID_MAX",
+                                   "SAFE_INPUT",
+                                   "FAULT_NONE",
+                                   "FAULT_MEASUREMENT_NOT_FINITE",
+                                   "FAULT_MEASUREMENT_OUT_OF_RANGE",
+                                   "FAULT_SETPOINT_NOT_FINITE",
+                                   "FAULT_OUTPUT_NOT_FINITE"};
 
   // static const PFX_real PFX_name[n] (a matrix column-major); at least one entry.
   void Array(const std::string& name, const Eigen::Ref<const Eigen::MatrixXd>& m,
@@ -124,6 +133,8 @@ class Module {
   std::string code_;
   std::vector<Field> state_, qp_;
   std::size_t const_bytes_ = 0;
+  // The QP's iteration cap in the module (the certificate's).
+  int qp_max_iterations_ = 0;
   // Kernels the code calls.
   bool dot_ = false, dot_strided_ = false, gemv_col_ = false, qp_solver_ = false;
 
@@ -165,9 +176,11 @@ void EmitQpData(Module& m, const QpSolver& qp, const InputLimits& lim, bool soft
   m.qp_solver_ = m.dot_ = m.dot_strided_ = m.gemv_col_ = true;
   m.constants_ += fmt::format("#define PFX_QP_N {} /* QP variables */\n", n);
   m.constants_ += fmt::format("#define PFX_QP_M {} /* QP constraint rows */\n", rows);
-  m.constants_ +=
-      fmt::format("#define PFX_QP_MAX_ITERATIONS {} /* 0: 10 (n + finite sides) + 10 */\n",
-                  qp.options().max_iterations);
+  m.constants_ += fmt::format(
+      "/* Iteration cap of one QP solve (0: 10 (n + finite sides) + 10); -D overrides it. A\n"
+      "   solve that reaches it applies the clipped unconstrained move (within the limits). */\n"
+      "#ifndef PFX_QP_MAX_ITERATIONS\n#define PFX_QP_MAX_ITERATIONS {}\n#endif\n",
+      m.qp_max_iterations_);
   m.constants_ += fmt::format("#define PFX_QP_WARM_START {}\n", qp.options().warm_start ? 1 : 0);
   const double tol = m.is_float() ? std::max(qp.options().feasibility_tolerance, 1e-4)
                                   : qp.options().feasibility_tolerance;
@@ -711,6 +724,453 @@ void PFX_applied(PFX_state* s, PFX_real u) {{
                          nz);
 }
 
+// Makes the entry points generated so far (PFX_reset, PFX_step, PFX_applied,
+// PFX_clip) static functions named PFX_<stem>reset, ..., so that a layer
+// around them can define its own.
+void HideEntryPoints(Module& m, const std::string& stem) {
+  auto replace_all = [&](const std::string& from, const std::string& to) {
+    std::string out;
+    std::size_t pos = 0;
+    for (std::size_t at; (at = m.code_.find(from, pos)) != std::string::npos; pos = at + from.size())
+      out.append(m.code_, pos, at - pos).append(to);
+    out.append(m.code_, pos, std::string::npos);
+    m.code_ = std::move(out);
+  };
+  for (const char* name : {"reset", "step", "applied", "clip"})
+    replace_all(fmt::format("PFX_{}(", name), fmt::format("PFX_{}{}(", stem, name));
+  replace_all(fmt::format("\nvoid PFX_{}reset(", stem),
+              fmt::format("\nstatic void PFX_{}reset(", stem));
+  replace_all(fmt::format("\nvoid PFX_{}applied(", stem),
+              fmt::format("\nstatic void PFX_{}applied(", stem));
+  replace_all(fmt::format("\nPFX_real PFX_{}step(", stem),
+              fmt::format("\nstatic PFX_real PFX_{}step(", stem));
+}
+
+// PFX_<name>_eval(u) and, for a monotone map, PFX_<name>_inverse(y): the
+// piecewise-linear map f and its inverse as StaticMap::Evaluate and
+// StaticMap::Inverse compute them (same segment search, same expressions).
+void EmitStaticMap(Module& m, const StaticMap& map, const std::string& name,
+                   const std::string& what, bool eval, bool inverse) {
+  const int n = static_cast<int>(map.size());
+  const Eigen::Map<const Eigen::VectorXd> u(map.u().data(), n), y(map.y().data(), n);
+  m.Array(name + "_u", u, what + ": knots u");
+  if (eval) m.Array(name + "_y", y, what + ": values y");
+  std::string ends;
+  if (map.extrapolation() == StaticMapExtrapolation::kClamp) {
+    ends = fmt::format("    return u <= PFX_{0}_u[0] ? PFX_{0}_y[0] : PFX_{0}_y[{1}];\n", name,
+                       n - 1);
+  } else {
+    ends = fmt::format(
+        "    i = u <= PFX_{0}_u[0] ? 0 : {1};\n"
+        "    if (PFX_{0}_y[i + 1] == PFX_{0}_y[i]) return PFX_{0}_y[i];\n"
+        "    return PFX_{0}_y[i] + (PFX_{0}_y[i + 1] - PFX_{0}_y[i]) * (u - PFX_{0}_u[i]) /\n"
+        "           (PFX_{0}_u[i + 1] - PFX_{0}_u[i]);\n",
+        name, n - 2);
+  }
+  if (eval)
+    m.code_ += fmt::format(
+      R"C(/* {2} (StaticMap::Evaluate, {3} extrapolation). */
+static PFX_real PFX_{0}_eval(PFX_real u) {{
+  int i;
+  if (u != u) return u;
+  if (u <= PFX_{0}_u[0] || u >= PFX_{0}_u[{1}]) {{
+{4}  }}
+  i = 0;
+  while (PFX_{0}_u[i + 1] <= u) ++i;
+  return PFX_{0}_y[i] + (PFX_{0}_y[i + 1] - PFX_{0}_y[i]) * (u - PFX_{0}_u[i]) /
+         (PFX_{0}_u[i + 1] - PFX_{0}_u[i]);
+}}
+
+)C",
+      name, n - 1, what, ToString(map.extrapolation()), ends);
+  if (!inverse) return;
+  PNEUMID_CHECK(map.IsMonotone(), "the {} ({}) is not monotone: it has no inverse", what,
+                map.Describe());
+  const double sign = map.Direction() == Monotonicity::kIncreasing ? 1.0 : -1.0;
+  Eigen::VectorXd ys = sign * y;
+  int low_end = 0, high_start = n - 1;
+  while (low_end + 1 < n && ys[low_end + 1] == ys[0]) ++low_end;
+  while (high_start > 0 && ys[high_start - 1] == ys[n - 1]) --high_start;
+  m.Array(name + "_ys", ys, what + ": values times the map's direction (+-1)");
+  m.code_ += fmt::format(
+      R"C(/* The inverse of the {2} (StaticMap::Inverse): y beyond the range gives the
+   end of the input range where the output starts to move. */
+static PFX_real PFX_{0}_inverse(PFX_real y) {{
+  const PFX_real v = {3} * y;
+  int i;
+  if (v <= PFX_{0}_ys[0]) return PFX_{0}_u[{4}];
+  if (v >= PFX_{0}_ys[{1}]) return PFX_{0}_u[{5}];
+  i = 1;
+  while (PFX_{0}_ys[i] < v) ++i;
+  return PFX_{0}_u[i - 1] + (PFX_{0}_u[i] - PFX_{0}_u[i - 1]) * (v - PFX_{0}_ys[i - 1]) /
+         (PFX_{0}_ys[i] - PFX_{0}_ys[i - 1]);
+}}
+
+)C",
+      name, n - 1, what, m.Literal(sign), low_end, high_start);
+}
+
+// InverseMapController: u = clip(f^-1(inner(r, y))), the inner controller
+// told f(u) when it differs from its request.
+void GenerateInverseMap(const InverseMapController& c, Module& m, const std::string& stem) {
+  const std::string map = stem + "imap";
+  EmitStaticMap(m, c.map(), map, "input map f (u -> v)", true, true);
+  EmitClip(m, c.limits());
+  m.Member({Field::kReal, stem + "u_prev", 0, "last input u (input map layer)"});
+  m.Member({Field::kReal, stem + "v", 0, "inner controller's request v"});
+  m.code_ += fmt::format(R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
+  s->{0}u_prev = u0;
+  s->{0}v = PFX_{1}_eval(u0);
+  PFX_{0}reset(s, s->{0}v, y0);
+}}
+
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
+  PFX_real u_inv, u, v_applied;
+  s->{0}v = PFX_{0}step(s, setpoint, measurement);
+  u_inv = PFX_ISFINITE(s->{0}v) ? PFX_{1}_inverse(s->{0}v) : s->{0}u_prev;
+  u = PFX_clip(u_inv, s->{0}u_prev);
+  v_applied = PFX_{1}_eval(u);
+  if (v_applied != s->{0}v) PFX_{0}applied(s, v_applied);
+  s->{0}u_prev = u;
+  return u;
+}}
+
+void PFX_applied(PFX_state* s, PFX_real u) {{
+  if (u == s->{0}u_prev || !PFX_ISFINITE(u)) return;
+  s->{0}u_prev = u;
+  PFX_{0}applied(s, PFX_{1}_eval(u));
+}}
+)C",
+                         stem, map);
+}
+
+// OutputMapController: the inner controller on g^-1(r), g^-1(y).
+void GenerateOutputMap(const OutputMapController& c, Module& m, const std::string& stem) {
+  const std::string map = stem + "omap";
+  EmitStaticMap(m, c.map(), map, "monotone envelope of the output map g", false, true);
+  m.code_ += fmt::format(R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
+  PFX_{0}reset(s, u0, PFX_{1}_inverse(y0));
+}}
+
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
+  return PFX_{0}step(s, PFX_{1}_inverse(setpoint), PFX_{1}_inverse(measurement));
+}}
+
+void PFX_applied(PFX_state* s, PFX_real u) {{ PFX_{0}applied(s, u); }}
+)C",
+                         stem, map);
+}
+
+// NarxLinearizingController: v = (p y + (1 - p) w - F(y)) / G(y), u = clip(f^-1(v)).
+void GenerateNarxLinearization(const NarxLinearizingController& c, Module& m,
+                               const std::string& stem) {
+  const InputAffineNarx& model = c.model();
+  const InputLimits& lim = c.limits();
+  const auto& drift = model.drift_coefficients();
+  const auto& gain = model.gain_coefficients();
+  m.Array(stem + "drift", Eigen::Map<const Eigen::VectorXd>(drift.data(), drift.size()),
+          "F(y) = y_scale sum_k F_k (y / y_scale)^k");
+  m.Array(stem + "gain", Eigen::Map<const Eigen::VectorXd>(gain.data(), gain.size()),
+          "G(y) = y_scale sum_k G_k (y / y_scale)^k");
+  const double p = std::exp(-model.Ts() / c.time_constant());
+  m.Scalar(internal::Upper(stem) + "P", p, "pole of the reference model, exp(-Ts / tau)");
+  m.Scalar(internal::Upper(stem) + "Y_SCALE", model.y_scale(), "output scale of the NARX terms");
+  m.macros_.insert(internal::Upper(stem) + "P");
+  m.macros_.insert(internal::Upper(stem) + "Y_SCALE");
+  std::string map_eval = "u", map_inverse = "v";
+  if (model.map()) {
+    EmitStaticMap(m, *model.map(), stem + "nmap", "NARX model's input map f", true, false);
+    EmitStaticMap(m, *model.envelope(), stem + "nenv", "monotone envelope of the input map",
+                  false, true);
+    map_eval = fmt::format("PFX_{}nmap_eval(u)", stem);
+    map_inverse = fmt::format("PFX_{}nenv_inverse(v)", stem);
+  }
+  EmitClip(m, lim);
+  m.Member({Field::kReal, stem + "u_prev", 0, "last input u (NARX layer)"});
+  m.Member({Field::kReal, stem + "y_last", 0, "last measurement"});
+  m.Member({Field::kReal, stem + "w", 0, "inner controller's request w"});
+  const std::string S = internal::Upper(stem);
+  m.code_ += fmt::format(
+      R"C(static PFX_real PFX_{0}poly(const PFX_real* c, int n, PFX_real y) {{
+  const PFX_real z = y / PFX_{1}Y_SCALE;
+  PFX_real sum = PFX_ZERO;
+  while (n-- > 0) sum = sum * z + c[n];
+  return PFX_{1}Y_SCALE * sum;
+}}
+
+static PFX_real PFX_{0}map(PFX_real u) {{ return {5}; }}
+static PFX_real PFX_{0}inverse_map(PFX_real v) {{ return {6}; }}
+
+/* w that the input u gives on the model from the last measurement. */
+static PFX_real PFX_{0}applied_w(const PFX_state* s, PFX_real u) {{
+  const PFX_real y = s->{0}y_last;
+  return (PFX_{0}poly(PFX_{0}drift, {2}, y) + PFX_{0}poly(PFX_{0}gain, {3}, y) * PFX_{0}map(u) -
+          PFX_{1}P * y) /
+         (PFX_ONE - PFX_{1}P);
+}}
+
+void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
+  s->{0}u_prev = u0;
+  s->{0}y_last = y0;
+  s->{0}w = y0;
+  PFX_{0}reset(s, s->{0}w, y0);
+}}
+
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
+  PFX_real u_target = s->{0}u_prev, u, w_applied;
+  s->{0}y_last = measurement;
+  s->{0}w = PFX_{0}step(s, setpoint, measurement);
+  if (PFX_ISFINITE(s->{0}w) && PFX_ISFINITE(measurement)) {{
+    const PFX_real target = PFX_{1}P * measurement + (PFX_ONE - PFX_{1}P) * s->{0}w;
+    const PFX_real drift = PFX_{0}poly(PFX_{0}drift, {2}, measurement);
+    const PFX_real gain = PFX_{0}poly(PFX_{0}gain, {3}, measurement);
+    if (PFX_FABS(gain) > {4} * (PFX_ONE + PFX_FABS(drift))) {{
+      u_target = PFX_{0}inverse_map((target - drift) / gain);
+    }} else {{
+      u_target = target > drift ? {7} : {8};
+      if (!PFX_ISFINITE(u_target)) u_target = s->{0}u_prev;
+    }}
+  }}
+  u = PFX_clip(u_target, s->{0}u_prev);
+  w_applied = PFX_{0}applied_w(s, u);
+  if (PFX_ISFINITE(w_applied) &&
+      PFX_FABS(w_applied - s->{0}w) > {4} * (PFX_ONE + PFX_FABS(s->{0}w)))
+    PFX_{0}applied(s, w_applied);
+  s->{0}u_prev = u;
+  return u;
+}}
+
+void PFX_applied(PFX_state* s, PFX_real u) {{
+  PFX_real w;
+  if (u == s->{0}u_prev || !PFX_ISFINITE(u)) return;
+  s->{0}u_prev = u;
+  w = PFX_{0}applied_w(s, u);
+  if (PFX_ISFINITE(w)) PFX_{0}applied(s, w);
+}}
+)C",
+      stem, S, drift.size(), gain.size(), m.Literal(1e-12), map_eval, map_inverse,
+      m.Literal(lim.u_max), m.Literal(lim.u_min));
+}
+
+// The guard of Controller::Update (MeasurementGuard): a sample with a
+// non-finite or out-of-range measurement or a non-finite set-point leaves the
+// state untouched and returns the held (or safe) input.
+void GenerateGuard(const Controller& c, Module& m) {
+  const MeasurementGuard& g = c.measurement_guard();
+  m.constants_ += fmt::format(
+      "/* The range of valid measurements (MeasurementGuard); -D overrides it. */\n"
+      "#ifndef PFX_Y_VALID_MIN\n#define PFX_Y_VALID_MIN {}\n#endif\n"
+      "#ifndef PFX_Y_VALID_MAX\n#define PFX_Y_VALID_MAX {}\n#endif\n",
+      std::isfinite(g.y_min) ? m.Literal(g.y_min) : "(-PFX_INF)",
+      std::isfinite(g.y_max) ? m.Literal(g.y_max) : "PFX_INF");
+  if (!std::isnan(g.safe_input))
+    m.constants_ += fmt::format(
+        "/* The input on a faulty sample (unset: hold the last input); -D overrides it. */\n"
+        "#ifndef PFX_SAFE_INPUT\n#define PFX_SAFE_INPUT {}\n#endif\n",
+        m.Literal(g.safe_input));
+  m.Member({Field::kReal, "u_hold", 0, "last valid input (held on a faulty sample)"});
+  m.Member({Field::kInt, "fault", 0, "PFX_FAULT_* of the last step"});
+  m.Member({Field::kInt, "faults", 0, "faulty samples since the last reset"});
+  m.code_ += R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {
+  s->u_hold = u0;
+  s->fault = PFX_FAULT_NONE;
+  s->faults = 0;
+  PFX_core_reset(s, u0, y0);
+}
+
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {
+  int fault = PFX_FAULT_NONE;
+  if (!PFX_ISFINITE(measurement)) {
+    fault = PFX_FAULT_MEASUREMENT_NOT_FINITE;
+  } else if (measurement < PFX_Y_VALID_MIN || measurement > PFX_Y_VALID_MAX) {
+    fault = PFX_FAULT_MEASUREMENT_OUT_OF_RANGE;
+  } else if (!PFX_ISFINITE(setpoint)) {
+    fault = PFX_FAULT_SETPOINT_NOT_FINITE;
+  } else {
+    const PFX_real u = PFX_core_step(s, setpoint, measurement);
+    if (PFX_ISFINITE(u)) {
+      s->u_hold = u;
+      s->fault = PFX_FAULT_NONE;
+      return u;
+    }
+    fault = PFX_FAULT_OUTPUT_NOT_FINITE;
+  }
+  s->fault = fault;
+  if (s->faults < 2147483647) ++s->faults;
+#ifdef PFX_SAFE_INPUT
+  if (s->u_hold != PFX_SAFE_INPUT) {
+    s->u_hold = PFX_SAFE_INPUT;
+    PFX_core_applied(s, s->u_hold);
+  }
+#endif
+  return s->u_hold;
+}
+
+void PFX_applied(PFX_state* s, PFX_real u) {
+  if (!PFX_ISFINITE(u)) return;
+  s->u_hold = u;
+  PFX_core_applied(s, u);
+}
+)C";
+}
+
+// Work units (multiply-adds, comparisons, map segments) of one step outside
+// the QP, and the QP's dimensions when there is one (RealTimeCertificate).
+struct StepCost {
+  double base = 0.0;
+  const QpSolver* qp = nullptr;
+};
+
+void AddStepCost(const Controller& controller, StepCost* cost) {
+  auto map_cost = [](const StaticMap& f) { return 6.0 * static_cast<double>(f.size()) + 10.0; };
+  if (dynamic_cast<const PidController*>(&controller)) {
+    cost->base += 30.0;
+  } else if (const auto* dmc = dynamic_cast<const DmcController*>(&controller)) {
+    const double N = static_cast<double>(dmc->step_coefficients().size());
+    const double P = dmc->options().P, M = dmc->options().M;
+    cost->base += 2.0 * N + 3.0 * P + 30.0;
+    if (dmc->options().constrained) {
+      cost->base += P * M + 4.0 * P + 2.0 * M;
+      cost->qp = &dmc->qp_solver();
+    }
+  } else if (const auto* gpc = dynamic_cast<const GpcController*>(&controller)) {
+    const double rows = static_cast<double>(gpc->f_matrix().rows());
+    cost->base += rows * static_cast<double>(gpc->f_matrix().cols() + gpc->gamma_matrix().cols()) +
+                  2.0 * rows + 2.0 * static_cast<double>(gpc->t_polynomial().size()) +
+                  static_cast<double>(gpc->y_history_length() + gpc->move_history_length()) + 30.0;
+  } else if (const auto* mpc = dynamic_cast<const MpcController*>(&controller)) {
+    const double nz = static_cast<double>(mpc->Az().rows());
+    const double P = mpc->options().P, M = mpc->options().M;
+    const double rows = mpc->constrained() ? M : 1.0;
+    cost->base += nz * nz + rows * nz + 6.0 * nz + 2.0 * rows + 30.0;
+    if (mpc->constrained()) {
+      // Free response, the feasibility test of the unconstrained moves, the
+      // QP's linear term and row bounds.
+      cost->base += P * nz + P * M + M * nz + 4.0 * P + 4.0 * M;
+      cost->qp = &mpc->qp_solver();
+    }
+  } else if (const auto* im = dynamic_cast<const InverseMapController*>(&controller)) {
+    cost->base += 3.0 * map_cost(im->map()) + 10.0;
+    AddStepCost(im->inner(), cost);
+  } else if (const auto* om = dynamic_cast<const OutputMapController*>(&controller)) {
+    cost->base += 2.0 * map_cost(om->map()) + 10.0;
+    AddStepCost(om->inner(), cost);
+  } else if (const auto* nl = dynamic_cast<const NarxLinearizingController*>(&controller)) {
+    const InputAffineNarx& m = nl->model();
+    const double poly =
+        static_cast<double>(m.drift_coefficients().size() + m.gain_coefficients().size()) * 2.0;
+    double maps = 0.0;
+    if (m.map()) maps = 2.0 * map_cost(*m.map()) + map_cost(*m.envelope());
+    cost->base += 2.0 * poly + maps + 40.0;
+    AddStepCost(nl->inner(), cost);
+  }
+}
+
+// The certificate of `controller` and the QP's iteration cap in the module.
+RealTimeCertificate Certify(const Controller& controller, const CodegenOptions& o) {
+  using C = RealTimeCertificate;
+  StepCost cost;
+  AddStepCost(controller, &cost);
+  C c;
+  c.base_units = cost.base + 20.0;  // the guard
+  c.cycles_per_instruction = o.cycles_per_instruction;
+  c.utilization = o.utilization;
+  int cap = 0;
+  if (cost.qp != nullptr) {
+    const double n = cost.qp->num_variables(), m = cost.qp->num_constraints();
+    const double sides = 2.0 * (m + n);
+    c.qp_init_units = 3.0 * n * n + 2.0 * sides + 50.0;
+    c.qp_iteration_units = 6.5 * n * n + m * n + 10.0 * sides + 50.0;
+    // The automatic cap when every side is finite (the worst case).
+    const int automatic = static_cast<int>(10.0 * (n + sides) + 10.0);
+    const int design = o.qp_max_iterations >= 0 ? o.qp_max_iterations
+                                                : cost.qp->options().max_iterations;
+    cap = design > 0 ? design : automatic;
+    c.qp_define = design;
+  }
+  auto instructions = [&](int iterations) {
+    const double units = c.base_units + (iterations > 0 || cost.qp ? c.qp_init_units : 0.0) +
+                         iterations * c.qp_iteration_units;
+    return C::kInstructionsPerUnit * units + C::kInstructionsFixed;
+  };
+  if (o.cpu_mhz > 0.0) {
+    c.present = true;
+    c.cpu_mhz = o.cpu_mhz;
+    c.period = o.period > 0.0 ? o.period : controller.Ts();
+    c.budget_cycles = o.utilization * c.period * o.cpu_mhz * 1e6;
+    const double budget_instructions = c.budget_cycles / o.cycles_per_instruction;
+    const double fixed = instructions(0);
+    PNEUMID_CHECK(fixed <= budget_instructions,
+                  "the real-time certificate cannot be met: a step of '{}' takes up to {:.0f} "
+                  "instructions ({:.0f} cycles at {} cycles per instruction) without a QP "
+                  "iteration, above the budget of {:.0f} cycles ({:g} of {:g} s at {:g} MHz); "
+                  "use a faster clock, a longer period or shorter horizons",
+                  controller.Describe(), fixed, fixed * o.cycles_per_instruction,
+                  o.cycles_per_instruction, c.budget_cycles, o.utilization, c.period, o.cpu_mhz);
+    if (cost.qp != nullptr) {
+      const int fits = static_cast<int>(
+          std::floor((budget_instructions - fixed) /
+                     (C::kInstructionsPerUnit * c.qp_iteration_units)));
+      PNEUMID_CHECK(fits >= 1,
+                    "the real-time certificate cannot be met: one QP iteration of '{}' takes up "
+                    "to {:.0f} instructions and the rest of the step {:.0f}, above the budget of "
+                    "{:.0f} cycles ({:g} of {:g} s at {:g} MHz, {} cycles per instruction); use a "
+                    "faster clock, a longer period or shorter horizons",
+                    controller.Describe(), C::kInstructionsPerUnit * c.qp_iteration_units, fixed,
+                    c.budget_cycles, o.utilization, c.period, o.cpu_mhz,
+                    o.cycles_per_instruction);
+      cap = std::min(cap, fits);
+      c.qp_define = cap;
+    }
+  }
+  c.qp_max_iterations = cap;
+  c.max_instructions = instructions(cap);
+  c.max_cycles = c.max_instructions * o.cycles_per_instruction;
+  if (c.present) c.max_time = c.max_cycles / (o.cpu_mhz * 1e6);
+  return c;
+}
+
+// The controller's code: a linear controller, or a layer (input map, output
+// map, NARX linearization) around its inner controller's code.
+void GenerateLayers(const Controller& controller, Module& m, int depth, CodegenResult* result) {
+  const std::string stem = fmt::format("l{}_", depth);
+  if (const auto* pid = dynamic_cast<const PidController*>(&controller)) {
+    result->type = ControllerType::kPid;
+    GeneratePid(*pid, m);
+  } else if (const auto* dmc = dynamic_cast<const DmcController*>(&controller)) {
+    result->type = ControllerType::kDmc;
+    result->constrained = dmc->options().constrained;
+    GenerateDmc(*dmc, m);
+  } else if (const auto* gpc = dynamic_cast<const GpcController*>(&controller)) {
+    result->type = ControllerType::kGpc;
+    GenerateGpc(*gpc, m);
+  } else if (const auto* mpc = dynamic_cast<const MpcController*>(&controller)) {
+    result->type = ControllerType::kMpc;
+    result->constrained = mpc->constrained();
+    GenerateMpc(*mpc, m);
+  } else if (const auto* im = dynamic_cast<const InverseMapController*>(&controller)) {
+    GenerateLayers(im->inner(), m, depth + 1, result);
+    HideEntryPoints(m, stem);
+    GenerateInverseMap(*im, m, stem);
+    result->layers.insert(result->layers.begin(), "input-map");
+  } else if (const auto* om = dynamic_cast<const OutputMapController*>(&controller)) {
+    GenerateLayers(om->inner(), m, depth + 1, result);
+    HideEntryPoints(m, stem);
+    GenerateOutputMap(*om, m, stem);
+    result->layers.insert(result->layers.begin(), "output-map");
+  } else if (const auto* nl = dynamic_cast<const NarxLinearizingController*>(&controller)) {
+    GenerateLayers(nl->inner(), m, depth + 1, result);
+    HideEntryPoints(m, stem);
+    GenerateNarxLinearization(*nl, m, stem);
+    result->layers.insert(result->layers.begin(), "narx-linearization");
+  } else {
+    PNEUMID_CHECK(false,
+                  "code generation supports the dmc, gpc, pid and mpc controllers, alone or "
+                  "behind an input map, an output map or a NARX linearization, not '{}'",
+                  controller.Describe());
+  }
+}
+
 // PFX_name -> prefix_name, and PFX_MACRO -> PREFIX_MACRO for the macros.
 std::string WithPrefix(const std::string& text, const std::string& prefix,
                        const std::set<std::string>& macros) {
@@ -730,6 +1190,23 @@ std::string WithPrefix(const std::string& text, const std::string& prefix,
   return out;
 }
 
+std::string CertificateText(const RealTimeCertificate& c, const std::string& upper) {
+  std::string text = fmt::format(
+      "\nWorst-case work of one step (pneumid's operation count, bounded by "
+      "measurements on a Cortex-M4F): {:.0f} instructions",
+      c.max_instructions);
+  if (c.qp_max_iterations > 0)
+    text += fmt::format(" with the QP capped at {} iterations (`{}_QP_MAX_ITERATIONS`)",
+                        c.qp_max_iterations, upper);
+  if (c.present)
+    text += fmt::format(
+        "; at {:g} MHz and {:g} cycles per instruction, {:.0f} cycles = {:.3g} ms, within the "
+        "budget of {:.0f} cycles ({:g} of the {:g} ms period)",
+        c.cpu_mhz, c.cycles_per_instruction, c.max_cycles, 1e3 * c.max_time, c.budget_cycles,
+        c.utilization, 1e3 * c.period);
+  return text + ".\n";
+}
+
 }  // namespace
 
 std::string ToString(CodegenPrecision v) { return std::string(EnumToString(kPrecisionNames, v)); }
@@ -743,6 +1220,19 @@ bool CodegenOptions::IsValid(std::string* error) const {
     if (error) *error = message;
     return false;
   };
+  if (!(cpu_mhz >= 0.0) || !std::isfinite(cpu_mhz))
+    return fail(fmt::format("the clock must be >= 0 MHz (0: no certificate), got {}", cpu_mhz));
+  if (!(period >= 0.0) || !std::isfinite(period))
+    return fail(fmt::format("the period must be >= 0 s (0: the controller's Ts), got {}", period));
+  if (!(utilization > 0.0 && utilization <= 1.0))
+    return fail(fmt::format("the utilization must be in (0, 1], got {}", utilization));
+  if (!(cycles_per_instruction >= 1.0) || !std::isfinite(cycles_per_instruction))
+    return fail(
+        fmt::format("cycles per instruction must be >= 1, got {}", cycles_per_instruction));
+  if (qp_max_iterations < -1)
+    return fail(fmt::format("qp_max_iterations must be -1 (the design's), 0 (automatic) or "
+                            "positive, got {}",
+                            qp_max_iterations));
   if (prefix.empty() || prefix.size() > 32)
     return fail(fmt::format("the prefix must have 1 to 32 characters, got {}", prefix.size()));
   if (std::isdigit(static_cast<unsigned char>(prefix[0])))
@@ -764,6 +1254,25 @@ nlohmann::ordered_json CodegenResult::ToJson() const {
   j["constrained"] = constrained;
   j["ram_bytes"] = ram_bytes;
   j["const_bytes"] = const_bytes;
+  j["layers"] = layers;
+  const RealTimeCertificate& c = certificate;
+  nlohmann::ordered_json cj;
+  cj["qp_max_iterations"] = c.qp_max_iterations;
+  cj["max_instructions_per_step"] = std::round(c.max_instructions);
+  cj["instructions_per_unit"] = RealTimeCertificate::kInstructionsPerUnit;
+  cj["units"] = {{"base", c.base_units},
+                 {"qp_init", c.qp_init_units},
+                 {"qp_iteration", c.qp_iteration_units}};
+  if (c.present) {
+    cj["cpu_mhz"] = c.cpu_mhz;
+    cj["period"] = c.period;
+    cj["utilization"] = c.utilization;
+    cj["cycles_per_instruction"] = c.cycles_per_instruction;
+    cj["max_cycles_per_step"] = std::round(c.max_cycles);
+    cj["budget_cycles"] = std::round(c.budget_cycles);
+    cj["max_time"] = c.max_time;
+  }
+  j["certificate"] = cj;
   j["files"] = {prefix + ".h", prefix + ".c", "README.md"};
   return j;
 }
@@ -776,29 +1285,11 @@ CodegenResult GenerateC(const Controller& controller, const CodegenOptions& opti
   result.prefix = options.prefix;
   result.precision = options.precision;
   result.description = controller.Describe();
-  if (const auto* pid = dynamic_cast<const PidController*>(&controller)) {
-    result.type = ControllerType::kPid;
-    GeneratePid(*pid, m);
-  } else if (const auto* dmc = dynamic_cast<const DmcController*>(&controller)) {
-    result.type = ControllerType::kDmc;
-    result.constrained = dmc->options().constrained;
-    GenerateDmc(*dmc, m);
-  } else if (const auto* gpc = dynamic_cast<const GpcController*>(&controller)) {
-    result.type = ControllerType::kGpc;
-    GenerateGpc(*gpc, m);
-  } else if (const auto* mpc = dynamic_cast<const MpcController*>(&controller)) {
-    result.type = ControllerType::kMpc;
-    result.constrained = mpc->constrained();
-    GenerateMpc(*mpc, m);
-  } else if (dynamic_cast<const InverseMapController*>(&controller)) {
-    PNEUMID_CHECK(false,
-                  "code generation does not support a controller behind an input map (--input-map "
-                  "or a Hammerstein model) yet: '{}'",
-                  controller.Describe());
-  } else {
-    PNEUMID_CHECK(false, "code generation supports the dmc, gpc, pid and mpc controllers, not '{}'",
-                  controller.Describe());
-  }
+  result.certificate = Certify(controller, options);
+  m.qp_max_iterations_ = result.certificate.qp_define;
+  GenerateLayers(controller, m, 1, &result);
+  HideEntryPoints(m, "core_");
+  GenerateGuard(controller, m);
   const std::string name = options.prefix;
   const std::string guard = internal::Upper(name) + "_H_";
   const bool is_float = m.is_float();
@@ -834,6 +1325,10 @@ CodegenResult GenerateC(const Controller& controller, const CodegenOptions& opti
   h += fmt::format("#define PFX_TS {} /* sample time, s */\n", m.Literal(controller.Ts()));
   h += fmt::format("#define PFX_STATE_BYTES {} /* sizeof(PFX_state) with 4-byte int */\n",
                    result.ram_bytes);
+  h += "\n/* Fault of the last step (PFX_state.fault; PFX_state.faults counts them). */\n"
+       "#define PFX_FAULT_NONE 0\n#define PFX_FAULT_MEASUREMENT_NOT_FINITE 1\n"
+       "#define PFX_FAULT_MEASUREMENT_OUT_OF_RANGE 2\n#define PFX_FAULT_SETPOINT_NOT_FINITE 3\n"
+       "#define PFX_FAULT_OUTPUT_NOT_FINITE 4\n";
   if (m.qp_solver_) {
     h += "\n/* QP status (PFX_state.qp.status). */\n#define PFX_QP_SOLVED 0\n"
          "#define PFX_QP_INFEASIBLE 1\n#define PFX_QP_MAX_ITERATIONS_REACHED 2\n";
@@ -845,7 +1340,11 @@ void PFX_init(PFX_state* s);
    output to settle at y0. */
 void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0);
 /* One control step: set-point and measured output at the current sample;
-   returns the input to hold over the next period (within the limits). */
+   returns the input to hold over the next period (within the limits). A NaN
+   or infinite measurement or set-point, or a measurement outside
+   [PFX_Y_VALID_MIN, PFX_Y_VALID_MAX], is a fault: the state is not updated,
+   the last valid input (or PFX_SAFE_INPUT, when defined) is returned, and
+   s->fault and s->faults say so; the next valid sample resumes control. */
 PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement);
 /* The input actually applied after the last step, when a later layer changed
    it (actuator saturation): the controller takes it as its own. */
@@ -921,8 +1420,16 @@ void control_init(void) {{ {0}_init(&ctrl); }}   /* or {0}_reset(&ctrl, u0, y0) 
 | `{0}_applied(s, u)` | the input actually applied (anti-windup), when it differs from the returned one |
 
 Sample time: `{7}_TS` = {4} s. State: `sizeof({0}_state)` = `{7}_STATE_BYTES` = {3} bytes;
-constant tables: {5} bytes.
-{6}
+constant tables: {5} bytes (the code adds to the flash: measure it with
+`arm-none-eabi-size` of the compiled `{0}.o`, text + data).
+
+Bad measurements: a NaN or infinite measurement or set-point, or a measurement
+outside `[{7}_Y_VALID_MIN, {7}_Y_VALID_MAX]` (compile with `-D` to set them on
+the bench), is a fault: the state is not updated, `{0}_step` returns the last
+valid input (or `{7}_SAFE_INPUT` when it is defined, e.g. `-D{7}_SAFE_INPUT=0.0`),
+`s->fault` holds the `{7}_FAULT_*` code and `s->faults` counts the faulty
+samples since the last reset; the next valid sample resumes control.
+{6}{8}
 The arithmetic follows pneumid's library controller step by step (same
 formulas, same order of the sums), so that the double-precision module
 reproduces the library's inputs to rounding.
@@ -937,7 +1444,7 @@ reproduces the library's inputs to rounding.
                 "counts it in `s->qp_failures` (reset by `{0}_reset`).\n",
                 name, internal::Upper(name))
           : std::string(),
-      internal::Upper(name));
+      internal::Upper(name), CertificateText(result.certificate, internal::Upper(name)));
   return result;
 }
 

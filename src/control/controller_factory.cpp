@@ -49,6 +49,11 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   spec.disturbance = DisturbanceModelFromString(settings.disturbance);
   spec.auto_options.disturbance = spec.disturbance;
   if (!settings.input_map.empty()) spec.input_map = ReadStaticMap(settings.input_map);
+  spec.guard.y_min = settings.y_valid_min;
+  spec.guard.y_max = settings.y_valid_max;
+  spec.guard.safe_input = settings.safe_input;
+  std::string error;
+  PNEUMID_CHECK(spec.guard.IsValid(&error), "{}", error);
   return spec;
 }
 
@@ -107,7 +112,8 @@ nlohmann::ordered_json BuiltController::SettingsToJson() const {
     j["Td"] = pid_gains.Td;
     j["rule"] = ToString(pid_rule);
   } else {
-    j["rule"] = ToString(tuning.rule);
+    // Settings tuned to specifications say so (their tuning result is explicit).
+    j["rule"] = auto_summary.empty() ? ToString(tuning.rule) : std::string("auto");
     j["P"] = tuning.P;
     j["M"] = tuning.M;
     j["lambda"] = tuning.lambda;
@@ -117,6 +123,10 @@ nlohmann::ordered_json BuiltController::SettingsToJson() const {
 }
 
 namespace {
+
+BuiltController BuildController(const TransferFunction& model, double Ts,
+                                const ControllerSpec& spec);
+BuiltController BuildController(const PredictionModel& model, const ControllerSpec& spec);
 
 // The spec's tuning replaced by the auto-tuner's design (rule "auto").
 AutoTuneResult AutoTuned(const TransferFunction& model, double Ts, const ControllerSpec& spec) {
@@ -163,7 +173,7 @@ BuiltController WithNarxLinearization(const ControllerSpec& spec, double Ts) {
   // model deserves at the ends of the range).
   if (inner.auto_tune && !std::isfinite(inner.auto_options.response_time))
     inner.auto_options.response_time = tau;
-  BuiltController b = MakeController(TransferFunction::Fopdt(1.0, tau, 0.0), Ts, inner);
+  BuiltController b = BuildController(TransferFunction::Fopdt(1.0, tau, 0.0), Ts, inner);
   b.controller =
       std::make_unique<NarxLinearizingController>(std::move(b.controller), narx, tau, spec.limits);
   return b;
@@ -191,17 +201,15 @@ TransferFunction UnitGain(const TransferFunction& model) {
   return TransferFunction(model.num() / K, model.den(), model.Ts(), model.delay());
 }
 
-}  // namespace
-
-BuiltController MakeController(const TransferFunction& model, double Ts,
-                               const ControllerSpec& spec) {
+BuiltController BuildController(const TransferFunction& model, double Ts,
+                                const ControllerSpec& spec) {
   if (spec.narx_model) return WithNarxLinearization(spec, Ts);
   if (spec.output_map)
     return WithOutputMap(spec,
-                         [&](const ControllerSpec& s) { return MakeController(model, Ts, s); });
+                         [&](const ControllerSpec& s) { return BuildController(model, Ts, s); });
   if (spec.input_map) {
     const TransferFunction g = UnitGain(model);
-    return WithInverseMap(spec, [&](const ControllerSpec& s) { return MakeController(g, Ts, s); });
+    return WithInverseMap(spec, [&](const ControllerSpec& s) { return BuildController(g, Ts, s); });
   }
   if (spec.auto_tune && spec.type == ControllerType::kPid) {
     const AutoTuneResult a = AutoTuned(model, Ts, spec);
@@ -232,21 +240,21 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
     b.controller = std::make_unique<PidController>(Ts, o);
     return b;
   }
-  return MakeController(PredictionModel(model, Ts), spec);
+  return BuildController(PredictionModel(model, Ts), spec);
 }
 
-BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec_in) {
+BuiltController BuildController(const PredictionModel& model, const ControllerSpec& spec_in) {
   if (spec_in.narx_model) return WithNarxLinearization(spec_in, model.Ts());
   if (spec_in.output_map)
     return WithOutputMap(spec_in,
-                         [&](const ControllerSpec& s) { return MakeController(model, s); });
+                         [&](const ControllerSpec& s) { return BuildController(model, s); });
   if (spec_in.input_map) {
     const PredictionModel unit(UnitGain(model.model()), model.Ts());
     return WithInverseMap(spec_in,
-                          [&](const ControllerSpec& s) { return MakeController(unit, s); });
+                          [&](const ControllerSpec& s) { return BuildController(unit, s); });
   }
   if (spec_in.auto_tune && spec_in.type == ControllerType::kPid)
-    return MakeController(model.model(), model.Ts(), spec_in);
+    return BuildController(model.model(), model.Ts(), spec_in);
   ControllerSpec spec = spec_in;
   std::string auto_summary;
   std::optional<TuningResult> auto_tuning;
@@ -313,9 +321,26 @@ BuiltController MakeController(const PredictionModel& model, const ControllerSpe
       break;
     }
     case ControllerType::kPid:
-      return MakeController(model.model(), model.Ts(), spec);
+      return BuildController(model.model(), model.Ts(), spec);
   }
   if (auto_tuning) b.tuning = *auto_tuning;
+  return b;
+}
+
+}  // namespace
+
+// The guard goes on the outermost controller only: behind an output map the
+// inner controller sees g^-1(y), and behind an input map its input is v.
+BuiltController MakeController(const TransferFunction& model, double Ts,
+                               const ControllerSpec& spec) {
+  BuiltController b = BuildController(model, Ts, spec);
+  b.controller->SetMeasurementGuard(spec.guard);
+  return b;
+}
+
+BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec) {
+  BuiltController b = BuildController(model, spec);
+  b.controller->SetMeasurementGuard(spec.guard);
   return b;
 }
 

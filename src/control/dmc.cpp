@@ -149,7 +149,7 @@ void DmcController::Build() {
   Reset();
 }
 
-void DmcController::Reset(double u0, double y0) {
+void DmcController::DoReset(double u0, double y0) {
   yhat_.setConstant(y0);
   free_.setConstant(y0);
   u_prev_ = u0;
@@ -158,7 +158,7 @@ void DmcController::Reset(double u0, double y0) {
   if (qp_) qp_->ClearWarmStart();
 }
 
-double DmcController::Update(double setpoint, double measurement) {
+double DmcController::DoUpdate(double setpoint, double measurement) {
   const int P = options_.P, M = options_.M;
   const double bias = measurement - yhat_(0);
   for (int i = 0; i < P; ++i) free_(i) = yhat_(i + 1) + bias;
@@ -190,7 +190,7 @@ double DmcController::Update(double setpoint, double measurement) {
   return u;
 }
 
-void DmcController::Applied(double u) {
+void DmcController::DoApplied(double u) {
   const double delta = u - u_prev_;
   if (delta == 0.0 || !std::isfinite(delta)) return;
   // The prediction was shifted with the move du; it should have been du + delta.

@@ -161,7 +161,7 @@ GpcController::GpcController(const PredictionModel& model, const GpcOptions& opt
   Reset();
 }
 
-void GpcController::Reset(double u0, double y0) {
+void GpcController::DoReset(double u0, double y0) {
   yf_hist_.setConstant(y0 / T_.sum());
   duf_hist_.setZero();
   free_.setConstant(y0);
@@ -169,7 +169,7 @@ void GpcController::Reset(double u0, double y0) {
   last_du_ = 0.0;
 }
 
-double GpcController::Update(double setpoint, double measurement) {
+double GpcController::DoUpdate(double setpoint, double measurement) {
   const Eigen::Index nT = T_.size();
   // y_f(t) = y(t) - sum_i t_i y_f(t-i).
   std::copy_backward(yf_hist_.data(), yf_hist_.data() + yf_hist_.size() - 1,
@@ -193,7 +193,7 @@ double GpcController::Update(double setpoint, double measurement) {
   return u;
 }
 
-void GpcController::Applied(double u) {
+void GpcController::DoApplied(double u) {
   const double delta = u - u_prev_;
   if (delta == 0.0 || !std::isfinite(delta)) return;
   // Delta u_f(t) is linear in Delta u(t): the correction adds delta to it.

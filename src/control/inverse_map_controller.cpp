@@ -52,13 +52,13 @@ InverseMapController::InverseMapController(std::unique_ptr<Controller> inner, St
   Reset();
 }
 
-void InverseMapController::Reset(double u0, double y0) {
+void InverseMapController::DoReset(double u0, double y0) {
   u_prev_ = u0;
   v_ = map_.Evaluate(u0);
   inner_->Reset(v_, y0);
 }
 
-double InverseMapController::Update(double setpoint, double measurement) {
+double InverseMapController::DoUpdate(double setpoint, double measurement) {
   v_ = inner_->Update(setpoint, measurement);
   const double u_inv = std::isfinite(v_) ? map_.Inverse(v_) : u_prev_;
   const double u = limits_.Clip(u_inv, u_prev_);
@@ -70,7 +70,7 @@ double InverseMapController::Update(double setpoint, double measurement) {
   return u;
 }
 
-void InverseMapController::Applied(double u) {
+void InverseMapController::DoApplied(double u) {
   if (u == u_prev_ || !std::isfinite(u)) return;
   u_prev_ = u;
   inner_->Applied(map_.Evaluate(u));
@@ -96,9 +96,9 @@ OutputMapController::OutputMapController(std::unique_ptr<Controller> inner,
   PNEUMID_CHECK(inner_ != nullptr, "OutputMapController needs a controller, got null");
 }
 
-void OutputMapController::Reset(double u0, double y0) { inner_->Reset(u0, map_.Inverse(y0)); }
+void OutputMapController::DoReset(double u0, double y0) { inner_->Reset(u0, map_.Inverse(y0)); }
 
-double OutputMapController::Update(double setpoint, double measurement) {
+double OutputMapController::DoUpdate(double setpoint, double measurement) {
   return inner_->Update(map_.Inverse(setpoint), map_.Inverse(measurement));
 }
 

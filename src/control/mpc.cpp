@@ -262,7 +262,7 @@ void MpcController::Build(const StateSpace& model_in) {
   Reset();
 }
 
-void MpcController::Reset(double u0, double y0) {
+void MpcController::DoReset(double u0, double y0) {
   switch (options_.disturbance) {
     case DisturbanceModel::kOutput:
       z_prior_.head(nx_) = xs_unit_ * u0;
@@ -312,7 +312,7 @@ double MpcController::disturbance_estimate() const {
   return options_.disturbance == DisturbanceModel::kNone ? 0.0 : z_post_(nx_);
 }
 
-double MpcController::Update(double setpoint, double measurement) {
+double MpcController::DoUpdate(double setpoint, double measurement) {
   const int M = options_.M;
   // Kalman correction.
   const double innovation = measurement - Cz_.dot(z_prior_);
@@ -369,7 +369,7 @@ double MpcController::Update(double setpoint, double measurement) {
   return u;
 }
 
-void MpcController::Applied(double u) {
+void MpcController::DoApplied(double u) {
   const double delta = u - u_prev_;
   if (delta == 0.0 || !std::isfinite(delta)) return;
   // z_k+1|k was predicted with u_prev_; correct it for the input really applied.

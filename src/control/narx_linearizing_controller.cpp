@@ -169,7 +169,7 @@ NarxLinearizingController::NarxLinearizingController(std::unique_ptr<Controller>
   Reset();
 }
 
-void NarxLinearizingController::Reset(double u0, double y0) {
+void NarxLinearizingController::DoReset(double u0, double y0) {
   u_prev_ = u0;
   y_last_ = y0;
   w_ = y0;  // at rest the reference model's input equals its output
@@ -180,7 +180,7 @@ double NarxLinearizingController::AppliedW(double u) const {
   return (model_.Drift(y_last_) + model_.Gain(y_last_) * model_.Map(u) - p_ * y_last_) / (1.0 - p_);
 }
 
-double NarxLinearizingController::Update(double setpoint, double measurement) {
+double NarxLinearizingController::DoUpdate(double setpoint, double measurement) {
   y_last_ = measurement;
   w_ = inner_->Update(setpoint, measurement);
   double u_target = u_prev_;
@@ -202,7 +202,7 @@ double NarxLinearizingController::Update(double setpoint, double measurement) {
   return u;
 }
 
-void NarxLinearizingController::Applied(double u) {
+void NarxLinearizingController::DoApplied(double u) {
   if (u == u_prev_ || !std::isfinite(u)) return;
   u_prev_ = u;
   const double w = AppliedW(u);

@@ -88,7 +88,7 @@ PidController::PidController(double Ts, const PidOptions& options) : options_(op
   Reset();
 }
 
-void PidController::Reset(double u0, double y0) {
+void PidController::DoReset(double u0, double y0) {
   // Bumpless start at rest: integral holds u0 with e = 0.
   integral_ = u0 - options_.gains.Kc * (options_.setpoint_weight - 1.0) * y0;
   derivative_ = 0.0;
@@ -96,7 +96,7 @@ void PidController::Reset(double u0, double y0) {
   u_prev_ = u0;
 }
 
-double PidController::Update(double setpoint, double measurement) {
+double PidController::DoUpdate(double setpoint, double measurement) {
   const PidGains& g = options_.gains;
   const double e = setpoint - measurement;
   const double p = g.Kc * (options_.setpoint_weight * setpoint - measurement);
@@ -115,7 +115,7 @@ double PidController::Update(double setpoint, double measurement) {
   return u;
 }
 
-void PidController::Applied(double u) {
+void PidController::DoApplied(double u) {
   const double delta = u - u_prev_;
   if (delta == 0.0 || !std::isfinite(delta)) return;
   // Back-calculation as for the controller's own limits: the integral

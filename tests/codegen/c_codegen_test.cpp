@@ -50,7 +50,37 @@ constexpr int kSteps = 10000;
 struct Case {
   std::string name;
   ControllerSettings settings;
+  /// The controller's model: "linear" (the paper's FOPDT), "hammerstein"
+  /// (an input map in front of it), "wiener" (an output map after it), "hw"
+  /// (both) or "narx" (an input-affine NARX model).
+  std::string model = "linear";
 };
+
+// Duty (%) -> force (N), monotone, with the twin's kind of jump between 85
+// and 90 % and a dead band below 10 %.
+StaticMap InputMap() {
+  return StaticMap({0, 10, 30, 60, 85, 90, 100}, {0, 2, 40, 95, 135, 193, 200});
+}
+// The output of the linear part (N) -> the measured force (N).
+StaticMap OutputMap() { return StaticMap({0, 40, 80, 120, 160, 250}, {0, 36, 80, 126, 168, 260}); }
+
+// y(t) = y(t-1) - 0.03 z - 0.02 z^2 + (0.12 - 0.05 z) v, z = y / 200 (N),
+// v = f(u) in [0, 1]: a first-order input-affine NARX model of a chamber,
+// written on normalised signals as the estimator writes it.
+NarxModel ChamberNarx() {
+  NarxModel m;
+  m.ny = m.nu = m.nk = 1;
+  m.degree = 3;
+  m.Ts = kTs;
+  m.u_offset = 0.5;
+  m.u_scale = 0.5;
+  m.y_scale = 200.0;
+  m.terms = {{}, {0}, {0, 0}, {1}, {0, 1}};
+  m.theta = {0.06, 1.0 - 0.03 - 0.025, -0.02, 0.06, -0.025};
+  m.err.assign(m.terms.size(), 0.0);
+  return m;
+}
+StaticMap ChamberValve() { return StaticMap({0, 5, 10, 50, 100}, {0, -0.01, 0, 0.6, 1.0}); }
 
 std::vector<Case> Cases() {
   std::vector<Case> cases;
@@ -84,8 +114,24 @@ std::vector<Case> Cases() {
     s.y_max = 82.0;
   });
   add("mpc_input_disturbance", "mpc", true, [](ControllerSettings& s) { s.disturbance = "input"; });
+  // Nonlinear models: each layer in front of a linear controller.
+  const std::pair<const char*, const char*> layered[] = {
+      {"hammerstein", "mpc"}, {"hammerstein", "dmc"}, {"hammerstein", "pid"},
+      {"hammerstein", "gpc"}, {"wiener", "mpc"},      {"wiener", "dmc"},
+      {"hw", "mpc"},          {"narx", "mpc"},        {"narx", "pid"}};
+  for (const auto& [model, controller] : layered) {
+    add(fmt::format("{}_{}", model, controller), controller, true, none);
+    cases.back().model = model;
+  }
+  add("hammerstein_mpc_constrained", "mpc", true, [](ControllerSettings& s) {
+    s.limits.du_max = 4.0;
+    s.y_max = 82.0;
+  });
+  cases.back().model = "hammerstein";
   return cases;
 }
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
 // The library's closed loop (requested inputs, what the controller saw).
 struct LibraryRun {
@@ -107,7 +153,11 @@ std::unique_ptr<Signal> Setpoint() {
 }
 
 std::unique_ptr<Controller> Build(const Case& c) {
-  return MakeController(PaperFopdtModel(), kTs, ToControllerSpec(c.settings)).controller;
+  ControllerSpec spec = ToControllerSpec(c.settings);
+  if (c.model == "hammerstein" || c.model == "hw") spec.input_map = InputMap();
+  if (c.model == "wiener" || c.model == "hw") spec.output_map = OutputMap();
+  if (c.model == "narx") spec.narx_model = InputAffineNarx(ChamberNarx(), ChamberValve());
+  return MakeController(PaperFopdtModel(), kTs, spec).controller;
 }
 
 const LibraryRun& Library(const Case& c) {
@@ -179,20 +229,20 @@ class GeneratedController : public Controller {
   ~GeneratedController() override {
     if (handle_) dlclose(handle_);
   }
-  void Reset(double u0, double y0) override {
+  void DoReset(double u0, double y0) override {
     if (single_)
       reinterpret_cast<void (*)(void*, float, float)>(reset_)(state_.data(), static_cast<float>(u0),
                                                               static_cast<float>(y0));
     else
       reinterpret_cast<void (*)(void*, double, double)>(reset_)(state_.data(), u0, y0);
   }
-  double Update(double r, double y) override {
+  double DoUpdate(double r, double y) override {
     if (single_)
       return reinterpret_cast<float (*)(void*, float, float)>(step_)(
           state_.data(), static_cast<float>(r), static_cast<float>(y));
     return reinterpret_cast<double (*)(void*, double, double)>(step_)(state_.data(), r, y);
   }
-  void Applied(double u) override {
+  void DoApplied(double u) override {
     if (single_)
       reinterpret_cast<void (*)(void*, float)>(applied_)(state_.data(), static_cast<float>(u));
     else
@@ -201,6 +251,9 @@ class GeneratedController : public Controller {
   double Ts() const override { return Ts_; }
   std::string Describe() const override { return description_; }
   std::size_t state_size() const { return state_size_; }
+  /// s.fault and s.faults of the module.
+  int module_fault() const { return StateInt("_fault"); }
+  int module_faults() const { return StateInt("_faults"); }
   /// s.qp_failures of a constrained module.
   int qp_failures() const {
     auto f =
@@ -210,6 +263,11 @@ class GeneratedController : public Controller {
   }
 
  private:
+  int StateInt(const std::string& name) const {
+    auto f = reinterpret_cast<int (*)(const void*)>(dlsym(handle_, (prefix_ + name).c_str()));
+    PNEUMID_CHECK(f != nullptr, "{}{}: no such probe", prefix_, name);
+    return f(state_.data());
+  }
   bool single_;
   double Ts_;
   std::string description_;
@@ -225,6 +283,13 @@ class GeneratedController : public Controller {
 fs::path Compile(const CodegenResult& gen, const fs::path& dir) {
   WriteCodegenFiles(gen, dir.string());
   std::string probe = kSizeProbe;
+  for (std::size_t p; (p = probe.find("NAME")) != std::string::npos;)
+    probe.replace(p, 4, gen.prefix);
+  probe +=
+      "int NAME_fault(const NAME_state* s);\n"
+      "int NAME_fault(const NAME_state* s) { return s->fault; }\n"
+      "int NAME_faults(const NAME_state* s);\n"
+      "int NAME_faults(const NAME_state* s) { return s->faults; }\n";
   for (std::size_t p; (p = probe.find("NAME")) != std::string::npos;)
     probe.replace(p, 4, gen.prefix);
   if (gen.constrained) {
@@ -332,6 +397,70 @@ INSTANTIATE_TEST_SUITE_P(Controllers, CodegenClosedLoopTest, ::testing::ValuesIn
                            return info.param.c.name + "_" + ToString(info.param.precision);
                          });
 
+// Bad samples: the library controller (through its guard) and the module's
+// own guard are fed the library loop's set-points and measurements with NaN,
+// +Inf and out-of-range measurements and a NaN set-point at known steps; the
+// module's inputs equal the library's on every step (double: to 1e-12 of
+// max |u|), are finite and within the limits, and its fault code and count
+// follow the library's.
+class CodegenFaultTest : public ::testing::TestWithParam<Case> {};
+
+TEST_P(CodegenFaultTest, BadSamplesAreHeldAsInTheLibrary) {
+  const Case& c = GetParam();
+  const LibraryRun& run = Library(c);
+  MeasurementGuard guard;
+  guard.y_min = -50.0;
+  guard.y_max = 400.0;
+  auto lib = Build(c);
+  lib->SetMeasurementGuard(guard);
+  CodegenOptions o;
+  o.prefix = "f_" + c.name;
+  const CodegenResult gen = GenerateC(*lib, o);
+  std::string upper = o.prefix;
+  for (char& ch : upper) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  EXPECT_THAT(gen.source, ::testing::HasSubstr("#define " + upper + "_Y_VALID_MAX 400.0"));
+  TempDir dir;
+  const fs::path so = Compile(gen, dir.path());
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  GeneratedController module(so, gen, false, kTs);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  auto bad = [&](Eigen::Index k, double* r, double* y) {
+    if (k >= 3000 && k < 3010) *y = nan;
+    if (k >= 5000 && k < 5003) *y = inf;
+    if (k >= 6000 && k < 6050) *y = -1000.0;  // a disconnected sensor
+    if (k >= 7000 && k < 7005) *r = nan;
+  };
+  lib->Reset(0.0, run.result.y_meas(0));
+  module.Reset(0.0, run.result.y_meas(0));
+  double worst = 0.0;
+  for (Eigen::Index k = 0; k < kSteps; ++k) {
+    double r = run.result.r(k), y = run.result.y_meas(k);
+    bad(k, &r, &y);
+    const double u_lib = lib->Update(r, y);
+    const double u_mod = module.DoUpdate(r, y);  // the module's own guard
+    ASSERT_TRUE(std::isfinite(u_mod)) << "step " << k;
+    ASSERT_GE(u_mod, c.settings.limits.u_min) << "step " << k;
+    ASSERT_LE(u_mod, c.settings.limits.u_max) << "step " << k;
+    worst = std::max(worst, std::abs(u_mod - u_lib));
+    ASSERT_EQ(module.module_fault(), static_cast<int>(lib->last_fault())) << "step " << k;
+    // The actuator's range, as in the closed loop.
+    const double applied = std::clamp(u_lib, 0.0, 100.0);
+    if (applied != u_lib) {
+      lib->Applied(applied);
+      module.DoApplied(applied);
+    }
+  }
+  EXPECT_EQ(lib->fault_count(), 10 + 3 + 50 + 5);
+  EXPECT_EQ(module.module_faults(), lib->fault_count());
+  EXPECT_LE(worst / run.u_range, 1e-12);
+}
+
+INSTANTIATE_TEST_SUITE_P(Controllers, CodegenFaultTest, ::testing::ValuesIn(Cases()),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           return info.param.name;
+                         });
+
 // The constrained scenarios do drive the constraints: the QDMC and MPC
 // inputs reach the rate limit and the QP is solved on some steps.
 TEST(CodegenScenarioTest, ConstrainedCasesHitTheirLimits) {
@@ -359,11 +488,13 @@ TEST(CodegenTest, RejectsAStateAboveTheRamBudget) {
                               gen.ram_bytes, gen.ram_bytes - 1))));
   o.max_ram_bytes = gen.ram_bytes;
   EXPECT_NO_THROW(GenerateC(dmc, o));
-  // Single precision halves the state: yhat_0..yhat_N and f_1..f_P, two scalars.
+  // Single precision halves the reals: yhat_0..yhat_N, f_1..f_P, u_prev,
+  // last_du and the guard's held input; the guard's fault code and count
+  // are two ints.
   o.precision = CodegenPrecision::kFloat;
   const CodegenResult f = GenerateC(dmc, o);
-  EXPECT_EQ(f.ram_bytes, 4 * (dmc.step_coefficients().size() + 126 + 2));
-  EXPECT_EQ(gen.ram_bytes, 8 * (dmc.step_coefficients().size() + 126 + 2));
+  EXPECT_EQ(f.ram_bytes, 4 * (dmc.step_coefficients().size() + 126 + 3) + 2 * 4);
+  EXPECT_EQ(gen.ram_bytes, 8 * (dmc.step_coefficients().size() + 126 + 3) + 2 * 4);
 }
 
 TEST(CodegenTest, RejectsBadPrefixesAndPrecisions) {
@@ -423,8 +554,8 @@ TEST(CodegenQpTest, FailuresFallBackAsInTheLibrary) {
 // A controller type the generator does not know is rejected by name.
 class OtherController : public Controller {
  public:
-  void Reset(double, double) override {}
-  double Update(double, double) override { return 0.0; }
+  void DoReset(double, double) override {}
+  double DoUpdate(double, double) override { return 0.0; }
   double Ts() const override { return 1.0; }
   std::string Describe() const override { return "other"; }
 };
@@ -433,7 +564,8 @@ TEST(CodegenTest, RejectsOtherControllers) {
   OtherController other;
   EXPECT_THAT([&] { GenerateC(other, CodegenOptions{}); },
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr(
-                  "supports the dmc, gpc, pid and mpc controllers, not 'other'")));
+                  "supports the dmc, gpc, pid and mpc controllers, alone or behind an input "
+                  "map, an output map or a NARX linearization, not 'other'")));
 }
 
 // The plant module (plant_codegen.hpp) of the paper's FOPDT: its unit step

@@ -59,9 +59,9 @@ StaticMap Valve() { return StaticMap({0, 5, 10, 50, 100}, {0, -0.01, 0, 0.6, 1.0
 class Fixed : public Controller {
  public:
   explicit Fixed(double w) : w_(w) {}
-  void Reset(double, double) override {}
-  double Update(double, double) override { return w_; }
-  void Applied(double v) override { applied.push_back(v); }
+  void DoReset(double, double) override {}
+  double DoUpdate(double, double) override { return w_; }
+  void DoApplied(double v) override { applied.push_back(v); }
   double Ts() const override { return kTs; }
   std::string Describe() const override { return "fixed"; }
   double w_;

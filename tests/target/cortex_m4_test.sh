@@ -22,7 +22,9 @@ common=(--model fopdt-paper --Ts 0.01 --u-min 0 --u-max 100 --prefix ctrl --with
 run_case() {
   local name=$1 precision=$2
   shift 2
-  expect_ok "$name codegen" codegen "${common[@]}" --precision "$precision" -o "$TMP/$name" "$@"
+  expect_ok "$name codegen" codegen "${common[@]}" --precision "$precision" -o "$TMP/$name" \
+    --cpu-mhz 168 --json "$@"
+  cp "$TMP/out" "$TMP/$name.codegen.json"
   if ! make -s -C "$SRC/examples/cortex-m4" GEN="$TMP/$name" TIMEOUT=60 run \
     COMPARE_FLAGS=--json >"$TMP/$name.json" 2>"$TMP/$name.err"; then
     fail "$name: target run or comparison failed: $(head -c 2000 "$TMP/$name.err")"
@@ -31,12 +33,37 @@ run_case() {
   check_json "$name report" "j['steps'] == 2000 and j['precision'] == '$precision' \
 and j['max_relative_difference_u'] <= j['tolerance'] and j['instructions_per_step_mean'] > 0 \
 and j['ctrl_text'] > 0 and j['state_bytes'] > 0" "$TMP/$name.json"
+  # The real-time certificate bounds the measured worst step.
+  "$PY" - "$TMP/$name.json" "$TMP/$name.codegen.json" "$name" <<'PY' || fail "$name: a step exceeds the certificate"
+import json, sys
+run, gen = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+bound = gen["certificate"]["max_instructions_per_step"]
+worst = run["instructions_per_step_max"]
+print(f"{sys.argv[3]}: worst step {worst:.0f} instructions, certificate {bound:.0f} "
+      f"({worst / bound:.2f}), QP cap {gen['certificate']['qp_max_iterations']}")
+sys.exit(0 if worst <= bound else 1)
+PY
   echo "$name: $(tr -d '\n ' <"$TMP/$name.json")"
 }
 
 run_case dmc float --controller dmc --P 126 --M 5 --lambda 2.25
 run_case mpc_constrained float --controller mpc --P 126 --M 5 --lambda 2.25 --du-max 4 --y-max 82
+run_case qdmc float --controller dmc --constrained --P 126 --M 5 --lambda 2.25 --du-max 4 --y-max 82
+run_case mpc_auto float --controller mpc --rule auto
+run_case gpc float --controller gpc --P 126 --M 5 --lambda 2.25
 run_case pid_double double --controller pid
+echo '{"u": [0, 10, 30, 60, 85, 90, 100], "y": [0, 2, 40, 95, 135, 193, 200]}' >"$TMP/map.json"
+run_case mpc_input_map float --controller mpc --input-map "$TMP/map.json" --du-max 4
+
+# The STM32F4 board example (timer interrupt, ADC, PWM) links with a
+# generated module; no board is needed to build it.
+expect_ok "board codegen" codegen --model fopdt-paper --Ts 0.01 --plant ipa --controller mpc \
+  --rule auto --precision float --prefix ctrl --y-valid-min -5 --y-valid-max 300 -o "$TMP/board"
+if make -s -C "$SRC/examples/stm32f4" GEN="$TMP/board" >"$TMP/board.txt" 2>&1; then
+  echo "stm32f4 board: $(tail -1 "$TMP/board.txt")"
+else
+  fail "stm32f4 board example does not build: $(head -c 2000 "$TMP/board.txt")"
+fi
 # The paper's DMC: the state is yhat_0..yhat_N, f_1..f_P and two scalars (float).
 check_json "dmc state" "j['state_bytes'] % 4 == 0 and j['state_bytes'] > 4 * (126 + 2)" "$TMP/dmc.json"
 finish

@@ -36,6 +36,15 @@
 // not return "solved" applies the clipped unconstrained move as the library
 // does, and counts it in qp_failures.
 //
+// Layers (inverse_map_controller.hpp, narx_linearizing_controller.hpp): the
+// input map's inverse in front of the inner controller's input (Hammerstein),
+// the output map's inverse on its set-point and measurement (Wiener), the
+// NARX linearization; piecewise-linear maps with StaticMap's segment search
+// and expressions, the NARX polynomials by Horner's rule as the library.
+// In front of everything, the MeasurementGuard (controller.hpp): a faulty
+// sample (NaN/Inf, out of [PFX_Y_VALID_MIN, PFX_Y_VALID_MAX]) leaves the
+// state untouched and returns the held or safe input.
+//
 // Single precision: the tables are rounded to float and so is the
 // arithmetic. The MPC computes its moves (and the QP's linear term) from the
 // deviation of the state and input from the target's steady state, and the
@@ -70,7 +79,56 @@ struct CodegenOptions {
   std::string prefix = "pneumid_ctrl";
   /// RAM budget in bytes for the controller's state struct (0 = none).
   std::size_t max_ram_bytes = 0;
+  /// Iteration cap of the constrained controllers' QP (PFX_QP_MAX_ITERATIONS,
+  /// which -D can override at compile time): -1 = the design's (QpOptions),
+  /// 0 = 10 (n + finite sides) + 10.
+  int qp_max_iterations = -1;
+  /// Real-time certificate (RealTimeCertificate): the target's clock in MHz
+  /// (0 = no certificate) and the control period in s (0 = the controller's
+  /// Ts). With a clock, the QP's iteration cap is the largest whose worst
+  /// case fits in `utilization` of the period (and at most the cap above).
+  double cpu_mhz = 0.0;
+  double period = 0.0;
+  /// Fraction of the period the controller may take (the rest is the ADC,
+  /// the PWM, communication and interrupts).
+  double utilization = 0.5;
+  /// Cycles per executed instruction assumed on the target: a Cortex-M4F
+  /// runs most instructions in one cycle; loads, multi-cycle FPU
+  /// divisions/square roots, branches and flash wait states raise the mean.
+  double cycles_per_instruction = 1.5;
   bool IsValid(std::string* error) const;
+};
+
+/// The worst-case work of one step of a generated module, from a count of
+/// its operations (multiply-adds, comparisons, map segments) at the largest
+/// QP work the iteration cap allows:
+///   instructions <= kInstructionsPerUnit * (base + init + cap * per_iteration)
+///                   + kInstructionsFixed,
+/// with base the step outside the QP, init the QP's set-up and per_iteration
+/// the dual active-set iteration's work (directions 2.5 n^2, Givens updates
+/// 4 n^2, constraint scan m n + 10 (2 m + 2 n), for n variables and m rows).
+/// The constants are upper bounds of the instructions per unit measured on a
+/// Cortex-M4F under QEMU (-icount, gcc -O2, examples/cortex-m4), where the
+/// test tests/target/cortex_m4_test.sh checks that every scenario's measured
+/// worst step stays below the certificate.
+struct RealTimeCertificate {
+  static constexpr double kInstructionsPerUnit = 6.0;
+  static constexpr double kInstructionsFixed = 400.0;
+  bool present = false;     ///< a clock was given
+  double cpu_mhz = 0.0;
+  double period = 0.0;      ///< s
+  double utilization = 0.0;
+  double cycles_per_instruction = 0.0;
+  /// The largest number of QP iterations a step can run (0: no QP).
+  int qp_max_iterations = 0;
+  /// PFX_QP_MAX_ITERATIONS in the module: the design's cap (0: automatic, at
+  /// most qp_max_iterations) without a clock, qp_max_iterations with one.
+  int qp_define = 0;
+  double base_units = 0.0, qp_init_units = 0.0, qp_iteration_units = 0.0;
+  double max_instructions = 0.0;  ///< per step, at the cap
+  double max_cycles = 0.0;        ///< max_instructions * cycles_per_instruction
+  double budget_cycles = 0.0;     ///< utilization * period * clock
+  double max_time = 0.0;          ///< s, max_cycles / clock
 };
 
 struct CodegenResult {
@@ -86,17 +144,27 @@ struct CodegenResult {
   /// Bytes of the constant tables (flash; code not included).
   std::size_t const_bytes = 0;
   bool constrained = false;  ///< the module contains the QP solver
+  /// The worst-case work per step (always computed; `present` with a clock).
+  RealTimeCertificate certificate;
+  /// Layers around the linear controller, outermost first: "input-map"
+  /// (Hammerstein), "output-map" (Wiener), "narx-linearization".
+  std::vector<std::string> layers;
   std::string description;   ///< controller.Describe()
   /// {prefix, controller, description, precision, constrained, ram_bytes,
-  /// const_bytes, files}.
+  /// const_bytes, layers, certificate, files}.
   nlohmann::ordered_json ToJson() const;
 };
 
 /// Generates the C module of `controller` (a PidController, DmcController,
-/// GpcController or MpcController).
+/// GpcController or MpcController, alone or behind an InverseMapController,
+/// OutputMapController or NarxLinearizingController, as the controller
+/// factory builds them for Hammerstein, Wiener and input-affine NARX models),
+/// with the controller's MeasurementGuard in front.
 /// @throws InvalidArgument for invalid options, another Controller type, a
-/// non-finite design constant, or a state above options.max_ram_bytes (the
-/// message gives the size and what it grows with).
+/// non-finite design constant, a state above options.max_ram_bytes (the
+/// message gives the size and what it grows with), or a certificate that
+/// cannot be met: the step without a QP iteration, or with fewer than one,
+/// above the budget (the message gives both figures).
 CodegenResult GenerateC(const Controller& controller, const CodegenOptions& options);
 
 /// Writes NAME.h, NAME.c and README.md of `result` into `directory`

@@ -7,6 +7,7 @@
 //   plant.Advance(u_k);
 #pragma once
 
+#include <cstdint>
 #include <limits>
 #include <string>
 
@@ -32,26 +33,95 @@ struct InputLimits {
   double Clip(double u, double u_prev) const;
 };
 
+/// What Controller::Update() found wrong with a sample (Controller::last_fault()).
+enum class ControllerFault {
+  kNone,                   ///< the sample was valid
+  kMeasurementNotFinite,   ///< y is NaN or infinite
+  kMeasurementOutOfRange,  ///< y outside MeasurementGuard's [y_min, y_max]
+  kSetpointNotFinite,      ///< r is NaN or infinite
+  kOutputNotFinite,        ///< the control law returned a non-finite input
+};
+
+/// "none", "measurement-not-finite", "measurement-out-of-range",
+/// "setpoint-not-finite", "output-not-finite".
+std::string ToString(ControllerFault fault);
+/// Inverse of ToString; throws InvalidArgument listing the valid names.
+ControllerFault ControllerFaultFromString(const std::string& name);
+
+/// Which samples a controller accepts, and what it applies on the others.
+///
+/// A sample whose measurement is not finite or outside [y_min, y_max], or
+/// whose set-point is not finite, is a fault: the controller's state is not
+/// updated with it, Update() returns the last valid input (or safe_input when
+/// it is set) and counts the fault, and the next valid sample resumes the
+/// control law from the state before the fault. The generated C modules do
+/// the same (c_codegen.hpp).
+struct MeasurementGuard {
+  /// The range of measurements a working sensor gives (plant units); the
+  /// default accepts every finite value.
+  double y_min = -std::numeric_limits<double>::infinity();
+  double y_max = std::numeric_limits<double>::infinity();
+  /// The input applied while the samples are faulty (e.g. the valves'
+  /// vented state); NaN holds the last valid input. It is applied as is,
+  /// outside the controller's limits, and the controller takes it as its own
+  /// (Applied), so that it resumes from it.
+  double safe_input = std::numeric_limits<double>::quiet_NaN();
+  /// True when y_min <= y_max, neither is NaN and safe_input is NaN or finite.
+  bool IsValid(std::string* error) const;
+  /// The fault of a sample (kNone for a valid one), in the order of the enum.
+  ControllerFault Check(double setpoint, double measurement) const;
+};
+
+/// The feedback controllers' interface. Update(), Reset() and Applied() are
+/// the guarded entry points (non-virtual); a controller implements DoReset(),
+/// DoUpdate() and DoApplied(), which see only valid samples.
 class Controller {
  public:
   virtual ~Controller() = default;
   /// Back to rest at an operating point: input u0 applied long enough for
-  /// the output to settle at y0 (both in plant units).
-  virtual void Reset(double u0 = 0.0, double y0 = 0.0) = 0;
+  /// the output to settle at y0 (both in plant units). Clears the fault
+  /// state and count.
+  void Reset(double u0 = 0.0, double y0 = 0.0);
   /// One control step: set-point r and measured output y at the current
   /// sample; returns the input u to hold over the next period (within the
-  /// controller's limits). Allocates no memory.
-  virtual double Update(double setpoint, double measurement) = 0;
+  /// controller's limits). A faulty sample (MeasurementGuard) leaves the
+  /// state untouched and returns the last valid input, or the guard's safe
+  /// input. Allocates no memory.
+  double Update(double setpoint, double measurement);
   /// The input actually applied after the last Update(), when a layer after
   /// the controller changed it (the plant's input range, a safety layer, a
   /// saturating actuator). Controllers that remember their past inputs
   /// (DMC's prediction, GPC's filtered moves, PID's integral) take it as their
-  /// own (anti-windup); the default does nothing. Allocates no memory.
-  virtual void Applied(double /*u*/) {}
+  /// own (anti-windup). A non-finite u is ignored. Allocates no memory.
+  void Applied(double u);
   /// Sample period in seconds.
   virtual double Ts() const = 0;
   /// Short description, e.g. "dmc P=126 M=5 lambda=2.25".
   virtual std::string Describe() const = 0;
+
+  /// @throws InvalidArgument for an invalid guard (the message names the field).
+  void SetMeasurementGuard(const MeasurementGuard& guard);
+  const MeasurementGuard& measurement_guard() const { return guard_; }
+  /// The fault of the last Update() (kNone after a valid sample).
+  ControllerFault last_fault() const { return last_fault_; }
+  /// Faulty samples since the last Reset().
+  std::int64_t fault_count() const { return fault_count_; }
+  /// The input of the last Update() or Applied() (the held input on a fault).
+  double last_input() const { return last_u_; }
+
+ protected:
+  /// The control law's Reset, Update and Applied: called with finite values
+  /// (and, for DoUpdate, a measurement within the guard's range) only.
+  virtual void DoReset(double u0, double y0) = 0;
+  virtual double DoUpdate(double setpoint, double measurement) = 0;
+  /// The default does nothing (a controller without memory of its inputs).
+  virtual void DoApplied(double /*u*/) {}
+
+ private:
+  MeasurementGuard guard_;
+  ControllerFault last_fault_ = ControllerFault::kNone;
+  std::int64_t fault_count_ = 0;
+  double last_u_ = 0.0;
 };
 
 }  // namespace pneumid

@@ -65,6 +65,9 @@ struct ControllerSpec {
   /// and measurement through g's inverse (OutputMapController).
   std::optional<StaticMap> output_map;
   NarxLinearizingOptions narx_options;  ///< the reference model's time constant
+  /// The measurements the controller accepts and its input on the others
+  /// (controller.hpp), set on the outermost controller.
+  MeasurementGuard guard;
 };
 
 /// Controller settings as a user states them (command line, configuration,
@@ -92,6 +95,11 @@ struct ControllerSettings {
   /// a static-map or Hammerstein model file, or {"u", "y"}); empty = none,
   /// or the model file's own input map (WithModelInputMap).
   std::string input_map;
+  /// The range of valid measurements (MeasurementGuard; infinite = any
+  /// finite value) and the input on a faulty sample (NaN = hold).
+  double y_valid_min = -std::numeric_limits<double>::infinity();
+  double y_valid_max = std::numeric_limits<double>::infinity();
+  double safe_input = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The tuning rule settings ask for: the named rule when `rule` is not empty;

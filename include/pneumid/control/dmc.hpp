@@ -88,10 +88,6 @@ class DmcController : public Controller {
   DmcController(const Eigen::VectorXd& step_coefficients, double Ts, const DmcOptions& options);
   ~DmcController() override;
 
-  void Reset(double u0 = 0.0, double y0 = 0.0) override;
-  /// One step; constant reference w = setpoint over the horizon.
-  double Update(double setpoint, double measurement) override;
-  void Applied(double u) override;
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
 
@@ -117,6 +113,12 @@ class DmcController : public Controller {
   /// Number of constrained steps whose QP did not return kSolved (the
   /// clipped unconstrained move was applied instead).
   int qp_failures() const { return qp_failures_; }
+
+ protected:
+  void DoReset(double u0, double y0) override;
+  /// One step; constant reference w = setpoint over the horizon.
+  double DoUpdate(double setpoint, double measurement) override;
+  void DoApplied(double u) override;
 
  private:
   void Build();

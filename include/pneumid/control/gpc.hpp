@@ -88,9 +88,6 @@ class GpcController : public Controller {
   /// GpcController(PredictionModel(model, Ts), options).
   GpcController(const TransferFunction& model, double Ts, const GpcOptions& options);
 
-  void Reset(double u0 = 0.0, double y0 = 0.0) override;
-  double Update(double setpoint, double measurement) override;
-  void Applied(double u) override;
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
 
@@ -112,6 +109,11 @@ class GpcController : public Controller {
   Eigen::Index move_history_length() const { return duf_hist_.size(); }
   const Eigen::VectorXd& free_response() const { return free_; }
   double last_move() const { return last_du_; }
+
+ protected:
+  void DoReset(double u0, double y0) override;
+  double DoUpdate(double setpoint, double measurement) override;
+  void DoApplied(double u) override;
 
  private:
   GpcOptions options_;

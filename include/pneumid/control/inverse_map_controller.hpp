@@ -48,13 +48,6 @@ class InverseMapController : public Controller {
   InverseMapController(std::unique_ptr<Controller> inner, StaticMap map,
                        const InputLimits& limits = {});
 
-  /// The inner controller at rest at v0 = f(u0), y0.
-  void Reset(double u0 = 0.0, double y0 = 0.0) override;
-  /// u = clip(f^-1(inner.Update(r, y))). Allocates no memory.
-  double Update(double setpoint, double measurement) override;
-  /// The input applied after the last Update(): the inner controller takes
-  /// f(u). Allocates no memory.
-  void Applied(double u) override;
   double Ts() const override { return inner_->Ts(); }
   /// The inner controller's description + " with inverse map (N knots, u in
   /// [a, b])".
@@ -62,8 +55,19 @@ class InverseMapController : public Controller {
 
   const Controller& inner() const { return *inner_; }
   const StaticMap& map() const { return map_; }
+  /// The actuator's limits on u.
+  const InputLimits& limits() const { return limits_; }
   /// v of the last Update() (the inner controller's request).
   double last_virtual_input() const { return v_; }
+
+ protected:
+  /// The inner controller at rest at v0 = f(u0), y0.
+  void DoReset(double u0, double y0) override;
+  /// u = clip(f^-1(inner.Update(r, y))). Allocates no memory.
+  double DoUpdate(double setpoint, double measurement) override;
+  /// The input applied after the last Update(): the inner controller takes
+  /// f(u). Allocates no memory.
+  void DoApplied(double u) override;
 
  private:
   std::unique_ptr<Controller> inner_;
@@ -88,10 +92,6 @@ class OutputMapController : public Controller {
   /// increase anywhere.
   OutputMapController(std::unique_ptr<Controller> inner, const StaticMap& output_map);
 
-  void Reset(double u0 = 0.0, double y0 = 0.0) override;
-  /// Allocates no memory.
-  double Update(double setpoint, double measurement) override;
-  void Applied(double u) override { inner_->Applied(u); }
   double Ts() const override { return inner_->Ts(); }
   /// The inner controller's description + " on the inverse output map (N knots)".
   std::string Describe() const override;
@@ -99,6 +99,12 @@ class OutputMapController : public Controller {
   const Controller& inner() const { return *inner_; }
   /// The monotone envelope of the output map that is inverted.
   const StaticMap& map() const { return map_; }
+
+ protected:
+  void DoReset(double u0, double y0) override;
+  /// Allocates no memory.
+  double DoUpdate(double setpoint, double measurement) override;
+  void DoApplied(double u) override { inner_->Applied(u); }
 
  private:
   std::unique_ptr<Controller> inner_;

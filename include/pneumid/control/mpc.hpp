@@ -148,15 +148,6 @@ class MpcController : public Controller {
   MpcController(const TransferFunction& model, double Ts, const MpcOptions& options);
   ~MpcController() override;
 
-  /// Observer at the steady state of u0, the disturbance estimate chosen so
-  /// that the estimated output is y0 (with model none: the steady state of u0).
-  void Reset(double u0 = 0.0, double y0 = 0.0) override;
-  /// One step; constant set-point over the horizon.
-  double Update(double setpoint, double measurement) override;
-  /// The input actually applied after the last Update() when a later layer
-  /// changed it (anti-windup): the observer's prediction and u_{k-1} use it.
-  /// Allocates no memory.
-  void Applied(double u) override;
   double Ts() const override { return Ts_; }
   /// e.g. "mpc P=126 M=5 lambda=2.25 disturbance=output" (+ " constrained").
   std::string Describe() const override;
@@ -216,6 +207,17 @@ class MpcController : public Controller {
   /// Constrained steps whose QP did not return kSolved (the clipped
   /// unconstrained move was applied instead).
   int qp_failures() const { return qp_failures_; }
+
+ protected:
+  /// Observer at the steady state of u0, the disturbance estimate chosen so
+  /// that the estimated output is y0 (with model none: the steady state of u0).
+  void DoReset(double u0, double y0) override;
+  /// One step; constant set-point over the horizon.
+  double DoUpdate(double setpoint, double measurement) override;
+  /// The input actually applied after the last Update() when a later layer
+  /// changed it (anti-windup): the observer's prediction and u_{k-1} use it.
+  /// Allocates no memory.
+  void DoApplied(double u) override;
 
  private:
   void Build(const StateSpace& model);

@@ -62,6 +62,13 @@ class InputAffineNarx {
   double InverseMap(double v) const;
   double Ts() const { return Ts_; }
   const std::optional<StaticMap>& map() const { return map_; }
+  /// The monotone envelope of the map that InverseMap inverts (none without a map).
+  const std::optional<StaticMap>& envelope() const { return envelope_; }
+  /// Coefficients of F and G in powers of z = y / y_scale (Drift(y) =
+  /// y_scale sum_k drift_k z^k, evaluated by Horner's rule).
+  const std::vector<double>& drift_coefficients() const { return drift_; }
+  const std::vector<double>& gain_coefficients() const { return gain_; }
+  double y_scale() const { return y_scale_; }
   /// The steady output for a constant input u: the fixed point of
   /// y = F(y) + G(y) f(u) reached from y0 (NaN when the model does not settle).
   double SteadyOutput(double u, double y0 = 0.0) const;
@@ -105,11 +112,6 @@ class NarxLinearizingController : public Controller {
   NarxLinearizingController(std::unique_ptr<Controller> inner, InputAffineNarx model,
                             double time_constant, const InputLimits& limits = {});
 
-  void Reset(double u0 = 0.0, double y0 = 0.0) override;
-  /// Allocates no memory.
-  double Update(double setpoint, double measurement) override;
-  /// The inner controller takes the w of the applied input. Allocates no memory.
-  void Applied(double u) override;
   double Ts() const override { return inner_->Ts(); }
   /// The inner controller's description + " behind a NARX linearization
   /// (tau = .. s)".
@@ -117,8 +119,18 @@ class NarxLinearizingController : public Controller {
 
   const Controller& inner() const { return *inner_; }
   double time_constant() const { return tau_; }
+  const InputAffineNarx& model() const { return model_; }
+  /// The actuator's limits on u.
+  const InputLimits& limits() const { return limits_; }
   /// w of the last Update() (the inner controller's request).
   double last_virtual_input() const { return w_; }
+
+ protected:
+  void DoReset(double u0, double y0) override;
+  /// Allocates no memory.
+  double DoUpdate(double setpoint, double measurement) override;
+  /// The inner controller takes the w of the applied input. Allocates no memory.
+  void DoApplied(double u) override;
 
  private:
   double AppliedW(double u) const;

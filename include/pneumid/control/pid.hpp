@@ -67,14 +67,16 @@ class PidController : public Controller {
   /// @throws InvalidArgument for invalid options or Ts <= 0.
   PidController(double Ts, const PidOptions& options);
 
-  void Reset(double u0 = 0.0, double y0 = 0.0) override;
-  double Update(double setpoint, double measurement) override;
-  void Applied(double u) override;
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
   const PidOptions& options() const { return options_; }
   /// Tracking time Tt (s) of the back-calculation actually used (0: none).
   double tracking_time() const { return Tt_; }
+
+ protected:
+  void DoReset(double u0, double y0) override;
+  double DoUpdate(double setpoint, double measurement) override;
+  void DoApplied(double u) override;
 
  private:
   PidOptions options_;
