@@ -106,10 +106,12 @@ void WriteCsv(const std::string& path, const std::vector<Run>& runs) {
   out << "\n";
   const auto& t = runs[0].result.t;
   for (Eigen::Index k = 0; k < t.size(); ++k) {
-    out << fmt::format("{:.6g},{:.10g}", t(k), runs[0].result.r(k));
+    // Values in their shortest exact form: a replay of the trace (through
+    // a generated module, say) sees what the controller saw.
+    out << fmt::format("{:.6g},{}", t(k), runs[0].result.r(k));
     for (const Run& r : runs) {
-      out << fmt::format(",{:.10g},{:.10g},{:.10g},{:.10g}", r.result.y(k), r.result.y_meas(k),
-                         r.result.u(k), r.result.d(k));
+      out << fmt::format(",{},{},{},{}", r.result.y(k), r.result.y_meas(k), r.result.u(k),
+                         r.result.d(k));
     }
     out << "\n";
   }

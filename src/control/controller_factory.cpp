@@ -146,12 +146,12 @@ namespace {
 // linear part with the map's image of the limits, behind the map's inverse.
 template <typename Make>
 BuiltController WithInverseMap(const ControllerSpec& spec, Make make) {
+  const StaticMap map = InvertibleInputMap(*spec.input_map);
   ControllerSpec inner = spec;
   inner.input_map.reset();
-  inner.limits = InnerLimits(*spec.input_map, spec.limits);
+  inner.limits = InnerLimits(map, spec.limits);
   BuiltController b = make(inner);
-  b.controller =
-      std::make_unique<InverseMapController>(std::move(b.controller), *spec.input_map, spec.limits);
+  b.controller = std::make_unique<InverseMapController>(std::move(b.controller), map, spec.limits);
   return b;
 }
 

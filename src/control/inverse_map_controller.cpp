@@ -81,6 +81,22 @@ std::string InverseMapController::Describe() const {
                      map_.size(), map_.u_min(), map_.u_max());
 }
 
+StaticMap InvertibleInputMap(const StaticMap& f, double tolerance) {
+  if (f.IsMonotone()) return f;
+  const auto [lo, hi] = std::minmax_element(f.y().begin(), f.y().end());
+  double running = f.y().front(), drop = 0.0;
+  for (double y : f.y()) {
+    running = std::max(running, y);
+    drop = std::max(drop, running - y);
+  }
+  PNEUMID_CHECK(drop <= tolerance * (*hi - *lo),
+                "the inverse of the static map is needed in front of the controller, but the "
+                "map ({}) is not monotone: it falls by {:.4g} after rising, more than {:g} % of its "
+                "range",
+                f.Describe(), drop, 100.0 * tolerance);
+  return MonotoneEnvelope(f, "input map");
+}
+
 StaticMap MonotoneEnvelope(const StaticMap& f, const std::string& what) {
   std::vector<double> y = f.y();
   for (std::size_t i = 1; i < y.size(); ++i) y[i] = std::max(y[i], y[i - 1]);

@@ -205,5 +205,21 @@ TEST(OutputMapControllerTest, InvertsTheMonotoneEnvelopeAndRefusesAFlatMap) {
       ThrowsMessage<InvalidArgument>(HasSubstr("got null")));
 }
 
+// A fitted map that dips by a little in its saturation (as the Hammerstein
+// estimate of the IPA's staircase: 194.12 N at 87 % then 193.97 N at 95 %)
+// is inverted through its monotone envelope; a map that turns by more than 2 %
+// of its range is refused with the drop.
+TEST(InvertibleInputMapTest, SmallDipsUseTheEnvelopeLargeTurnsAreRefused) {
+  const StaticMap dip({15, 55, 87, 95}, {14.3, 67.0, 194.12, 193.97});
+  const StaticMap inv = InvertibleInputMap(dip);
+  EXPECT_TRUE(inv.IsMonotone());
+  EXPECT_EQ(inv.y(), (std::vector<double>{14.3, 67.0, 194.12, 194.12}));
+  EXPECT_DOUBLE_EQ(inv.Inverse(194.12), 87.0);
+  const StaticMap monotone({0, 50, 100}, {0, 80, 90});
+  EXPECT_EQ(InvertibleInputMap(monotone), monotone);
+  EXPECT_THAT([] { InvertibleInputMap(StaticMap({0, 50, 100}, {0, 80, 40})); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("falls by 40 after rising, more than 2 %")));
+}
+
 }  // namespace
 }  // namespace pneumid

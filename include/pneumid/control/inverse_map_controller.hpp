@@ -111,6 +111,14 @@ class OutputMapController : public Controller {
   StaticMap map_;
 };
 
+/// The map a controller inverts: `f` itself when it is monotone; else, when
+/// it dips by at most `tolerance` of its range after rising (a fitted map in
+/// a dead band or a saturation, where the output hardly moves), its
+/// monotone envelope (MonotoneEnvelope).
+/// @throws InvalidArgument for a map that falls by more (the message gives
+/// the drop).
+StaticMap InvertibleInputMap(const StaticMap& f, double tolerance = 0.02);
+
 /// The running maximum of a map's knot values (non-decreasing), as the
 /// inverses of fitted maps use it.
 /// @throws InvalidArgument naming `what` when the envelope is constant.
