@@ -1023,30 +1023,35 @@ struct StepCost {
 
 void AddStepCost(const Controller& controller, StepCost* cost) {
   auto map_cost = [](const StaticMap& f) { return 6.0 * static_cast<double>(f.size()) + 10.0; };
+  // A matrix-vector product and an inner product, with their loop overheads.
+  auto gemv = [](double rows, double cols) { return rows * (cols + 4.0); };
+  auto dot = [](double n) { return n + 4.0; };
   if (dynamic_cast<const PidController*>(&controller)) {
     cost->base += 30.0;
   } else if (const auto* dmc = dynamic_cast<const DmcController*>(&controller)) {
     const double N = static_cast<double>(dmc->step_coefficients().size());
     const double P = dmc->options().P, M = dmc->options().M;
-    cost->base += 2.0 * N + 3.0 * P + 30.0;
+    cost->base += 2.0 * N + 2.0 * P + dot(P) + 30.0;
     if (dmc->options().constrained) {
-      cost->base += P * M + 4.0 * P + 2.0 * M;
+      cost->base += gemv(M, P) + 4.0 * P + 2.0 * M;
       cost->qp = &dmc->qp_solver();
     }
   } else if (const auto* gpc = dynamic_cast<const GpcController*>(&controller)) {
     const double rows = static_cast<double>(gpc->f_matrix().rows());
-    cost->base += rows * static_cast<double>(gpc->f_matrix().cols() + gpc->gamma_matrix().cols()) +
-                  2.0 * rows + 2.0 * static_cast<double>(gpc->t_polynomial().size()) +
-                  static_cast<double>(gpc->y_history_length() + gpc->move_history_length()) + 30.0;
+    cost->base += gemv(rows, static_cast<double>(gpc->f_matrix().cols())) +
+                  gemv(rows, static_cast<double>(gpc->gamma_matrix().cols())) + dot(rows) +
+                  rows + 2.0 * static_cast<double>(gpc->t_polynomial().size()) +
+                  2.0 * static_cast<double>(gpc->y_history_length() + gpc->move_history_length()) +
+                  30.0;
   } else if (const auto* mpc = dynamic_cast<const MpcController*>(&controller)) {
     const double nz = static_cast<double>(mpc->Az().rows());
     const double P = mpc->options().P, M = mpc->options().M;
     const double rows = mpc->constrained() ? M : 1.0;
-    cost->base += nz * nz + rows * nz + 6.0 * nz + 2.0 * rows + 30.0;
+    cost->base += gemv(nz, nz) + gemv(rows, nz) + dot(nz) + 6.0 * nz + 2.0 * rows + 30.0;
     if (mpc->constrained()) {
       // Free response, the feasibility test of the unconstrained moves, the
       // QP's linear term and row bounds.
-      cost->base += P * nz + P * M + M * nz + 4.0 * P + 4.0 * M;
+      cost->base += gemv(P, nz) + gemv(P, M) + gemv(M, nz) + 4.0 * P + 4.0 * M;
       cost->qp = &mpc->qp_solver();
     }
   } else if (const auto* im = dynamic_cast<const InverseMapController*>(&controller)) {
@@ -1079,8 +1084,12 @@ RealTimeCertificate Certify(const Controller& controller, const CodegenOptions& 
   if (cost.qp != nullptr) {
     const double n = cost.qp->num_variables(), m = cost.qp->num_constraints();
     const double sides = 2.0 * (m + n);
-    c.qp_init_units = 3.0 * n * n + 2.0 * sides + 50.0;
-    c.qp_iteration_units = 6.5 * n * n + m * n + 10.0 * sides + 50.0;
+    // The set-up (J0, the unconstrained solution, the finite sides) and one
+    // constraint scan more than iterations: the scan that finds a violated
+    // constraint runs before the cap is tested.
+    const double scan = m * n + 15.0 * sides;
+    c.qp_init_units = 3.0 * n * n + 2.0 * sides + scan + 50.0;
+    c.qp_iteration_units = 6.5 * n * n + scan + 50.0;
     // The automatic cap when every side is finite (the worst case).
     const int automatic = static_cast<int>(10.0 * (n + sides) + 10.0);
     const int design = o.qp_max_iterations >= 0 ? o.qp_max_iterations
@@ -1088,10 +1097,14 @@ RealTimeCertificate Certify(const Controller& controller, const CodegenOptions& 
     cap = design > 0 ? design : automatic;
     c.qp_define = design;
   }
+  // Double precision runs in software on a single-precision FPU.
+  const double per_unit = C::kInstructionsPerUnit *
+                          (o.precision == CodegenPrecision::kDouble ? C::kDoubleFactor : 1.0);
+  c.instructions_per_unit = per_unit;
   auto instructions = [&](int iterations) {
     const double units = c.base_units + (iterations > 0 || cost.qp ? c.qp_init_units : 0.0) +
                          iterations * c.qp_iteration_units;
-    return C::kInstructionsPerUnit * units + C::kInstructionsFixed;
+    return per_unit * units + C::kInstructionsFixed;
   };
   if (o.cpu_mhz > 0.0) {
     c.present = true;
@@ -1109,14 +1122,13 @@ RealTimeCertificate Certify(const Controller& controller, const CodegenOptions& 
                   o.cycles_per_instruction, c.budget_cycles, o.utilization, c.period, o.cpu_mhz);
     if (cost.qp != nullptr) {
       const int fits = static_cast<int>(
-          std::floor((budget_instructions - fixed) /
-                     (C::kInstructionsPerUnit * c.qp_iteration_units)));
+          std::floor((budget_instructions - fixed) / (per_unit * c.qp_iteration_units)));
       PNEUMID_CHECK(fits >= 1,
                     "the real-time certificate cannot be met: one QP iteration of '{}' takes up "
                     "to {:.0f} instructions and the rest of the step {:.0f}, above the budget of "
                     "{:.0f} cycles ({:g} of {:g} s at {:g} MHz, {} cycles per instruction); use a "
                     "faster clock, a longer period or shorter horizons",
-                    controller.Describe(), C::kInstructionsPerUnit * c.qp_iteration_units, fixed,
+                    controller.Describe(), per_unit * c.qp_iteration_units, fixed,
                     c.budget_cycles, o.utilization, c.period, o.cpu_mhz,
                     o.cycles_per_instruction);
       cap = std::min(cap, fits);
@@ -1259,7 +1271,7 @@ nlohmann::ordered_json CodegenResult::ToJson() const {
   nlohmann::ordered_json cj;
   cj["qp_max_iterations"] = c.qp_max_iterations;
   cj["max_instructions_per_step"] = std::round(c.max_instructions);
-  cj["instructions_per_unit"] = RealTimeCertificate::kInstructionsPerUnit;
+  cj["instructions_per_unit"] = c.instructions_per_unit;
   cj["units"] = {{"base", c.base_units},
                  {"qp_init", c.qp_init_units},
                  {"qp_iteration", c.qp_iteration_units}};

@@ -103,10 +103,12 @@ struct CodegenOptions {
 /// its operations (multiply-adds, comparisons, map segments) at the largest
 /// QP work the iteration cap allows:
 ///   instructions <= kInstructionsPerUnit * (base + init + cap * per_iteration)
-///                   + kInstructionsFixed,
-/// with base the step outside the QP, init the QP's set-up and per_iteration
-/// the dual active-set iteration's work (directions 2.5 n^2, Givens updates
-/// 4 n^2, constraint scan m n + 10 (2 m + 2 n), for n variables and m rows).
+///                   + kInstructionsFixed
+/// (kInstructionsPerUnit times kDoubleFactor in double precision),
+/// with base the step outside the QP, init the QP's set-up and one constraint
+/// scan, per_iteration the dual active-set iteration's work (directions
+/// 2.5 n^2, Givens updates 4 n^2, constraint scan m n + 15 (2 m + 2 n), for n
+/// variables and m rows).
 /// The constants are upper bounds of the instructions per unit measured on a
 /// Cortex-M4F under QEMU (-icount, gcc -O2, examples/cortex-m4), where the
 /// test tests/target/cortex_m4_test.sh checks that every scenario's measured
@@ -114,6 +116,9 @@ struct CodegenOptions {
 struct RealTimeCertificate {
   static constexpr double kInstructionsPerUnit = 6.0;
   static constexpr double kInstructionsFixed = 400.0;
+  /// Double precision in software on the M4F's single-precision FPU (the
+  /// paper's DMC: 17 times the instructions of float).
+  static constexpr double kDoubleFactor = 20.0;
   bool present = false;     ///< a clock was given
   double cpu_mhz = 0.0;
   double period = 0.0;      ///< s
@@ -125,6 +130,7 @@ struct RealTimeCertificate {
   /// most qp_max_iterations) without a clock, qp_max_iterations with one.
   int qp_define = 0;
   double base_units = 0.0, qp_init_units = 0.0, qp_iteration_units = 0.0;
+  double instructions_per_unit = 0.0;  ///< kInstructionsPerUnit, times kDoubleFactor in double
   double max_instructions = 0.0;  ///< per step, at the cap
   double max_cycles = 0.0;        ///< max_instructions * cycles_per_instruction
   double budget_cycles = 0.0;     ///< utilization * period * clock
