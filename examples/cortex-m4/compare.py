@@ -43,6 +43,7 @@ def main():
     p.add_argument("host")
     p.add_argument("target")
     p.add_argument("--size", help="arm-none-eabi-size output for the controller object")
+    p.add_argument("--stack-usage", help="gcc -fstack-usage output (.su) of the controller object")
     p.add_argument("--icount-shift", type=int, default=6)
     p.add_argument("--tolerance", type=float)
     p.add_argument("--json", action="store_true")
@@ -79,6 +80,20 @@ def main():
             lines = f.read().split("\n")
         text, data, bss = (int(v) for v in lines[1].split()[:3])
         report.update({"ctrl_text": text, "ctrl_data": data, "ctrl_bss": bss})
+    if a.stack_usage:
+        # Static frames only (no recursion, no variable-length arrays in the
+        # module): the sum of all frames bounds the deepest call chain.
+        frames = {}
+        with open(a.stack_usage) as f:
+            for line in f:
+                parts = line.rstrip("\n").split("\t")
+                if len(parts) >= 3:
+                    frames[parts[0].split(":")[-1]] = (int(parts[1]), parts[2])
+        report["stack_bytes_bound"] = sum(v[0] for v in frames.values())
+        report["stack_all_static"] = all(v[1] == "static" for v in frames.values())
+        if not report["stack_all_static"]:
+            ok = False
+            print("a function of the controller has a dynamic stack frame", file=sys.stderr)
     if a.json:
         print(json.dumps(report, indent=2))
     else:

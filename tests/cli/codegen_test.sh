@@ -116,6 +116,11 @@ replay wiener_mpc "['output-map']" --model "$TMP/models.json#wiener" --controlle
 replay narx_mpc "['narx-linearization']" --model "$TMP/models.json#affine-narx" --controller mpc
 replay narx_pid "['narx-linearization']" --model "$TMP/models.json#affine-narx" --controller pid
 
+# --rule auto is reported as such (its settings are the tuner's explicit ones).
+expect_ok "auto rule" codegen "${common[@]}" --controller mpc --plant ipa --rule auto --prefix ctrl \
+  -o "$TMP/auto" --json
+check_json "auto rule json" "j['settings']['rule'] == 'auto' and j['settings']['P'] > 0"
+
 # Faults: a NaN or out-of-range measurement holds the last input; the range
 # is set at generation (--y-valid-min/--y-valid-max) or with -D on the bench.
 expect_ok "guarded" codegen "${common[@]}" --controller mpc --plant ipa --y-valid-min -5 \
@@ -153,7 +158,7 @@ and j['certificate']['qp_max_iterations'] >= 1 and j['certificate']['cpu_mhz'] =
 cap=$("$PY" -c "import json,sys; print(json.load(open(sys.argv[1]))['certificate']['qp_max_iterations'])" "$TMP/out")
 grep -q "define CTRL_QP_MAX_ITERATIONS $cap\$" "$TMP/cert/ctrl.c" || fail "the certificate's cap $cap is not the module's"
 expect_ok "slow clock" codegen "${common[@]}" --controller mpc --plant ipa --du-max 4 --y-max 82 \
-  --precision float --cpu-mhz 16 --period 0.01 --prefix ctrl -o "$TMP/cert16" --json
+  --precision float --cpu-mhz 30 --period 0.01 --prefix ctrl -o "$TMP/cert30" --json
 check_json "slower clock, smaller cap" "j['certificate']['qp_max_iterations'] < $cap"
 
 # Bad input.
