@@ -110,20 +110,19 @@ void Execute(const CodegenCli& c) {
   }
   std::cout << fmt::format("{} ({} precision)\n", result.description, ToString(options.precision));
   std::cout << fmt::format("design: {}\n", built.Summary());
-  std::cout << fmt::format("state (RAM): {} bytes; constant tables: {} bytes{}\n",
-                           result.ram_bytes, result.const_bytes,
+  std::cout << fmt::format("state (RAM): {} bytes; constant tables: {} bytes{}\n", result.ram_bytes,
+                           result.const_bytes,
                            result.constrained ? "; with the embedded QP solver" : "");
   const RealTimeCertificate& rt = result.certificate;
-  std::cout << fmt::format("worst step: {:.0f} instructions{}{}\n", rt.max_instructions,
-                           rt.qp_max_iterations > 0
-                               ? fmt::format(" with {} QP iterations", rt.qp_max_iterations)
+  std::cout << fmt::format(
+      "worst step: {:.0f} instructions{}{}\n", rt.max_instructions,
+      rt.qp_max_iterations > 0 ? fmt::format(" with {} QP iterations", rt.qp_max_iterations)
                                : std::string(),
-                           rt.present ? fmt::format(" = {:.0f} cycles = {:.3g} ms at {:g} MHz, "
-                                                    "budget {:.0f} cycles ({:g} of {:g} ms)",
-                                                    rt.max_cycles, 1e3 * rt.max_time, rt.cpu_mhz,
-                                                    rt.budget_cycles, rt.utilization,
-                                                    1e3 * rt.period)
-                                      : std::string());
+      rt.present ? fmt::format(" = {:.0f} cycles = {:.3g} ms at {:g} MHz, "
+                               "budget {:.0f} cycles ({:g} of {:g} ms)",
+                               rt.max_cycles, 1e3 * rt.max_time, rt.cpu_mhz, rt.budget_cycles,
+                               rt.utilization, 1e3 * rt.period)
+                 : std::string());
   if (!result.layers.empty())
     std::cout << fmt::format("layers in front of the {}: {}\n", ToString(result.type),
                              fmt::join(result.layers, ", "));
@@ -181,8 +180,7 @@ const Registrar reg(
                      "becomes the largest whose worst step fits the budget (0: no certificate)")
           ->capture_default_str()
           ->check(NonNegative());
-      app.add_option("--period", c->period,
-                     "Control period in s for the certificate (0: --Ts)")
+      app.add_option("--period", c->period, "Control period in s for the certificate (0: --Ts)")
           ->capture_default_str()
           ->check(NonNegative());
       app.add_option("--utilization", c->utilization,

@@ -13,8 +13,8 @@ namespace pneumid::python {
 
 namespace {
 
-CodegenOptions Options(const std::string& precision, const std::string& prefix,
-                       std::size_t max_ram, double cpu_mhz, double period) {
+CodegenOptions Options(const std::string& precision, const std::string& prefix, std::size_t max_ram,
+                       double cpu_mhz, double period) {
   CodegenOptions o;
   o.precision = CodegenPrecisionFromString(precision);
   o.prefix = prefix;

@@ -34,14 +34,13 @@ py::dict TuningToDict(const TuningResult& t) {
   py::dict d = JsonToPython(t.ToJson());
   const bool fopdt = t.rule == TuningRule::kShridharCooper;
   auto number = [](double v) { return std::isfinite(v) ? py::object(py::float_(v)) : py::none(); };
-  for (const auto& [key, value] :
-       {std::pair<const char*, double>{"K", fopdt ? t.fopdt.K : NAN},
-        {"tau", fopdt ? t.fopdt.tau : NAN},
-        {"theta", fopdt ? t.fopdt.theta : NAN},
-        {"lambda_condition", t.lambda_condition},
-        {"lambda_formula", t.lambda_formula},
-        {"P_unrounded", fopdt ? t.P_unrounded : NAN},
-        {"tau_used", fopdt ? t.tau_used : NAN}}) {
+  for (const auto& [key, value] : {std::pair<const char*, double>{"K", fopdt ? t.fopdt.K : NAN},
+                                   {"tau", fopdt ? t.fopdt.tau : NAN},
+                                   {"theta", fopdt ? t.fopdt.theta : NAN},
+                                   {"lambda_condition", t.lambda_condition},
+                                   {"lambda_formula", t.lambda_formula},
+                                   {"P_unrounded", fopdt ? t.P_unrounded : NAN},
+                                   {"tau_used", fopdt ? t.tau_used : NAN}}) {
     if (!d.contains(key)) d[key] = number(value);
   }
   return d;

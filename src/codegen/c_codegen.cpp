@@ -731,7 +731,8 @@ void HideEntryPoints(Module& m, const std::string& stem) {
   auto replace_all = [&](const std::string& from, const std::string& to) {
     std::string out;
     std::size_t pos = 0;
-    for (std::size_t at; (at = m.code_.find(from, pos)) != std::string::npos; pos = at + from.size())
+    for (std::size_t at; (at = m.code_.find(from, pos)) != std::string::npos;
+         pos = at + from.size())
       out.append(m.code_, pos, at - pos).append(to);
     out.append(m.code_, pos, std::string::npos);
     m.code_ = std::move(out);
@@ -757,8 +758,8 @@ void EmitStaticMap(Module& m, const StaticMap& map, const std::string& name,
   if (eval) m.Array(name + "_y", y, what + ": values y");
   std::string ends;
   if (map.extrapolation() == StaticMapExtrapolation::kClamp) {
-    ends = fmt::format("    return u <= PFX_{0}_u[0] ? PFX_{0}_y[0] : PFX_{0}_y[{1}];\n", name,
-                       n - 1);
+    ends =
+        fmt::format("    return u <= PFX_{0}_u[0] ? PFX_{0}_y[0] : PFX_{0}_y[{1}];\n", name, n - 1);
   } else {
     ends = fmt::format(
         "    i = u <= PFX_{0}_u[0] ? 0 : {1};\n"
@@ -769,7 +770,7 @@ void EmitStaticMap(Module& m, const StaticMap& map, const std::string& name,
   }
   if (eval)
     m.code_ += fmt::format(
-      R"C(/* {2} (StaticMap::Evaluate, {3} extrapolation). */
+        R"C(/* {2} (StaticMap::Evaluate, {3} extrapolation). */
 static PFX_real PFX_{0}_eval(PFX_real u) {{
   int i;
   if (u != u) return u;
@@ -782,7 +783,7 @@ static PFX_real PFX_{0}_eval(PFX_real u) {{
 }}
 
 )C",
-      name, n - 1, what, ToString(map.extrapolation()), ends);
+        name, n - 1, what, ToString(map.extrapolation()), ends);
   if (!inverse) return;
   PNEUMID_CHECK(map.IsMonotone(), "the {} ({}) is not monotone: it has no inverse", what,
                 map.Describe());
@@ -880,8 +881,8 @@ void GenerateNarxLinearization(const NarxLinearizingController& c, Module& m,
   std::string map_eval = "u", map_inverse = "v";
   if (model.map()) {
     EmitStaticMap(m, *model.map(), stem + "nmap", "NARX model's input map f", true, false);
-    EmitStaticMap(m, *model.envelope(), stem + "nenv", "monotone envelope of the input map",
-                  false, true);
+    EmitStaticMap(m, *model.envelope(), stem + "nenv", "monotone envelope of the input map", false,
+                  true);
     map_eval = fmt::format("PFX_{}nmap_eval(u)", stem);
     map_inverse = fmt::format("PFX_{}nenv_inverse(v)", stem);
   }
@@ -1039,8 +1040,8 @@ void AddStepCost(const Controller& controller, StepCost* cost) {
   } else if (const auto* gpc = dynamic_cast<const GpcController*>(&controller)) {
     const double rows = static_cast<double>(gpc->f_matrix().rows());
     cost->base += gemv(rows, static_cast<double>(gpc->f_matrix().cols())) +
-                  gemv(rows, static_cast<double>(gpc->gamma_matrix().cols())) + dot(rows) +
-                  rows + 2.0 * static_cast<double>(gpc->t_polynomial().size()) +
+                  gemv(rows, static_cast<double>(gpc->gamma_matrix().cols())) + dot(rows) + rows +
+                  2.0 * static_cast<double>(gpc->t_polynomial().size()) +
                   2.0 * static_cast<double>(gpc->y_history_length() + gpc->move_history_length()) +
                   30.0;
   } else if (const auto* mpc = dynamic_cast<const MpcController*>(&controller)) {
@@ -1092,14 +1093,14 @@ RealTimeCertificate Certify(const Controller& controller, const CodegenOptions& 
     c.qp_iteration_units = 6.5 * n * n + scan + 50.0;
     // The automatic cap when every side is finite (the worst case).
     const int automatic = static_cast<int>(10.0 * (n + sides) + 10.0);
-    const int design = o.qp_max_iterations >= 0 ? o.qp_max_iterations
-                                                : cost.qp->options().max_iterations;
+    const int design =
+        o.qp_max_iterations >= 0 ? o.qp_max_iterations : cost.qp->options().max_iterations;
     cap = design > 0 ? design : automatic;
     c.qp_define = design;
   }
   // Double precision runs in software on a single-precision FPU.
-  const double per_unit = C::kInstructionsPerUnit *
-                          (o.precision == CodegenPrecision::kDouble ? C::kDoubleFactor : 1.0);
+  const double per_unit =
+      C::kInstructionsPerUnit * (o.precision == CodegenPrecision::kDouble ? C::kDoubleFactor : 1.0);
   c.instructions_per_unit = per_unit;
   auto instructions = [&](int iterations) {
     const double units = c.base_units + (iterations > 0 || cost.qp ? c.qp_init_units : 0.0) +
@@ -1128,9 +1129,8 @@ RealTimeCertificate Certify(const Controller& controller, const CodegenOptions& 
                     "to {:.0f} instructions and the rest of the step {:.0f}, above the budget of "
                     "{:.0f} cycles ({:g} of {:g} s at {:g} MHz, {} cycles per instruction); use a "
                     "faster clock, a longer period or shorter horizons",
-                    controller.Describe(), per_unit * c.qp_iteration_units, fixed,
-                    c.budget_cycles, o.utilization, c.period, o.cpu_mhz,
-                    o.cycles_per_instruction);
+                    controller.Describe(), per_unit * c.qp_iteration_units, fixed, c.budget_cycles,
+                    o.utilization, c.period, o.cpu_mhz, o.cycles_per_instruction);
       cap = std::min(cap, fits);
       c.qp_define = cap;
     }
@@ -1239,12 +1239,12 @@ bool CodegenOptions::IsValid(std::string* error) const {
   if (!(utilization > 0.0 && utilization <= 1.0))
     return fail(fmt::format("the utilization must be in (0, 1], got {}", utilization));
   if (!(cycles_per_instruction >= 1.0) || !std::isfinite(cycles_per_instruction))
-    return fail(
-        fmt::format("cycles per instruction must be >= 1, got {}", cycles_per_instruction));
+    return fail(fmt::format("cycles per instruction must be >= 1, got {}", cycles_per_instruction));
   if (qp_max_iterations < -1)
-    return fail(fmt::format("qp_max_iterations must be -1 (the design's), 0 (automatic) or "
-                            "positive, got {}",
-                            qp_max_iterations));
+    return fail(
+        fmt::format("qp_max_iterations must be -1 (the design's), 0 (automatic) or "
+                    "positive, got {}",
+                    qp_max_iterations));
   if (prefix.empty() || prefix.size() > 32)
     return fail(fmt::format("the prefix must have 1 to 32 characters, got {}", prefix.size()));
   if (std::isdigit(static_cast<unsigned char>(prefix[0])))
@@ -1272,9 +1272,8 @@ nlohmann::ordered_json CodegenResult::ToJson() const {
   cj["qp_max_iterations"] = c.qp_max_iterations;
   cj["max_instructions_per_step"] = std::round(c.max_instructions);
   cj["instructions_per_unit"] = c.instructions_per_unit;
-  cj["units"] = {{"base", c.base_units},
-                 {"qp_init", c.qp_init_units},
-                 {"qp_iteration", c.qp_iteration_units}};
+  cj["units"] = {
+      {"base", c.base_units}, {"qp_init", c.qp_init_units}, {"qp_iteration", c.qp_iteration_units}};
   if (c.present) {
     cj["cpu_mhz"] = c.cpu_mhz;
     cj["period"] = c.period;

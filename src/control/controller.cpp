@@ -49,11 +49,11 @@ bool MeasurementGuard::IsValid(std::string* error) const {
     return false;
   };
   if (std::isnan(y_min) || std::isnan(y_max))
-    return fail(fmt::format("the valid measurement range must not be NaN, got [{}, {}]", y_min,
-                            y_max));
+    return fail(
+        fmt::format("the valid measurement range must not be NaN, got [{}, {}]", y_min, y_max));
   if (y_min > y_max)
-    return fail(fmt::format("the valid measurement range needs y_min <= y_max, got [{}, {}]",
-                            y_min, y_max));
+    return fail(fmt::format("the valid measurement range needs y_min <= y_max, got [{}, {}]", y_min,
+                            y_max));
   if (std::isinf(safe_input))
     return fail(fmt::format("the safe input must be finite (or NaN: hold), got {}", safe_input));
   return true;

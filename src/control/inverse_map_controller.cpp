@@ -89,11 +89,12 @@ StaticMap InvertibleInputMap(const StaticMap& f, double tolerance) {
     running = std::max(running, y);
     drop = std::max(drop, running - y);
   }
-  PNEUMID_CHECK(drop <= tolerance * (*hi - *lo),
-                "the inverse of the static map is needed in front of the controller, but the "
-                "map ({}) is not monotone: it falls by {:.4g} after rising, more than {:g} % of its "
-                "range",
-                f.Describe(), drop, 100.0 * tolerance);
+  PNEUMID_CHECK(
+      drop <= tolerance * (*hi - *lo),
+      "the inverse of the static map is needed in front of the controller, but the "
+      "map ({}) is not monotone: it falls by {:.4g} after rising, more than {:g} % of its "
+      "range",
+      f.Describe(), drop, 100.0 * tolerance);
   return MonotoneEnvelope(f, "input map");
 }
 

@@ -28,6 +28,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "../control/chamber_narx.hpp"
+
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller_factory.hpp"
@@ -63,24 +65,6 @@ StaticMap InputMap() {
 }
 // The output of the linear part (N) -> the measured force (N).
 StaticMap OutputMap() { return StaticMap({0, 40, 80, 120, 160, 250}, {0, 36, 80, 126, 168, 260}); }
-
-// y(t) = y(t-1) - 0.03 z - 0.02 z^2 + (0.12 - 0.05 z) v, z = y / 200 (N),
-// v = f(u) in [0, 1]: a first-order input-affine NARX model of a chamber,
-// written on normalised signals as the estimator writes it.
-NarxModel ChamberNarx() {
-  NarxModel m;
-  m.ny = m.nu = m.nk = 1;
-  m.degree = 3;
-  m.Ts = kTs;
-  m.u_offset = 0.5;
-  m.u_scale = 0.5;
-  m.y_scale = 200.0;
-  m.terms = {{}, {0}, {0, 0}, {1}, {0, 1}};
-  m.theta = {0.06, 1.0 - 0.03 - 0.025, -0.02, 0.06, -0.025};
-  m.err.assign(m.terms.size(), 0.0);
-  return m;
-}
-StaticMap ChamberValve() { return StaticMap({0, 5, 10, 50, 100}, {0, -0.01, 0, 0.6, 1.0}); }
 
 std::vector<Case> Cases() {
   std::vector<Case> cases;
@@ -156,7 +140,9 @@ std::unique_ptr<Controller> Build(const Case& c) {
   ControllerSpec spec = ToControllerSpec(c.settings);
   if (c.model == "hammerstein" || c.model == "hw") spec.input_map = InputMap();
   if (c.model == "wiener" || c.model == "hw") spec.output_map = OutputMap();
-  if (c.model == "narx") spec.narx_model = InputAffineNarx(ChamberNarx(), ChamberValve());
+  if (c.model == "narx")
+    spec.narx_model =
+        InputAffineNarx(testing_models::ChamberNarx(kTs), testing_models::ChamberValve());
   return MakeController(PaperFopdtModel(), kTs, spec).controller;
 }
 

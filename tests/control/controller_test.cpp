@@ -164,14 +164,15 @@ TEST_P(ControllerGuardTest, AFaultFreeRunIsUnchangedByTheGuard) {
   EXPECT_EQ(a.controller->fault_count(), 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Controllers, ControllerGuardTest,
-    ::testing::Values(GuardCase{"dmc", "dmc"}, GuardCase{"qdmc", "dmc", true, 5.0},
-                      GuardCase{"gpc", "gpc"}, GuardCase{"pid", "pid"}, GuardCase{"mpc", "mpc"},
-                      GuardCase{"mpc_rate", "mpc", false, 5.0},
-                      GuardCase{"mpc_input_map", "mpc", false, kInf, true},
-                      GuardCase{"dmc_input_map", "dmc", false, kInf, true}),
-    [](const auto& info) { return info.param.name; });
+INSTANTIATE_TEST_SUITE_P(Controllers, ControllerGuardTest,
+                         ::testing::Values(GuardCase{"dmc", "dmc"},
+                                           GuardCase{"qdmc", "dmc", true, 5.0},
+                                           GuardCase{"gpc", "gpc"}, GuardCase{"pid", "pid"},
+                                           GuardCase{"mpc", "mpc"},
+                                           GuardCase{"mpc_rate", "mpc", false, 5.0},
+                                           GuardCase{"mpc_input_map", "mpc", false, kInf, true},
+                                           GuardCase{"dmc_input_map", "dmc", false, kInf, true}),
+                         [](const auto& info) { return info.param.name; });
 
 TEST(MeasurementGuardTest, ValidityAndChecksInOrder) {
   MeasurementGuard g;
@@ -196,10 +197,9 @@ TEST(MeasurementGuardTest, ValidityAndChecksInOrder) {
 }
 
 TEST(ControllerFaultTest, NamesRoundTrip) {
-  for (ControllerFault f :
-       {ControllerFault::kNone, ControllerFault::kMeasurementNotFinite,
-        ControllerFault::kMeasurementOutOfRange, ControllerFault::kSetpointNotFinite,
-        ControllerFault::kOutputNotFinite})
+  for (ControllerFault f : {ControllerFault::kNone, ControllerFault::kMeasurementNotFinite,
+                            ControllerFault::kMeasurementOutOfRange,
+                            ControllerFault::kSetpointNotFinite, ControllerFault::kOutputNotFinite})
     EXPECT_EQ(ControllerFaultFromString(ToString(f)), f);
   EXPECT_EQ(ToString(ControllerFault::kMeasurementNotFinite), "measurement-not-finite");
   EXPECT_THROW(ControllerFaultFromString("nan"), InvalidArgument);

@@ -217,8 +217,11 @@ TEST(InvertibleInputMapTest, SmallDipsUseTheEnvelopeLargeTurnsAreRefused) {
   EXPECT_DOUBLE_EQ(inv.Inverse(194.12), 87.0);
   const StaticMap monotone({0, 50, 100}, {0, 80, 90});
   EXPECT_EQ(InvertibleInputMap(monotone), monotone);
-  EXPECT_THAT([] { InvertibleInputMap(StaticMap({0, 50, 100}, {0, 80, 40})); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("falls by 40 after rising, more than 2 %")));
+  EXPECT_THAT(
+      [] {
+        InvertibleInputMap(StaticMap({0, 50, 100}, {0, 80, 40}));
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("falls by 40 after rising, more than 2 %")));
 }
 
 }  // namespace

@@ -119,9 +119,9 @@ struct RealTimeCertificate {
   /// Double precision in software on the M4F's single-precision FPU (the
   /// paper's DMC: 17 times the instructions of float).
   static constexpr double kDoubleFactor = 20.0;
-  bool present = false;     ///< a clock was given
+  bool present = false;  ///< a clock was given
   double cpu_mhz = 0.0;
-  double period = 0.0;      ///< s
+  double period = 0.0;  ///< s
   double utilization = 0.0;
   double cycles_per_instruction = 0.0;
   /// The largest number of QP iterations a step can run (0: no QP).
@@ -131,10 +131,10 @@ struct RealTimeCertificate {
   int qp_define = 0;
   double base_units = 0.0, qp_init_units = 0.0, qp_iteration_units = 0.0;
   double instructions_per_unit = 0.0;  ///< kInstructionsPerUnit, times kDoubleFactor in double
-  double max_instructions = 0.0;  ///< per step, at the cap
-  double max_cycles = 0.0;        ///< max_instructions * cycles_per_instruction
-  double budget_cycles = 0.0;     ///< utilization * period * clock
-  double max_time = 0.0;          ///< s, max_cycles / clock
+  double max_instructions = 0.0;       ///< per step, at the cap
+  double max_cycles = 0.0;             ///< max_instructions * cycles_per_instruction
+  double budget_cycles = 0.0;          ///< utilization * period * clock
+  double max_time = 0.0;               ///< s, max_cycles / clock
 };
 
 struct CodegenResult {
@@ -155,7 +155,7 @@ struct CodegenResult {
   /// Layers around the linear controller, outermost first: "input-map"
   /// (Hammerstein), "output-map" (Wiener), "narx-linearization".
   std::vector<std::string> layers;
-  std::string description;   ///< controller.Describe()
+  std::string description;  ///< controller.Describe()
   /// {prefix, controller, description, precision, constrained, ram_bytes,
   /// const_bytes, layers, certificate, files}.
   nlohmann::ordered_json ToJson() const;
