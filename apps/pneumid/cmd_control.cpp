@@ -235,7 +235,7 @@ void Execute(const ControlCli& c) {
 }
 
 const Registrar reg(
-    "control", "Closed-loop simulation of DMC, GPC or PID against a plant, with metrics",
+    "control", "Closed-loop simulation of DMC, GPC, PID or MPC against a plant, with metrics",
     [](CLI::App& app) {
       auto c = std::make_shared<ControlCli>();
       app.add_option("--model", c->model,

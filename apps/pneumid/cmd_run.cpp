@@ -1,4 +1,4 @@
-// pneumid run: the closed loop (DMC, GPC or PID designed from a model) in real
+// pneumid run: the closed loop (DMC, GPC, PID or MPC designed from a model) in real
 // time on the simulator, a plant server (udp) or a comedi card, with a live
 // status line, the full log, timing statistics and closed-loop metrics.
 #include <cmath>
@@ -174,7 +174,7 @@ void Run(const RunOptions& o, CLI::App& app) {
 
 static Registrar reg(
     "run",
-    "Run a DMC, GPC or PID loop in real time on the simulator, a plant server (udp) or a "
+    "Run a DMC, GPC, PID or MPC loop in real time on the simulator, a plant server (udp) or a "
     "comedi card, with safety limits, a log and timing statistics",
     [](CLI::App& app) {
       auto o = std::make_shared<RunOptions>();
