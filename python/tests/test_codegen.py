@@ -24,6 +24,17 @@ def test_generate_c_reports_sizes_and_texts():
         pneumid.generate_c(c, prefix="a-b")
 
 
+def test_generate_c_certificate_caps_the_qp_by_the_clock():
+    c = pneumid.make_controller(pneumid.paper_fopdt_model(), 0.01, "mpc", u_min=0.0, u_max=100.0)
+    fast = pneumid.generate_c(c, precision="float", cpu_mhz=168.0)["certificate"]
+    slow = pneumid.generate_c(c, precision="float", cpu_mhz=30.0)["certificate"]
+    assert fast["max_cycles_per_step"] <= fast["budget_cycles"] == 0.5 * 0.01 * 168e6
+    assert 1 <= slow["qp_max_iterations"] < fast["qp_max_iterations"]
+    assert slow["max_cycles_per_step"] <= slow["budget_cycles"]
+    with pytest.raises(pneumid.InvalidArgument, match="certificate cannot be met"):
+        pneumid.generate_c(c, precision="float", cpu_mhz=1.0, period=0.001)
+
+
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
 @pytest.mark.parametrize("kind", ["dmc", "gpc", "pid", "mpc"])
 def test_written_module_runs_like_the_library(tmp_path, kind):
