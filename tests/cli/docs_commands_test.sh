@@ -111,6 +111,10 @@ for path in files:
             fail(where, f"exit {r.returncode}: {r.stderr.strip()[:500]}")
 
 print(f"{ran} documented commands run")
+# A parser that stops matching would run nothing and pass: the docs hold 37
+# runnable commands (2026-11); fewer than 30 means the parser lost them.
+if ran < 30:
+    fail("docs", f"only {ran} commands were found and run (at least 30 expected)")
 sys.exit(1 if failures else 0)
 PYEOF
 finish

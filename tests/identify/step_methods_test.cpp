@@ -160,9 +160,14 @@ TEST(StepMethodComparison, PrintTable) {
                                cell(r.k_err, "{:+.2f}"), cell(r.tau1_err, "{:+.2f}"),
                                cell(r.tau2_err, "{:+.2f}"), cell(r.theta_err_samples, "{:+.2f}"),
                                cell(r.true_fit, "{:.2f}"), cell(r.data_fit, "{:.2f}"));
+      // Every method gives a model whose response follows the data: a
+      // method that fails or returns a wrong-signed or empty model shows here.
+      EXPECT_TRUE(std::isfinite(r.k_err)) << p.name << " " << r.method;
+      EXPECT_GT(r.true_fit, 50.0) << p.name << " " << r.method;
+      EXPECT_GT(r.data_fit, 50.0) << p.name << " " << r.method;
     }
+    EXPECT_GE(Results().at(p.name).size(), 6u) << p.name;
   }
-  SUCCEED();
 }
 
 TEST(StepMethodsTest, NamesAndErrors) {

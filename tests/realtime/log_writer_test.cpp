@@ -80,10 +80,15 @@ TEST(LogWriter, FullBufferDropsAndCountsInsteadOfBlocking) {
   LogWriterOptions o;
   o.capacity = 16;
   LogWriter w(path, {}, o);
-  // Far more than the buffer holds, faster than any writer: some may be dropped, none
-  // blocks; written + dropped accounts for every record.
+  // Far more than the buffer holds, faster than the writer formats lines:
+  // records are dropped (a writer that blocked the loop would drop none), and
+  // written + dropped accounts for every record.
   for (int k = 0; k < 100000; ++k) w.Push(Rec(k));
+  const std::int64_t dropped_while_pushing = w.dropped();
   w.Close();
+  EXPECT_GT(dropped_while_pushing, 0);
+  EXPECT_EQ(w.dropped(), dropped_while_pushing);  // Close() drains, it drops nothing
+  EXPECT_GT(w.written(), 0);
   EXPECT_EQ(w.written() + w.dropped(), 100000);
 }
 
