@@ -45,11 +45,9 @@ grep -v '^#' "$TMP/step.csv" | head -1 | grep -qx 't,u,y' || fail "experiment he
 grep -q '"samples": 100' "$TMP/prbs.json" || fail "experiment prbs json"
 "$PNEUMID" experiment staircase --fast --duration 1 -o "$TMP/stairs.mat" > /dev/null || fail "experiment .mat"
 [ -s "$TMP/stairs.mat" ] || fail "no .mat written"
-if "$PNEUMID" --help 2>&1 | grep -qE '^ +identify '; then
-  "$PNEUMID" identify "$TMP/step.csv" > "$TMP/id.txt" 2>&1 ||
-    "$PNEUMID" identify --data "$TMP/step.csv" > "$TMP/id.txt" 2>&1 ||
-    fail "identify cannot read the experiment data: $(cat "$TMP/id.txt")"
-fi
+"$PNEUMID" identify "$TMP/step.csv" > "$TMP/id.txt" 2>&1 ||
+  fail "identify cannot read the experiment data: $(cat "$TMP/id.txt")"
+grep -q "reaction-curve" "$TMP/id.txt" || fail "identify of the experiment lists no model: $(head -c 500 "$TMP/id.txt")"
 
 # closed loop through a plant server (hardware in the loop on 127.0.0.1)
 start_server
