@@ -190,7 +190,7 @@ void Dataset::RequireUniform(double rel_tol) const {
           "{}: column '{}': sampling is not uniform: interval {:g} s between t = {:g} and t = {:g} "
           "differs from the typical (median) interval {:g} s by {:.3g} % (tolerance {:g} %); "
           "resample the data "
-          "to a uniform grid first (pneumid::Resample, or `pneumid info {} --resample {:g} --save "
+          "to a uniform grid first (pneumid::Resample, or `pneumid info {} --resample {:g} -o "
           "FILE`)",
           Where(i), time_channel_.name, dt, time()[i - 1], time()[i], Ts,
           100.0 * std::abs(dt - Ts) / Ts, 100.0 * rel_tol,
