@@ -15,6 +15,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 #include <thread>
 
 #include <fmt/format.h>
@@ -38,6 +39,7 @@ struct AppCli {
   bool open = false;
   std::string assets;
   std::string token;
+  std::vector<std::string> allow_devices;
 };
 
 std::string RandomToken() {
@@ -94,6 +96,7 @@ void Serve(const AppCli& c) {
   options.root = root;
   options.assets = c.assets.empty() ? DefaultAssets() : fs::path(c.assets);
   options.token = c.token.empty() ? RandomToken() : c.token;
+  options.allowed_devices = c.allow_devices;
   std::string work = (fs::temp_directory_path() / "pneumid-app-XXXXXX").string();
   if (mkdtemp(work.data()) == nullptr)
     throw DataError(fmt::format("cannot create a temporary folder {}", work));
@@ -152,6 +155,9 @@ const Registrar reg(
                      "Folder of the built page (index.html, assets/; default: "
                      "web/ beside the program, or ../share/pneumid/web)");
       app.add_option("--token", c->token, "Access token (default: 32 random hex digits)");
+      app.add_option("--allow-device", c->allow_devices,
+                     "A data-acquisition device the page may drive (comedi:PATH), repeatable; "
+                     "by default the page drives the simulator or a plant server only");
       app.callback([c] { Serve(*c); });
     });
 

@@ -106,6 +106,33 @@ s, a = call("POST", "/api/data/open", {"path": "link/passwd"})
 expect(s, a, 403, "open through a symbolic link that leaves the root")
 s, a = call("POST", "/api/control", {"model": "../x.json", "setpoint": "step:to=1", "duration": 1})
 expect(s, a, 403, "a model file outside the root")
+# Every path-like field is confined, and no content of a file outside leaks.
+outside = os.path.join(tmp, "outside.csv")
+with open(outside, "w") as f:
+    f.write("t,u\n0,31337.25\n0.01,31337.25\n")
+secret_toml = os.path.join(tmp, "outside.toml")
+with open(secret_toml, "w") as f:
+    f.write("[secret_section]\nsecret_key_name = 1\n")
+ctl = {"model": "fopdt-paper", "Ts": 0.01, "duration": 0.2}
+for sp in ["file:" + outside + ",col=u", "file:../outside.csv,col=u", "  file:" + outside]:
+    s, a = call("POST", "/api/control", dict(ctl, setpoint=sp))
+    if expect(s, a, 403, f"a set-point file outside the root ({sp})") and "31337" in str(a):
+        fail(f"the outside file's values leak: {str(a)[:200]}")
+for plant in ["ipa:config=/etc/shadow", "ipa:config=" + secret_toml, "ipa-position:mode=position,config=../outside.toml"]:
+    s, a = call("POST", "/api/control", dict(ctl, setpoint="step:to=50", plant=plant))
+    if expect(s, a, 403, f"a plant configuration outside the root ({plant})") and "secret" in str(a):
+        fail(f"the outside TOML's keys leak: {str(a)[:200]}")
+s, a = call("POST", "/api/run/start", {"model": "fopdt-paper", "io": "comedi:/dev/null",
+                                       "setpoint": "step:to=1", "duration": 0.5})
+expect(s, a, 403, "a device not allowed on the command line")
+s, a = call("POST", "/api/control", dict(ctl, setpoint="file:demo.csv\u0000x,col=u"))
+expect(s, a, 400, "a NUL byte in a path")
+s, a = call("POST", "/api/control", dict(ctl, setpoint="file:" + "a/" * 3000 + "x.csv"))
+if expect(s, a, 400, "an over-long path") and len(str(a)) > 1000:
+    fail(f"the over-long path is echoed whole: {len(str(a))} characters")
+# A set-point file under the root is read.
+s, a = call("POST", "/api/control", dict(ctl, setpoint="file:demo.csv,col=u", plant="ipa"))
+expect(s, a, 200, "a set-point file under the root")
 
 # --- files and data
 s, a = call("GET", "/api/files")

@@ -291,13 +291,66 @@ Response AppApi::Asset(const std::string& rel) {
 
 fs::path AppApi::Confine(const std::string& path) const {
   if (path.empty()) return options_.root;
+  if (path.find('\0') != std::string::npos)
+    throw HttpError(400, fmt::format("the path {} holds a NUL byte", Excerpt(path)));
+  if (path.size() > 4096)
+    throw HttpError(400, fmt::format("the path {} is longer than 4096 bytes", Excerpt(path)));
   std::error_code ec;
   const fs::path given(path);
   const fs::path full =
       fs::weakly_canonical(given.is_absolute() ? given : options_.root / given, ec);
   if (ec || !Inside(full, options_.root))
-    throw HttpError(403, fmt::format("{} is outside the root {}", path, options_.root.string()));
+    throw HttpError(403, fmt::format("{} is outside the root {}", Excerpt(path),
+                                     options_.root.string()));
   return full;
+}
+
+std::string AppApi::SignalSpec(const std::string& spec) const {
+  std::size_t start = spec.find_first_not_of(" \t");
+  if (start == std::string::npos || spec.compare(start, 5, "file:") != 0) return spec;
+  start += 5;
+  const std::size_t end = spec.find(',', start);
+  const std::string path = spec.substr(start, end == std::string::npos ? end : end - start);
+  return "file:" + Confine(path).string() +
+         (end == std::string::npos ? std::string() : spec.substr(end));
+}
+
+std::string AppApi::PlantSpec(const std::string& spec) const {
+  const std::size_t colon = spec.find(':');
+  const std::string base = spec.substr(0, colon);
+  if ((base == "ipa" || base == "ipa-position") && colon != std::string::npos) {
+    // ipa:config=PATH[,mode=..]: the configuration file under the root.
+    std::string out = spec.substr(0, colon + 1), rest = spec.substr(colon + 1);
+    std::size_t pos = 0;
+    bool first = true;
+    while (pos <= rest.size()) {
+      const std::size_t comma = rest.find(',', pos);
+      std::string field = rest.substr(pos, comma == std::string::npos ? comma : comma - pos);
+      const std::size_t eq = field.find('=');
+      std::string key = field.substr(0, eq);
+      key.erase(0, key.find_first_not_of(" \t"));
+      key.erase(key.find_last_not_of(" \t") + 1);
+      if (key == "config" && eq != std::string::npos)
+        field = "config=" + Confine(field.substr(eq + 1)).string();
+      out += (first ? "" : ",") + field;
+      first = false;
+      if (comma == std::string::npos) break;
+      pos = comma + 1;
+    }
+    return out;
+  }
+  return FileSpec(spec);
+}
+
+void AppApi::CheckIo(const std::string& io) const {
+  if (io.empty()) return;
+  const IoSpec parsed = ParseIoSpec(io);
+  if (parsed.kind != IoKind::kComedi) return;
+  const auto& allowed = options_.allowed_devices;
+  if (std::find(allowed.begin(), allowed.end(), parsed.device) == allowed.end())
+    throw HttpError(403, fmt::format("the device {} is not allowed: start the app with "
+                                     "--allow-device {} to drive it from the page",
+                                     Excerpt(parsed.device), Excerpt(parsed.device)));
 }
 
 nlohmann::json AppApi::Files(const Request& req) {
@@ -568,7 +621,7 @@ nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
     Get(b, "du_max", c.du_max);
     // The loop's plant bounds the design as in /api/control: the review then
     // describes the controller that runs.
-    if (Get(b, "plant", c.plant)) FileSpec(c.plant);
+    if (Get(b, "plant", c.plant)) c.plant = PlantSpec(c.plant);
   }
   return cli::TuneJson(c);
 }
@@ -580,9 +633,10 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b) {
   ReadControllerSettings(b, c.controller);
   Get(b, "u_min", c.controller.limits.u_min);
   Get(b, "u_max", c.controller.limits.u_max);
-  if (Get(b, "plant", c.plant)) FileSpec(c.plant);
+  if (Get(b, "plant", c.plant)) c.plant = PlantSpec(c.plant);
   Get(b, "Ts", c.Ts);
   if (!Get(b, "setpoint", c.setpoint)) throw HttpError(400, "field 'setpoint' is missing");
+  c.setpoint = SignalSpec(c.setpoint);
   if (!Get(b, "duration", c.duration)) throw HttpError(400, "field 'duration' is missing");
   PNEUMID_CHECK(c.duration > 0.0, "duration must be positive, got {}", c.duration);
   Get(b, "noise", c.noise);
@@ -602,15 +656,15 @@ Response AppApi::RunStart(const nlohmann::json& b) {
   cli::RunOptions o;
   if (b.contains("model")) o.model = ModelSpec(b["model"]);
   ReadControllerSettings(b, o.controller);
-  Get(b, "setpoint", o.setpoint);
+  if (Get(b, "setpoint", o.setpoint)) o.setpoint = SignalSpec(o.setpoint);
   o.load_steps = LoadSteps(b);
   double u = 0.0;
   if (Get(b, "u_min", u)) o.u_min = u;
   if (Get(b, "u_max", u)) o.u_max = u;
   if (Get(b, "rate_max", u)) o.rate_max = u;
   RealtimeConfig config;
-  Get(b, "io", config.io);
-  if (Get(b, "plant", config.plant)) FileSpec(config.plant);
+  if (Get(b, "io", config.io)) CheckIo(config.io);
+  if (Get(b, "plant", config.plant)) config.plant = PlantSpec(config.plant);
   Get(b, "Ts", config.loop.period);
   Get(b, "duration", config.loop.duration);
   Get(b, "seed", o.rt.seed);
@@ -675,8 +729,8 @@ void AppApi::Stream(const Request& req, const std::function<bool(const std::stri
 
 Response AppApi::ExportController(const nlohmann::json& b) {
   RealtimeConfig config;
-  Get(b, "io", config.io);
-  Get(b, "plant", config.plant);
+  if (Get(b, "io", config.io)) CheckIo(config.io);
+  if (Get(b, "plant", config.plant)) PlantSpec(config.plant);
   Get(b, "Ts", config.loop.period);
   Get(b, "duration", config.loop.duration);
   Get(b, "u_min", config.safety.u_min);

@@ -11,6 +11,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -26,6 +27,8 @@ struct AppOptions {
   std::filesystem::path assets;  ///< the built page (index.html, assets/); may not exist
   std::filesystem::path work;    ///< the server's own temporary folder
   std::string token;
+  /// Device paths a request may name as its I/O (comedi:PATH); none by default.
+  std::vector<std::string> allowed_devices;
 };
 
 class AppApi {
@@ -68,6 +71,14 @@ class AppApi {
   std::filesystem::path Confine(const std::string& path) const;
   std::string ModelSpec(const nlohmann::json& model);
   std::string FileSpec(const std::string& spec) const;
+  /// A set-point or input signal spec whose file (file:PATH,...) lies under
+  /// the root, with the path made absolute; other signals unchanged.
+  std::string SignalSpec(const std::string& spec) const;
+  /// A plant spec whose files (ipa:config=PATH, FILE.json, FILE.toml) lie
+  /// under the root, with the configuration path made absolute.
+  std::string PlantSpec(const std::string& spec) const;
+  /// An I/O spec; a device (comedi:PATH) only from options_.allowed_devices.
+  void CheckIo(const std::string& io) const;
 
   AppOptions options_;
   mutable std::mutex mutex_;
