@@ -28,8 +28,9 @@ ln -s /etc "$ROOT/link"
 
 # Empty the file before the background job starts (its redirection may come late).
 : > "$TMP/app.txt"
-"$PNEUMID" app --port 0 --root "$ROOT" --assets "$TMP/no-assets" --token secret123 \
-  > "$TMP/app.txt" 2>&1 &
+mkdir -p "$TMP/apptmp"  # the app's temporary folder goes here (checked below)
+TMPDIR="$TMP/apptmp" "$PNEUMID" app --port 0 --root "$ROOT" --assets "$TMP/no-assets" \
+  --token secret123 > "$TMP/app.txt" 2>&1 &
 APP_PID=$!
 URL=""
 for _ in $(seq 100); do
@@ -230,6 +231,22 @@ if expect(s, a, 200, "control with a model object"):
     for key in ["iae", "rise_time", "overshoot_percent", "settling_time"]:
         if a.get(key) != cli.get(key):
             fail(f"control with a model object: {key} {a.get(key)} != {cli.get(key)}")
+import glob
+left = glob.glob(tmp + "/apptmp/pneumid-app-*/model*.json")
+if left:
+    fail(f"a request's model object is left in the temporary folder: {left}")
+if not glob.glob(tmp + "/apptmp/pneumid-app-*"):
+    fail("the app's temporary folder is not under TMPDIR")
+# Numbers: integers are integers in range, Ts and the samples are bounded.
+for bad, what in [({"P": 1e308}, "P = 1e308"), ({"P": 2.5}, "P = 2.5"), ({"M": -3e9}, "M = -3e9"),
+                  ({"Ts": 1e-300}, "Ts = 1e-300"), ({"duration": 1e9}, "duration = 1e9"),
+                  ({"Ts": 1e-6, "controller": "dmc"}, "Ts = 1e-6"), ({"P": 100000}, "P = 1e5")]:
+    s, a = call("POST", "/api/control", dict(scenario, model="fopdt-paper", **bad))
+    expect(s, a, 422, f"control with {what}")
+for bad in [{"controller": "foo"}, {"controller": ["dmc"]}]:
+    s, a = call("POST", "/api/tune", {"model": "fopdt-paper", **bad})
+    if s == 200:
+        fail(f"tune accepts {bad}: {str(a)[:200]}")
 s, a = call("POST", "/api/control", {"model": "fopdt-paper", "duration": 1})
 if expect(s, a, 400, "control without a set point") and "setpoint" not in a.get("error", ""):
     fail(f"control without a set point: {a}")

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
+#include <type_traits>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -94,10 +96,33 @@ nlohmann::json Decimate(const Eigen::VectorXd& v) {
 template <typename T>
 bool Get(const nlohmann::json& body, const char* key, T& out) {
   if (!body.contains(key) || body[key].is_null()) return false;
+  const nlohmann::json& v = body[key];
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    // An integer field takes an integer within its type's range: 2.5 or
+    // 1e308 is an error, not 2 or a wrapped value.
+    if (v.is_number_float()) {
+      const double x = v.get<double>();
+      if (!(std::floor(x) == x) || x < static_cast<double>(std::numeric_limits<T>::min()) ||
+          x > static_cast<double>(std::numeric_limits<T>::max()))
+        throw HttpError(422, fmt::format("field '{}' must be an integer in [{}, {}], got {}", key,
+                                         std::numeric_limits<T>::min(),
+                                         std::numeric_limits<T>::max(), Excerpt(v.dump())));
+    } else if (v.is_number_unsigned() &&
+               v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<T>::max())) {
+      throw HttpError(422, fmt::format("field '{}' must be at most {}, got {}", key,
+                                       std::numeric_limits<T>::max(), Excerpt(v.dump())));
+    } else if (v.is_number_integer() && !v.is_number_unsigned() &&
+               (v.get<std::int64_t>() < static_cast<std::int64_t>(std::numeric_limits<T>::min()) ||
+                v.get<std::int64_t>() > static_cast<std::int64_t>(std::numeric_limits<T>::max()))) {
+      throw HttpError(422, fmt::format("field '{}' must be an integer in [{}, {}], got {}", key,
+                                       std::numeric_limits<T>::min(),
+                                       std::numeric_limits<T>::max(), Excerpt(v.dump())));
+    }
+  }
   try {
-    out = body[key].get<T>();
+    out = v.get<T>();
   } catch (const nlohmann::json::exception&) {
-    throw HttpError(400, fmt::format("field '{}' has the wrong type: {}", key, body[key].dump()));
+    throw HttpError(400, fmt::format("field '{}' has the wrong type: {}", key, Excerpt(v.dump())));
   }
   return true;
 }
@@ -598,12 +623,42 @@ nlohmann::json Trace(const ClosedLoopResult& r) {
   return {{"t", Decimate(r.t)}, {"r", Decimate(r.r)}, {"y", Decimate(r.y)}, {"u", Decimate(r.u)}};
 }
 
+// Removes a temporary model file of a request when the request is done.
+struct RemoveWhenDone {
+  std::string path;
+  ~RemoveWhenDone() {
+    std::error_code ec;
+    if (!path.empty()) fs::remove(path, ec);
+  }
+};
+
+// Bounded work per request: the sample time, the samples of a run and the
+// horizons (each with the limit it broke; 422).
+constexpr double kMinTs = 1e-4;             // s
+constexpr double kMaxSamples = 2e6;         // duration / Ts
+constexpr int kMaxHorizon = 5000;           // P, M (samples)
+void CheckWork(double Ts, double duration, int P, int M) {
+  if (!(Ts >= kMinTs) || !std::isfinite(Ts))
+    throw HttpError(422, fmt::format("Ts must be at least {:g} s in the app, got {:g}", kMinTs, Ts));
+  if (std::isfinite(duration) && duration / Ts > kMaxSamples)
+    throw HttpError(422, fmt::format("duration / Ts = {:.3g} samples, above the app's limit of "
+                                     "{:g} per request",
+                                     duration / Ts, kMaxSamples));
+  if (!std::isfinite(duration))
+    throw HttpError(422, fmt::format("duration must be finite, got {}", duration));
+  if (P > kMaxHorizon || M > kMaxHorizon)
+    throw HttpError(422, fmt::format("horizons above {} samples are refused in the app, got "
+                                     "P = {}, M = {}",
+                                     kMaxHorizon, P, M));
+}
+
 }  // namespace
 
 nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
   cli::TuneCli c;
   if (!b.contains("model")) throw HttpError(400, "field 'model' is missing");
   c.model = ModelSpec(b["model"]);
+  const RemoveWhenDone stored{b["model"].is_object() ? c.model : std::string()};
   c.Ts = 0.01;
   Get(b, "Ts", c.Ts);
   Get(b, "rule", c.rule);
@@ -611,8 +666,12 @@ nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
   Get(b, "M", c.M);
   Get(b, "P", c.P);
   Get(b, "lambda", c.lambda);
+  CheckWork(c.Ts, 0.0, c.P, c.M);
+  // A controller, when given, must be one (whatever the rule).
+  std::string controller;
+  if (Get(b, "controller", controller)) ControllerTypeFromString(controller);
   if (c.rule == "auto") {
-    Get(b, "controller", c.controller);
+    if (!controller.empty()) c.controller = controller;
     Get(b, "response_time", c.response_time);
     Get(b, "overshoot", c.overshoot);
     Get(b, "aggressiveness", c.aggressiveness);
@@ -630,6 +689,7 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b) {
   cli::ControlCli c;
   if (!b.contains("model")) throw HttpError(400, "field 'model' is missing");
   c.model = ModelSpec(b["model"]);
+  const RemoveWhenDone stored{b["model"].is_object() ? c.model : std::string()};
   ReadControllerSettings(b, c.controller);
   Get(b, "u_min", c.controller.limits.u_min);
   Get(b, "u_max", c.controller.limits.u_max);
@@ -639,6 +699,7 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b) {
   c.setpoint = SignalSpec(c.setpoint);
   if (!Get(b, "duration", c.duration)) throw HttpError(400, "field 'duration' is missing");
   PNEUMID_CHECK(c.duration > 0.0, "duration must be positive, got {}", c.duration);
+  CheckWork(c.Ts, c.duration, c.controller.P, c.controller.M);
   Get(b, "noise", c.noise);
   Get(b, "seed", c.seed);
   c.load_steps = LoadSteps(b);
@@ -667,6 +728,7 @@ Response AppApi::RunStart(const nlohmann::json& b) {
   if (Get(b, "plant", config.plant)) config.plant = PlantSpec(config.plant);
   Get(b, "Ts", config.loop.period);
   Get(b, "duration", config.loop.duration);
+  CheckWork(config.loop.period, config.loop.duration, o.controller.P, o.controller.M);
   Get(b, "seed", o.rt.seed);
   double noise = 0.0;
   if (Get(b, "noise", noise)) o.rt.noise = noise;
