@@ -135,6 +135,29 @@ if expect(s, a, 400, "an over-long path") and len(str(a)) > 1000:
 s, a = call("POST", "/api/control", dict(ctl, setpoint="file:demo.csv,col=u", plant="ipa"))
 expect(s, a, 200, "a set-point file under the root")
 
+# --- idle connections cannot hold the server: 40 sockets that send nothing
+# (the limit is 32 connections), then a request is still answered, and a
+# socket that sends nothing is closed by the server within the header deadline.
+import socket as _socket
+host, port = base.split("//")[1].split(":")
+idle = []
+for _ in range(40):
+    c = _socket.create_connection((host, int(port)), timeout=5)
+    idle.append(c)
+time.sleep(0.5)
+s, a = call("GET", "/api/version")
+expect(s, a, 200, "a request while 40 idle connections are open")
+probe = idle[-1]
+probe.settimeout(15)
+try:
+    closed = probe.recv(1) == b""
+except OSError:
+    closed = True
+if not closed:
+    fail("an idle connection was not closed by the server")
+for c in idle:
+    c.close()
+
 # --- files and data
 s, a = call("GET", "/api/files")
 if expect(s, a, 200, "files"):

@@ -6,7 +6,9 @@
 #include <chrono>
 #include <condition_variable>
 #include <limits>
+#include <map>
 #include <set>
+#include <thread>
 
 #include <fmt/format.h>
 #include <boost/asio/ip/tcp.hpp>
@@ -26,7 +28,11 @@ namespace websocket = beast::websocket;
 namespace net = boost::asio;
 using tcp = net::ip::tcp;
 
-constexpr int kIdleSeconds = 60;  // a keep-alive connection idle this long is closed
+constexpr int kIdleSeconds = 60;  // no byte for this long ends a connection
+// A request's header must arrive within this time of the connection's turn to
+// send one (a new or a kept-alive connection), however slowly its bytes come:
+// idle and slow connections cannot hold the server's connection slots.
+constexpr auto kHeaderDeadline = std::chrono::seconds(10);
 
 std::string LimitText(std::size_t bytes) {
   return bytes % (1u << 20) == 0 ? fmt::format("{} MB", bytes >> 20)
@@ -116,6 +122,41 @@ struct HttpServer::Impl {
   std::condition_variable idle;
   std::set<int> sockets;  // native handles of open connections
   int active = 0;
+  // Connections waiting for a request header, since when (guarded by mutex).
+  std::map<int, std::chrono::steady_clock::time_point> waiting;
+
+  void WaitingForHeader(int fd, bool waits) {
+    std::lock_guard lock(mutex);
+    if (waits)
+      waiting[fd] = std::chrono::steady_clock::now();
+    else
+      waiting.erase(fd);
+  }
+
+  // Ends the connections whose header is overdue; with `oldest`, also the one
+  // that has waited longest (to make room). Returns whether one was ended.
+  // Called with the mutex held.
+  bool EndWaiting(bool oldest) {
+    const auto now = std::chrono::steady_clock::now();
+    bool ended = false;
+    auto longest = waiting.end();
+    for (auto it = waiting.begin(); it != waiting.end();) {
+      if (now - it->second > kHeaderDeadline) {
+        ::shutdown(it->first, SHUT_RDWR);
+        it = waiting.erase(it);
+        ended = true;
+        continue;
+      }
+      if (longest == waiting.end() || it->second < longest->second) longest = it;
+      ++it;
+    }
+    if (oldest && !ended && longest != waiting.end()) {
+      ::shutdown(longest->first, SHUT_RDWR);
+      waiting.erase(longest);
+      ended = true;
+    }
+    return ended;
+  }
 
   // The security checks; an empty optional when the request may go on.
   std::optional<Response> Check(const http::request<http::string_body>& req,
@@ -185,7 +226,9 @@ struct HttpServer::Impl {
       // The limit is set once the path is known (a larger Content-Length would fail
       // read_header itself, without an answer).
       parser.body_limit(std::numeric_limits<std::uint64_t>::max());
+      WaitingForHeader(socket.native_handle(), true);
       http::read_header(socket, buffer, parser, ec);
+      WaitingForHeader(socket.native_handle(), false);
       if (ec) break;
       const auto& head = parser.get();
       const std::string target(head.target());
@@ -299,6 +342,14 @@ HttpServer::~HttpServer() { Stop(); }
 
 void HttpServer::Run() {
   Impl& s = *impl_;
+  // The header deadline's watchdog.
+  std::thread watchdog([&s] {
+    while (!s.stopping) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      std::lock_guard lock(s.mutex);
+      s.EndWaiting(false);
+    }
+  });
   while (!s.stopping) {
     beast::error_code ec;
     tcp::socket socket(s.ioc);
@@ -310,7 +361,8 @@ void HttpServer::Run() {
     ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
     {
       std::lock_guard lock(s.mutex);
-      if (s.active >= s.options.max_connections) {
+      // Full: a connection that has sent no request yet makes room.
+      if (s.active >= s.options.max_connections && !s.EndWaiting(true)) {
         Impl::Write(socket, ErrorResponse(503, "too many connections"), 11, false, ec);
         continue;
       }
@@ -329,6 +381,7 @@ void HttpServer::Run() {
       s.idle.notify_all();
     }).detach();
   }
+  watchdog.join();
   // Wait for the connection threads: they use `s`.
   std::unique_lock lock(s.mutex);
   s.idle.wait(lock, [&] { return s.active == 0; });
