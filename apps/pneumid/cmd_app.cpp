@@ -40,7 +40,12 @@ struct AppCli {
   std::string assets;
   std::string token;
   std::vector<std::string> allow_devices;
+  bool allow_remote = false;
 };
+
+bool IsLoopback(const std::string& host) {
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
 
 std::string RandomToken() {
   std::random_device rd;
@@ -72,6 +77,13 @@ void Serve(const AppCli& c) {
   PNEUMID_CHECK(c.port >= 0 && c.port <= 65535, "--port must be 0 .. 65535, got {}", c.port);
   PNEUMID_CHECK(c.token.find_first_of(" \t\r\n&;=%#?") == std::string::npos,
                 "--token must not contain spaces or any of &;=%#?");
+  PNEUMID_CHECK(IsLoopback(c.host) || c.allow_remote,
+                "--host {} exposes the app to the network (anyone who has the token can read "
+                "--root and drive the plant); add --allow-remote to do so, or keep 127.0.0.1",
+                c.host);
+  if (!IsLoopback(c.host))
+    std::cerr << "pneumid app: warning: listening on " << c.host
+              << ", reachable from the network; the token is the only protection (no TLS)\n";
   std::error_code ec;
   const fs::path root = fs::canonical(c.root, ec);
   if (ec || !fs::is_directory(root))
@@ -115,12 +127,18 @@ void Serve(const AppCli& c) {
   so.host = c.host;
   so.port = c.port;
   so.token = options.token;
+  // A wildcard address has no one name to check the Host header against.
+  so.check_host = !(c.host == "0.0.0.0" || c.host == "::");
   app::HttpServer server(
       so, [&api](const app::Request& r) { return api.Handle(r); },
       [&api](const app::Request& r, const std::function<bool(const std::string&)>& send) {
         api.Stream(r, send);
       });
-  const std::string shown = c.host == "0.0.0.0" || c.host == "::" ? "127.0.0.1" : c.host;
+  const bool wildcard = c.host == "0.0.0.0" || c.host == "::";
+  const std::string shown = wildcard ? "127.0.0.1" : c.host;
+  if (wildcard)
+    std::cerr << "pneumid app: listening on every interface; from another machine use this "
+                 "machine's address in place of 127.0.0.1\n";
   const std::string url =
       fmt::format("http://{}:{}/?token={}", shown, server.port(), options.token);
   std::cout << "pneumid app: serving " << root.string() << " at " << url << std::endl;
@@ -155,6 +173,9 @@ const Registrar reg(
                      "Folder of the built page (index.html, assets/; default: "
                      "web/ beside the program, or ../share/pneumid/web)");
       app.add_option("--token", c->token, "Access token (default: 32 random hex digits)");
+      app.add_flag("--allow-remote", c->allow_remote,
+                   "Allow a --host other than loopback (the app is then reachable from the "
+                   "network, behind its token, without TLS)");
       app.add_option("--allow-device", c->allow_devices,
                      "A data-acquisition device the page may drive (comedi:PATH), repeatable; "
                      "by default the page drives the simulator or a plant server only");

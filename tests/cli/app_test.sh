@@ -8,7 +8,8 @@ cleanup() {  # called by lib.sh on exit
   if [ -n "$APP_PID" ]; then kill "$APP_PID" 2>/dev/null; wait "$APP_PID" 2>/dev/null; fi
 }
 
-check_help app --port --host --root --open --assets --token
+check_help app --port --host --root --open --assets --token --allow-remote --allow-device
+expect_error "remote host" "add --allow-remote" app --host 0.0.0.0 --port 0
 
 ROOT="$TMP/root"
 mkdir -p "$ROOT/sub"
@@ -93,6 +94,13 @@ s, a = call("GET", "/api/version", headers={"Origin": "http://evil.example"})
 expect(s, a, 403, "a foreign Origin")
 s, a = call("GET", "/api/version", headers={"Origin": base})
 expect(s, a, 200, "the server's own Origin")
+s, a = call("GET", "/api/version", headers={"Host": "evil.example:80"})
+expect(s, a, 403, "a foreign Host header (DNS rebinding)")
+req = urllib.request.Request(base + "/api/version", headers={"X-Pneumid-Token": token})
+with urllib.request.urlopen(req, timeout=30) as r:
+    csp = r.headers.get("Content-Security-Policy", "")
+    if "frame-ancestors 'none'" not in csp or r.headers.get("X-Frame-Options") != "DENY":
+        fail(f"no CSP / X-Frame-Options: {csp!r} {r.headers.get('X-Frame-Options')!r}")
 s, a = call("GET", "/", raw=True)
 if expect(s, a, 200, "GET / without assets") and "not built" not in a:
     fail("GET / without assets does not say the front end was not built")

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/common/strings.hpp"
 
 namespace pneumid::app {
 namespace {
@@ -161,6 +162,15 @@ struct HttpServer::Impl {
   // The security checks; an empty optional when the request may go on.
   std::optional<Response> Check(const http::request<http::string_body>& req,
                                 const std::string& query_token) const {
+    if (options.check_host) {
+      const auto host = req.find(http::field::host);
+      const std::string value = host == req.end() ? std::string() : std::string(host->value());
+      bool ok = false;
+      for (const std::string& o : origins) ok = ok || "http://" + value == o;
+      if (!ok)
+        return ErrorResponse(403, fmt::format("host '{}' is not this server's ({})",
+                                              Excerpt(value), origins.front().substr(7)));
+    }
     const auto origin = req.find(http::field::origin);
     if (origin != req.end()) {
       const std::string value(origin->value());
@@ -194,6 +204,14 @@ struct HttpServer::Impl {
     res.set(http::field::content_type, r.content_type);
     res.set(http::field::cache_control, "no-store");
     res.set("X-Content-Type-Options", "nosniff");
+    // The page loads only its own scripts, styles and connections, and no
+    // other site may frame it.
+    res.set("Content-Security-Policy",
+            "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; "
+            "img-src 'self' data: blob:; connect-src 'self' ws: wss:; object-src 'none'; "
+            "base-uri 'none'; frame-ancestors 'none'; form-action 'self'");
+    res.set("X-Frame-Options", "DENY");
+    res.set("Referrer-Policy", "no-referrer");
     for (const auto& [k, v] : r.headers) res.set(k, v);
     res.keep_alive(keep_alive);
     res.body() = r.body;

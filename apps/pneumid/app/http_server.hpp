@@ -53,6 +53,10 @@ struct ServerOptions {
   std::size_t upload_limit = 50u << 20;  ///< bytes
   std::size_t body_limit = 1u << 20;     ///< bytes
   int max_connections = 32;
+  /// Refuse a Host header other than this server's address (127.0.0.1:PORT,
+  /// localhost:PORT, HOST:PORT): a page of another site that a DNS name
+  /// resolves to 127.0.0.1 cannot reach the app. Off for a wildcard --host.
+  bool check_host = true;
 };
 
 /// The JSON error body {"error": message}.
