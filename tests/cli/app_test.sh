@@ -166,12 +166,38 @@ if not closed:
 for c in idle:
     c.close()
 
+# --- malformed HTTP gets a status before the connection closes
+def raw_status(raw):
+    c = _socket.create_connection((host, int(port)), timeout=10)
+    c.sendall(raw)
+    data = b""
+    try:
+        while True:
+            d = c.recv(65536)
+            if not d:
+                break
+            data += d
+    except OSError:
+        pass
+    c.close()
+    return data.split(b"\r\n")[0].decode(errors="replace")
+hdr = f"Host: {host}:{port}\r\nX-Pneumid-Token: {token}\r\n"
+for raw, want, what in [
+        (f"POST /api/tune HTTP/1.1\r\n{hdr}Content-Length: abc\r\n\r\n", " 400 ", "a bad Content-Length"),
+        (f"POST /api/tune HTTP/1.1\r\n{hdr}Transfer-Encoding: chunked\r\n\r\nzz\r\nxx\r\n", " 400 ", "a bad chunk"),
+        (f"GET /api/version HTTP/1.1\r\n{hdr}X-Big: {'a' * 100000}\r\n\r\n", " 431 ", "a 100 kB header")]:
+    line = raw_status(raw.encode())
+    if want not in line:
+        fail(f"{what}: answered {line!r} (expected{want.rstrip()})")
+
 # --- files and data
 s, a = call("GET", "/api/files")
 if expect(s, a, 200, "files"):
     names = {(e["name"], e["type"]) for e in a["entries"]}
     if ("demo.csv", "file") not in names or ("sub", "dir") not in names:
         fail(f"files: {a}")
+    if any(e["name"] == "link" for e in a["entries"]):
+        fail(f"the listing shows a link that leaves the root: {a}")
 s, a = call("POST", "/api/data/open", {"path": "demo.csv"})
 data_id = None
 if expect(s, a, 200, "open demo.csv"):

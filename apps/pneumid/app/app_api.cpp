@@ -389,6 +389,11 @@ nlohmann::json AppApi::Files(const Request& req) {
     const std::string name = e.path().filename().string();
     if (name.empty() || name[0] == '.') continue;
     std::error_code e2;
+    // A symbolic link that leaves the root is not listed (it could not be opened).
+    if (e.is_symlink(e2)) {
+      const fs::path target = fs::weakly_canonical(e.path(), e2);
+      if (e2 || !Inside(target, options_.root)) continue;
+    }
     if (e.is_directory(e2)) {
       dirs.push_back({{"name", name}, {"type", "dir"}, {"size", nullptr}});
     } else if (e.is_regular_file(e2) && IsDataFile(e.path())) {

@@ -247,7 +247,19 @@ struct HttpServer::Impl {
       WaitingForHeader(socket.native_handle(), true);
       http::read_header(socket, buffer, parser, ec);
       WaitingForHeader(socket.native_handle(), false);
-      if (ec) break;
+      if (ec) {
+        // A malformed request gets a status before the connection closes
+        // (not a connection that ended or timed out).
+        if (ec == http::error::header_limit) {
+          Write(socket, ErrorResponse(431, "the request header is larger than 64 KB"), 11, false,
+                ec);
+          Drain(socket);
+        } else if (ec.category() == beast::error_code(http::error::bad_content_length).category()) {
+          Write(socket, ErrorResponse(400, "malformed request: " + ec.message()), 11, false, ec);
+          Drain(socket);
+        }
+        return;
+      }
       const auto& head = parser.get();
       const std::string target(head.target());
       const std::size_t q = target.find('?');
@@ -286,6 +298,13 @@ struct HttpServer::Impl {
       if (!parser.is_done()) http::read(socket, buffer, parser, ec);
       if (ec == http::error::body_limit) {
         Write(socket, too_large(std::nullopt), head.version(), false, ec);
+        Drain(socket);
+        return;
+      }
+      if (ec && ec != http::error::end_of_stream &&
+          ec.category() == beast::error_code(http::error::bad_content_length).category()) {
+        Write(socket, ErrorResponse(400, "malformed request body: " + ec.message()),
+              head.version(), false, ec);
         Drain(socket);
         return;
       }
