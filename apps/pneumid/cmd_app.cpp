@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -154,6 +155,15 @@ void Serve(const AppCli& c) {
   if (c.open) OpenBrowser(url);
   server.Run();
   waiter.join();
+  if (server.Abandoned()) {
+    // A request still computing holds the server: end within the second
+    // anyway, the temporary folder removed.
+    std::error_code e;
+    fs::remove_all(work, e);
+    std::cerr << "pneumid app: requests still running were abandoned\n";
+    std::fflush(stderr);
+    std::_Exit(0);
+  }
 }
 
 const Registrar reg(

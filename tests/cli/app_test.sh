@@ -476,4 +476,45 @@ wait "$APP_PID" || rc=$?
 APP_PID=""
 [ "$rc" -eq 0 ] || fail "pneumid app exit status after SIGTERM: $rc"
 
+# SIGTERM during a long request: the app ends within about a second of it,
+# its temporary folder removed.
+mkdir -p "$TMP/apptmp2"
+: > "$TMP/app2.txt"
+TMPDIR="$TMP/apptmp2" "$PNEUMID" app --port 0 --root "$ROOT" --assets "$TMP/no-assets" \
+  --token t2 > "$TMP/app2.txt" 2>&1 &
+APP_PID=$!
+URL2=""
+for _ in $(seq 100); do
+  URL2=$(sed -n 's/^pneumid app: serving.*\(http:\/\/127\.0\.0\.1:[0-9]*\)\/?token.*/\1/p' "$TMP/app2.txt")
+  [ -n "$URL2" ] && break
+  sleep 0.1
+done
+[ -n "$URL2" ] || die "the second app did not start: $(cat "$TMP/app2.txt")"
+# 2e6 samples of a DMC with P = 5000: minutes of work, within the limits.
+"$PY" -c "
+import json, sys, urllib.request
+req = urllib.request.Request(sys.argv[1] + '/api/control', method='POST',
+    data=json.dumps({'model': 'fopdt-paper', 'controller': 'dmc', 'P': 5000, 'M': 5, 'lambda': 1,
+                     'Ts': 0.0001, 'duration': 199, 'setpoint': 'step:to=1'}).encode(),
+    headers={'X-Pneumid-Token': 't2', 'Content-Type': 'application/json'})
+try:
+    urllib.request.urlopen(req, timeout=60)
+except Exception:
+    pass
+" "$URL2" &
+CLIENT_PID=$!
+sleep 2
+start=$(date +%s%N)
+kill -TERM "$APP_PID"
+wait "$APP_PID" 2>/dev/null
+elapsed_ms=$(( ($(date +%s%N) - start) / 1000000 ))
+APP_PID=""
+kill "$CLIENT_PID" 2>/dev/null; wait "$CLIENT_PID" 2>/dev/null
+echo "SIGTERM during a long request: the app ended in $elapsed_ms ms"
+[ "$elapsed_ms" -lt 3000 ] || fail "the app took $elapsed_ms ms to end after SIGTERM during a request"
+grep -q "abandoned" "$TMP/app2.txt" || fail "the long request was not running: $(cat "$TMP/app2.txt")"
+if ls -d "$TMP"/apptmp2/pneumid-app-* >/dev/null 2>&1; then
+  fail "the app's temporary folder is left after SIGTERM: $(ls "$TMP/apptmp2")"
+fi
+
 finish

@@ -419,9 +419,10 @@ void HttpServer::Run() {
     }).detach();
   }
   watchdog.join();
-  // Wait for the connection threads: they use `s`.
+  // Wait for the connection threads (they use `s`), at most 1 s: a request
+  // still computing is abandoned (the caller ends the process).
   std::unique_lock lock(s.mutex);
-  s.idle.wait(lock, [&] { return s.active == 0; });
+  abandoned_ = !s.idle.wait_for(lock, std::chrono::seconds(1), [&] { return s.active == 0; });
 }
 
 void HttpServer::Stop() {

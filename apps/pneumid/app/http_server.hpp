@@ -80,8 +80,13 @@ class HttpServer {
 
   /// The port bound (the free one chosen for port 0).
   int port() const { return port_; }
-  /// Accepts connections until Stop() (blocks).
+  /// Accepts connections until Stop() (blocks). Returns after Stop(): at once when every connection has ended, else
+  /// after 1 s with requests still running (Abandoned()).
   void Run();
+  /// Run() returned while requests were still being answered: their threads
+  /// use the server, so the process must end without destroying it
+  /// (std::_Exit after its own clean-up).
+  bool Abandoned() const { return abandoned_; }
   /// Stops accepting and closes the open connections; Run() returns.
   void Stop();
 
@@ -89,6 +94,7 @@ class HttpServer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   int port_ = 0;
+  bool abandoned_ = false;
 };
 
 }  // namespace pneumid::app
