@@ -27,6 +27,22 @@ ln -s /etc "$ROOT/link"
 "$PNEUMID" tune --rule auto --model fopdt-paper --Ts 0.01 --plant ipa --json > "$TMP/tune_auto_cli.json" ||
   fail "tune --rule auto --plant ipa --json"
 
+# start_app LOG [OPTIONS...]: pneumid app on a free port under $ROOT in the
+# background (APP_PID); URL is the address it prints ("" when none in 10 s).
+start_app() {
+  local log=$1
+  shift
+  : > "$log"  # empty before the job starts (its redirection may come late)
+  "$PNEUMID" app --port 0 --root "$ROOT" "$@" > "$log" 2>&1 &
+  APP_PID=$!
+  URL=""
+  for _ in $(seq 100); do
+    URL=$(grep -o 'http://127\.0\.0\.1:[0-9]*/?token=[0-9a-z]*' "$log" | head -1)
+    [ -n "$URL" ] && break
+    sleep 0.1
+  done
+}
+
 # Empty the file before the background job starts (its redirection may come late).
 : > "$TMP/app.txt"
 mkdir -p "$TMP/apptmp"  # the app's temporary folder goes here (checked below)
@@ -429,15 +445,8 @@ mkdir -p "$TMP/web/assets"
 echo '<!doctype html><script type="module" src="./assets/app.js"></script>' > "$TMP/web/index.html"
 echo 'console.log("pneumid");' > "$TMP/web/assets/app.js"
 echo 'top-secret-content' > "$TMP/web/secret.txt"
-: > "$TMP/app.txt"
-"$PNEUMID" app --port 0 --root "$ROOT" --assets "$TMP/web" > "$TMP/app.txt" 2>&1 &
-APP_PID=$!
-URL=""
-for _ in $(seq 100); do
-  URL=$(grep -o 'http://127\.0\.0\.1:[0-9]*/?token=[0-9a-f]\{32\}$' "$TMP/app.txt")
-  [ -n "$URL" ] && break
-  sleep 0.1
-done
+start_app "$TMP/app.txt" --assets "$TMP/web"
+grep -q 'http://127\.0\.0\.1:[0-9]*/?token=[0-9a-f]\{32\}$' "$TMP/app.txt" || URL=""
 [ -n "$URL" ] || fail "no address with a 32-digit random token: $(cat "$TMP/app.txt")"
 if [ -n "$URL" ]; then
   $PY - "$URL" << 'PYEOF' || fail "page and assets (above)"
@@ -479,17 +488,9 @@ APP_PID=""
 # SIGTERM during a long request: the app ends within about a second of it,
 # its temporary folder removed.
 mkdir -p "$TMP/apptmp2"
-: > "$TMP/app2.txt"
-TMPDIR="$TMP/apptmp2" "$PNEUMID" app --port 0 --root "$ROOT" --assets "$TMP/no-assets" \
-  --token t2 > "$TMP/app2.txt" 2>&1 &
-APP_PID=$!
-URL2=""
-for _ in $(seq 100); do
-  URL2=$(sed -n 's/^pneumid app: serving.*\(http:\/\/127\.0\.0\.1:[0-9]*\)\/?token.*/\1/p' "$TMP/app2.txt")
-  [ -n "$URL2" ] && break
-  sleep 0.1
-done
-[ -n "$URL2" ] || die "the second app did not start: $(cat "$TMP/app2.txt")"
+TMPDIR="$TMP/apptmp2" start_app "$TMP/app2.txt" --assets "$TMP/no-assets" --token t2
+URL2=${URL%%/\?token=*}
+[ -n "$URL" ] || die "the second app did not start: $(cat "$TMP/app2.txt")"
 # 2e6 samples of a DMC with P = 5000: minutes of work, within the limits.
 "$PY" -c "
 import json, sys, urllib.request
