@@ -16,8 +16,8 @@
 #include <memory>
 #include <random>
 #include <string>
-#include <vector>
 #include <thread>
+#include <vector>
 
 #include <fmt/format.h>
 

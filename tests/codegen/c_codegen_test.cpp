@@ -447,6 +447,51 @@ INSTANTIATE_TEST_SUITE_P(Controllers, CodegenFaultTest, ::testing::ValuesIn(Case
                            return info.param.name;
                          });
 
+// The module's own guard in closed loop (float, as on the Cortex-M4F): the
+// paper's FOPDT plant in N at 60 N, NaN and Inf readings for 0.1 s during the
+// step response, then valid ones: the inputs stay finite and within 0..100 %,
+// the faults are counted, and the force is within 0.5 N of the set-point
+// 0.5 s after the valid samples return.
+TEST(CodegenFaultTest, ModuleRecoversInClosedLoop) {
+  for (const char* name : {"dmc_clipped", "qdmc", "gpc", "pid_simc", "mpc_constrained"}) {
+    SCOPED_TRACE(name);
+    Case c;
+    for (const Case& k : Cases())
+      if (k.name == name) c = k;
+    ASSERT_EQ(c.name, name);
+    auto lib = Build(c);
+    CodegenOptions o;
+    o.precision = CodegenPrecision::kFloat;
+    o.prefix = std::string("cl_") + name;
+    const CodegenResult gen = GenerateC(*lib, o);
+    TempDir dir;
+    const fs::path so = Compile(gen, dir.path());
+    ASSERT_FALSE(::testing::Test::HasFailure());
+    GeneratedController module(so, gen, true, kTs);
+    auto plant = MakePlant("fopdt-paper", kTs);
+    plant->Reset();
+    module.DoReset(0.0, 0.0);
+    std::vector<double> y_after;
+    int faults = 0;
+    for (int k = 0; k < 600; ++k) {
+      double y = plant->Measure();
+      const double y_true = y;
+      if (k >= 150 && k < 160)
+        y = k % 2 ? std::numeric_limits<double>::quiet_NaN()
+                  : std::numeric_limits<double>::infinity();
+      const double u = module.DoUpdate(60.0, y);  // the module's own guard
+      ASSERT_TRUE(std::isfinite(u)) << "step " << k;
+      ASSERT_GE(u, 0.0) << "step " << k;
+      ASSERT_LE(u, 100.0) << "step " << k;
+      if (k >= 150 && k < 160) ++faults;
+      if (k >= 210) y_after.push_back(y_true);
+      plant->Advance(u);
+    }
+    EXPECT_EQ(module.module_faults(), faults);
+    for (double y : y_after) EXPECT_NEAR(y, 60.0, 0.5);
+  }
+}
+
 // The constrained scenarios do drive the constraints: the QDMC and MPC
 // inputs reach the rate limit and the QP is solved on some steps.
 TEST(CodegenScenarioTest, ConstrainedCasesHitTheirLimits) {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
-#include <type_traits>
 #include <sstream>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -115,8 +115,8 @@ bool Get(const nlohmann::json& body, const char* key, T& out) {
                (v.get<std::int64_t>() < static_cast<std::int64_t>(std::numeric_limits<T>::min()) ||
                 v.get<std::int64_t>() > static_cast<std::int64_t>(std::numeric_limits<T>::max()))) {
       throw HttpError(422, fmt::format("field '{}' must be an integer in [{}, {}], got {}", key,
-                                       std::numeric_limits<T>::min(),
-                                       std::numeric_limits<T>::max(), Excerpt(v.dump())));
+                                       std::numeric_limits<T>::min(), std::numeric_limits<T>::max(),
+                                       Excerpt(v.dump())));
     }
   }
   try {
@@ -325,8 +325,8 @@ fs::path AppApi::Confine(const std::string& path) const {
   const fs::path full =
       fs::weakly_canonical(given.is_absolute() ? given : options_.root / given, ec);
   if (ec || !Inside(full, options_.root))
-    throw HttpError(403, fmt::format("{} is outside the root {}", Excerpt(path),
-                                     options_.root.string()));
+    throw HttpError(
+        403, fmt::format("{} is outside the root {}", Excerpt(path), options_.root.string()));
   return full;
 }
 
@@ -639,12 +639,13 @@ struct RemoveWhenDone {
 
 // Bounded work per request: the sample time, the samples of a run and the
 // horizons (each with the limit it broke; 422).
-constexpr double kMinTs = 1e-4;             // s
-constexpr double kMaxSamples = 2e6;         // duration / Ts
-constexpr int kMaxHorizon = 5000;           // P, M (samples)
+constexpr double kMinTs = 1e-4;      // s
+constexpr double kMaxSamples = 2e6;  // duration / Ts
+constexpr int kMaxHorizon = 5000;    // P, M (samples)
 void CheckWork(double Ts, double duration, int P, int M) {
   if (!(Ts >= kMinTs) || !std::isfinite(Ts))
-    throw HttpError(422, fmt::format("Ts must be at least {:g} s in the app, got {:g}", kMinTs, Ts));
+    throw HttpError(422,
+                    fmt::format("Ts must be at least {:g} s in the app, got {:g}", kMinTs, Ts));
   if (std::isfinite(duration) && duration / Ts > kMaxSamples)
     throw HttpError(422, fmt::format("duration / Ts = {:.3g} samples, above the app's limit of "
                                      "{:g} per request",

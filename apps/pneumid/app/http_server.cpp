@@ -168,8 +168,8 @@ struct HttpServer::Impl {
       bool ok = false;
       for (const std::string& o : origins) ok = ok || "http://" + value == o;
       if (!ok)
-        return ErrorResponse(403, fmt::format("host '{}' is not this server's ({})",
-                                              Excerpt(value), origins.front().substr(7)));
+        return ErrorResponse(403, fmt::format("host '{}' is not this server's ({})", Excerpt(value),
+                                              origins.front().substr(7)));
     }
     const auto origin = req.find(http::field::origin);
     if (origin != req.end()) {
@@ -303,8 +303,8 @@ struct HttpServer::Impl {
       }
       if (ec && ec != http::error::end_of_stream &&
           ec.category() == beast::error_code(http::error::bad_content_length).category()) {
-        Write(socket, ErrorResponse(400, "malformed request body: " + ec.message()),
-              head.version(), false, ec);
+        Write(socket, ErrorResponse(400, "malformed request body: " + ec.message()), head.version(),
+              false, ec);
         Drain(socket);
         return;
       }

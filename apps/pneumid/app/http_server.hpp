@@ -80,8 +80,8 @@ class HttpServer {
 
   /// The port bound (the free one chosen for port 0).
   int port() const { return port_; }
-  /// Accepts connections until Stop() (blocks). Returns after Stop(): at once when every connection has ended, else
-  /// after 1 s with requests still running (Abandoned()).
+  /// Accepts connections until Stop() (blocks). Returns after Stop(): at once when every connection
+  /// has ended, else after 1 s with requests still running (Abandoned()).
   void Run();
   /// Run() returned while requests were still being answered: their threads
   /// use the server, so the process must end without destroying it
