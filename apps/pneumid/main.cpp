@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   mallopt(M_MMAP_THRESHOLD, 512 * 1024 * 1024);
   mallopt(M_TRIM_THRESHOLD, 1024 * 1024 * 1024);
   CLI::App app{"pneumid: identify models of a plant from a step test, compare them, and tune,\n"
-               "simulate and run predictive controllers (DMC, GPC, PID) against it."};
+               "simulate and run predictive controllers (DMC, GPC, MPC, PID) against it."};
   app.name("pneumid");
   app.set_version_flag("--version", std::string(pneumid::Version()));
   app.require_subcommand(1);
