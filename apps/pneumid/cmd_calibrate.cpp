@@ -252,7 +252,9 @@ static Registrar reg(
                      "Comma-separated parameters to estimate (TOML keys such as "
                      "valves.inlet_conductance or unique last parts such as bore); default "
                      "force mode: inlet/exhaust conductance and critical ratio, bore, open "
-                     "delay (position mode adds mass, viscous and Coulomb friction)");
+                     "delay, and the sensor filter's time constant when the starting twin has "
+                     "one, as the default twin does (position mode adds mass, viscous and "
+                     "Coulomb friction)");
       app.add_option("--weights", args->weights,
                      "Weight of each experiment in the cost, one per DATA file in their order "
                      "(comma-separated; default 1 each: every experiment counts by its fit)")
