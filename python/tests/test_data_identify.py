@@ -84,16 +84,27 @@ def test_identify_unknown_method_lists_valid_names():
 
 
 def test_identify_releases_the_gil():
-    t, u, y = first_order_step(n=2000)
+    # While identify runs in a thread, this thread runs Python: with the GIL
+    # held through the call it could not count at all until the call returned.
+    t, u, y = first_order_step(n=200000)
     d = pneumid.Dataset.from_uniform(TS, u, y)
-    results = []
-    threads = [threading.Thread(target=lambda: results.append(pneumid.identify("arx", d)))
-               for _ in range(2)]
-    for th in threads:
-        th.start()
-    for th in threads:
-        th.join()
-    assert len(results) == 2
+    results, started = [], threading.Event()
+
+    def work():
+        started.set()
+        results.append(pneumid.identify("arx", d))
+
+    th = threading.Thread(target=work)
+    th.start()
+    started.wait()
+    counted = 0
+    while th.is_alive():
+        counted += 1
+    th.join()
+    assert counted > 1000, counted
+    # The result is the same as a call in this thread.
+    again = pneumid.identify("arx", d)
+    assert results[0].params == again.params
 
 
 def test_plots_write_png_and_svg(out_dir):
