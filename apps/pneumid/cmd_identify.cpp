@@ -142,7 +142,10 @@ IdentifyOutcome IdentifyData(const IdentifyArgs& args, const Dataset& raw,
 
   nlohmann::json& j = out.json;
   j["models"] = nlohmann::json::array();
-  for (const IdentifiedModel& m : models) j["models"].push_back(ToJson(m));
+  for (const IdentifiedModel& m : models) {
+    j["models"].push_back(ToJson(m));
+    j["models"].back()["rank_reason"] = RankReason(m);
+  }
   j["best"] = models.front().method;
   j["ranked_by"] = held_out ? "validation_fit_percent" : "fit_percent";
   j["estimation_samples"] = summary.estimation_samples;
@@ -197,6 +200,7 @@ void Run(const IdentifyArgs& args) {
       if (held_out) b["validation_fit_percent"] = JsonNumber(m.validation_fit_percent);
       b["flags"] = nlohmann::json::array();
       for (const ModelFlagNote& f : m.flags) b["flags"].push_back(ToString(f.flag));
+      b["rank_reason"] = RankReason(m);
       brief["models"].push_back(b);
     }
     brief["best"] = models.front().method;
@@ -230,10 +234,8 @@ void Run(const IdentifyArgs& args) {
     for (const std::string& note : m.notes) std::cout << fmt::format("{:<16} note: {}\n", "", note);
   }
   const IdentifiedModel& best = models.front();
-  std::cout << fmt::format(
-      "best: {} ({:.2f} % {}fit){}\n", best.method, RankScore(best), held_out ? "validation " : "",
-      best.flags.empty() ? ""
-                         : fmt::format("; every model is flagged, {} least severely", best.method));
+  std::cout << fmt::format("best: {} ({:.2f} % {}fit): {}\n", best.method, RankScore(best),
+                           held_out ? "validation " : "", RankReason(best));
   if (!summary.failures.empty())
     std::cout << fmt::format("failed: {}\n", [&] {
       std::vector<std::string> f;
@@ -259,10 +261,15 @@ static Registrar reg(
       app.add_option("--order", args->request.order, "PTn order n (ptn)")
           ->capture_default_str()
           ->check(CLI::Range(1, 20));
-      app.add_option("--na", args->request.na, "A order (arx, armax, iv4; n4sid state order)")
-          ->capture_default_str();
-      app.add_option("--nb", args->request.nb, "B order")->capture_default_str();
-      app.add_option("--nk", args->request.nk, "input delay in samples")->capture_default_str();
+      CLI::Option* na =
+          app.add_option("--na", args->request.na,
+                         "A order (arx, armax, iv4; n4sid state order); hammerstein, wiener, hw: "
+                         "when none of --na --nb --nk is given, all three are chosen on held-out "
+                         "data (--validation, else the last 30 % of DATA) and the choice is noted")
+              ->capture_default_str();
+      CLI::Option* nb = app.add_option("--nb", args->request.nb, "B order")->capture_default_str();
+      CLI::Option* nk =
+          app.add_option("--nk", args->request.nk, "input delay in samples")->capture_default_str();
       app.add_option("--nc", args->request.nc, "C order (armax, bj)")->capture_default_str();
       app.add_option("--nd", args->request.nd, "D order (bj)")->capture_default_str();
       app.add_option("--nf", args->request.nf, "F order (oe, bj)")->capture_default_str();
@@ -284,9 +291,10 @@ static Registrar reg(
           });
       app.add_option(
              "--knots", args->nonlinear.block.num_knots,
-             "hammerstein, wiener, hw, affine-narx: knots of the static map, spread over the "
-             "input range (hw: as many for the output map, over the range of G f(u))")
-          ->capture_default_str()
+             "hammerstein, wiener, hw, affine-narx: knots of the static map, spread evenly over "
+             "the input range (hw: as many for the output map, over the range of G f(u)); "
+             "default: where the data are (the levels of a staircase or multi-level input, "
+             "else 11 quantiles; wiener: of G u)")
           ->check(CLI::Range(2, 1000));
       app.add_flag("--monotone-map", args->nonlinear.block.monotone_map,
                    "hammerstein: keep the input map monotone (invertible)");
@@ -330,7 +338,10 @@ static Registrar reg(
           ->check(CLI::Range(0.0, 1.0));
       app.add_flag("--progress", args->progress,
                    "Draw the progress bar even when stderr is not a terminal");
-      app.callback([args] { Run(*args); });
+      app.callback([args, na, nb, nk] {
+        args->nonlinear.choose_structure = na->count() == 0 && nb->count() == 0 && nk->count() == 0;
+        Run(*args);
+      });
     });
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/nonlinear.hpp"
 #include "pneumid/identify/parametric_model.hpp"
 #include "pneumid/identify/residual_analysis.hpp"
 #include "pneumid/identify/validation.hpp"
@@ -34,8 +35,24 @@ struct ValidateArgs {
   int skip = 0;
   std::string initial_state = "zero";
   std::string plot;
+  std::string output;  // trace CSV: t, u, y, y_model
   bool json = false;
 };
+
+// The trace of the validation: t, u, y, y_model (and y_pred with --horizon).
+void WriteTrace(const std::string& path, const Dataset& data, const CompareResult& sim,
+                const CompareResult* pred, int horizon) {
+  std::ofstream f(path);
+  PNEUMID_CHECK(f.good(), "cannot write the trace file {}", path);
+  f << "t,u,y,y_model" << (pred ? fmt::format(",y_pred{}", horizon) : "") << "\n";
+  const Eigen::VectorXd u = data.u(0);
+  for (Eigen::Index i = 0; i < sim.t.size(); ++i) {
+    f << fmt::format("{},{},{},{}", sim.t[i], u[i], sim.y[i], sim.yhat[i]);
+    if (pred) f << fmt::format(",{}", i < pred->yhat.size() ? pred->yhat[i] : 0.0);
+    f << "\n";
+  }
+  PNEUMID_CHECK(f.good(), "writing the trace file {} failed", path);
+}
 
 // The polynomial form of an identified ARX/ARMAX/OE/BJ model (k-step prediction
 // and prediction-error residuals need its noise model).
@@ -101,11 +118,14 @@ void Run(const ValidateArgs& a) {
   ResidualAnalysisOptions ro;
   ro.max_lag = a.max_lag;
   CompareResult sim, pred;
+  std::vector<std::string> warnings;
   ResidualAnalysis res;
   std::string residuals_unavailable;  // why the residual tests are undefined (constant input)
   bool have_pred = false;
   if (identified) {
     sim = SimulateIdentified(*identified, data, a.skip, initial);
+    warnings = ExtrapolationWarnings(*identified, data, 0);
+    for (const std::string& w : warnings) std::cerr << "pneumid validate: warning: " << w << "\n";
     PNEUMID_CHECK(a.horizon == 0 || poly,
                   "--horizon needs a polynomial model with a noise model; '{}' is a {} model "
                   "(simulation only)",
@@ -136,6 +156,7 @@ void Run(const ValidateArgs& a) {
     residuals_unavailable =
         TryResiduals(&res, [&] { return AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro); });
   }
+  if (!a.output.empty()) WriteTrace(a.output, data, sim, have_pred ? &pred : nullptr, a.horizon);
   if (!a.plot.empty()) {
     Figure fig(residuals_unavailable.empty() ? 3 : 1);
     fig.title = fmt::format("Validation of {}", label);
@@ -171,6 +192,7 @@ void Run(const ValidateArgs& a) {
     j["model"] = label;
     j["samples"] = data.size();
     j["fit_percent"] = sim.fit_percent;
+    j["warnings"] = warnings;
     j["initial_state"] = ToString(initial);
     j["rmse"] = sim.rmse;
     if (have_pred) {
@@ -238,6 +260,8 @@ static Registrar reg(
           ->capture_default_str()
           ->check(AtLeast(0));
       AddPlotOption(app, args->plot, "data/model and residual correlations");
+      app.add_option("-o,--output", args->output,
+                     "Write the trace as CSV: t, u, y, y_model (and y_predK with --horizon K)");
       app.add_flag("--json", args->json, "Print the results as JSON");
       app.callback([args] { Run(*args); });
     });

@@ -9,6 +9,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/static_map_fit.hpp"
 
 namespace pneumid {
 
@@ -18,9 +19,9 @@ bool AffineNarxOptions::IsValid(std::string* error) const {
     return false;
   };
   if (degree < 1 || degree > 3) return fail(fmt::format("degree must be in 1..3, got {}", degree));
-  if (nk < 1) return fail(fmt::format("nk must be >= 1, got {}", nk));
-  if (knots.empty() && num_knots < 2)
-    return fail(fmt::format("num_knots must be >= 2, got {}", num_knots));
+  if (nk < 0) return fail(fmt::format("nk must be >= 0, got {}", nk));
+  if (knots.empty() && num_knots != 0 && num_knots < 2)
+    return fail(fmt::format("num_knots must be 0 (automatic) or >= 2, got {}", num_knots));
   if (!knots.empty()) {
     if (knots.size() < 2) return fail(fmt::format("need >= 2 knots, got {}", knots.size()));
     for (std::size_t i = 0; i < knots.size(); ++i) {
@@ -71,13 +72,11 @@ AffineNarxResult EstimateAffineNarx(const Eigen::VectorXd& u, const Eigen::Vecto
   PNEUMID_CHECK(y_scale > 0.0, "affine NARX: the output is zero throughout");
 
   std::vector<double> knots = o.knots;
-  if (knots.empty()) {
-    const Eigen::VectorXd k = Eigen::VectorXd::LinSpaced(o.num_knots, lo, hi);
-    knots.assign(k.data(), k.data() + k.size());
-  }
+  if (knots.empty()) knots = PlaceMapKnots(u, o.num_knots);
   const auto m = static_cast<Eigen::Index>(knots.size());
   const int d = o.degree;
-  const Eigen::Index n0 = o.nk;  // rows t = nk .. N-1 (y(t-1) and u(t-nk) exist)
+  // rows t = max(1, nk) .. N-1 (y(t-1) and u(t-nk) exist)
+  const Eigen::Index n0 = std::max(1, o.nk);
   const Eigen::Index rows = std::max<Eigen::Index>(0, y.size() - n0);
   const Eigen::Index num_params = 2 * (d + 1) + m;
   PNEUMID_CHECK(rows >= num_params,

@@ -212,7 +212,8 @@ void CheckSignals(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
                 y.size());
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
   PNEUMID_CHECK(u.allFinite() && y.allFinite(), "{}: the data hold non-finite values", what);
-  const int m = o.knots.empty() ? o.num_knots : static_cast<int>(o.knots.size());
+  const int m = o.knots.empty() ? (o.num_knots == 0 ? 2 : o.num_knots)
+                                : static_cast<int>(o.knots.size());
   const int np = o.na + o.nb - 1 + (two_maps ? 2 * m - 2 : m);
   PNEUMID_CHECK(u.size() >= 2 * np,
                 "{}: {} samples are too few for {} parameters (na = {}, nb = {}, {} knots)", what,
@@ -223,16 +224,20 @@ void CheckSignals(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
                 what, u[0]);
 }
 
+void CheckParameterCount(Eigen::Index n, const Layout& l, const char* what) {
+  PNEUMID_CHECK(n >= 2 * l.size(),
+                "{}: {} samples are too few for {} parameters (na = {}, nb = {}, {} knots); give "
+                "fewer knots or more data",
+                what, n, l.size(), l.na, l.nb, l.m);
+}
+
 // The knots: given, or spread evenly over the range of u; knots whose tent
 // holds no sample are dropped (their value would be undetermined). `name`
 // names the signal in the warnings.
 std::vector<double> Knots(const Eigen::VectorXd& u, const BlockModelOptions& o,
                           std::vector<std::string>* warnings, const char* name = "u") {
   std::vector<double> c = o.knots;
-  if (c.empty()) {
-    const Eigen::VectorXd k = Eigen::VectorXd::LinSpaced(o.num_knots, u.minCoeff(), u.maxCoeff());
-    c.assign(k.data(), k.data() + k.size());
-  }
+  if (c.empty()) c = PlaceMapKnots(u, o.num_knots);
   for (;;) {
     std::vector<double> support(c.size(), 0.0);
     for (Eigen::Index t = 0; t < u.size(); ++t) {
@@ -341,8 +346,9 @@ bool BlockModelOptions::IsValid(std::string* error) const {
         "BlockModelOptions: orders must be na >= 0, nb >= 1, nk >= 0, got na = {}, nb = {}, "
         "nk = {}",
         na, nb, nk));
-  if (knots.empty() && num_knots < 2)
-    return fail(fmt::format("BlockModelOptions::num_knots must be >= 2, got {}", num_knots));
+  if (knots.empty() && num_knots != 0 && num_knots < 2)
+    return fail(fmt::format("BlockModelOptions::num_knots must be 0 (automatic) or >= 2, got {}",
+                            num_knots));
   if (!knots.empty()) {
     if (knots.size() < 2)
       return fail(
@@ -369,6 +375,7 @@ BlockModelResult EstimateHammerstein(const Eigen::VectorXd& u, const Eigen::Vect
   EstimationSummary s;
   const std::vector<double> knots = Knots(u, o, &s.warnings);
   const Layout l{o.na, o.nb, o.nk, static_cast<int>(knots.size())};
+  CheckParameterCount(u.size(), l, "Hammerstein");
   std::vector<Tent> tents(static_cast<std::size_t>(u.size()));
   for (Eigen::Index t = 0; t < u.size(); ++t)
     tents[static_cast<std::size_t>(t)] = TentAt(knots, u[t]);
@@ -440,24 +447,35 @@ BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd&
                                 const BlockModelOptions& o) {
   CheckSignals(u, y, Ts, o, "Wiener");
   EstimationSummary s;
-  const std::vector<double> knots = Knots(u, o, &s.warnings);
-  const Layout l{o.na, o.nb, o.nk, static_cast<int>(knots.size())};
 
-  // Start: ARX scaled to unit gain, x simulated from rest at u(0), f fitted on x.
+  // Start: ARX scaled to unit gain, x simulated from rest at u(0); the knots
+  // of f over the range of x (where the output map is evaluated), f fitted on x.
   ArxOptions ao;
-  ao.na = l.na;
-  ao.nb = {l.nb};
-  ao.nk = {l.nk};
+  ao.na = o.na;
+  ao.nb = {o.nb};
+  ao.nk = {o.nk};
   const ArxResult arx = EstimateArx(y, u, Ts, ao);
-  const Eigen::VectorXd a = arx.model.a.tail(l.na);
-  const Eigen::VectorXd b = arx.model.b[0].segment(l.nk, l.nb);
-  Eigen::VectorXd theta = Normalised(a, b, Eigen::VectorXd::Zero(l.m), l, true, &s.warnings);
+  const Eigen::VectorXd a = arx.model.a.tail(o.na);
+  const Eigen::VectorXd b = arx.model.b[0].segment(o.nk, o.nb);
+  const Layout l0{o.na, o.nb, o.nk, 0};
+  Eigen::VectorXd theta = Normalised(a, b, Eigen::VectorXd(), l0, true, &s.warnings);
+  std::vector<double> x;
   {
-    std::vector<double> v(u.data(), u.data() + u.size()), x;
-    SimulateUnitGain(theta.data(), l, v, &x);
-    const Eigen::VectorXd xv = Eigen::Map<const Eigen::VectorXd>(x.data(), u.size());
-    theta.segment(l.map_offset(), l.m) = FitMapValues(knots, xv, y);
+    std::vector<double> v(u.data(), u.data() + u.size());
+    SimulateUnitGain(theta.data(), l0, v, &x);
   }
+  const Eigen::VectorXd xv = Eigen::Map<const Eigen::VectorXd>(x.data(), u.size());
+  const bool x_finite = xv.allFinite() && xv.maxCoeff() > xv.minCoeff();
+  if (!x_finite)
+    s.warnings.push_back(
+        "the initial linear part gives no usable x (unstable or constant): output-map knots "
+        "placed over the input range");
+  const std::vector<double> knots = Knots(x_finite ? xv : u, o, &s.warnings, "x");
+  const Layout l{o.na, o.nb, o.nk, static_cast<int>(knots.size())};
+  CheckParameterCount(u.size(), l, "Wiener");
+  theta.conservativeResize(l.size());
+  theta.segment(l.map_offset(), l.m) =
+      x_finite ? FitMapValues(knots, xv, y) : FitMapValues(knots, u, y);
   RefineOutputError(std::make_unique<WienerError>(WienerError{l, &y, &u, knots}), u.size(), o,
                     &theta, &s);
   s.num_rows = u.size();

@@ -173,10 +173,22 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
         progress(started++, n, methods[i]);
       }
       try {
-        IdentifiedModel m = Identify(methods[i], estimation, request, options);
+        // A structure search of the nonlinear methods uses the held-out file
+        // when there is one (a split's rest is not separate data: it searches
+        // on its own split of the estimation part).
+        IdentifiedModel m;
+        if (IsNonlinearMethod(methods[i]) && validation != nullptr) {
+          estimation.RequireNumericScale();
+          m = IdentifyNonlinear(methods[i], estimation, request, options.nonlinear, validation);
+        } else {
+          m = Identify(methods[i], estimation, request, options);
+        }
         m.flags = AssessModel(m, estimation, request.input, request.output, options.quality);
         if (scored != nullptr) {
-          const FitMetrics f = EvaluateModel(m, *scored, request.input, request.output, score_from);
+          const FitMetrics f = ScoreSimulation(
+              *scored, request.output,
+              SimulateModel(m, *scored, request.input, request.output, options.validation_initial),
+              score_from);
           m.validation_fit_percent = f.fit_percent;
         }
         results[i] = std::move(m);

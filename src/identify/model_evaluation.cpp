@@ -6,6 +6,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <Eigen/Dense>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/enum_names.hpp"
@@ -78,14 +79,85 @@ InitialCondition InitialConditionFromString(const std::string& name) {
   return EnumFromString(kInitialConditionNames, name, "initial condition");
 }
 
+namespace {
+
+// A block-oriented model (Hammerstein, Wiener, Hammerstein-Wiener) simulated
+// from the initial state of its linear part that best explains output column
+// `output`: with v = f(u) (or u) and x(t) = x_v(t) + Phi(t) x0 the linear
+// part's output (x_v its zero-state response, Phi(t) = C A^t), the
+// Hammerstein output x is linear in x0 (least squares, EstimateInitialState);
+// through an output map g, y = g(x) is not, and x0 minimises
+// sum_t (y(t) - g(x(t)))^2 by Gauss-Newton with step halving, from the state
+// at rest at v(0).
+Eigen::VectorXd SimulateBlockFromEstimatedState(const IdentifiedModel& model, const Dataset& data,
+                                                int input, int output) {
+  PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
+                "output column {} does not exist (the data have {} output(s))", output,
+                data.num_outputs());
+  PNEUMID_CHECK(model.discrete.has_value(),
+                "the block-oriented model{} has no discrete linear part",
+                model.method.empty() ? "" : " '" + model.method + "'");
+  const double Ts = data.SampleTime();
+  PNEUMID_CHECK(std::abs(model.discrete->Ts() - Ts) <= 1e-6 * Ts,
+                "the model{} has sample time {} s, the data{} {} s",
+                model.method.empty() ? "" : " '" + model.method + "'", model.discrete->Ts(),
+                data.source().empty() ? "" : " of " + data.source(), Ts);
+  const TransferFunction g(model.discrete->num(), model.discrete->den(), Ts,
+                           model.discrete->delay());
+  const StateSpace ss = ToStateSpace(g);
+  const Eigen::VectorXd u = data.u(input), y = data.y(output);
+  const Eigen::MatrixXd v = model.input_map ? model.input_map->Evaluate(u) : u;
+  if (!model.output_map) {
+    const Eigen::VectorXd x0 = EstimateInitialState(ss, v, y);
+    return SimulateFromState(ss, v, x0).col(0);
+  }
+  const StaticMap& out = *model.output_map;
+  const Eigen::Index nx = ss.A().rows(), n = u.size();
+  const Eigen::VectorXd xv = SimulateFromState(ss, v, Eigen::VectorXd::Zero(nx)).col(0);
+  Eigen::MatrixXd phi(n, nx);
+  for (Eigen::Index i = 0; i < nx; ++i)
+    phi.col(i) = SimulateFromState(ss, Eigen::MatrixXd::Zero(n, 1), Eigen::VectorXd::Unit(nx, i));
+  Eigen::VectorXd x0 = Eigen::VectorXd::Zero(nx);
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(nx, nx);
+  const Eigen::VectorXd rest = (I - ss.A()).colPivHouseholderQr().solve(ss.B() * v(0, 0));
+  if (rest.allFinite()) x0 = rest;
+  auto residual = [&](const Eigen::VectorXd& x) {
+    return (y - out.Evaluate((xv + phi * x).eval())).eval();
+  };
+  Eigen::VectorXd r = residual(x0);
+  double cost = r.squaredNorm();
+  for (int it = 0; it < 50 && std::isfinite(cost); ++it) {
+    const Eigen::VectorXd x = xv + phi * x0;
+    Eigen::MatrixXd J(n, nx);
+    for (Eigen::Index t = 0; t < n; ++t) J.row(t) = out.Slope(x[t]) * phi.row(t);
+    const Eigen::VectorXd step = J.colPivHouseholderQr().solve(r);
+    if (!step.allFinite()) break;
+    bool improved = false;
+    for (double a = 1.0; a > 1e-4; a *= 0.5) {
+      const Eigen::VectorXd trial = x0 + a * step;
+      const Eigen::VectorXd rt = residual(trial);
+      if (rt.squaredNorm() < cost) {
+        x0 = trial;
+        r = rt;
+        improved = cost - rt.squaredNorm() > 1e-12 * cost;
+        cost = rt.squaredNorm();
+        break;
+      }
+    }
+    if (!improved) break;
+  }
+  return out.Evaluate((xv + phi * x0).eval());
+}
+
+}  // namespace
+
 Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input,
                               int output, InitialCondition initial) {
   if (IsNonlinearModel(model)) {
-    PNEUMID_CHECK(initial == InitialCondition::kZero,
-                  "the initial-state estimate is for linear models; the {} model '{}' starts "
-                  "at rest (initial condition zero)",
-                  model.structure, model.method);
-    return SimulateNonlinear(model, data, input, output);
+    // A NARX simulation starts from the measured outputs in either case.
+    if (initial == InitialCondition::kZero || model.narx)
+      return SimulateNonlinear(model, data, input, output);
+    return SimulateBlockFromEstimatedState(model, data, input, output);
   }
   if (initial == InitialCondition::kZero) return SimulateModel(model, data, input);
   PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
@@ -184,40 +256,43 @@ std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Datas
     flags.push_back({ModelFlag::kNoConvergence,
                      fmt::format("the estimator ended with '{}'", ToString(model.termination))});
   }
-  // A model with a finite fit has a finite simulation: simulate (again) only
-  // where the residual test needs it.
+  // The whiteness test runs on the simulation errors for every class (the
+  // criterion the models are ranked by); a model with a noise model also
+  // reports its one-step prediction errors' test in the note.
   const bool noise_model = IsPolynomial(model) && model.structure != "OE";
-  Eigen::VectorXd yhat;
-  if (!noise_model || !std::isfinite(model.fit_percent)) {
-    yhat = IsNonlinearModel(model) ? SimulateNonlinear(model, data, input, output)
+  const Eigen::VectorXd yhat = IsNonlinearModel(model)
+                                   ? SimulateNonlinear(model, data, input, output)
                                    : SimulateModel(model, data, input);
-    if (!yhat.allFinite()) {
-      flags.push_back({ModelFlag::kNotFinite, "the simulated output is not finite"});
-      return flags;
-    }
+  if (!yhat.allFinite()) {
+    flags.push_back({ModelFlag::kNotFinite, "the simulated output is not finite"});
+    return flags;
   }
   ResidualAnalysisOptions ro;
   ro.max_lag = std::min<int>(options.max_lag, static_cast<int>(data.size() / 2) - 1);
   ro.confidence = options.confidence;
   if (ro.max_lag < 1) return flags;
   try {
-    Eigen::VectorXd e;
-    if (noise_model) {
-      const PolynomialModel poly =
-          PolynomialModel::FromParamsJson(ToJson(model.params), model.structure);
-      e = PredictionErrors(poly, data.y(output), data.u(input));
-    } else {
-      e = data.y(output) - yhat;
-    }
-    const ResidualAnalysis r = AnalyzeWhiteness(e, ro);
+    const ResidualAnalysis r = AnalyzeWhiteness((data.y(output) - yhat).eval(), ro);
     if (!r.whiteness_passed) {
+      std::string one_step;
+      if (noise_model) {
+        try {
+          const PolynomialModel poly =
+              PolynomialModel::FromParamsJson(ToJson(model.params), model.structure);
+          const ResidualAnalysis p =
+              AnalyzeWhiteness(PredictionErrors(poly, data.y(output), data.u(input)), ro);
+          one_step = fmt::format("; one-step prediction errors {} (Q = {:.4g})",
+                                 p.whiteness_passed ? "white" : "not white either",
+                                 p.whiteness_statistic);
+        } catch (const InvalidArgument&) {
+        }
+      }
       flags.push_back(
           {ModelFlag::kResidualsNotWhite,
-           fmt::format("{} errors not white: Q = {:.4g} > {:.4g} ({:g} % level), {} of {} lags "
-                       "outside the band",
-                       noise_model ? "one-step prediction" : "simulation", r.whiteness_statistic,
-                       r.whiteness_threshold, 100.0 * options.confidence, r.auto_outside,
-                       r.autocorr.size() - 1)});
+           fmt::format("simulation errors not white: Q = {:.4g} > {:.4g} ({:g} % level), {} of {} "
+                       "lags outside the band{}",
+                       r.whiteness_statistic, r.whiteness_threshold, 100.0 * options.confidence,
+                       r.auto_outside, r.autocorr.size() - 1, one_step)});
     }
   } catch (const InvalidArgument&) {
     // constant residuals or input: the test is undefined, nothing to flag
@@ -226,17 +301,37 @@ std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Datas
 }
 
 int RankGroup(const IdentifiedModel& model) {
-  if (model.flags.empty()) return 0;
-  const bool only_residuals =
-      std::all_of(model.flags.begin(), model.flags.end(),
-                  [](const ModelFlagNote& f) { return f.flag == ModelFlag::kResidualsNotWhite; });
-  return only_residuals ? 1 : 2;
+  int group = 0;
+  for (const ModelFlagNote& f : model.flags) {
+    if (f.flag == ModelFlag::kNotFinite || f.flag == ModelFlag::kUnstable) group = 2;
+    if (f.flag == ModelFlag::kNyquistPole) group = std::max(group, 1);
+  }
+  return group;
 }
 
 double RankScore(const IdentifiedModel& model) {
   const double s = std::isfinite(model.validation_fit_percent) ? model.validation_fit_percent
                                                                : model.fit_percent;
   return std::isnan(s) ? -std::numeric_limits<double>::infinity() : s;
+}
+
+std::string RankReason(const IdentifiedModel& model) {
+  const bool held_out = std::isfinite(model.validation_fit_percent);
+  std::string why = held_out ? fmt::format("held-out simulation fit {:.2f} %",
+                                           model.validation_fit_percent)
+                             : fmt::format("estimation fit {:.2f} % (no held-out data)",
+                                           model.fit_percent);
+  std::vector<std::string> soft, hard;
+  for (const ModelFlagNote& f : model.flags)
+    (f.flag == ModelFlag::kNoConvergence || f.flag == ModelFlag::kResidualsNotWhite ? soft : hard)
+        .push_back(ToString(f.flag));
+  if (!hard.empty())
+    why += fmt::format("; ranked after the models without {} ({})", fmt::join(hard, ", "),
+                       RankGroup(model) == 2 ? "its simulation cannot be trusted"
+                                             : "a ripple at the Nyquist frequency");
+  if (!soft.empty())
+    why += fmt::format("; flagged {}, ranked by its fit all the same", fmt::join(soft, ", "));
+  return why;
 }
 
 void RankModels(std::vector<IdentifiedModel>* models) {

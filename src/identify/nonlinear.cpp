@@ -2,12 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/validation.hpp"
 #include "pneumid/lti/conversion.hpp"
+#include "pneumid/lti/response.hpp"
 
 namespace pneumid {
 
@@ -70,6 +74,17 @@ bool NonlinearOptions::IsValid(std::string* error) const {
   n.ny = 0;
   n.nu = 1;
   n.nk = 0;
+  if (!(structure_split > 0.0 && structure_split < 1.0)) {
+    if (error)
+      *error = fmt::format("NonlinearOptions::structure_split must be in (0, 1), got {}",
+                           structure_split);
+    return false;
+  }
+  if (max_delay < 0 || max_delay > 1000) {
+    if (error)
+      *error = fmt::format("NonlinearOptions::max_delay must be in 0..1000, got {}", max_delay);
+    return false;
+  }
   return static_map.IsValid(error) && b.IsValid(error) && n.IsValid(error);
 }
 
@@ -88,8 +103,130 @@ bool IsNonlinearModel(const IdentifiedModel& model) {
   return model.input_map.has_value() || model.output_map.has_value() || model.narx.has_value();
 }
 
+namespace {
+
+bool IsBlockMethod(const std::string& method) {
+  return method == "hammerstein" || method == "wiener" || method == "hw";
+}
+
+}  // namespace
+
+std::string StructureChoice::Describe() const {
+  std::vector<std::string> tried;
+  for (const StructureCandidate& c : candidates)
+    tried.push_back(std::isfinite(c.fit_percent)
+                        ? fmt::format("{} {} {}: {:.2f}", c.na, c.nb, c.nk, c.fit_percent)
+                        : fmt::format("{} {} {}: failed", c.na, c.nb, c.nk));
+  return fmt::format(
+      "na = {}, nb = {}, nk = {} (held-out simulation fit {:.2f} % on {}); tried (na nb nk: fit "
+      "%): {}",
+      na, nb, nk, fit_percent, held_out, fmt::join(tried, ", "));
+}
+
+StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& data,
+                                     const IdentifyRequest& request,
+                                     const NonlinearOptions& options, const Dataset* held_out) {
+  PNEUMID_CHECK(IsBlockMethod(method),
+                "the structure search is for hammerstein, wiener and hw, got '{}'", method);
+  std::string why;
+  PNEUMID_CHECK(options.IsValid(&why), "{}", why);
+  data.RequireUniform();
+  StructureChoice out;
+  std::optional<Dataset> head;
+  const Dataset* scored = held_out;
+  Eigen::Index score_from = 0;
+  if (held_out == nullptr) {
+    auto parts = SplitDataset(data, options.structure_split);
+    PNEUMID_CHECK(parts.first.size() >= 20 && parts.second.size() >= 10,
+                  "{}: {} samples are too few to choose the structure on held-out data (a split "
+                  "at {:g} leaves {} to estimate and {} to validate); give the orders "
+                  "(--na, --nb, --nk) or more data",
+                  method, data.size(), options.structure_split, parts.first.size(),
+                  parts.second.size());
+    const auto range = [](const Eigen::VectorXd& v) { return v.maxCoeff() - v.minCoeff(); };
+    PNEUMID_CHECK(range(parts.second.u(request.input)) > 0.0,
+                  "{}: the held-out last {:.0f} % of the data hold a constant input (no "
+                  "excitation to choose the structure on); give the orders (--na, --nb, --nk), "
+                  "another --split or --validation data",
+                  method, 100.0 * (1.0 - options.structure_split));
+    head.emplace(std::move(parts.first));
+    scored = &data;
+    score_from = head->size();
+    out.held_out = fmt::format("the last {:.0f} % of the data", 100.0 * (1.0 - options.structure_split));
+  } else {
+    out.held_out = held_out->source().empty() ? "the validation data" : held_out->source();
+  }
+  const Dataset& estimation = head ? *head : data;
+  NonlinearOptions fixed = options;
+  fixed.choose_structure = false;
+  auto try_one = [&](int na, int nb, int nk) {
+    StructureCandidate c{na, nb, nk, -std::numeric_limits<double>::infinity(), ""};
+    try {
+      IdentifyRequest r = request;
+      r.na = na;
+      r.nb = nb;
+      r.nk = nk;
+      const IdentifiedModel m = IdentifyNonlinear(method, estimation, r, fixed);
+      const double fit =
+          ScoreSimulation(*scored, request.output,
+                          SimulateModel(m, *scored, request.input, request.output,
+                                        InitialCondition::kEstimate),
+                          score_from)
+              .fit_percent;
+      if (std::isfinite(fit)) c.fit_percent = fit;
+    } catch (const std::exception& e) {
+      c.error = e.what();
+    }
+    out.candidates.push_back(c);
+    return c.fit_percent;
+  };
+  // 1. The delay with first-order dynamics.
+  int best_nk = 0;
+  double best = -std::numeric_limits<double>::infinity();
+  for (int nk = 0; nk <= options.max_delay; ++nk) {
+    const double f = try_one(1, 1, nk);
+    if (f > best) {
+      best = f;
+      best_nk = nk;
+    }
+  }
+  // 2. The orders with that delay.
+  for (int na = 1; na <= 3; ++na)
+    for (int nb = 1; nb <= 3; ++nb)
+      if (na > 1 || nb > 1) try_one(na, nb, best_nk);
+  // 3. The most parsimonious within 0.1 point of the best.
+  for (const StructureCandidate& c : out.candidates) best = std::max(best, c.fit_percent);
+  PNEUMID_CHECK(std::isfinite(best), "{}: no structure could be estimated ({})", method,
+                out.candidates.front().error);
+  const StructureCandidate* pick = nullptr;
+  for (const StructureCandidate& c : out.candidates) {
+    if (!(c.fit_percent >= best - 0.1)) continue;
+    if (pick == nullptr || c.na + c.nb < pick->na + pick->nb ||
+        (c.na + c.nb == pick->na + pick->nb && c.nk < pick->nk))
+      pick = &c;
+  }
+  out.na = pick->na;
+  out.nb = pick->nb;
+  out.nk = pick->nk;
+  out.fit_percent = pick->fit_percent;
+  return out;
+}
+
 IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data,
-                                  const IdentifyRequest& request, const NonlinearOptions& options) {
+                                  const IdentifyRequest& request, const NonlinearOptions& options,
+                                  const Dataset* held_out) {
+  if (options.choose_structure && IsBlockMethod(method)) {
+    const StructureChoice c = ChooseBlockStructure(method, data, request, options, held_out);
+    IdentifyRequest r = request;
+    r.na = c.na;
+    r.nb = c.nb;
+    r.nk = c.nk;
+    NonlinearOptions o = options;
+    o.choose_structure = false;
+    IdentifiedModel m = IdentifyNonlinear(method, data, r, o);
+    m.notes.insert(m.notes.begin(), "structure chosen on held-out data: " + c.Describe());
+    return m;
+  }
   std::string why;
   PNEUMID_CHECK(IsNonlinearMethod(method), "unknown nonlinear method '{}' (valid: {})", method,
                 fmt::join(NonlinearMethodNames(), ", "));
@@ -139,7 +276,7 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
   } else if (method == "affine-narx") {
     AffineNarxOptions o;
     o.degree = options.narx.degree;
-    o.nk = std::max(1, request.nk);
+    o.nk = request.nk;
     o.knots = options.block.knots;
     o.num_knots = options.block.num_knots;
     const AffineNarxResult r = EstimateAffineNarx(u, y, Ts, o);
@@ -185,8 +322,31 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
     for (const std::string& w : r.summary.warnings) m.notes.push_back(w);
     m.termination = r.summary.termination;
   }
+  if (m.input_map)
+    for (const MapGap& gap : FindMapGaps(*m.input_map, u))
+      m.notes.push_back("input map: " + gap.Describe());
   ScoreModel(data, request.input, request.output, &m);
   return m;
+}
+
+std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, const Dataset& data,
+                                               int input) {
+  std::vector<std::string> w;
+  if (!model.input_map || input < 0 || input >= data.num_inputs() || data.size() == 0) return w;
+  const Eigen::VectorXd u = data.u(input);
+  const double c1 = model.input_map->u().front(), cm = model.input_map->u().back();
+  const double margin = 0.05 * (cm - c1);
+  const double lo = u.minCoeff(), hi = u.maxCoeff();
+  if (lo < c1 - margin || hi > cm + margin) {
+    const Eigen::Index outside = (u.array() < c1 - margin || u.array() > cm + margin).count();
+    w.push_back(fmt::format(
+        "the input reaches [{:g}, {:g}], beyond the input map's range [{:g}, {:g}] that the "
+        "model{} was estimated on ({} of {} samples more than 5 % of that range outside): the "
+        "map is held at its end values there, an extrapolation the data do not support",
+        lo, hi, c1, cm, model.method.empty() ? "" : " '" + model.method + "'", outside,
+        u.size()));
+  }
+  return w;
 }
 
 Eigen::VectorXd SimulateNonlinear(const IdentifiedModel& model, const Dataset& data, int input,
@@ -217,12 +377,31 @@ Eigen::VectorXd SimulateNonlinear(const IdentifiedModel& model, const Dataset& d
                 model.method.empty() ? "" : " '" + model.method + "'");
   const TransferFunction g(model.discrete->num(), model.discrete->den(), Ts,
                            model.discrete->delay());
+  // At rest at the first measured output when there is one (the record
+  // starts at rest, wherever), else at rest at the first input.
+  std::optional<double> y_first;
+  if (output >= 0 && output < data.num_outputs() && data.size() > 0 &&
+      std::isfinite(data.y(output)[0]))
+    y_first = data.y(output)[0];
+  const double dc = g.DcGain();
+  const bool gain = std::isfinite(dc) && std::abs(dc) > 1e-9;
+  const Eigen::VectorXd v = model.input_map ? model.input_map->Evaluate(u) : u;
+  if (v.size() == 0) return v;
+  // x = dc v_rest + G (v - v_rest): the linear part at rest with input v_rest.
+  auto linear = [&](double v_rest) {
+    return (Lsim(g, (v.array() - v_rest).matrix(), Ts).array() + dc * v_rest).matrix().eval();
+  };
   if (model.output_map) {
-    Eigen::VectorXd v = u;
-    if (model.input_map) v = model.input_map->Evaluate(u);
-    return SimulateWiener(g, *model.output_map, v);
+    const StaticMap& out = *model.output_map;
+    double v_rest = v[0];
+    if (y_first && gain && (out.Direction() == Monotonicity::kIncreasing ||
+                                 out.Direction() == Monotonicity::kDecreasing)) {
+      const auto [lo, hi] = std::minmax_element(out.y().begin(), out.y().end());
+      if (*y_first > *lo && *y_first < *hi) v_rest = out.Inverse(*y_first) / dc;
+    }
+    return out.Evaluate(linear(v_rest));
   }
-  return SimulateHammerstein(*model.input_map, g, u);
+  return linear(y_first && gain ? *y_first / dc : v[0]);
 }
 
 }  // namespace pneumid

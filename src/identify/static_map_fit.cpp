@@ -267,4 +267,90 @@ StaticMapFitResult FitStaticMap(const Dataset& data, int input, int output,
   return FitStaticMap(data.u(input), data.y(output), data.SampleTime(), options);
 }
 
+std::vector<double> PlaceMapKnots(const Eigen::VectorXd& u, int num_knots, int max_levels) {
+  PNEUMID_CHECK(u.size() > 0 && u.allFinite(), "map knots need finite input samples, got {} {}",
+                u.size(), u.size() ? "with non-finite values" : "samples");
+  PNEUMID_CHECK(num_knots == 0 || num_knots >= 2,
+                "num_knots must be 0 (automatic) or >= 2, got {}", num_knots);
+  PNEUMID_CHECK(max_levels >= 2, "max_levels must be >= 2, got {}", max_levels);
+  const double lo = u.minCoeff(), hi = u.maxCoeff();
+  std::vector<double> knots;
+  if (!(hi > lo)) return {lo, lo + std::max(1.0, std::abs(lo))};  // one level: callers refuse
+  if (num_knots >= 2) {
+    const Eigen::VectorXd k = Eigen::VectorXd::LinSpaced(num_knots, lo, hi);
+    return {k.data(), k.data() + k.size()};
+  }
+  // Levels: values held for 3 or more consecutive samples, merged within
+  // 1e-6 of the range.
+  const double tol = 1e-6 * (hi - lo);
+  std::vector<std::pair<double, Eigen::Index>> runs;  // (level, samples)
+  for (Eigen::Index t = 0; t < u.size();) {
+    Eigen::Index e = t + 1;
+    while (e < u.size() && std::abs(u[e] - u[t]) <= tol) ++e;
+    if (e - t >= 3) runs.emplace_back(u[t], e - t);
+    t = e;
+  }
+  std::sort(runs.begin(), runs.end());
+  std::vector<double> levels;
+  Eigen::Index held = 0;
+  for (const auto& [level, count] : runs) {
+    if (levels.empty() || level - levels.back() > tol) levels.push_back(level);
+    held += count;
+  }
+  const auto n = static_cast<double>(u.size());
+  if (levels.size() >= 2 && static_cast<int>(levels.size()) <= max_levels &&
+      static_cast<double>(held) >= 0.9 * n) {
+    if (levels.front() - lo > tol) levels.insert(levels.begin(), lo);
+    if (hi - levels.back() > tol) levels.push_back(hi);
+    return levels;
+  }
+  std::vector<double> sorted(u.data(), u.data() + u.size());
+  std::sort(sorted.begin(), sorted.end());
+  const int m = 11;
+  for (int i = 0; i < m; ++i) {
+    const double q = sorted[static_cast<std::size_t>(
+        std::lround(static_cast<double>(i) / (m - 1) * static_cast<double>(sorted.size() - 1)))];
+    if (knots.empty() || q - knots.back() > 1e-3 * (hi - lo)) knots.push_back(q);
+  }
+  if (knots.back() < hi) knots.back() = hi;
+  if (knots.size() < 2) knots = {lo, hi};
+  return knots;
+}
+
+std::string MapGap::Describe() const {
+  return fmt::format(
+      "between u = {:g} and {:g} the map changes by {:.4g} with no data in between: the data "
+      "leave it undetermined there (a step may lie anywhere inside); an experiment with levels "
+      "between them would place it",
+      u_lo, u_hi, change);
+}
+
+std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u) {
+  const std::vector<double>& c = map.u();
+  const std::vector<double>& f = map.y();
+  const std::size_t m = c.size();
+  std::vector<MapGap> gaps;
+  if (m < 2) return gaps;
+  const auto [fmin, fmax] = std::minmax_element(f.begin(), f.end());
+  const double range = *fmax - *fmin;
+  if (!(range > 0.0)) return gaps;
+  std::vector<bool> inside(m - 1, false);
+  for (Eigen::Index t = 0; t < u.size(); ++t) {
+    const auto it = std::upper_bound(c.begin(), c.end(), u[t]);
+    if (it == c.begin() || it == c.end()) continue;
+    const auto j = static_cast<std::size_t>(it - c.begin()) - 1;
+    const double margin = 0.01 * (c[j + 1] - c[j]);
+    if (u[t] > c[j] + margin && u[t] < c[j + 1] - margin) inside[j] = true;
+  }
+  const auto slope = [&](std::size_t j) { return std::abs(f[j + 1] - f[j]) / (c[j + 1] - c[j]); };
+  for (std::size_t j = 0; j + 1 < m; ++j) {
+    if (inside[j] || std::abs(f[j + 1] - f[j]) < 0.05 * range) continue;
+    double beside = 0.0;
+    if (j > 0) beside = std::max(beside, slope(j - 1));
+    if (j + 2 < m) beside = std::max(beside, slope(j + 1));
+    if (slope(j) >= 2.5 * beside) gaps.push_back({c[j], c[j + 1], f[j + 1] - f[j]});
+  }
+  return gaps;
+}
+
 }  // namespace pneumid

@@ -205,7 +205,7 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
       if (m.input_map) maps.push_back({m.method, *m.input_map, m.narx.has_value()});
       if (IsNonlinearModel(m)) {
         nonlinear.push_back(m.method);  // no single step or frequency response
-      } else if (RankGroup(m) < 2) {
+      } else if (RankGroup(m) == 0) {
         trusted.push_back(nm);
       } else {
         left_out.push_back(m.method);

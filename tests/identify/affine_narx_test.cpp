@@ -98,8 +98,10 @@ TEST(AffineNarxTest, BadInputGivesClearErrors) {
   EXPECT_THAT(
       [&] { EstimateAffineNarx(r.u.head(10), r.y, 0.01); },
       ThrowsMessage<InvalidArgument>(HasSubstr("the input has 10 samples, the output 500")));
+  AffineNarxOptions k21;
+  k21.num_knots = 21;
   EXPECT_THAT(
-      [&] { EstimateAffineNarx(Eigen::VectorXd::LinSpaced(20, 0, 100), r.y.head(20), 0.01); },
+      [&] { EstimateAffineNarx(Eigen::VectorXd::LinSpaced(20, 0, 100), r.y.head(20), 0.01, k21); },
       ThrowsMessage<InvalidArgument>(
           HasSubstr("27 parameters (degree 2, 21 knots) exceed the 19 regression rows")));
   AffineNarxOptions o;

@@ -157,8 +157,10 @@ TEST(HammersteinWienerTest, RejectsBadInput) {
               ThrowsMessage<InvalidArgument>(HasSubstr(
                   "Hammerstein-Wiener: the input never leaves one operating point (u = 30")));
   // Two maps of 11 knots: 9 + 11 free map values besides the 3 of G.
+  BlockModelOptions k11;
+  k11.num_knots = 11;
   EXPECT_THAT(
-      [&] { EstimateHammersteinWiener(u.head(30), y.head(30), 0.01); },
+      [&] { EstimateHammersteinWiener(u.head(30), y.head(30), 0.01, k11); },
       ThrowsMessage<InvalidArgument>(HasSubstr("30 samples are too few for 23 parameters")));
 }
 
@@ -191,8 +193,10 @@ TEST(HammersteinTest, RejectsBadInput) {
   EXPECT_THAT([&] { EstimateHammerstein(u, y, 0.01); },
               ThrowsMessage<InvalidArgument>(
                   HasSubstr("never leaves one operating point (u = 30 throughout)")));
+  BlockModelOptions k11;
+  k11.num_knots = 11;
   EXPECT_THAT(
-      [&] { EstimateWiener(u.head(20), y.head(20), 0.01); },
+      [&] { EstimateWiener(u.head(20), y.head(20), 0.01, k11); },
       ThrowsMessage<InvalidArgument>(HasSubstr("20 samples are too few for 14 parameters")));
   BlockModelOptions o;
   o.knots = {0, 50, 40};

@@ -51,11 +51,14 @@ namespace pneumid {
 
 struct AffineNarxOptions {
   int degree = 2;  ///< degree d of a(z) and b(z), 1..3
-  int nk = 1;      ///< input delay in samples (>= 1)
-  /// Knots of f (strictly increasing); empty: `num_knots` spread evenly over
-  /// the input range.
+  int nk = 1;      ///< input delay in samples (>= 0; 0: u(t) acts on z(t))
+  /// Knots of f (strictly increasing); empty: PlaceMapKnots(u, num_knots)
+  /// (static_map_fit.hpp).
   std::vector<double> knots;
-  int num_knots = 21;  ///< >= 2, used when `knots` is empty
+  /// Used when `knots` is empty: 0 (default) = where the data are (the levels
+  /// of a staircase or multi-level input, else 11 quantiles); >= 2 = that many
+  /// spread evenly over the input range.
+  int num_knots = 0;
   int max_iterations = 100;
   double tolerance = 1e-9;  ///< relative decrease of the loss that ends the iteration
   bool IsValid(std::string* error) const;

@@ -7,7 +7,7 @@
 //   Hammerstein-Wiener:  x(t) = G(q) f(u(t)),  y(t) = g(x(t)) + e(t)
 //
 // with f a piecewise-linear StaticMap (lti/static_map.hpp) through knots
-// c_1 < ... < c_m (given, or spread evenly over the input range) and
+// c_1 < ... < c_m (given, or placed where the data are: PlaceMapKnots) and
 //   G(q) = B(q) / A(q) = (b_1 q^-nk + ... + b_nb q^-(nk+nb-1)) / (1 + a_1 q^-1 + ... + a_na q^-na).
 //
 // Normalisation: the product of the two blocks leaves one scale free
@@ -81,10 +81,13 @@ struct BlockModelOptions {
   int na = 2;  ///< A coefficients (>= 0)
   int nb = 2;  ///< B coefficients (>= 1)
   int nk = 1;  ///< input delay in samples (>= 0)
-  /// Knots of the static map (strictly increasing); empty: `num_knots`
-  /// spread evenly over [min u, max u] of the data.
+  /// Knots of the static map (strictly increasing); empty: placed by
+  /// PlaceMapKnots(u, num_knots) (static_map_fit.hpp).
   std::vector<double> knots;
-  int num_knots = 11;  ///< >= 2, used when `knots` is empty
+  /// Used when `knots` is empty: 0 (default) = where the data are (the levels
+  /// of a staircase or multi-level input, else 11 quantiles of u); >= 2 = that
+  /// many spread evenly over [min u, max u].
+  int num_knots = 0;
   /// Hammerstein only (not Hammerstein-Wiener): keep f monotone (non-decreasing or non-increasing,
   /// the direction of the initial estimate's trend) for an invertible map: the start is made
   /// monotone by PAVA and the refinement runs over alpha_1 and the square roots of the increments,

@@ -45,6 +45,12 @@ struct IdentifyOptions {
   /// samples estimates, the rest validates (models simulated over the whole
   /// record, scored on the rest). 0 (default) = no split; else in (0, 1).
   double split = 0.0;
+  /// How the held-out scoring starts each model's simulation: kEstimate
+  /// (default; MATLAB compare's 'e') from the initial state that best explains
+  /// the held-out output, for every model class (a record that does not start
+  /// at rest at its first input is then no penalty on one class and not on
+  /// another: a NARX starts from the measured outputs anyway), or kZero (at rest).
+  InitialCondition validation_initial = InitialCondition::kEstimate;
   /// Worker threads of IdentifyModels (methods run side by side); 0 = one per
   /// hardware thread. Results do not depend on it.
   int num_threads = 0;
@@ -98,8 +104,8 @@ using IdentifyProgress =
 /// a method that fails is listed in failures with its reason and the others
 /// still run. Each model is flagged (AssessModel on the estimation data),
 /// scored on the held-out data when given (`validation`, scored from its first
-/// sample with the model at rest at its operating point; or the split's rest),
-/// and the list is ranked.
+/// sample, simulated from options.validation_initial; or the split's rest), and
+/// the list is ranked (RankModels).
 /// @throws InvalidArgument for an empty method list, an unknown method, invalid
 ///         request/options, a split together with a validation dataset, or a
 ///         validation dataset whose channels differ from the data's.

@@ -16,7 +16,7 @@
 // (a split), the model is simulated over the whole record and scored on the
 // held-out tail only, so that its state carries over.
 //
-// Flags (a model is trusted only without flags; [2] sec. 16.5-16.6):
+// Flags ([2] sec. 16.5-16.6):
 //   not_finite           the simulated output is not finite;
 //   unstable             a discrete pole with |z| > 1 or a continuous pole with
 //                        Re(s) > 0 (integrators, |z| = 1 or s = 0, are allowed);
@@ -25,14 +25,15 @@
 //                        ripple aliased onto the Nyquist frequency (e.g. PWM);
 //   no_convergence       the iterative estimator stopped before converging;
 //   residuals_not_white  the whiteness test of resid at `confidence` fails on
-//                        the model's one-step prediction errors (polynomial
-//                        models with a noise model: ARX, ARMAX, BJ), or on its
-//                        simulation errors (every other model, whose noise
-//                        model is white output noise).
-// Ranking: models without flags first, then models whose only flag is
-// residuals_not_white, then the rest; within each group by validation fit
-// when held-out data were given, else by estimation fit. So a flagged model
-// is never ranked best while an unflagged model exists.
+//                        the model's simulation errors (every class; for ARX,
+//                        ARMAX and BJ the note adds the test of the one-step
+//                        prediction errors).
+// Ranking by evidence: within each group by the held-out simulation fit when
+// held-out data were given, else by the estimation fit; the groups are
+// 0 (no flag, or only no_convergence / residuals_not_white: flagged, but
+// its fit is what it is), 1 (nyquist_pole), 2 (unstable, not_finite). So a
+// model whose estimator stopped early but validates best is ranked best,
+// with its flag and RankReason saying so.
 //
 // [1] MathWorks, System Identification Toolbox, compare,
 //     https://www.mathworks.com/help/ident/ref/dynamicsystem.compare.html
@@ -68,6 +69,10 @@ InitialCondition InitialConditionFromString(const std::string& name);
 /// model's discrete state-space form (EstimateInitialState, initial_state.hpp;
 /// a continuous model is first sampled at the data's Ts with a zero-order
 /// hold) fitted to output column `output`, as MATLAB's compare(..., 'e').
+/// Block-oriented models estimate the initial state of their linear part
+/// (least squares for Hammerstein; through the output map of a Wiener or
+/// Hammerstein-Wiener model by Gauss-Newton from the state at rest at the
+/// first input); a NARX starts from the measured outputs with either choice.
 /// @throws InvalidArgument as SimulateModel or for a bad output column.
 Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input,
                               int output, InitialCondition initial);
@@ -103,19 +108,30 @@ struct ModelQualityOptions {
 };
 
 /// The flags above of `model` on the data it was identified from (the residual
-/// test needs the data; the pole tests only the model).
+/// test needs the data; the pole tests only the model). The whiteness test
+/// runs on the simulation errors y - yhat of every model class; for a model
+/// with a noise model (ARX, ARMAX, BJ) the note adds the test of its one-step
+/// prediction errors as extra information.
 /// @throws InvalidArgument for invalid options or channels.
 std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Dataset& data,
                                        int input = 0, int output = 0,
                                        const ModelQualityOptions& options = {});
 
-/// The ranking group of a model: 0 without flags, 1 when its only flag is
-/// residuals_not_white, 2 otherwise.
+/// The ranking group of a model: 2 when its simulation cannot be trusted
+/// (flags not_finite or unstable), 1 for a pole near z = -1 (nyquist_pole),
+/// 0 otherwise. no_convergence and residuals_not_white do not move a model to
+/// a later group: the fit is the evidence (an estimator that stopped on its
+/// iteration limit may still hold the best model; simulation errors of a
+/// good model of a noisy plant are rarely white).
 int RankGroup(const IdentifiedModel& model);
 
 /// The score that ranks a model within its group: validation_fit_percent when
 /// finite, otherwise fit_percent.
 double RankScore(const IdentifiedModel& model);
+
+/// One line on why the model stands where it does, e.g. "held-out simulation
+/// fit 97.01 %; flagged no_convergence, ranked by its fit all the same".
+std::string RankReason(const IdentifiedModel& model);
 
 /// Sorts best first by (RankGroup, -RankScore); stable for ties.
 void RankModels(std::vector<IdentifiedModel>* models);

@@ -43,8 +43,51 @@ struct NonlinearOptions {
   BlockModelOptions block;
   /// degree, err_tolerance, max_terms of narx; the lags come from the request.
   NarxOptions narx;
+  /// hammerstein, wiener, hw: choose the orders na, nb, nk on held-out data
+  /// instead of taking the request's (ChooseBlockStructure below). Off by
+  /// default in the library; `pneumid identify` turns it on when none of
+  /// --na, --nb, --nk is given.
+  bool choose_structure = false;
+  /// Estimation fraction of the internal split when the structure is chosen
+  /// without held-out data; in (0, 1). Default 0.7.
+  double structure_split = 0.7;
+  /// Largest input delay nk the structure search tries (>= 0, default 10).
+  int max_delay = 10;
   bool IsValid(std::string* error) const;
 };
+
+/// One candidate of the structure search and its held-out simulation fit.
+struct StructureCandidate {
+  int na = 0, nb = 0, nk = 0;
+  double fit_percent = 0.0;  ///< -inf when the estimate failed
+  std::string error;         ///< why it failed, else empty
+};
+
+/// The orders of a block-oriented model (hammerstein, wiener, hw) chosen by
+/// the simulation fit on held-out data, as MATLAB's compare scores (each
+/// candidate simulated from its estimated initial state):
+///   1. the delay: nk = 0 .. max_delay with na = nb = 1;
+///   2. the orders: na = 1..3, nb = 1..3 with that delay;
+///   3. the most parsimonious candidate (fewest na + nb, then smallest nk)
+///      within 0.1 point of the best fit.
+/// Held-out data: `held_out` when given (scored from its first sample), else
+/// the last 1 - structure_split of `data` (estimated on the first part,
+/// simulated over the whole record, scored on the rest).
+struct StructureChoice {
+  int na = 1, nb = 1, nk = 1;
+  double fit_percent = 0.0;
+  std::string held_out;  ///< "the last 30 % of the data" or the file
+  std::vector<StructureCandidate> candidates;  ///< in the order tried
+  /// "na = 1, nb = 1, nk = 2 (held-out fit 98.7 % on ...); tried: ...".
+  std::string Describe() const;
+};
+/// @throws InvalidArgument for a method other than hammerstein, wiener, hw,
+///         too few samples in either part, or when no candidate could be
+///         estimated (with the first candidate's reason).
+StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& data,
+                                     const IdentifyRequest& request,
+                                     const NonlinearOptions& options,
+                                     const Dataset* held_out = nullptr);
 
 /// "static-map", "hammerstein", "wiener", "hw", "narx", "affine-narx".
 const std::vector<std::string>& NonlinearMethodNames();
@@ -55,19 +98,34 @@ bool IsNonlinearModel(const IdentifiedModel& model);
 
 /// Identifies input column request.input -> output column request.output
 /// with one nonlinear method and scores it on the data (fit_percent, iae).
-/// Notes list the map (knots and values, dead zone, saturation) or the
-/// selected NARX terms with their ERR, and the estimator's summary.
+/// Notes list the map (knots and values, dead zone, saturation; the knot
+/// intervals the data leave undetermined, FindMapGaps) or the selected NARX
+/// terms with their ERR, and the estimator's summary.
 /// @throws InvalidArgument for an unknown method, invalid options, or data
 ///         from which the method cannot work (the estimators' messages).
+/// With options.choose_structure (hammerstein, wiener, hw) the orders come
+/// from ChooseBlockStructure on `held_out` (or the internal split) and the
+/// model is then estimated on all of `data`; a note states the choice.
 IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data,
                                   const IdentifyRequest& request,
-                                  const NonlinearOptions& options = {});
+                                  const NonlinearOptions& options = {},
+                                  const Dataset* held_out = nullptr);
+
+/// Warnings for simulating `model` on input column `input` of `data`: an
+/// input that leaves the input map's knot range by more than 5 % of it (the
+/// map is held there: an extrapolation the estimation data do not support).
+std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, const Dataset& data,
+                                               int input = 0);
 
 /// Simulated output of a nonlinear model on `data` (see the module comment
-/// and each estimator's header): Hammerstein / static map
-/// f(u(0)) + G (f(u) - f(u(0))), Wiener f(u(0) + G (u - u(0))),
-/// Hammerstein-Wiener g(f(u(0)) + G (f(u) - f(u(0)))), NARX free
-/// run with its first max-lag outputs from output column `output`.
+/// and each estimator's header), with v = f(u) (or u) and G of static gain
+/// G(1): Hammerstein / static map y = G(1) v_r + G (v - v_r), Wiener and
+/// Hammerstein-Wiener y = g(G(1) v_r + G (v - v_r)), the linear part at rest
+/// with input v_r: the rest that gives the first measured output y(0) of
+/// column `output` (v_r = y(0) / G(1), through the inverse output map when it
+/// is monotone and y(0) within its range), otherwise v(0) (at rest at the
+/// first input); a record that starts at rest anywhere then starts right.
+/// NARX: free run with its first max-lag outputs from output column `output`.
 /// @throws InvalidArgument for a model without nonlinear part, bad columns,
 ///         or a sample time that differs from the model's.
 Eigen::VectorXd SimulateNonlinear(const IdentifiedModel& model, const Dataset& data, int input,

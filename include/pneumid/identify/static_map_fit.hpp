@@ -108,6 +108,35 @@ StaticMapFitResult FitStaticMap(const Eigen::VectorXd& u, const Eigen::VectorXd&
 StaticMapFitResult FitStaticMap(const Dataset& data, int input = 0, int output = 0,
                                 const StaticMapFitOptions& options = {});
 
+/// Knots of a piecewise-linear map of u placed where the data are (the input
+/// map of hammerstein, hw and affine-narx):
+///  - num_knots == 0 (automatic): when the input dwells on few levels (a
+///    staircase or a multi-level signal: at least 90 % of the samples on at
+///    most `max_levels` values, each held for 3 or more samples), the knots are
+///    those levels, plus min u / max u where samples lie beyond them (ramps
+///    between levels); otherwise 11 knots at the quantiles 0, 0.1, .., 1 of u
+///    (equal values merged), so that every tent holds about as many samples;
+///  - num_knots >= 2: that many spread evenly over [min u, max u].
+/// @throws InvalidArgument for an empty or non-finite u, num_knots 1 or < 0.
+std::vector<double> PlaceMapKnots(const Eigen::VectorXd& u, int num_knots = 0,
+                                  int max_levels = 60);
+
+/// A knot interval of a map whose value changes much more steeply than on
+/// the intervals beside it with no data inside: the data leave the map
+/// undetermined there (a jump may lie anywhere between the two knots).
+struct MapGap {
+  double u_lo = 0.0, u_hi = 0.0;  ///< the knots around the gap
+  double change = 0.0;            ///< f(u_hi) - f(u_lo)
+  std::string Describe() const;   ///< "between u = 85 and 95 the map changes by 58 (...)"
+};
+
+/// The gaps of `map` fitted on input u: intervals (c_j, c_j+1) that hold no
+/// sample of u strictly inside (beyond 1 % of the interval from either knot),
+/// whose change |f(c_j+1) - f(c_j)| is at least 5 % of the map's range and
+/// whose slope is at least 2.5 times the steeper of the neighbouring
+/// intervals' slopes.
+std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u);
+
 /// The weighted least-squares non-decreasing (`increasing`) or non-increasing
 /// sequence closest to `values` (PAVA [2]), weights > 0.
 /// @throws InvalidArgument for sizes that differ or a weight <= 0.
