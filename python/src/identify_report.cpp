@@ -117,6 +117,9 @@ void BindIdentify(py::module_& m) {
           },
           "Reasons not to trust the model: [{'flag': 'nyquist_pole', 'reason': ...}, ...].")
       .def_property_readonly(
+          "rank_reason", [](const IdentifiedModel& r) { return RankReason(r); },
+          "One line on why the model stands where it does in identify_models' ranking.")
+      .def_property_readonly(
           "preprocessing",
           [](const IdentifiedModel& r) -> py::object {
             if (!r.preprocessing) return py::none();

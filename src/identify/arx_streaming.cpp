@@ -53,9 +53,9 @@ StreamingArxResult EstimateArxFromFile(const std::string& path, const StreamingA
   std::error_code ec;
   result.bytes = static_cast<double>(std::filesystem::file_size(path, ec));
   if (Ts <= 0.0) {
-    throw DataError(fmt::format(
-        "{}: cannot determine the sample time from column '{}' (need two samples)", path,
-        o.time_column));
+    throw DataError(
+        fmt::format("{}: cannot determine the sample time from column '{}' (need two samples)",
+                    path, o.time_column));
   }
   if (result.num_samples <= o.arx.FirstRow()) {
     throw DataError(fmt::format("{}: {} samples are too few for ARX", path, result.num_samples));

@@ -103,7 +103,9 @@ constexpr EnumName<TwoPointMethod> kTwoPointMethodNames[] = {
 };
 }  // namespace
 
-std::string ToString(TwoPointMethod v) { return std::string(EnumToString(kTwoPointMethodNames, v)); }
+std::string ToString(TwoPointMethod v) {
+  return std::string(EnumToString(kTwoPointMethodNames, v));
+}
 
 TwoPointMethod TwoPointMethodFromString(const std::string& name) {
   return EnumFromString(kTwoPointMethodNames, name, "two-point method");

@@ -212,8 +212,8 @@ void CheckSignals(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double Ts,
                 y.size());
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
   PNEUMID_CHECK(u.allFinite() && y.allFinite(), "{}: the data hold non-finite values", what);
-  const int m = o.knots.empty() ? (o.num_knots == 0 ? 2 : o.num_knots)
-                                : static_cast<int>(o.knots.size());
+  const int m =
+      o.knots.empty() ? (o.num_knots == 0 ? 2 : o.num_knots) : static_cast<int>(o.knots.size());
   const int np = o.na + o.nb - 1 + (two_maps ? 2 * m - 2 : m);
   PNEUMID_CHECK(u.size() >= 2 * np,
                 "{}: {} samples are too few for {} parameters (na = {}, nb = {}, {} knots)", what,
@@ -470,7 +470,20 @@ BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd&
     s.warnings.push_back(
         "the initial linear part gives no usable x (unstable or constant): output-map knots "
         "placed over the input range");
-  const std::vector<double> knots = Knots(x_finite ? xv : u, o, &s.warnings, "x");
+  // With G(1) = 1 the settled values of x are the input levels: the knots
+  // where the input dwells (PlaceMapKnots of u), widened to the range of x
+  // where its transients leave them; knots no sample of x reaches are dropped.
+  BlockModelOptions ko = o;
+  if (ko.knots.empty()) {
+    ko.knots = PlaceMapKnots(u, o.num_knots);
+    if (x_finite) {
+      const double margin = 0.01 * (ko.knots.back() - ko.knots.front());
+      if (xv.minCoeff() < ko.knots.front() - margin)
+        ko.knots.insert(ko.knots.begin(), xv.minCoeff());
+      if (xv.maxCoeff() > ko.knots.back() + margin) ko.knots.push_back(xv.maxCoeff());
+    }
+  }
+  const std::vector<double> knots = Knots(x_finite ? xv : u, ko, &s.warnings, "x");
   const Layout l{o.na, o.nb, o.nk, static_cast<int>(knots.size())};
   CheckParameterCount(u.size(), l, "Wiener");
   theta.conservativeResize(l.size());

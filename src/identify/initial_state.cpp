@@ -26,8 +26,8 @@ int CheckAndDelay(const StateSpace& sys, const Eigen::MatrixXd& u) {
 Eigen::MatrixXd SimulateFromState(const StateSpace& sys, const Eigen::MatrixXd& u,
                                   const Eigen::VectorXd& x0) {
   const int d = CheckAndDelay(sys, u);
-  PNEUMID_CHECK(x0.size() == sys.num_states(), "x0 has {} entries, the model {} states",
-                x0.size(), sys.num_states());
+  PNEUMID_CHECK(x0.size() == sys.num_states(), "x0 has {} entries, the model {} states", x0.size(),
+                sys.num_states());
   const Eigen::Index N = u.rows();
   Eigen::MatrixXd y(N, sys.num_outputs());
   Eigen::VectorXd x = x0;

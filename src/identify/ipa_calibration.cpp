@@ -49,8 +49,8 @@ bool IpaCalibrationOptions::IsValid(std::string* error) const {
   if (!(std::isfinite(warmup) && warmup >= 0.0 && warmup <= 1e4))
     return fail(fmt::format("warmup must be in 0..1e4 s, got {}", warmup));
   if (!(integration_tolerance >= 1e-14 && integration_tolerance <= 1e-3))
-    return fail(fmt::format("integration_tolerance must be in 1e-14..1e-3, got {}",
-                            integration_tolerance));
+    return fail(
+        fmt::format("integration_tolerance must be in 1e-14..1e-3, got {}", integration_tolerance));
   if (!(relative_step > 0.0 && relative_step <= 0.1))
     return fail(fmt::format("relative_step must be in (0, 0.1], got {}", relative_step));
   if (max_iterations < 0 || max_iterations > 100000)
@@ -63,15 +63,18 @@ bool IpaCalibrationOptions::IsValid(std::string* error) const {
     return fail(
         fmt::format("correlation_threshold must be in (0, 1], got {}", correlation_threshold));
   if (!(fit_warning_percent <= 100.0))
-    return fail(fmt::format("fit_warning_percent must be at most 100, got {}",
-                            fit_warning_percent));
+    return fail(
+        fmt::format("fit_warning_percent must be at most 100, got {}", fit_warning_percent));
   return true;
 }
 
 std::vector<std::string> DefaultCalibrationParameters(IpaMode mode) {
-  std::vector<std::string> names = {"valves.inlet_conductance",    "valves.exhaust_conductance",
-                                    "valves.inlet_critical_ratio", "valves.exhaust_critical_ratio",
-                                    "cylinder.bore",               "valves.open_delay"};
+  std::vector<std::string> names = {"valves.inlet_conductance",
+                                    "valves.exhaust_conductance",
+                                    "valves.inlet_critical_ratio",
+                                    "valves.exhaust_critical_ratio",
+                                    "cylinder.bore",
+                                    "valves.open_delay"};
   if (mode == IpaMode::kPosition) {
     names.push_back("mechanics.mass");
     names.push_back("mechanics.viscous_friction");
@@ -265,8 +268,8 @@ class OutputErrorCost : public ceres::CostFunction {
     const int np = problem_->num_parameters();
     Eigen::MatrixXd J(N, np);
     if (!problem_->Jacobian(parameters[0], residuals, J.data())) return false;
-    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-        jacobians[0], N, np) = J;
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(jacobians[0],
+                                                                                       N, np) = J;
     return true;
   }
 
@@ -307,12 +310,11 @@ Eigen::VectorXd SimulateIpaOnData(const IpaParameters& parameters, const Dataset
 }
 
 std::string IpaCalibrationSummary::BriefReport() const {
-  std::string s = fmt::format("IPA calibration: {}, {} iterations, cost {:.4g} -> {:.4g}, {} "
-                              "simulations, {:.2f} s",
-                              ToString(termination), iterations, initial_cost, final_cost,
-                              simulations, seconds);
-  for (const auto& e : experiments)
-    s += fmt::format("; {} fit {:.2f} %", e.name, e.fit_percent);
+  std::string s = fmt::format(
+      "IPA calibration: {}, {} iterations, cost {:.4g} -> {:.4g}, {} "
+      "simulations, {:.2f} s",
+      ToString(termination), iterations, initial_cost, final_cost, simulations, seconds);
+  for (const auto& e : experiments) s += fmt::format("; {} fit {:.2f} %", e.name, e.fit_percent);
   return s;
 }
 
@@ -324,8 +326,8 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
 
   // Free parameters, their ranges and scales.
   std::vector<std::string> keys;
-  for (const auto& name : options.free.empty() ? DefaultCalibrationParameters(options.start)
-                                                : options.free) {
+  for (const auto& name :
+       options.free.empty() ? DefaultCalibrationParameters(options.start) : options.free) {
     const IpaParameterInfo& info = FindIpaParameter(name);
     PNEUMID_CHECK(info.calibratable,
                   "'{}' is a numerical or sensor-scaling setting, not a physical parameter a "
@@ -385,8 +387,7 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
                   "the data say nothing about the dynamics; use a step, staircase or PRBS",
                   name, p.u[0], d.size());
     const double w = experiments[e].weight;
-    PNEUMID_CHECK(std::isfinite(w) && w > 0.0, "{}: the weight must be positive, got {}", name,
-                  w);
+    PNEUMID_CHECK(std::isfinite(w) && w > 0.0, "{}: the weight must be positive, got {}", name, w);
     p.norm = (p.y.array() - p.y.mean()).matrix().norm();
     PNEUMID_CHECK(p.norm > 0.0, "{}: the output is constant ({}), nothing to fit", name, p.y[0]);
     p.norm /= std::sqrt(w);
@@ -462,9 +463,10 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
   out.iterations = static_cast<int>(summary.iterations.size()) - 1;
   out.initial_cost = summary.initial_cost;
   out.final_cost = summary.final_cost;
-  out.termination = summary.termination_type == ceres::CONVERGENCE      ? Termination::kConvergence
-                    : summary.termination_type == ceres::NO_CONVERGENCE ? Termination::kNoConvergence
-                                                                        : Termination::kFailure;
+  out.termination = summary.termination_type == ceres::CONVERGENCE ? Termination::kConvergence
+                    : summary.termination_type == ceres::NO_CONVERGENCE
+                        ? Termination::kNoConvergence
+                        : Termination::kFailure;
   out.message = summary.message;
   out.parameters = options.start;
   for (int i = 0; i < np; ++i) SetIpaParameter(out.parameters, keys[i], z[i] * scale[i]);
@@ -516,8 +518,9 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
           out.correlations.push_back({keys[i], keys[j], rho});
       }
   } else {
-    out.warnings.push_back("the Jacobian at the solution could not be formed: no standard "
-                           "deviations");
+    out.warnings.push_back(
+        "the Jacobian at the solution could not be formed: no standard "
+        "deviations");
   }
   std::vector<std::string> undetermined;
   for (int i = 0; i < np; ++i) {
@@ -536,12 +539,13 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
     if (!determined[i])
       undetermined.push_back(c.name);
     else if (vague)
-      out.warnings.push_back(fmt::format(
-          "{} is poorly determined by the data: {:.4g} +- {:.2g} {} ({:.0f} %)", c.name, c.value,
-          c.std, c.unit, 100.0 * c.std / std::abs(c.value)));
+      out.warnings.push_back(
+          fmt::format("{} is poorly determined by the data: {:.4g} +- {:.2g} {} ({:.0f} %)", c.name,
+                      c.value, c.std, c.unit, 100.0 * c.std / std::abs(c.value)));
     if (c.at_bound)
-      out.warnings.push_back(fmt::format("{} ended at its bound ({:.4g} {}, range {:.4g} .. {:.4g})",
-                                         c.name, c.value, c.unit, c.lower, c.upper));
+      out.warnings.push_back(
+          fmt::format("{} ended at its bound ({:.4g} {}, range {:.4g} .. {:.4g})", c.name, c.value,
+                      c.unit, c.lower, c.upper));
     out.estimates.push_back(c);
   }
   if (!undetermined.empty()) {
@@ -559,8 +563,7 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
                           list));
   }
   out.simulations = problem.simulations();
-  out.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_begin).count();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_begin).count();
   return out;
 }
 

@@ -281,9 +281,9 @@ std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Datas
               PolynomialModel::FromParamsJson(ToJson(model.params), model.structure);
           const ResidualAnalysis p =
               AnalyzeWhiteness(PredictionErrors(poly, data.y(output), data.u(input)), ro);
-          one_step = fmt::format("; one-step prediction errors {} (Q = {:.4g})",
-                                 p.whiteness_passed ? "white" : "not white either",
-                                 p.whiteness_statistic);
+          one_step =
+              fmt::format("; one-step prediction errors {} (Q = {:.4g})",
+                          p.whiteness_passed ? "white" : "not white either", p.whiteness_statistic);
         } catch (const InvalidArgument&) {
         }
       }
@@ -317,10 +317,9 @@ double RankScore(const IdentifiedModel& model) {
 
 std::string RankReason(const IdentifiedModel& model) {
   const bool held_out = std::isfinite(model.validation_fit_percent);
-  std::string why = held_out ? fmt::format("held-out simulation fit {:.2f} %",
-                                           model.validation_fit_percent)
-                             : fmt::format("estimation fit {:.2f} % (no held-out data)",
-                                           model.fit_percent);
+  std::string why =
+      held_out ? fmt::format("held-out simulation fit {:.2f} %", model.validation_fit_percent)
+               : fmt::format("estimation fit {:.2f} % (no held-out data)", model.fit_percent);
   std::vector<std::string> soft, hard;
   for (const ModelFlagNote& f : model.flags)
     (f.flag == ModelFlag::kNoConvergence || f.flag == ModelFlag::kResidualsNotWhite ? soft : hard)

@@ -115,11 +115,12 @@ std::string StructureChoice::Describe() const {
   std::vector<std::string> tried;
   for (const StructureCandidate& c : candidates)
     tried.push_back(std::isfinite(c.fit_percent)
-                        ? fmt::format("{} {} {}: {:.2f}", c.na, c.nb, c.nk, c.fit_percent)
+                        ? fmt::format("{} {} {}: {:.2f} / {:.2f}", c.na, c.nb, c.nk,
+                                      c.record_fit_percent, c.fit_percent)
                         : fmt::format("{} {} {}: failed", c.na, c.nb, c.nk));
   return fmt::format(
-      "na = {}, nb = {}, nk = {} (held-out simulation fit {:.2f} % on {}); tried (na nb nk: fit "
-      "%): {}",
+      "na = {}, nb = {}, nk = {} (held-out simulation fit {:.2f} % on {}); tried (na nb nk: "
+      "estimation / held-out fit %): {}",
       na, nb, nk, fit_percent, held_out, fmt::join(tried, ", "));
 }
 
@@ -152,7 +153,8 @@ StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& d
     head.emplace(std::move(parts.first));
     scored = &data;
     score_from = head->size();
-    out.held_out = fmt::format("the last {:.0f} % of the data", 100.0 * (1.0 - options.structure_split));
+    out.held_out =
+        fmt::format("the last {:.0f} % of the data", 100.0 * (1.0 - options.structure_split));
   } else {
     out.held_out = held_out->source().empty() ? "the validation data" : held_out->source();
   }
@@ -160,27 +162,32 @@ StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& d
   NonlinearOptions fixed = options;
   fixed.choose_structure = false;
   auto try_one = [&](int na, int nb, int nk) {
-    StructureCandidate c{na, nb, nk, -std::numeric_limits<double>::infinity(), ""};
+    StructureCandidate c{na,
+                         nb,
+                         nk,
+                         -std::numeric_limits<double>::infinity(),
+                         -std::numeric_limits<double>::infinity(),
+                         ""};
     try {
       IdentifyRequest r = request;
       r.na = na;
       r.nb = nb;
       r.nk = nk;
       const IdentifiedModel m = IdentifyNonlinear(method, estimation, r, fixed);
-      const double fit =
-          ScoreSimulation(*scored, request.output,
-                          SimulateModel(m, *scored, request.input, request.output,
-                                        InitialCondition::kEstimate),
-                          score_from)
-              .fit_percent;
+      const Eigen::VectorXd yhat =
+          SimulateModel(m, *scored, request.input, request.output, InitialCondition::kEstimate);
+      const double fit = ScoreSimulation(*scored, request.output, yhat, score_from).fit_percent;
       if (std::isfinite(fit)) c.fit_percent = fit;
+      if (std::isfinite(m.fit_percent)) c.record_fit_percent = m.fit_percent;
     } catch (const std::exception& e) {
       c.error = e.what();
     }
     out.candidates.push_back(c);
-    return c.fit_percent;
+    return c.record_fit_percent;
   };
-  // 1. The delay with first-order dynamics.
+  // 1. The delay with first-order dynamics: candidates of equal size, so the
+  //    fit on the estimation part decides (a held-out part is dominated by
+  //    the map between the levels it adds, not by the delay).
   int best_nk = 0;
   double best = -std::numeric_limits<double>::infinity();
   for (int nk = 0; nk <= options.max_delay; ++nk) {
@@ -190,19 +197,22 @@ StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& d
       best_nk = nk;
     }
   }
+  best = -std::numeric_limits<double>::infinity();
   // 2. The orders with that delay.
   for (int na = 1; na <= 3; ++na)
     for (int nb = 1; nb <= 3; ++nb)
       if (na > 1 || nb > 1) try_one(na, nb, best_nk);
-  // 3. The most parsimonious within 0.1 point of the best.
-  for (const StructureCandidate& c : out.candidates) best = std::max(best, c.fit_percent);
+  // 3. The most parsimonious within 0.1 point of the best held-out fit, among
+  //    the candidates with the chosen delay.
+  for (const StructureCandidate& c : out.candidates)
+    if (c.nk == best_nk) best = std::max(best, c.fit_percent);
   PNEUMID_CHECK(std::isfinite(best), "{}: no structure could be estimated ({})", method,
                 out.candidates.front().error);
   const StructureCandidate* pick = nullptr;
   for (const StructureCandidate& c : out.candidates) {
-    if (!(c.fit_percent >= best - 0.1)) continue;
+    if (c.nk != best_nk || !(c.fit_percent >= best - 0.1)) continue;
     if (pick == nullptr || c.na + c.nb < pick->na + pick->nb ||
-        (c.na + c.nb == pick->na + pick->nb && c.nk < pick->nk))
+        (c.na + c.nb == pick->na + pick->nb && c.na < pick->na))
       pick = &c;
   }
   out.na = pick->na;
@@ -343,8 +353,7 @@ std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, con
         "the input reaches [{:g}, {:g}], beyond the input map's range [{:g}, {:g}] that the "
         "model{} was estimated on ({} of {} samples more than 5 % of that range outside): the "
         "map is held at its end values there, an extrapolation the data do not support",
-        lo, hi, c1, cm, model.method.empty() ? "" : " '" + model.method + "'", outside,
-        u.size()));
+        lo, hi, c1, cm, model.method.empty() ? "" : " '" + model.method + "'", outside, u.size()));
   }
   return w;
 }
@@ -394,8 +403,9 @@ Eigen::VectorXd SimulateNonlinear(const IdentifiedModel& model, const Dataset& d
   if (model.output_map) {
     const StaticMap& out = *model.output_map;
     double v_rest = v[0];
-    if (y_first && gain && (out.Direction() == Monotonicity::kIncreasing ||
-                                 out.Direction() == Monotonicity::kDecreasing)) {
+    if (y_first && gain &&
+        (out.Direction() == Monotonicity::kIncreasing ||
+         out.Direction() == Monotonicity::kDecreasing)) {
       const auto [lo, hi] = std::minmax_element(out.y().begin(), out.y().end());
       if (*y_first > *lo && *y_first < *hi) v_rest = out.Inverse(*y_first) / dc;
     }

@@ -776,8 +776,8 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
       const std::vector<Slot> lag_slots{kT1, kT2, kT3};
       std::vector<int> pos(lags.size());  // index of each lag slot in the covariance
       for (std::size_t i = 0; i < lags.size(); ++i)
-        pos[i] = static_cast<int>(std::find(slots.begin(), slots.end(), lag_slots[i]) -
-                                  slots.begin());
+        pos[i] =
+            static_cast<int>(std::find(slots.begin(), slots.end(), lag_slots[i]) - slots.begin());
       Eigen::VectorXi perm = Eigen::VectorXi::LinSpaced(np, 0, np - 1);
       for (std::size_t k = 0; k < lags.size(); ++k) perm[pos[k]] = pos[order[k]];
       Eigen::MatrixXd P(np, np);

@@ -270,8 +270,8 @@ StaticMapFitResult FitStaticMap(const Dataset& data, int input, int output,
 std::vector<double> PlaceMapKnots(const Eigen::VectorXd& u, int num_knots, int max_levels) {
   PNEUMID_CHECK(u.size() > 0 && u.allFinite(), "map knots need finite input samples, got {} {}",
                 u.size(), u.size() ? "with non-finite values" : "samples");
-  PNEUMID_CHECK(num_knots == 0 || num_knots >= 2,
-                "num_knots must be 0 (automatic) or >= 2, got {}", num_knots);
+  PNEUMID_CHECK(num_knots == 0 || num_knots >= 2, "num_knots must be 0 (automatic) or >= 2, got {}",
+                num_knots);
   PNEUMID_CHECK(max_levels >= 2, "max_levels must be >= 2, got {}", max_levels);
   const double lo = u.minCoeff(), hi = u.maxCoeff();
   std::vector<double> knots;

@@ -12,12 +12,12 @@
 //   subject to lower_i <= theta_i <= upper_i,
 //
 // so every experiment counts by its relative fit, fit_e = 100 (1 - ||ysim_e - y_e|| /
-// ||y_e - mean(y_e)||) %, whatever its amplitude, times its weight w_e (default 1). Ceres Solver (Levenberg-
-// Marquardt, bounds) works on the scaled variables z_i = theta_i / s_i with s_i
-// = |start_i| (or the width of the range when the start is 0); the Jacobian is
-// formed by central differences of the simulation (one-sided at a bound), its
-// columns simulated on worker threads. The bounds default to the physical
-// ranges of IpaParameterTable (docs/simulator.md states their sources).
+// ||y_e - mean(y_e)||) %, whatever its amplitude, times its weight w_e (default 1). Ceres Solver
+// (Levenberg- Marquardt, bounds) works on the scaled variables z_i = theta_i / s_i with s_i =
+// |start_i| (or the width of the range when the start is 0); the Jacobian is formed by central
+// differences of the simulation (one-sided at a bound), its columns simulated on worker threads.
+// The bounds default to the physical ranges of IpaParameterTable (docs/simulator.md states their
+// sources).
 //
 // Uncertainty [1, ch. 9]: Cov(theta) = s^2 (J^T J)^+ in physical units, s^2 =
 // 2 cost / (N - p). A parameter is reported as not determined by the data when
@@ -86,11 +86,11 @@ struct IpaCalibrationOptions {
   double integration_tolerance = 1e-8;
   /// Finite-difference step relative to the scaled variable (default 1e-4).
   double relative_step = 1e-4;
-  int max_iterations = 100;            ///< Levenberg-Marquardt iterations
-  double function_tolerance = 1e-10;   ///< relative cost change to stop
-  double parameter_tolerance = 1e-9;   ///< relative step to stop
-  int num_threads = 2;                 ///< threads for the Jacobian's simulations
-  double correlation_threshold = 0.95; ///< |rho| from which a pair is reported
+  int max_iterations = 100;             ///< Levenberg-Marquardt iterations
+  double function_tolerance = 1e-10;    ///< relative cost change to stop
+  double parameter_tolerance = 1e-9;    ///< relative step to stop
+  int num_threads = 2;                  ///< threads for the Jacobian's simulations
+  double correlation_threshold = 0.95;  ///< |rho| from which a pair is reported
   /// A calibrated experiment fitted by less than this NRMSE (%) gets a
   /// warning: the twin does not reproduce it (units, initial state, free
   /// parameters or a structure the simulator lacks). Default 90.
@@ -135,7 +135,7 @@ struct IpaCalibrationSummary {
   std::vector<CalibratedParameter> estimates;
   std::vector<CalibrationExperimentFit> experiments;
   std::vector<ParameterCorrelation> correlations;  ///< |rho| >= correlation_threshold
-  std::vector<std::string> warnings;  ///< undetermined parameters, bounds reached, ...
+  std::vector<std::string> warnings;               ///< undetermined parameters, bounds reached, ...
   int iterations = 0;
   double initial_cost = 0.0, final_cost = 0.0;
   long long simulations = 0;  ///< simulator runs of whole experiments
@@ -159,10 +159,10 @@ std::vector<std::string> DefaultCalibrationParameters(const IpaParameters& start
 /// `parameters` (noise-free, no quantization) driven by the data's input.
 /// @throws InvalidArgument for invalid parameters or non-uniform data;
 ///         std::runtime_error when the ODE integration fails.
-Eigen::VectorXd SimulateIpaOnData(const IpaParameters& parameters, const Dataset& data,
-                                  CalibrationInitialState initial_state =
-                                      CalibrationInitialState::kMeasured,
-                                  double warmup = 2.0, double integration_tolerance = 1e-8);
+Eigen::VectorXd SimulateIpaOnData(
+    const IpaParameters& parameters, const Dataset& data,
+    CalibrationInitialState initial_state = CalibrationInitialState::kMeasured, double warmup = 2.0,
+    double integration_tolerance = 1e-8);
 
 /// Calibrates the free parameters on the experiments (see the header comment).
 /// @throws InvalidArgument (at the API boundary, naming the offending values)

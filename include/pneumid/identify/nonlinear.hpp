@@ -59,24 +59,28 @@ struct NonlinearOptions {
 /// One candidate of the structure search and its held-out simulation fit.
 struct StructureCandidate {
   int na = 0, nb = 0, nk = 0;
-  double fit_percent = 0.0;  ///< -inf when the estimate failed
-  std::string error;         ///< why it failed, else empty
+  double fit_percent = 0.0;  ///< held-out fit; -inf when the estimate failed
+  /// Simulation fit on the estimation part; -inf when the estimate failed.
+  double record_fit_percent = 0.0;
+  std::string error;  ///< why it failed, else empty
 };
 
 /// The orders of a block-oriented model (hammerstein, wiener, hw) chosen by
 /// the simulation fit on held-out data, as MATLAB's compare scores (each
 /// candidate simulated from its estimated initial state):
-///   1. the delay: nk = 0 .. max_delay with na = nb = 1;
-///   2. the orders: na = 1..3, nb = 1..3 with that delay;
-///   3. the most parsimonious candidate (fewest na + nb, then smallest nk)
-///      within 0.1 point of the best fit.
+///   1. the delay: nk = 0 .. max_delay with na = nb = 1, by the simulation
+///      fit on the estimation part (candidates of one size; a held-out part
+///      mostly measures the map between the levels it adds, not the delay);
+///   2. the orders: na = 1..3, nb = 1..3 with that delay, by the held-out fit;
+///   3. the most parsimonious candidate (fewest na + nb, then smaller na)
+///      within 0.1 point of the best held-out fit.
 /// Held-out data: `held_out` when given (scored from its first sample), else
 /// the last 1 - structure_split of `data` (estimated on the first part,
 /// simulated over the whole record, scored on the rest).
 struct StructureChoice {
   int na = 1, nb = 1, nk = 1;
   double fit_percent = 0.0;
-  std::string held_out;  ///< "the last 30 % of the data" or the file
+  std::string held_out;                        ///< "the last 30 % of the data" or the file
   std::vector<StructureCandidate> candidates;  ///< in the order tried
   /// "na = 1, nb = 1, nk = 2 (held-out fit 98.7 % on ...); tried: ...".
   std::string Describe() const;

@@ -115,8 +115,8 @@ struct ProcessFitResult {
   /// Tz, theta, y0, for the parameters that were estimated).
   Eigen::MatrixXd covariance;
   std::vector<std::string> covariance_names;
-  TransferFunction tf;      ///< the fitted model (continuous, with delay)
-  Eigen::VectorXd yhat;     ///< simulated output on the data samples
+  TransferFunction tf;   ///< the fitted model (continuous, with delay)
+  Eigen::VectorXd yhat;  ///< simulated output on the data samples
   ProcessFitSummary summary;
 };
 

@@ -118,8 +118,7 @@ StaticMapFitResult FitStaticMap(const Dataset& data, int input = 0, int output =
 ///    (equal values merged), so that every tent holds about as many samples;
 ///  - num_knots >= 2: that many spread evenly over [min u, max u].
 /// @throws InvalidArgument for an empty or non-finite u, num_knots 1 or < 0.
-std::vector<double> PlaceMapKnots(const Eigen::VectorXd& u, int num_knots = 0,
-                                  int max_levels = 60);
+std::vector<double> PlaceMapKnots(const Eigen::VectorXd& u, int num_knots = 0, int max_levels = 60);
 
 /// A knot interval of a map whose value changes much more steeply than on
 /// the intervals beside it with no data inside: the data leave the map

@@ -64,5 +64,4 @@ Eigen::VectorXd SimulateOnData(const TransferFunction& g, const Dataset& data, i
                                int output = 0,
                                double y0 = std::numeric_limits<double>::quiet_NaN());
 
-
 }  // namespace pneumid

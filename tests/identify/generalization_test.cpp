@@ -1,0 +1,164 @@
+// Models that hold on experiments of another design: a known Hammerstein
+// system (gen_generalization.py beside this file, simulated with scipy:
+// dead zone, two steep rises, first-order lag, two samples of dead time,
+// noise std 0.3) estimated on one staircase with default options and
+// validated on a staircase of other levels and dwell times and on a
+// multi-level PRBS; the structure search finds the true orders; the map
+// intervals the staircase leaves undetermined are named; ranking and
+// initial conditions do not favour one model class.
+#include <cmath>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/data/load.hpp"
+#include "pneumid/identify/identify.hpp"
+#include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/nonlinear.hpp"
+#include "pneumid/identify/static_map_fit.hpp"
+#include "pneumid/identify/validation.hpp"
+
+namespace pneumid {
+namespace {
+
+using ::testing::Contains;
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
+
+Dataset Recorded(const std::string& name) {
+  LoadOptions o;
+  o.output_columns = {"y"};
+  return LoadDataset(std::string(PNEUMID_SOURCE_DIR) + "/tests/identify/data/" + name + ".csv", o);
+}
+
+// The true map of gen_generalization.py.
+double TrueMap(double u) {
+  static const StaticMap f({0, 12, 15, 30, 50, 70, 85, 88, 100},
+                           {0, 0, 15, 26, 56, 107, 135, 193, 193});
+  return f.Evaluate(u);
+}
+
+IdentifyOptions Defaults() {
+  IdentifyOptions o;
+  o.nonlinear.choose_structure = true;  // what `pneumid identify` does without --na --nb --nk
+  return o;
+}
+
+double Fit(const IdentifiedModel& m, const Dataset& d, InitialCondition ic) {
+  return ScoreSimulation(d, 0, SimulateModel(m, d, 0, 0, ic)).fit_percent;
+}
+
+TEST(PlaceMapKnotsTest, LevelsOfAStaircaseElseQuantilesElseEven) {
+  Eigen::VectorXd stairs(60);
+  for (Eigen::Index t = 0; t < 60; ++t) stairs[t] = (t / 10 % 3) * 25.0 + 5.0;  // 5 30 55
+  EXPECT_EQ(PlaceMapKnots(stairs), (std::vector<double>{5, 30, 55}));
+  // A ramp between two levels adds the range ends only where samples lie beyond.
+  Eigen::VectorXd ramp(40);
+  for (Eigen::Index t = 0; t < 40; ++t)
+    ramp[t] = t < 18 ? 10.0 : (t < 22 ? 10.0 + 5.0 * (t - 17) : 30.0);
+  EXPECT_EQ(PlaceMapKnots(ramp), (std::vector<double>{10, 30}));
+  // A continuous input: quantiles (11), so every tent holds about as many samples.
+  const Eigen::VectorXd sq = Eigen::VectorXd::LinSpaced(1001, 0.0, 1.0).array().square();
+  const std::vector<double> q = PlaceMapKnots(sq);
+  ASSERT_EQ(q.size(), 11u);
+  EXPECT_NEAR(q[5], 0.25, 1e-12);  // the median of t^2 on [0, 1]
+  EXPECT_EQ(q.front(), 0.0);
+  EXPECT_EQ(q.back(), 1.0);
+  // An explicit count: evenly spread, as before.
+  EXPECT_EQ(PlaceMapKnots(stairs, 3), (std::vector<double>{5, 30, 55}));
+  EXPECT_EQ(PlaceMapKnots(sq, 5), (std::vector<double>{0, 0.25, 0.5, 0.75, 1}));
+  EXPECT_THAT([&] { PlaceMapKnots(sq, 1); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("0 (automatic) or >= 2, got 1")));
+}
+
+TEST(FindMapGapsTest, NamesTheStepsBetweenVisitedLevels) {
+  // Steep only between 10 and 15 (7.5 per unit against 1 beside it).
+  const StaticMap f({0, 5, 10, 15, 20, 25}, {0, 5, 10, 47.5, 52.5, 57.5});
+  Eigen::VectorXd u(6);
+  u << 0, 5, 10, 15, 20, 25;
+  const std::vector<MapGap> gaps = FindMapGaps(f, u);
+  ASSERT_EQ(gaps.size(), 1u);
+  EXPECT_EQ(gaps[0].u_lo, 10.0);
+  EXPECT_EQ(gaps[0].u_hi, 15.0);
+  EXPECT_DOUBLE_EQ(gaps[0].change, 37.5);
+  EXPECT_THAT(gaps[0].Describe(), HasSubstr("between u = 10 and 15 the map changes by 37.5"));
+  // A sample inside the interval determines it: no gap.
+  Eigen::VectorXd v(7);
+  v << 0, 5, 10, 12.5, 15, 20, 25;
+  EXPECT_TRUE(FindMapGaps(f, v).empty());
+}
+
+TEST(GeneralizationTest, HammersteinWithDefaultsHoldsOnExperimentsOfOtherDesigns) {
+  const Dataset est = Recorded("gen_est");
+  const IdentifiedModel m = Identify("hammerstein", est, IdentifyRequest{}, Defaults());
+  // The structure search on the held-out last 30 % finds the true orders.
+  ASSERT_FALSE(m.notes.empty());
+  EXPECT_THAT(m.notes[0], HasSubstr("structure chosen on held-out data: na = 1, nb = 1, nk = 2"));
+  // The map at the visited levels is the true one within the noise (std 0.3).
+  ASSERT_TRUE(m.input_map.has_value());
+  EXPECT_EQ(m.input_map->u(),
+            (std::vector<double>{5, 10, 15, 25, 30, 35, 45, 50, 55, 60, 65, 75, 80, 85, 95}));
+  for (std::size_t j = 0; j < m.input_map->size(); ++j)
+    EXPECT_NEAR(m.input_map->y()[j], TrueMap(m.input_map->u()[j]), 0.3) << m.input_map->u()[j];
+  EXPECT_NEAR(m.discrete->DcGain(), 1.0, 1e-9);
+  EXPECT_EQ(m.termination, Termination::kConvergence);
+  // The undetermined intervals are named: the dead zone's end and the last rise.
+  EXPECT_THAT(m.notes, Contains(HasSubstr("between u = 10 and 15 the map changes by")));
+  EXPECT_THAT(m.notes, Contains(HasSubstr("between u = 85 and 95 the map changes by")));
+  // Other designs, records that start at rest at u = 0 (y = 0): at least 98 %
+  // from the start at rest at the first measured output (the default) and
+  // from the estimated initial state.
+  for (const char* name : {"gen_val_stairs", "gen_val_prbs"}) {
+    const Dataset v = Recorded(name);
+    EXPECT_GT(Fit(m, v, InitialCondition::kZero), 98.0) << name;
+    EXPECT_GT(Fit(m, v, InitialCondition::kEstimate), 98.0) << name;
+  }
+  // Where the estimation data leave the map undetermined, no model can hold.
+  EXPECT_LT(Fit(m, Recorded("gen_val_gap"), InitialCondition::kZero), 90.0);
+}
+
+TEST(GeneralizationTest, TheBestRankedModelHoldsOnAThirdExperiment) {
+  IdentifyOptions o = Defaults();
+  o.num_threads = 1;
+  const Dataset est = Recorded("gen_est"), val = Recorded("gen_val_stairs");
+  const IdentificationSummary s =
+      IdentifyModels({"fit-p1d", "arx", "hammerstein", "affine-narx"}, est, {}, o, &val);
+  ASSERT_EQ(s.models.size(), 4u);
+  const IdentifiedModel& best = s.models.front();
+  EXPECT_EQ(best.method, "hammerstein");
+  EXPECT_THAT(RankReason(best), HasSubstr("held-out simulation fit"));
+  EXPECT_GT(Fit(best, Recorded("gen_val_prbs"), InitialCondition::kZero), 98.0);
+  for (std::size_t i = 1; i < s.models.size(); ++i)
+    EXPECT_LE(RankScore(s.models[i]), RankScore(best)) << s.models[i].method;
+}
+
+TEST(GeneralizationTest, WarnsWhenTheInputLeavesTheMapsRange) {
+  const Dataset est = Recorded("gen_est");
+  IdentifyRequest r;
+  r.na = 1;
+  r.nb = 1;
+  r.nk = 2;
+  const Dataset low = SliceDataset(est, 0, 800);  // levels 5, 15, 25, 35
+  const IdentifiedModel m = Identify("hammerstein", low, r);
+  const std::vector<std::string> w = ExtrapolationWarnings(m, Recorded("gen_val_stairs"));
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_THAT(w[0], HasSubstr("beyond the input map's range [5, 35]"));
+  EXPECT_TRUE(ExtrapolationWarnings(m, low).empty());
+}
+
+TEST(GeneralizationTest, StructureSearchErrorsAreClear) {
+  const Dataset est = Recorded("gen_est");
+  NonlinearOptions o;
+  EXPECT_THAT([&] { ChooseBlockStructure("hammerstein", SliceDataset(est, 0, 20), {}, o); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("too few to choose the structure")));
+  // The last 30 % of the first 4 s is one level: nothing to choose on.
+  EXPECT_THAT([&] { ChooseBlockStructure("hammerstein", SliceDataset(est, 0, 330), {}, o); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("hold a constant input")));
+  EXPECT_THAT([&] { ChooseBlockStructure("narx", est, {}, o); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("for hammerstein, wiener and hw")));
+}
+
+}  // namespace
+}  // namespace pneumid
