@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <thread>
+#include <vector>
 
 #include <fmt/format.h>
 #include <Eigen/Dense>
@@ -89,29 +91,50 @@ NarxResult EstimateNarx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, doub
                 "regression rows of the {} samples; lower the lags or the degree, or give "
                 "more data",
                 M, o.ny, o.nu, o.degree, rows, y.size());
-  Eigen::MatrixXd P(rows, M);
-  for (Eigen::Index r = 0; r < rows; ++r)
-    for (Eigen::Index c = 0; c < M; ++c) P(r, c) = m.TermValue(cand[c], r + n0, y, u);
+  // FROLS without modifying the candidates (one rows x M matrix W): with the
+  // chosen terms orthonormalised to q_1..q_s, a candidate's part orthogonal
+  // to them, w = p - sum_k (q_k'p) q_k, has
+  //   w'w = p'p - sum_k (q_k'p)^2,   w't = p't - sum_k (q_k'p)(q_k't),
+  // so each step needs one product q_s'p per candidate (a read-only pass over
+  // W) to update ww and wt. The chosen term's q is orthogonalised explicitly
+  // (twice, classical Gram-Schmidt with re-orthogonalisation) and a candidate
+  // whose explicit remainder is below 1e-10 of its norm is dependent.
+  // The regressors (normalised lagged outputs and inputs), then each
+  // candidate as the product of its regressors' columns (as TermValue).
+  const int nr = o.ny + o.nu;
+  Eigen::MatrixXd R(rows, nr);
+  for (int k = 0; k < nr; ++k)
+    for (Eigen::Index r = 0; r < rows; ++r) R(r, k) = m.TermValue(NarxTerm(1, k), r + n0, y, u);
+  Eigen::MatrixXd W(rows, M);
+  for (Eigen::Index c = 0; c < M; ++c) {
+    auto w = W.col(c);
+    w.setOnes();
+    for (int k : cand[static_cast<std::size_t>(c)]) w.array() *= R.col(k).array();
+  }
+  R.resize(0, 0);
   const Eigen::VectorXd target = y.tail(rows) / m.y_scale;
   const double yy = target.squaredNorm();
   PNEUMID_CHECK(yy > 0.0, "NARX: the output is zero throughout (y'y = 0)");
-
-  // FROLS: W holds the candidates orthogonalised against the chosen terms.
-  Eigen::MatrixXd W = P;
-  const Eigen::VectorXd norms = P.colwise().norm();
+  Eigen::VectorXd norms2(M), ww(M), wt(M);
+  for (Eigen::Index c = 0; c < M; ++c) {
+    norms2[c] = ww[c] = W.col(c).squaredNorm();
+    wt[c] = W.col(c).dot(target);
+  }
   std::vector<bool> used(static_cast<std::size_t>(M), false);
   std::vector<Eigen::Index> chosen;
+  std::vector<Eigen::VectorXd> basis;  // q_1..q_s, unit norm
   double esr = 1.0;
   std::string stop;
+  const Eigen::Index work = rows * M;
+  const unsigned threads =
+      work < 4'000'000 ? 1u : std::max(1u, std::min(8u, std::thread::hardware_concurrency()));
   while (true) {
     Eigen::Index best = -1;
     double best_err = 0.0;
     for (Eigen::Index c = 0; c < M; ++c) {
-      if (used[c]) continue;
-      const double ww = W.col(c).squaredNorm();
-      if (ww <= 1e-20 * norms[c] * norms[c] || ww == 0.0) continue;
-      const double g = W.col(c).dot(target) / ww;
-      const double err = g * g * ww / yy;
+      if (used[static_cast<std::size_t>(c)]) continue;
+      if (!(ww[c] > 1e-10 * norms2[c])) continue;
+      const double err = wt[c] * wt[c] / (ww[c] * yy);  // g^2 w'w / y'y, g = w't / w'w
       if (err > best_err) {
         best_err = err;
         best = c;
@@ -121,14 +144,39 @@ NarxResult EstimateNarx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, doub
       stop = "no independent candidate left";
       break;
     }
-    used[best] = true;
-    chosen.push_back(best);
-    m.err.push_back(best_err);
-    esr -= best_err;
-    const Eigen::VectorXd q = W.col(best);
+    Eigen::VectorXd q = W.col(best);
+    for (int pass = 0; pass < 2; ++pass)
+      for (const Eigen::VectorXd& b : basis) q -= b.dot(q) * b;
     const double qq = q.squaredNorm();
-    for (Eigen::Index c = 0; c < M; ++c)
-      if (!used[c]) W.col(c) -= (q.dot(W.col(c)) / qq) * q;
+    used[static_cast<std::size_t>(best)] = true;
+    if (!(qq > 1e-10 * norms2[best])) continue;  // dependent after all: never chosen
+    q /= std::sqrt(qq);
+    const double err = std::pow(q.dot(target), 2) / yy;
+    chosen.push_back(best);
+    m.err.push_back(err);
+    esr -= err;
+    const double qt = q.dot(target);
+    // Columns are independent: split them over the hardware threads (the
+    // result does not depend on the split).
+    auto downdate = [&](Eigen::Index from, Eigen::Index to) {
+      for (Eigen::Index c = from; c < to; ++c) {
+        if (used[static_cast<std::size_t>(c)]) continue;
+        const double d = q.dot(W.col(c));
+        ww[c] -= d * d;
+        wt[c] -= d * qt;
+      }
+    };
+    if (threads == 1) {
+      downdate(0, M);
+    } else {
+      std::vector<std::thread> pool;
+      const Eigen::Index chunk = (M + threads - 1) / threads;
+      for (unsigned k = 0; k < threads; ++k)
+        pool.emplace_back(downdate, std::min<Eigen::Index>(M, k * chunk),
+                          std::min<Eigen::Index>(M, (k + 1) * chunk));
+      for (std::thread& t : pool) t.join();
+    }
+    basis.push_back(std::move(q));
     if (esr < o.err_tolerance) {
       stop = fmt::format("1 - sum ERR = {:.3g} < {:g}", esr, o.err_tolerance);
       break;
@@ -138,11 +186,13 @@ NarxResult EstimateNarx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, doub
       break;
     }
   }
+  basis.clear();
   Eigen::MatrixXd S(rows, static_cast<Eigen::Index>(chosen.size()));
   for (std::size_t i = 0; i < chosen.size(); ++i) {
-    S.col(static_cast<Eigen::Index>(i)) = P.col(chosen[i]);
+    S.col(static_cast<Eigen::Index>(i)) = W.col(chosen[i]);
     m.terms.push_back(cand[chosen[i]]);
   }
+  W.resize(0, 0);
   const Eigen::VectorXd theta = S.colPivHouseholderQr().solve(target);
   m.theta.assign(theta.data(), theta.data() + theta.size());
 
