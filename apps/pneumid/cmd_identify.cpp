@@ -263,9 +263,10 @@ static Registrar reg(
           ->check(CLI::Range(1, 20));
       CLI::Option* na =
           app.add_option("--na", args->request.na,
-                         "A order (arx, armax, iv4; n4sid state order); hammerstein, wiener, hw: "
-                         "when none of --na --nb --nk is given, all three are chosen on held-out "
-                         "data (--validation, else the last 30 % of DATA) and the choice is noted")
+                         "A order (arx, armax, iv4; n4sid state order); hammerstein, wiener, hw, "
+                         "narx: when none of --na --nb --nk is given, they (narx: lags, delay and "
+                         "terms) are chosen on held-out data (--validation, else the last 30 % of "
+                         "DATA) and the choice is noted")
               ->capture_default_str();
       CLI::Option* nb = app.add_option("--nb", args->request.nb, "B order")->capture_default_str();
       CLI::Option* nk =
@@ -312,9 +313,12 @@ static Registrar reg(
                      "of its a(y) and b(y)")
           ->capture_default_str()
           ->check(CLI::Range(1, 3));
-      app.add_option("--max-terms", args->nonlinear.narx.max_terms, "narx: most terms selected")
-          ->capture_default_str()
-          ->check(CLI::Range(1, 1000));
+      CLI::Option* max_terms =
+          app.add_option("--max-terms", args->nonlinear.narx.max_terms,
+                         "narx: most terms selected (without --na --nb --nk: the largest number "
+                         "the structure search tries, default 60)")
+              ->capture_default_str()
+              ->check(CLI::Range(1, 1000));
       app.add_option("--err-tolerance", args->nonlinear.narx.err_tolerance,
                      "narx: stop when 1 - sum ERR falls below this")
           ->capture_default_str()
@@ -338,8 +342,9 @@ static Registrar reg(
           ->check(CLI::Range(0.0, 1.0));
       app.add_flag("--progress", args->progress,
                    "Draw the progress bar even when stderr is not a terminal");
-      app.callback([args, na, nb, nk] {
+      app.callback([args, na, nb, nk, max_terms] {
         args->nonlinear.choose_structure = na->count() == 0 && nb->count() == 0 && nk->count() == 0;
+        if (max_terms->count() > 0) args->nonlinear.max_narx_terms = args->nonlinear.narx.max_terms;
         Run(*args);
       });
     });

@@ -6,8 +6,10 @@
 #include <optional>
 
 #include <fmt/format.h>
+#include <Eigen/Dense>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
 #include "pneumid/identify/validation.hpp"
 #include "pneumid/lti/conversion.hpp"
@@ -80,6 +82,13 @@ bool NonlinearOptions::IsValid(std::string* error) const {
                            structure_split);
     return false;
   }
+  if (max_narx_lag < 1 || max_narx_terms < 1) {
+    if (error)
+      *error = fmt::format(
+          "NonlinearOptions: max_narx_lag and max_narx_terms must be >= 1, got {} and {}",
+          max_narx_lag, max_narx_terms);
+    return false;
+  }
   if (max_delay < 0 || max_delay > 1000) {
     if (error)
       *error = fmt::format("NonlinearOptions::max_delay must be in 0..1000, got {}", max_delay);
@@ -111,7 +120,87 @@ bool IsBlockMethod(const std::string& method) {
 
 }  // namespace
 
+namespace {
+
+// The NARX part of ChooseBlockStructure (see nonlinear.hpp): `tail` is the
+// held-out record, simulated from its own first outputs.
+StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& tail,
+                                    const IdentifyRequest& request, const NonlinearOptions& options,
+                                    StructureChoice out) {
+  const Eigen::VectorXd ue = estimation.u(request.input), ye = estimation.y(request.output);
+  const Eigen::VectorXd uv = tail.u(request.input), yv = tail.y(request.output);
+  const double Ts = estimation.SampleTime();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int nk = 0; nk <= std::min(1, options.max_delay); ++nk) {
+    for (int lag = 1; lag <= options.max_narx_lag; ++lag) {
+      NarxOptions no = options.narx;
+      no.ny = lag;
+      no.nu = lag;
+      no.nk = nk;
+      no.max_terms = options.max_narx_terms;
+      try {
+        const NarxModel full = EstimateNarx(ue, ye, Ts, no).model;
+        const Eigen::Index n0 = full.FirstSample(), rows = ye.size() - n0;
+        const auto K = static_cast<Eigen::Index>(full.terms.size());
+        PNEUMID_CHECK(yv.size() > n0 + 2, "the held-out part has {} samples, {} start a simulation",
+                      yv.size(), n0);
+        Eigen::MatrixXd S(rows, K);
+        for (Eigen::Index i = 0; i < K; ++i)
+          for (Eigen::Index r = 0; r < rows; ++r)
+            S(r, i) = full.TermValue(full.terms[static_cast<std::size_t>(i)], r + n0, ye, ue);
+        const Eigen::VectorXd target = ye.tail(rows) / full.y_scale;
+        // Prefixes of 1, 2, .., 10 terms, then every 5th.
+        for (Eigen::Index k = std::min<Eigen::Index>(1, K);;
+             k = std::min(K, k + (k < 10 ? 1 : 5))) {
+          NarxModel pm = full;
+          pm.terms.resize(static_cast<std::size_t>(k));
+          pm.err.resize(static_cast<std::size_t>(k));
+          const Eigen::VectorXd theta = S.leftCols(k).colPivHouseholderQr().solve(target);
+          pm.theta.assign(theta.data(), theta.data() + k);
+          const Eigen::VectorXd sim = pm.Simulate(uv, yv);
+          const Eigen::Index nv = yv.size() - n0;
+          double fit = -inf;
+          if (sim.allFinite()) fit = NrmseFit(yv.tail(nv).eval(), sim.tail(nv).eval());
+          if (!std::isfinite(fit)) fit = -inf;
+          out.candidates.push_back({lag, lag, nk, static_cast<int>(k), fit, -inf, ""});
+          if (k == K) break;
+        }
+      } catch (const std::exception& e) {
+        out.candidates.push_back({lag, lag, nk, 0, -inf, -inf, e.what()});
+      }
+    }
+  }
+  double best = -inf;
+  for (const StructureCandidate& c : out.candidates) best = std::max(best, c.fit_percent);
+  PNEUMID_CHECK(std::isfinite(best), "narx: no structure could be estimated ({})",
+                out.candidates.front().error);
+  const StructureCandidate* pick = nullptr;
+  for (const StructureCandidate& c : out.candidates) {
+    if (!(c.fit_percent >= best - 0.1)) continue;
+    if (pick == nullptr || c.terms < pick->terms || (c.terms == pick->terms && c.na < pick->na))
+      pick = &c;
+  }
+  out.na = pick->na;
+  out.nb = pick->nb;
+  out.nk = pick->nk;
+  out.terms = pick->terms;
+  out.fit_percent = pick->fit_percent;
+  return out;
+}
+
+}  // namespace
+
 std::string StructureChoice::Describe() const {
+  if (terms > 0) {
+    std::vector<std::string> tried;
+    for (const StructureCandidate& c : candidates)
+      if (std::isfinite(c.fit_percent))
+        tried.push_back(fmt::format("{} {} {}: {:.2f}", c.na, c.nk, c.terms, c.fit_percent));
+    return fmt::format(
+        "ny = nu = {}, nk = {}, {} terms (held-out simulation fit {:.2f} % on {}); tried (lags nk "
+        "terms: held-out fit %): {}",
+        na, nk, terms, fit_percent, held_out, fmt::join(tried, ", "));
+  }
   std::vector<std::string> tried;
   for (const StructureCandidate& c : candidates)
     tried.push_back(std::isfinite(c.fit_percent)
@@ -127,8 +216,8 @@ std::string StructureChoice::Describe() const {
 StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& data,
                                      const IdentifyRequest& request,
                                      const NonlinearOptions& options, const Dataset* held_out) {
-  PNEUMID_CHECK(IsBlockMethod(method),
-                "the structure search is for hammerstein, wiener and hw, got '{}'", method);
+  PNEUMID_CHECK(IsBlockMethod(method) || method == "narx",
+                "the structure search is for hammerstein, wiener, hw and narx, got '{}'", method);
   std::string why;
   PNEUMID_CHECK(options.IsValid(&why), "{}", why);
   data.RequireUniform();
@@ -159,12 +248,17 @@ StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& d
     out.held_out = held_out->source().empty() ? "the validation data" : held_out->source();
   }
   const Dataset& estimation = head ? *head : data;
+  if (method == "narx")
+    return ChooseNarxStructure(estimation,
+                               held_out ? *held_out : SliceDataset(data, score_from, data.size()),
+                               request, options, std::move(out));
   NonlinearOptions fixed = options;
   fixed.choose_structure = false;
   auto try_one = [&](int na, int nb, int nk) {
     StructureCandidate c{na,
                          nb,
                          nk,
+                         0,
                          -std::numeric_limits<double>::infinity(),
                          -std::numeric_limits<double>::infinity(),
                          ""};
@@ -225,7 +319,7 @@ StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& d
 IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data,
                                   const IdentifyRequest& request, const NonlinearOptions& options,
                                   const Dataset* held_out) {
-  if (options.choose_structure && IsBlockMethod(method)) {
+  if (options.choose_structure && (IsBlockMethod(method) || method == "narx")) {
     const StructureChoice c = ChooseBlockStructure(method, data, request, options, held_out);
     IdentifyRequest r = request;
     r.na = c.na;
@@ -233,7 +327,22 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
     r.nk = c.nk;
     NonlinearOptions o = options;
     o.choose_structure = false;
+    if (c.terms > 0) o.narx.max_terms = c.terms;
     IdentifiedModel m = IdentifyNonlinear(method, data, r, o);
+    if (!std::isfinite(m.fit_percent) && held_out == nullptr) {
+      // The refit on all the data does not simulate: keep the model the
+      // search scored, estimated on the first part, scored on all the data.
+      IdentifiedModel part =
+          IdentifyNonlinear(method, SplitDataset(data, options.structure_split).first, r, o);
+      ScoreModel(data, request.input, request.output, &part);
+      if (std::isfinite(part.fit_percent)) {
+        part.notes.insert(part.notes.begin(),
+                          fmt::format("the refit on all the data does not simulate (not "
+                                      "finite): the model estimated on the first {:.0f} % is kept",
+                                      100.0 * options.structure_split));
+        m = std::move(part);
+      }
+    }
     m.notes.insert(m.notes.begin(), "structure chosen on held-out data: " + c.Describe());
     return m;
   }

@@ -156,8 +156,23 @@ TEST(GeneralizationTest, StructureSearchErrorsAreClear) {
   // The last 30 % of the first 4 s is one level: nothing to choose on.
   EXPECT_THAT([&] { ChooseBlockStructure("hammerstein", SliceDataset(est, 0, 330), {}, o); },
               ThrowsMessage<InvalidArgument>(HasSubstr("hold a constant input")));
-  EXPECT_THAT([&] { ChooseBlockStructure("narx", est, {}, o); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("for hammerstein, wiener and hw")));
+  EXPECT_THAT(
+      [&] { ChooseBlockStructure("arx", est, {}, o); },
+      ThrowsMessage<InvalidArgument>(HasSubstr("for hammerstein, wiener, hw and narx, got 'arx'")));
+}
+
+TEST(GeneralizationTest, NarxStructureSearchFindsTheTrueLagsAndTerms) {
+  // narx.csv (gen_nonlinear_systems.py): y(t) = -0.605 y(t-1) - 0.163 y(t-2)^2
+  // + 0.588 v(t-1) - 0.240 v(t-2) + e(t): lags 2, delay 1, four terms.
+  const Dataset d = Recorded("narx");
+  IdentifyOptions o;
+  o.nonlinear.choose_structure = true;
+  const IdentifiedModel m = Identify("narx", d, IdentifyRequest{}, o);
+  ASSERT_TRUE(m.narx.has_value());
+  EXPECT_THAT(m.notes[0], HasSubstr("ny = nu = 2, nk = 1, 4 terms"));
+  EXPECT_EQ(m.narx->terms.size(), 4u);
+  EXPECT_EQ(m.narx->ny, 2);
+  EXPECT_EQ(m.narx->nk, 1);
 }
 
 }  // namespace

@@ -51,14 +51,20 @@ struct NonlinearOptions {
   /// Estimation fraction of the internal split when the structure is chosen
   /// without held-out data; in (0, 1). Default 0.7.
   double structure_split = 0.7;
-  /// Largest input delay nk the structure search tries (>= 0, default 10).
+  /// Largest input delay nk the structure search tries (>= 0, default 10;
+  /// narx: nk = 0 and 1 only, its lags cover longer delays).
   int max_delay = 10;
+  /// narx: the largest lag ny = nu and the most terms the structure search
+  /// tries (>= 1; defaults 8 and 60).
+  int max_narx_lag = 8;
+  int max_narx_terms = 60;
   bool IsValid(std::string* error) const;
 };
 
 /// One candidate of the structure search and its held-out simulation fit.
 struct StructureCandidate {
   int na = 0, nb = 0, nk = 0;
+  int terms = 0;             ///< narx: terms of the candidate
   double fit_percent = 0.0;  ///< held-out fit; -inf when the estimate failed
   /// Simulation fit on the estimation part; -inf when the estimate failed.
   double record_fit_percent = 0.0;
@@ -79,6 +85,7 @@ struct StructureCandidate {
 /// simulated over the whole record, scored on the rest).
 struct StructureChoice {
   int na = 1, nb = 1, nk = 1;
+  int terms = 0;  ///< narx: terms chosen (0 for the block models)
   double fit_percent = 0.0;
   std::string held_out;                        ///< "the last 30 % of the data" or the file
   std::vector<StructureCandidate> candidates;  ///< in the order tried
@@ -88,6 +95,14 @@ struct StructureChoice {
 /// @throws InvalidArgument for a method other than hammerstein, wiener, hw,
 ///         too few samples in either part, or when no candidate could be
 ///         estimated (with the first candidate's reason).
+///
+/// narx (options.narx.degree kept): for nk = 0, 1 and lags ny = nu =
+/// 1..max_narx_lag, FROLS orders up to max_narx_terms terms on the
+/// estimation part; every prefix of 1, 2, .., 10, 15, 20, .. terms is refitted by least
+/// squares and simulated on the held-out part from its own first measured
+/// outputs; the best held-out simulation fit wins (the most parsimonious,
+/// fewest terms then shortest lags, within 0.1 point). The choice sets na =
+/// nb = lags, nk, and `terms` (StructureChoice::terms).
 StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& data,
                                      const IdentifyRequest& request,
                                      const NonlinearOptions& options,
