@@ -24,6 +24,9 @@ $PY -c "
 import sys
 sys.stdout.write('t,u,y\n0,0,' + 'x' * 10_000_000 + '\n')" >"$TMP/cell.csv"
 expect_short_error "10 MB cell" "not a number: 'xxxx" info "$TMP/cell.csv"
+# A first word that is no command is named, with the closest command.
+expect_error "misspelt command" "unknown command 'identfy'; did you mean 'identify'?" identfy data.csv
+expect_error "unknown command" "unknown command 'frobnicate' (commands: app, bode," frobnicate
 expect_error "10 MB cell size" "... (10000000 bytes)" info "$TMP/cell.csv"
 
 # Values near the double range: named as overflow or extreme scale, not as
