@@ -59,7 +59,11 @@ struct AffineNarxOptions {
   /// of a staircase or multi-level input, else 11 quantiles); >= 2 = that many
   /// spread evenly over the input range.
   int num_knots = 0;
-  int max_iterations = 100;
+  /// Rounds of the alternating least squares (>= 1). Each round is two small
+  /// least-squares solves; the alternation is slow (about 150 rounds on the
+  /// IPA twin's staircase), so the limit is high enough that stopping on it
+  /// means the loss is still falling.
+  int max_iterations = 1000;
   double tolerance = 1e-9;  ///< relative decrease of the loss that ends the iteration
   bool IsValid(std::string* error) const;
 };
