@@ -159,6 +159,18 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
     score_from = head->size();
   }
   const Dataset& estimation = head ? *head : data;
+  if (scored != nullptr) {
+    const Eigen::VectorXd y = scored->y(request.output).tail(scored->size() - score_from);
+    PNEUMID_CHECK(y.size() >= 2 && y.maxCoeff() > y.minCoeff(),
+                  "the held-out {} holds a constant output ({} samples at y = {:g}): no fit can be "
+                  "scored on it; {}",
+                  validation
+                      ? "data"
+                      : fmt::format("last {:.0f} % of the data", 100.0 * (1.0 - options.split)),
+                  y.size(), y.size() ? y[0] : 0.0,
+                  validation ? "give a validation record that excites the plant"
+                             : "choose another --split or give --validation data");
+  }
 
   const std::size_t n = methods.size();
   std::vector<std::optional<IdentifiedModel>> results(n);

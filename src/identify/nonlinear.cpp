@@ -320,7 +320,21 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
                                   const IdentifyRequest& request, const NonlinearOptions& options,
                                   const Dataset* held_out) {
   if (options.choose_structure && (IsBlockMethod(method) || method == "narx")) {
-    const StructureChoice c = ChooseBlockStructure(method, data, request, options, held_out);
+    StructureChoice c;
+    try {
+      c = ChooseBlockStructure(method, data, request, options, held_out);
+    } catch (const InvalidArgument& e) {
+      // No held-out part to choose on (too short, no excitation): the
+      // request's orders, and a note that says why.
+      NonlinearOptions o = options;
+      o.choose_structure = false;
+      IdentifiedModel m = IdentifyNonlinear(method, data, request, o);
+      m.notes.insert(m.notes.begin(),
+                     fmt::format("warning: structure not chosen on held-out data ({}); the default "
+                                 "orders na = {}, nb = {}, nk = {} are used",
+                                 e.what(), request.na, request.nb, request.nk));
+      return m;
+    }
     IdentifyRequest r = request;
     r.na = c.na;
     r.nb = c.nb;

@@ -156,6 +156,24 @@ TEST(GeneralizationTest, StructureSearchErrorsAreClear) {
   // The last 30 % of the first 4 s is one level: nothing to choose on.
   EXPECT_THAT([&] { ChooseBlockStructure("hammerstein", SliceDataset(est, 0, 330), {}, o); },
               ThrowsMessage<InvalidArgument>(HasSubstr("hold a constant input")));
+  // Identify falls back on the request's orders and says why.
+  IdentifyOptions io;
+  io.nonlinear.choose_structure = true;
+  const IdentifiedModel m = Identify("hammerstein", SliceDataset(est, 0, 330), {}, io);
+  EXPECT_THAT(m.notes[0], HasSubstr("warning: structure not chosen on held-out data"));
+  EXPECT_THAT(m.notes[0], HasSubstr("na = 3, nb = 3, nk = 1 are used"));
+  // A held-out part with a constant output cannot score any model.
+  IdentifyOptions split;
+  split.split = 0.5;
+  Eigen::VectorXd u = Eigen::VectorXd::Constant(400, 50.0),
+                  y = Eigen::VectorXd::Constant(400, 75.0);
+  for (Eigen::Index t = 0; t < 200; ++t) {
+    u[t] = 10.0 * static_cast<double>(t / 40);
+    y[t] = 1.5 * u[t];
+  }
+  const Dataset flat_tail = Dataset::FromUniform(0.01, u, y);
+  EXPECT_THAT([&] { IdentifyModels({"hammerstein"}, flat_tail, {}, split); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("holds a constant output")));
   EXPECT_THAT(
       [&] { ChooseBlockStructure("arx", est, {}, o); },
       ThrowsMessage<InvalidArgument>(HasSubstr("for hammerstein, wiener, hw and narx, got 'arx'")));
