@@ -86,6 +86,13 @@ class Scanner {
     if ((w0 >> 16) != 0) {  // small data element: 2-byte size, data in the tag
       e.type = w0 & 0xFFFF;
       e.nbytes = w0 >> 16;
+      // matio reads the claimed bytes past the tag (a small dimensions
+      // element claiming 2048 bytes made it allocate 2.5 GB).
+      if (e.nbytes > 4)
+        Fail(
+            fmt::format("{}: a small data element (type {}) claims {} bytes, more than the 4 its "
+                        "tag holds: the file is corrupt",
+                        Variable(), e.type, e.nbytes));
       e.data = s.substr(4, std::min<std::uint64_t>(e.nbytes, 4));
       e.size_on_disk = 8;
       return e;
@@ -192,9 +199,10 @@ class Scanner {
         // matio reads the dimensions as int32 whatever the tag says, so a
         // mistyped tag would reach it unchecked (10 "dimensions" from 50
         // bytes of text made it allocate 1.8 GB).
-        Fail(fmt::format("{}: its dimensions element has type {}, not miINT32 (5): the file is "
-                         "corrupt",
-                         Variable(), e.type));
+        Fail(
+            fmt::format("{}: its dimensions element has type {}, not miINT32 (5): the file is "
+                        "corrupt",
+                        Variable(), e.type));
       } else if (k == 1) {
         for (std::size_t d = 0; d + 4 <= e.data.size(); d += 4) {
           const auto n = static_cast<std::int32_t>(U32(e.data, d));

@@ -284,8 +284,7 @@ TEST_F(BadInputTest, MatDimensionsOfTheWrongTypeAreRejected) {
                   "variable 1: its dimensions element has type 10, not miINT32 (5): the file is "
                   "corrupt")));
   const std::string zpath = Write("zdims_type.mat", MatHeader() + Compress(bad));
-  EXPECT_THAT([&] { ReadMat(zpath); },
-              ThrowsMessage<DataError>(HasSubstr("not miINT32 (5)")));
+  EXPECT_THAT([&] { ReadMat(zpath); }, ThrowsMessage<DataError>(HasSubstr("not miINT32 (5)")));
 }
 
 TEST_F(BadInputTest, MatFunctionClassDimensionsAreCheckedLikeNumericOnes) {
@@ -302,6 +301,28 @@ TEST_F(BadInputTest, MatFunctionClassDimensionsAreCheckedLikeNumericOnes) {
   EXPECT_THAT([&] { ReadMat(path); },
               ThrowsMessage<DataError>(AllOf(HasSubstr("claims dimensions 1296629765x1"),
                                              HasSubstr("the file is corrupt"))));
+}
+
+TEST_F(BadInputTest, MatSmallElementClaimingMoreThanItsTagIsCorrupt) {
+  // Found by mat_fuzz: in a compressed variable, a small-format dimensions
+  // element (type 5) claiming 2048 bytes; matio read 512 "dimensions" past it
+  // and allocated 2.5 GB.
+  std::string flags, dims;
+  PutU32(&flags, 6);  // mxDOUBLE_CLASS
+  PutU32(&flags, 0);
+  PutU32(&dims, (2048u << 16) | 5u);  // small element: 2048 bytes of miINT32
+  PutU32(&dims, 1);
+  const std::string bad =
+      Element(14, Element(6, flags) + dims + Element(1, "t") + Element(9, std::string(8, '\0')));
+  for (const auto& [name, body] :
+       {std::pair<std::string, std::string>{"small.mat", bad}, {"zsmall.mat", Compress(bad)}}) {
+    const std::string path = Write(name, MatHeader() + body);
+    EXPECT_THAT([&] { ReadMat(path); }, ThrowsMessage<DataError>(AllOf(
+                                            HasSubstr("a small data element (type 5) claims 2048 "
+                                                      "bytes"),
+                                            HasSubstr("the file is corrupt"))))
+        << name;
+  }
 }
 
 TEST_F(BadInputTest, MatVariableListIsCappedAndLongNamesAreExcerpts) {
