@@ -231,7 +231,7 @@ void CheckParameterCount(Eigen::Index n, const Layout& l, const char* what) {
                 what, n, l.size(), l.na, l.nb, l.m);
 }
 
-// The knots: given, or spread evenly over the range of u; knots whose tent
+// The knots: given, or placed by PlaceMapKnots(u, num_knots); knots whose tent
 // holds no sample are dropped (their value would be undetermined). `name`
 // names the signal in the warnings.
 std::vector<double> Knots(const Eigen::VectorXd& u, const BlockModelOptions& o,

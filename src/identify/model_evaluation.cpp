@@ -97,14 +97,7 @@ Eigen::VectorXd SimulateBlockFromEstimatedState(const IdentifiedModel& model, co
   PNEUMID_CHECK(model.discrete.has_value(),
                 "the block-oriented model{} has no discrete linear part",
                 model.method.empty() ? "" : " '" + model.method + "'");
-  const double Ts = data.SampleTime();
-  PNEUMID_CHECK(std::abs(model.discrete->Ts() - Ts) <= 1e-6 * Ts,
-                "the model{} has sample time {} s, the data{} {} s",
-                model.method.empty() ? "" : " '" + model.method + "'", model.discrete->Ts(),
-                data.source().empty() ? "" : " of " + data.source(), Ts);
-  const TransferFunction g(model.discrete->num(), model.discrete->den(), Ts,
-                           model.discrete->delay());
-  const StateSpace ss = ToStateSpace(g);
+  const StateSpace ss = ToStateSpace(FormOnDataGrid(model, data, input));
   const Eigen::VectorXd u = data.u(input), y = data.y(output);
   const Eigen::MatrixXd v = model.input_map ? model.input_map->Evaluate(u) : u;
   if (!model.output_map) {

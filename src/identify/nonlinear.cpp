@@ -118,10 +118,6 @@ bool IsBlockMethod(const std::string& method) {
   return method == "hammerstein" || method == "wiener" || method == "hw";
 }
 
-}  // namespace
-
-namespace {
-
 // The NARX part of ChooseBlockStructure (see nonlinear.hpp): `tail` is the
 // held-out record, simulated from its own first outputs.
 StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& tail,
