@@ -290,6 +290,23 @@ static Registrar reg(
               return std::string(e.what());
             }
           });
+      app.add_option_function<std::string>(
+             "--operating-point",
+             [args](const std::string& s) {
+               args->request.operating_point = OperatingPointKindFromString(s);
+             },
+             "arx, iv4, armax, oe, bj, n4sid: the levels (u0, y0) the model is identified "
+             "around: auto (default: zero for a record that starts at rest at zero, else the "
+             "raw signals or the means, whichever simulates the data better), zero (the raw "
+             "signals), mean, initial (the first samples' level)")
+          ->check([](const std::string& s) {
+            try {
+              OperatingPointKindFromString(s);
+              return std::string();
+            } catch (const InvalidArgument& e) {
+              return std::string(e.what());
+            }
+          });
       app.add_option(
              "--knots", args->nonlinear.block.num_knots,
              "hammerstein, wiener, hw, affine-narx: knots of the static map, spread evenly over "

@@ -164,21 +164,26 @@ void BindIdentify(py::module_& m) {
   m.def(
       "identify",
       [](const std::string& method, const Dataset& data, int input, int output, int order, int na,
-         int nb, int nk, int nc, int nd, int nf, bool feedthrough,
-         const std::string& n4sid_weight) {
+         int nb, int nk, int nc, int nd, int nf, bool feedthrough, const std::string& n4sid_weight,
+         const std::string& operating_point) {
         IdentifyRequest r = MakeRequest(input, output, order, na, nb, nk, nc, nd, nf);
         r.feedthrough = feedthrough;
         r.n4sid_weight = SubspaceWeightingFromString(n4sid_weight);
+        r.operating_point = OperatingPointKindFromString(operating_point);
         py::gil_scoped_release release;
         return Identify(method, data, r);
       },
       "method"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3, "nb"_a = 3,
       "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3, "feedthrough"_a = false,
-      "n4sid_weight"_a = "moesp",
+      "n4sid_weight"_a = "moesp", "operating_point"_a = "auto",
       "Identifies a model of data with a method of identify_methods(): e.g. "
       "'reaction-curve' (FOPDT, paper Eq. 2), 'ptn' (PTn of order `order`, Eq. 3), 'arx' "
       "(ARX(na, nb, nk), Eq. 4); 'n4sid' (order na, D term when `feedthrough`, weighting "
-      "`n4sid_weight` 'moesp', 'n4sid' or 'cva'). Raises DataError when the data do not suit the "
+      "`n4sid_weight` 'moesp', 'n4sid' or 'cva'). `operating_point` ('auto', 'zero', 'mean', "
+      "'initial') sets the levels u0, y0 the polynomial and subspace models are identified "
+      "around (auto: zero for a record starting at rest at zero, else the raw signals or the "
+      "means, "
+      "whichever simulates the data better). Raises DataError when the data do not suit the "
       "method.");
   m.def(
       "preprocess",
@@ -205,8 +210,10 @@ void BindIdentify(py::module_& m) {
       [](const std::vector<std::string>& methods, const Dataset& data, int input, int output,
          int order, int na, int nb, int nk, int nc, int nd, int nf, double split,
          std::optional<Dataset> validation, const std::string& window, double resample,
-         bool remove_initial, const std::string& detrend, const std::string& filter, int decimate) {
-        const IdentifyRequest r = MakeRequest(input, output, order, na, nb, nk, nc, nd, nf);
+         bool remove_initial, const std::string& detrend, const std::string& filter, int decimate,
+         const std::string& operating_point) {
+        IdentifyRequest r = MakeRequest(input, output, order, na, nb, nk, nc, nd, nf);
+        r.operating_point = OperatingPointKindFromString(operating_point);
         IdentifyOptions o;
         o.split = split;
         const PreprocessOptions p =
@@ -233,7 +240,7 @@ void BindIdentify(py::module_& m) {
       "methods"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3, "nb"_a = 3,
       "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3, "split"_a = 0.0, "validation"_a = py::none(),
       "window"_a = "", "resample"_a = 0.0, "remove_initial"_a = false, "detrend"_a = "none",
-      "filter"_a = "", "decimate"_a = 1,
+      "filter"_a = "", "decimate"_a = 1, "operating_point"_a = "auto",
       "Runs several methods as `pneumid identify -m` does: each fails alone, models are "
       "flagged and ranked (unflagged first; by validation fit with `split` or `validation` "
       "data). Returns {'models': [IdentifiedModel, best first], 'failures': [{'method', "

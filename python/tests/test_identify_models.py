@@ -65,9 +65,15 @@ def test_preprocess_matches_numpy():
 
 def test_offsets_travel_with_the_model():
     d = prbs_record(4, u_offset=50.0, y_offset=300.0)
-    raw = pneumid.identify_models(["arx"], d)["models"][0]
+    raw = pneumid.identify_models(["arx"], d, operating_point="zero")["models"][0]
     pre = pneumid.identify_models(["arx"], d, detrend="constant")["models"][0]
     assert pre.fit_percent > raw.fit_percent + 5
+    # By default the ARX is identified around the means and keeps them as its
+    # operating point: the same coefficients as from the detrended record.
+    auto = pneumid.identify_models(["arx"], d)["models"][0]
+    np.testing.assert_allclose(auto.params["a"], pre.params["a"], rtol=1e-9, atol=1e-12)
+    assert auto.u0 == pytest.approx(d.u(0).mean()) and auto.y0 == pytest.approx(d.y(0).mean())
+    assert auto.fit_percent == pytest.approx(pre.fit_percent, abs=1e-6)
     assert pre.preprocessing["offsets"] == "constant"
     # simulate_model is the simulation identify scores: same fit.
     out, _ = pneumid.preprocess(d, detrend="constant")

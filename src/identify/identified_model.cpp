@@ -24,6 +24,22 @@ ModelFlag ModelFlagFromString(const std::string& name) {
 }
 
 namespace {
+inline constexpr EnumName<OperatingPointKind> kOperatingPointKindNames[] = {
+    {OperatingPointKind::kAuto, "auto"},
+    {OperatingPointKind::kZero, "zero"},
+    {OperatingPointKind::kMean, "mean"},
+    {OperatingPointKind::kInitial, "initial"}};
+}  // namespace
+
+std::string ToString(OperatingPointKind k) {
+  return std::string(EnumToString(kOperatingPointKindNames, k));
+}
+
+OperatingPointKind OperatingPointKindFromString(const std::string& name) {
+  return EnumFromString(kOperatingPointKindNames, name, "operating point");
+}
+
+namespace {
 
 std::string Names(const ModelParams& p) {
   std::string names;

@@ -69,25 +69,56 @@ struct IvSolution {
   Eigen::MatrixXd cov;
   double loss = 0.0;
   double cond = 0.0;
+  int dropped = 0;  ///< directions left out by the truncated SVD (0: full rank)
   bool ok = false;
 };
 
+// Smallest singular value, relative to the largest, of the column-scaled
+// instrument matrix that SolveIv uses (about sqrt of double precision: a
+// direction weaker than this is lost to rounding in the products zeta' phi).
+constexpr double kIvRankTolerance = 1e-7;
+
+// Solves the IV equations (zeta' phi) theta = zeta' y. Columns of zeta and phi
+// are scaled to unit norm first so that the rank decision does not depend on
+// the signals' units. When the scaled matrix has singular values below
+// kIvRankTolerance times the largest (the instruments are nearly collinear:
+// the model that generated them has a near-common factor of A and B, i.e. the
+// orders exceed what the data determine), the equations are solved in the
+// subspace they determine (truncated SVD: the minimum-norm solution in the
+// scaled parameters, Söderström & Stoica 1983, Sec. 8.2) instead of through
+// the near-null direction, whose amplification gives unstable models.
 IvSolution SolveIv(const Eigen::MatrixXd& zeta, const Eigen::MatrixXd& phi,
                    const Eigen::VectorXd& y) {
   IvSolution s;
+  const Eigen::VectorXd dz = zeta.colwise().norm().cwiseMax(1e-300).cwiseInverse();
+  const Eigen::VectorXd dp = phi.colwise().norm().cwiseMax(1e-300).cwiseInverse();
   const Eigen::MatrixXd M = zeta.transpose() * phi;
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(M);
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(M);
-  const auto sv = svd.singularValues();
-  s.cond = sv[sv.size() - 1] > 0 ? sv[0] / sv[sv.size() - 1] : INFINITY;
-  if (qr.rank() < M.cols()) return s;
-  s.theta = qr.solve(zeta.transpose() * y);
+  const Eigen::MatrixXd Ms = dz.asDiagonal() * M * dp.asDiagonal();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Ms, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  if (!(sv.size() > 0 && sv[0] > 0.0 && sv.allFinite())) return s;
+  {
+    Eigen::JacobiSVD<Eigen::MatrixXd> raw(M);
+    const auto& r = raw.singularValues();
+    s.cond = r[r.size() - 1] > 0 ? r[0] / r[r.size() - 1] : INFINITY;
+  }
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(sv.size());
+  for (Eigen::Index i = 0; i < sv.size(); ++i) {
+    if (sv[i] > kIvRankTolerance * sv[0]) {
+      inv[i] = 1.0 / sv[i];
+    } else {
+      ++s.dropped;
+    }
+  }
+  // M^+ = Dp V S^+ U' Dz: the (truncated) inverse of M in the scaled coordinates.
+  const Eigen::MatrixXd Mpinv = dp.asDiagonal() * svd.matrixV() * inv.asDiagonal() *
+                                svd.matrixU().transpose() * dz.asDiagonal();
+  s.theta = Mpinv * (zeta.transpose() * y);
   const Eigen::VectorXd e = y - phi * s.theta;
   s.loss = e.squaredNorm() / static_cast<double>(y.size());
   const double lambda = e.squaredNorm() / static_cast<double>(y.size() - phi.cols());
-  const Eigen::MatrixXd Minv = qr.inverse();
-  s.cov = lambda * Minv * (zeta.transpose() * zeta) * Minv.transpose();
-  s.ok = s.theta.allFinite();
+  s.cov = lambda * Mpinv * (zeta.transpose() * zeta) * Mpinv.transpose();
+  s.ok = s.theta.allFinite() && s.dropped < sv.size();
   return s;
 }
 
@@ -177,6 +208,13 @@ IvResult EstimateIv4(const Eigen::VectorXd& y, const Eigen::VectorXd& u, double 
   sum.condition_number = s4.cond;
   sum.scaled_condition_number = ls.summary.scaled_condition_number;
   sum.warnings = ls.summary.warnings;
+  if (s4.dropped > 0)
+    sum.warnings.push_back(fmt::format(
+        "IV4: the instruments are nearly collinear ({} of {} directions below {} of the largest "
+        "scaled singular value): the orders na = {}, nb = {} exceed what the data determine; the "
+        "IV equations were solved in the subspace they determine (truncated SVD); lower orders "
+        "may fit as well",
+        s4.dropped, d, kIvRankTolerance, o.na, o.nb));
   sum.termination = EstimationTermination::kConvergence;
   sum.message = "four-stage instrumental variables";
   return result;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/arx.hpp"
@@ -124,13 +125,137 @@ IdentifiedModel FinishTransferFunctionModel(IdentifiedModel m, const TransferFun
   return m;
 }
 
+// The operating point of OperatingPointKind (identified_model.hpp) on SISO
+// data, with a note saying which was taken; (0, 0) and no note for kZero.
+struct ChosenOperatingPoint {
+  double u0 = 0.0;
+  double y0 = 0.0;
+  std::string note;
+  bool ambiguous = false;  ///< kAuto away from rest at zero: also try the raw signals
+};
+
+ChosenOperatingPoint ChooseOperatingPoint(const Dataset& d, OperatingPointKind kind) {
+  const Eigen::VectorXd u = d.u(0);
+  const Eigen::VectorXd y = d.y(0);
+  const Eigen::Index n0 = std::max<Eigen::Index>(1, std::min<Eigen::Index>(20, d.size() / 50));
+  const double u_init = u.head(n0).mean();
+  const double y_init = y.head(n0).mean();
+  ChosenOperatingPoint op;
+  if (kind == OperatingPointKind::kAuto) {
+    const double u_range = u.maxCoeff() - u.minCoeff();
+    const double y_range = y.maxCoeff() - y.minCoeff();
+    const bool at_zero = std::abs(u_init) <= 0.05 * u_range && std::abs(y_init) <= 0.05 * y_range;
+    if (at_zero) return op;
+    op.ambiguous = true;
+    kind = OperatingPointKind::kMean;
+  }
+  if (kind == OperatingPointKind::kMean) {
+    op.u0 = u.mean();
+    op.y0 = y.mean();
+    op.note = fmt::format(
+        "operating point u0 = {:.6g}, y0 = {:.6g} (the means of the record): the model is G "
+        "from u - u0 to y - y0; --operating-point zero models the raw signals",
+        op.u0, op.y0);
+  } else if (kind == OperatingPointKind::kInitial) {
+    op.u0 = u_init;
+    op.y0 = y_init;
+    op.note = fmt::format(
+        "operating point u0 = {:.6g}, y0 = {:.6g} (the means of the first {} samples): the model "
+        "is G from u - u0 to y - y0",
+        op.u0, op.y0, n0);
+  }
+  return op;
+}
+
+// The SISO data less an operating point (shares nothing with `d`).
+Dataset Deviations(const Dataset& d, const ChosenOperatingPoint& op) {
+  if (op.u0 == 0.0 && op.y0 == 0.0) return d;
+  Dataset out(d.time(), (d.inputs().array() - op.u0).matrix(),
+              (d.outputs().array() - op.y0).matrix(), d.input_channels(), d.output_channels());
+  out.set_time_channel(d.time_channel());
+  out.set_source(d.source());
+  return out;
+}
+
+// Moves a model identified from deviations to the operating point: the fit
+// and IAE are offset-free, so the scores stay as computed.
+IdentifiedModel AtOperatingPoint(IdentifiedModel m, const ChosenOperatingPoint& op) {
+  if (op.note.empty()) return m;
+  m.u0 += op.u0;
+  m.y0 += op.y0;
+  m.notes.insert(m.notes.begin(), op.note);
+  return m;
+}
+
+// NRMSE fit of the model simulated on SISO data from its estimated initial
+// state (-inf when the simulation fails or diverges).
+double FitFromEstimatedState(const IdentifiedModel& m, const Dataset& d) {
+  try {
+    const Eigen::VectorXd yhat = SimulateModel(m, d, 0, 0, InitialCondition::kEstimate);
+    return yhat.allFinite() ? NrmseFit(d.y(0), yhat) : -std::numeric_limits<double>::infinity();
+  } catch (const InvalidArgument&) {
+    return -std::numeric_limits<double>::infinity();
+  }
+}
+
+}  // namespace
+
+namespace {
+IdentifiedModel IdentifyParametricAtRest(const std::string& method, const Dataset& d,
+                                         const IdentifyRequest& request);
 }  // namespace
 
 IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& data,
                                    const IdentifyRequest& request) {
   PNEUMID_CHECK(IsParametricMethod(method), "unknown parametric method '{}'; valid: {}", method,
                 fmt::format("{}", fmt::join(ParametricMethodNames(), ", ")));
-  const Dataset d = SisoData(data, request);
+  const Dataset siso = SisoData(data, request);
+  const bool offset_model = method != "cra" && method != "spa";
+  const ChosenOperatingPoint op =
+      offset_model ? ChooseOperatingPoint(siso, request.operating_point) : ChosenOperatingPoint{};
+  if (!op.ambiguous)
+    return AtOperatingPoint(IdentifyParametricAtRest(method, Deviations(siso, op), request), op);
+  // kAuto on a record that does not start at rest at zero: the raw signals
+  // (the data may be linear without offset, as a simulation from rest) or the
+  // means (an offset the linear model cannot hold, as on the cascaded tanks),
+  // whichever simulates the estimation data better from its estimated
+  // initial state (the record need not start at rest at either point).
+  IdentifiedModel raw;
+  std::string raw_error;
+  try {
+    raw = IdentifyParametricAtRest(method, siso, request);
+  } catch (const DataError& e) {
+    raw_error = e.what();
+  } catch (const InvalidArgument& e) {
+    raw_error = e.what();
+  }
+  IdentifiedModel centred =
+      AtOperatingPoint(IdentifyParametricAtRest(method, Deviations(siso, op), request), op);
+  const double raw_fit = raw_error.empty() ? FitFromEstimatedState(raw, siso)
+                                           : -std::numeric_limits<double>::infinity();
+  const double centred_fit = FitFromEstimatedState(centred, siso);
+  if (std::isfinite(raw_fit) && !(centred_fit > raw_fit)) {
+    raw.notes.insert(raw.notes.begin(),
+                     fmt::format("operating point zero (the raw signals): simulation fit {:.2f} % "
+                                 "from an estimated initial state, against {:.2f} % around the "
+                                 "means u0 = {:.6g}, y0 = {:.6g}",
+                                 raw_fit, centred_fit, op.u0, op.y0));
+    return raw;
+  }
+  centred.notes.insert(
+      centred.notes.begin() + 1,
+      std::isfinite(raw_fit)
+          ? fmt::format("simulation fit {:.2f} % from an estimated initial state, against {:.2f} "
+                        "% for the raw signals (operating point zero)",
+                        centred_fit, raw_fit)
+          : std::string("the raw signals (operating point zero) gave no usable model"));
+  return centred;
+}
+
+namespace {
+
+IdentifiedModel IdentifyParametricAtRest(const std::string& method, const Dataset& d,
+                                         const IdentifyRequest& request) {
   if (method == "arx") {
     ArxOptions o;
     o.na = request.na;
@@ -251,5 +376,7 @@ IdentifiedModel IdentifyParametric(const std::string& method, const Dataset& dat
   return FinishTransferFunctionModel(
       std::move(m), TransferFunction::Discrete(g, {1.0}, d.SampleTime()), s, d, false);
 }
+
+}  // namespace
 
 }  // namespace pneumid

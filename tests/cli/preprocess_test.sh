@@ -25,8 +25,13 @@ np.savetxt(sys.argv[2], d, delimiter=",", header="t,u,y", comments="")
 PYEOF
 expect_ok "clean" identify "$TMP/clean.csv" -m arx --json
 clean=$("$PY" -c "import json,sys; print(json.load(open(sys.argv[1]))['models'][0]['params']['a'][1])" "$TMP/out")
-expect_ok "raw offsets" identify "$TMP/offset.csv" -m arx --json
+expect_ok "raw offsets" identify "$TMP/offset.csv" -m arx --operating-point zero --json
 check_json "raw is off" 'abs(j["models"][0]["params"]["a"][1] - ('"$clean"')) > 0.5 and j["models"][0]["fit_percent"] < 0'
+# By default the offsets become the model's operating point (the means); the
+# drift still needs --detrend linear.
+expect_ok "default operating point" identify "$TMP/offset.csv" -m arx --json
+check_json "operating point stored" 'abs(j["models"][0]["operating_point"]["u0"] - 98.4) < 5 and j["models"][0]["operating_point"]["y0"] > 300'
+expect_error "bad operating point" "operating point" identify "$TMP/offset.csv" -m arx --operating-point median
 expect_ok "detrended" identify "$TMP/offset.csv" -m arx --detrend linear --json
 check_json "detrended recovers" 'abs(j["models"][0]["params"]["a"][1] - ('"$clean"')) < 0.05 and j["models"][0]["fit_percent"] > 60'
 check_json "recorded" 'j["models"][0]["preprocessing"]["offsets"] == "linear"'

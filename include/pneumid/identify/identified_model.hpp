@@ -137,6 +137,28 @@ struct IdentifiedModel {
   std::optional<NarxModel> narx;
 };
 
+/// The operating point (u0, y0) the polynomial and state-space methods (arx,
+/// iv4, armax, oe, bj, n4sid) model the signals around: they estimate
+/// G from the deviations u - u0, y - y0 and the model predicts
+/// y0 + G (u - u0) (MATLAB: detrend before estimation, the offsets stored in
+/// the model as getTrend/retrend do).
+///  - kAuto: zero when the record starts at rest at zero (the first samples of
+///    u and y within 5 % of their range of 0: a step test from rest, as the
+///    paper's, is modelled as it is). Otherwise the model is identified both
+///    from the raw signals and around the means, and the one that simulates
+///    the estimation data better is kept (a note gives both fits): raw data
+///    need no detrending by hand (the cascaded tanks start at 5 V), and data
+///    that are linear without offset keep their exact model.
+///  - kZero: the signals as they are (an offset is then a model error).
+///  - kMean: the means of u and y over the record (`--detrend mean`).
+///  - kInitial: the means over the first samples (the level before a step;
+///    `--remove-initial`), n = max(1, min(20, N / 50)).
+enum class OperatingPointKind { kAuto, kZero, kMean, kInitial };
+/// "auto", "zero", "mean", "initial".
+std::string ToString(OperatingPointKind k);
+/// Parses the names of ToString; @throws InvalidArgument naming the valid ones.
+OperatingPointKind OperatingPointKindFromString(const std::string& name);
+
 /// Options shared by every method of `pneumid identify`.
 struct IdentifyRequest {
   int input = 0;               ///< input column
@@ -146,6 +168,8 @@ struct IdentifyRequest {
   int nc = 1, nd = 1, nf = 3;  ///< ARMAX/BJ/OE orders
   bool feedthrough = false;    ///< n4sid: estimate the D term (subspace.hpp)
   SubspaceWeighting n4sid_weight = SubspaceWeighting::kMoesp;  ///< n4sid: W1/W2 weighting
+  /// Operating point of arx, iv4, armax, oe, bj, n4sid (see OperatingPointKind).
+  OperatingPointKind operating_point = OperatingPointKind::kAuto;
   bool IsValid(std::string* error) const;
 };
 
