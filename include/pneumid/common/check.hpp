@@ -32,7 +32,7 @@ class DataError : public std::runtime_error {
 /// User data quoted in an error message, bounded in length: `text` itself when
 /// it has at most `max_chars` bytes, otherwise its first `max_chars` bytes (cut
 /// at a character boundary) followed by "... (N bytes)". Control characters and
-/// bytes that are not valid UTF-8 are written as \xHH so that a binary file
+/// bytes that are not valid UTF-8 are written as `\\xHH` so that a binary file
 /// cannot garble the terminal. Use it wherever a cell, a line, a name or a value
 /// from a file or the command line is echoed into an exception.
 std::string Excerpt(std::string_view text, std::size_t max_chars = 40);

@@ -39,7 +39,7 @@ inline constexpr std::size_t kCsvMaxHeaderBytes = 1 << 20;
 inline constexpr std::size_t kCsvMaxColumns = 10000;
 
 struct CsvReadOptions {
-  /// Cell delimiter; '\0' detects it from the header row among ',' ';' '\t'
+  /// Cell delimiter; `'\0'` detects it from the header row among comma, semicolon and tab
   /// (and runs of blanks when none of them occurs). ' ' means runs of blanks.
   char delimiter = '\0';
   /// Text from this character to the end of a line is ignored; '\0' disables.
@@ -99,7 +99,7 @@ struct CsvColumn {
 };
 
 struct CsvWriteOptions {
-  /// Cell delimiter: ',' (default), ';', '\t' or ' '.
+  /// Cell delimiter: ',' (default), ';', a tab or ' '.
   char delimiter = ',';
   /// Optional comment lines written before the header, each prefixed by "# ".
   std::vector<std::string> comments;

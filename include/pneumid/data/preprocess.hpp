@@ -43,6 +43,8 @@ struct OperatingPoint {
 };
 
 /// Subtracts the mean of each selected channel over all samples.
+/// @param data     the samples (not changed).
+/// @param which    the channels to centre.
 /// @param removed  if not null, receives the subtracted values.
 /// @throws DataError when the dataset is empty.
 Dataset RemoveMeans(const Dataset& data, ChannelSet which = ChannelSet::kBoth,
@@ -65,6 +67,8 @@ struct LinearTrend {
 /// Removes a least-squares straight line a + b t (t in seconds) from each
 /// selected channel; the result has zero mean and no linear trend [1]. For
 /// uniform sampling this is scipy.signal.detrend(x, type='linear').
+/// @param data     the samples (not changed).
+/// @param which    the channels to detrend.
 /// @param removed  if not null, receives the lines that were subtracted.
 /// @throws DataError when the dataset has fewer than 2 samples.
 Dataset Detrend(const Dataset& data, ChannelSet which = ChannelSet::kBoth,
@@ -141,7 +145,7 @@ struct DecimateOptions {
 /// (fs / 2) / factor [2], run forward and backward with odd extension of
 /// 3 * (order + 1) samples at each end and steady-state initial conditions [3]
 /// (identical to scipy.signal.sosfiltfilt(butter(order, cutoff / factor,
-/// output='sos'), x)[::factor]). The magnitude response is |H|^2: no phase
+/// output='sos'), x) sliced with step factor). The magnitude response is |H|^2: no phase
 /// shift, -6 dB at the cutoff, DC gain exactly 1.
 /// @throws InvalidArgument when factor < 1 or the options are invalid.
 /// @throws DataError when the sampling is not uniform or the data is shorter

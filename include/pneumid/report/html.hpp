@@ -32,10 +32,10 @@ std::string HtmlEscape(const std::string& text);
 
 class HtmlDocument {
  public:
-  /// A document with the given <title> and top-level heading.
+  /// A document with the given `<title>` and top-level heading.
   explicit HtmlDocument(std::string title);
 
-  /// Heading of level 2..4 (level 2 starts a new <section>).
+  /// Heading of level 2..4 (level 2 starts a new `<section>`).
   /// @throws InvalidArgument for another level.
   void AddHeading(const std::string& text, int level = 2);
   /// A paragraph of plain text (escaped).
@@ -53,7 +53,7 @@ class HtmlDocument {
   int num_figures() const { return num_figures_; }
   int num_tables() const { return num_tables_; }
 
-  /// The complete page (<!DOCTYPE html> ... </html>).
+  /// The complete page (`<!DOCTYPE html> ... </html>`).
   std::string Render() const;
   /// Writes Render() to `path`. @throws DataError when it cannot be written.
   void Write(const std::string& path) const;

@@ -149,7 +149,7 @@ class Figure {
   void Save(const std::string& path, ImageFormat format) const;
   /// The figure as an SVG document (no XML prolog). Element ids are prefixed
   /// with `id_prefix` so that several figures can be inlined in one HTML page.
-  /// The SVG carries <title> and <desc> elements listing the title, axis labels
+  /// The SVG carries `<title>` and `<desc>` elements listing the title, axis labels
   /// and legend entries (text is drawn as glyph outlines by cairo).
   std::string ToSvg(const std::string& id_prefix = "fig") const;
 
@@ -160,11 +160,11 @@ class Figure {
 
 /// `text` for a title, label or legend entry, with PLplot's escape character
 /// '#' doubled, so that user text such as "models.json#fit-p1d" is drawn as
-/// written (a lone '#' starts an escape: #u superscript, #f font, ...).
+/// written (a lone '#' starts an escape: `#u` superscript, `#f` font, ...).
 std::string PlotLiteral(const std::string& text);
 
 /// Plain-text description of a figure (title, axis labels, legend entries),
-/// one item per line; used for the SVG <desc> element and the HTML alt text.
+/// one item per line; used for the SVG `<desc>` element and the HTML alt text.
 std::string DescribeFigure(const Figure& figure);
 
 }  // namespace pneumid
