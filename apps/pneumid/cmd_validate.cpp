@@ -12,6 +12,7 @@
 #include "identified_spec.hpp"
 #include "output_options.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/data/preprocess.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
@@ -130,13 +131,21 @@ void Run(const ValidateArgs& a) {
                   "--horizon needs a polynomial model with a noise model; '{}' is a {} model "
                   "(simulation only)",
                   a.model, identified->structure);
+    // The polynomial form acts on the deviations from the model's operating point.
+    OperatingPoint op{Eigen::VectorXd::Zero(data.num_inputs()),
+                      Eigen::VectorXd::Zero(data.num_outputs())};
+    op.u0[co.input] = identified->u0;
+    op.y0[co.output] = identified->y0;
+    const Dataset deviations = SubtractOperatingPoint(data, op);
     if (a.horizon > 0) {
       co.horizon = a.horizon;
-      pred = Compare(*poly, data, co);
+      pred = Compare(*poly, deviations, co);
+      pred.y.array() += identified->y0;
+      pred.yhat.array() += identified->y0;
       have_pred = true;
     }
     residuals_unavailable = TryResiduals(&res, [&] {
-      return poly ? AnalyzeResiduals(*poly, data, ro)
+      return poly ? AnalyzeResiduals(*poly, deviations, ro)
                   : AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro);
     });
   } else {

@@ -46,6 +46,32 @@ double RippleHalfBand(const Eigen::VectorXd& y, Eigen::Index begin, Eigen::Index
   }
   return worst;
 }
+// The summary's worst-step metrics (closed_loop.hpp): the largest overshoot,
+// the longest settling time or the first step that did not settle.
+void SummarizeWorstStep(ClosedLoopMetrics* m) {
+  const std::vector<StepMetrics>& steps = m->steps;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const double os = steps[i].overshoot_percent;
+    if (std::isfinite(os) && !(m->worst_overshoot_step >= 0 && os <= m->overshoot_percent)) {
+      m->overshoot_percent = os;
+      m->worst_overshoot_step = static_cast<int>(i);
+    }
+  }
+  m->settled = true;
+  for (std::size_t i = 0; i < steps.size() && m->settled; ++i) {
+    if (!steps[i].settled) {
+      m->settled = false;
+      m->worst_settling_step = static_cast<int>(i);
+    } else if (m->worst_settling_step < 0 ||
+               steps[i].settling_time > steps[m->worst_settling_step].settling_time) {
+      m->worst_settling_step = static_cast<int>(i);
+    }
+  }
+  const StepMetrics& worst = steps[m->worst_settling_step];
+  m->settling_time = m->settled ? worst.settling_time : kNaN;
+  m->settling_band = worst.settling_band;
+}
+
 }  // namespace
 
 nlohmann::ordered_json StepMetrics::ToJson() const {
@@ -61,6 +87,11 @@ nlohmann::ordered_json StepMetrics::ToJson() const {
 nlohmann::ordered_json ClosedLoopMetrics::ToJson() const {
   nlohmann::ordered_json j;
   PutStepResponse(*this, j);
+  j["worst_overshoot_step"] = worst_overshoot_step >= 0
+                                  ? nlohmann::ordered_json(worst_overshoot_step)
+                                  : nlohmann::ordered_json();
+  j["worst_settling_step"] = worst_settling_step >= 0 ? nlohmann::ordered_json(worst_settling_step)
+                                                      : nlohmann::ordered_json();
   j["iae"] = Number(iae);
   j["ise"] = Number(ise);
   j["itae"] = Number(itae);
@@ -199,11 +230,8 @@ ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen
   }
   if (!m.steps.empty()) {
     m.rise_time = m.steps[0].rise_time;
-    m.overshoot_percent = m.steps[0].overshoot_percent;
-    m.settling_time = m.steps[0].settling_time;
     m.first_move = m.steps[0].first_move;
-    m.settling_band = m.steps[0].settling_band;
-    m.settled = m.steps[0].settled;
+    SummarizeWorstStep(&m);
   }
   const Eigen::Index last_begin = changes.empty() ? 0 : changes.back();
   m.steady_state_error = segment_error(last_begin, n);

@@ -95,6 +95,14 @@ Dataset RemoveInitialOffset(const Dataset& data, Eigen::Index n, ChannelSet whic
   return OffsetFromFirst(data, n, which, removed);
 }
 
+Dataset SubtractOperatingPoint(const Dataset& data, const OperatingPoint& op) {
+  PNEUMID_CHECK(op.u0.size() == data.num_inputs() && op.y0.size() == data.num_outputs(),
+                "SubtractOperatingPoint: {} input and {} output levels for data with {} inputs "
+                "and {} outputs",
+                op.u0.size(), op.y0.size(), data.num_inputs(), data.num_outputs());
+  return SubtractOffsets(data, op.u0.transpose(), op.y0.transpose(), nullptr);
+}
+
 Dataset RemoveInitialOffset(const Dataset& data, const StepEvent& step, ChannelSet which,
                             OperatingPoint* removed) {
   PNEUMID_CHECK(step.index >= 0 && step.index < data.size(),

@@ -489,6 +489,24 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
           "position in m), the initial state and the free parameters",
           e.name, e.fit_percent, e.initial_fit_percent));
   const bool have_j = problem.Jacobian(z.data(), r.data(), J.data());
+  // Ceres stops with "convergence" on a zero gradient, which a flat region
+  // also gives: a step that makes the twin stop responding to every free
+  // parameter (e.g. a valve delay longer than the PWM pulses: no valve opens,
+  // the force is constant). Such an end point is not a minimum.
+  if (have_j && out.termination == Termination::kConvergence && J.allFinite()) {
+    const double flat = 1e-9 * std::max(r.norm(), 1e-300);
+    std::vector<std::string> responding;
+    for (int i = 0; i < np; ++i)
+      if (J.col(i).norm() > flat) responding.push_back(keys[i]);
+    if (responding.empty()) {
+      out.termination = Termination::kFailure;
+      out.message = fmt::format(
+          "the calibration stopped where the simulated output no longer responds to any free "
+          "parameter ({}): a flat region, not a minimum (Ceres: {}); free fewer parameters or "
+          "start closer to the actuator",
+          fmt::join(keys, ", "), summary.message);
+    }
+  }
 
   // Uncertainty and identifiability (header comment).
   Eigen::VectorXd sd = Eigen::VectorXd::Constant(np, kNaN);

@@ -272,8 +272,10 @@ std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Datas
         try {
           const PolynomialModel poly =
               PolynomialModel::FromParamsJson(ToJson(model.params), model.structure);
-          const ResidualAnalysis p =
-              AnalyzeWhiteness(PredictionErrors(poly, data.y(output), data.u(input)), ro);
+          // The polynomial acts on the deviations from the operating point.
+          const Eigen::VectorXd dy = (data.y(output).array() - model.y0).matrix();
+          const Eigen::VectorXd du = (data.u(input).array() - model.u0).matrix();
+          const ResidualAnalysis p = AnalyzeWhiteness(PredictionErrors(poly, dy, du), ro);
           one_step =
               fmt::format("; one-step prediction errors {} (Q = {:.4g})",
                           p.whiteness_passed ? "white" : "not white either", p.whiteness_statistic);

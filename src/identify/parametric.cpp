@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/data/preprocess.hpp"
 #include "pneumid/identify/arx.hpp"
 #include "pneumid/identify/cra.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
@@ -167,14 +168,11 @@ ChosenOperatingPoint ChooseOperatingPoint(const Dataset& d, OperatingPointKind k
   return op;
 }
 
-// The SISO data less an operating point (shares nothing with `d`).
+// The SISO data less an operating point.
 Dataset Deviations(const Dataset& d, const ChosenOperatingPoint& op) {
   if (op.u0 == 0.0 && op.y0 == 0.0) return d;
-  Dataset out(d.time(), (d.inputs().array() - op.u0).matrix(),
-              (d.outputs().array() - op.y0).matrix(), d.input_channels(), d.output_channels());
-  out.set_time_channel(d.time_channel());
-  out.set_source(d.source());
-  return out;
+  return SubtractOperatingPoint(
+      d, {Eigen::VectorXd::Constant(1, op.u0), Eigen::VectorXd::Constant(1, op.y0)});
 }
 
 // Moves a model identified from deviations to the operating point: the fit

@@ -118,17 +118,40 @@ BodeData Bode(const TransferFunction& g, const Eigen::VectorXd& omega_in) {
   b.magnitude.resize(omega.size());
   b.magnitude_db.resize(omega.size());
   b.phase_deg.resize(omega.size());
+  // The rational part's phase is unwrapped along a fine grid between the
+  // requested frequencies (at least 200 per decade; a discrete factor's
+  // angle can cross the branch cut, a root on the axis jumps), so that a
+  // coarse grid (bode --points 5) gets the same continuous phase as a fine
+  // one; the delay's -w delay is exact and added afterwards.
+  double previous = 0.0;  // rational phase (deg) at the last evaluated frequency
+  double w_prev = -1.0;
   for (Eigen::Index i = 0; i < omega.size(); ++i) {
+    const double w = omega[i];
     double m = 0.0, ph = 0.0;
-    f.Eval(omega[i], &m, &ph);
+    auto rational_deg = [&](double x) {
+      double mx = 0.0, px = 0.0;
+      f.Eval(x, &mx, &px);
+      return (px + x * f.delay) * kRadToDeg;
+    };
+    auto unwrap_to = [&previous](double deg) {
+      while (deg - previous > 180.0) deg -= 360.0;
+      while (deg - previous < -180.0) deg += 360.0;
+      return deg;
+    };
+    if (w_prev >= 0.0) {
+      const double lo = std::max(w_prev, 1e-300), hi = std::max(w, 1e-300);
+      const int sub =
+          std::min(20000, static_cast<int>(std::ceil(200.0 * std::abs(std::log10(hi / lo)))));
+      for (int k = 1; k < sub; ++k)
+        previous = unwrap_to(rational_deg(lo * std::pow(hi / lo, static_cast<double>(k) / sub)));
+    }
+    f.Eval(w, &m, &ph);
+    const double rational = i == 0 ? rational_deg(w) : unwrap_to(rational_deg(w));
+    previous = rational;
+    w_prev = w;
     b.magnitude[i] = m;
     b.magnitude_db[i] = 20.0 * std::log10(m);
-    b.phase_deg[i] = ph * kRadToDeg;
-    // Unwrap jumps from roots on the axis (the factored phase is otherwise continuous).
-    if (i > 0) {
-      while (b.phase_deg[i] - b.phase_deg[i - 1] > 180.0) b.phase_deg[i] -= 360.0;
-      while (b.phase_deg[i] - b.phase_deg[i - 1] < -180.0) b.phase_deg[i] += 360.0;
-    }
+    b.phase_deg[i] = rational - w * f.delay * kRadToDeg;
   }
   // Start in (-180, 180] at the first frequency.
   if (omega.size() > 0) {

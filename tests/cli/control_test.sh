@@ -54,6 +54,15 @@ j = json.load(sys.stdin)
 assert j["u_min"] >= 0 and j["u_max"] <= 100, (j["u_min"], j["u_max"])
 assert abs(j["steady_state_error"]) < 2.0, j["steady_state_error"]
 assert j["load_peak_deviation"] < -5, j["load_peak_deviation"]
+# The summary reports the worst step; steps[0] keeps the first step.
+steps = j["steps"]
+assert len(steps) == 2, steps
+worst = max(range(2), key=lambda i: steps[i]["overshoot_percent"])
+assert j["overshoot_percent"] == steps[worst]["overshoot_percent"] and j["worst_overshoot_step"] == worst, j
+assert j["settled"] == all(s["settled"] for s in steps), j
+if j["settled"]:
+    assert j["settling_time"] == max(s["settling_time"] for s in steps), j
+assert j["rise_time"] == steps[0]["rise_time"], j
 ' || fail "ipa metrics: $out"
 
 # The plant's input range applies by default: the IPA's duty stays within 0..100 %
@@ -121,7 +130,7 @@ check_output "plot compare" "DMC paper-modified (P=126, M=10, lambda=1.92)" "$tm
 # JSON keys are a contract: the run, its settings and its metrics (ClosedLoopMetrics::ToJson).
 expect_ok "json keys" control --controller dmc --model fopdt-paper --Ts 0.01 \
   --setpoint "staircase:levels=0 1,dwell=0.5" --duration 1 --json
-check_json "json keys" "list(j) == ['label', 'controller', 'plant', 'settings', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'iae', 'ise', 'itae', 'tv_u', 'u_min', 'u_max', 'load_peak_deviation', 'load_recovery_time', 'steps']"
+check_json "json keys" "list(j) == ['label', 'controller', 'plant', 'settings', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'worst_overshoot_step', 'worst_settling_step', 'iae', 'ise', 'itae', 'tv_u', 'u_min', 'u_max', 'load_peak_deviation', 'load_recovery_time', 'steps']"
 check_json "settings keys" "list(j['settings']) == ['rule', 'P', 'M', 'lambda', 'formula']"
 check_json "step keys" "sorted(j['steps'][0]) == sorted(['time', 'from', 'to', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'ripple'])"
 check_json "no load step" "j['load_peak_deviation'] is None and j['settings']['rule'] == 'shridhar-cooper'"

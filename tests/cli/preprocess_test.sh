@@ -32,6 +32,13 @@ check_json "raw is off" 'abs(j["models"][0]["params"]["a"][1] - ('"$clean"')) > 
 expect_ok "default operating point" identify "$TMP/offset.csv" -m arx --json
 check_json "operating point stored" 'abs(j["models"][0]["operating_point"]["u0"] - 98.4) < 5 and j["models"][0]["operating_point"]["y0"] > 300'
 expect_error "bad operating point" "operating point" identify "$TMP/offset.csv" -m arx --operating-point median
+# The one-step predictor and the residual tests of validate act on the
+# deviations from that operating point too (started from raw levels they
+# would see the offsets as errors).
+expect_ok "default to file" identify "$TMP/offset.csv" -m arx -o "$TMP/op.json"
+expect_ok "one-step prediction" validate "$TMP/op.json#arx" "$TMP/offset.csv" --horizon 1 --json
+check_json "prediction around the operating point" 'j["prediction"]["fit_percent"] > 88'  # 76.5 % from raw levels
+
 expect_ok "detrended" identify "$TMP/offset.csv" -m arx --detrend linear --json
 check_json "detrended recovers" 'abs(j["models"][0]["params"]["a"][1] - ('"$clean"')) < 0.05 and j["models"][0]["fit_percent"] > 60'
 check_json "recorded" 'j["models"][0]["preprocessing"]["offsets"] == "linear"'

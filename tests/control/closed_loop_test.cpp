@@ -11,8 +11,8 @@
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/gpc.hpp"
 #include "pneumid/control/pid.hpp"
-#include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
 
@@ -109,9 +109,9 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
   for (const auto& [key, value] : j.items()) keys.push_back(key);
   EXPECT_THAT(keys, ::testing::ElementsAre("rise_time", "overshoot_percent", "settling_time",
                                            "steady_state_error", "first_move", "settling_band",
-                                           "settled", "iae", "ise",
-                                           "itae", "tv_u", "u_min", "u_max", "load_peak_deviation",
-                                           "load_recovery_time", "steps"));
+                                           "settled", "worst_overshoot_step", "worst_settling_step",
+                                           "iae", "ise", "itae", "tv_u", "u_min", "u_max",
+                                           "load_peak_deviation", "load_recovery_time", "steps"));
   EXPECT_EQ(j["rise_time"], 0.1);
   EXPECT_TRUE(j["overshoot_percent"].is_null());
   EXPECT_TRUE(j["load_recovery_time"].is_null());
@@ -126,6 +126,62 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
   EXPECT_TRUE(j["steps"][0]["first_move"].is_null());
 }
 
+// Three set-point steps whose responses are written in closed form: the
+// summary takes the worst overshoot and the longest settling time, steps[0]
+// keeps the first step's, and a step that never settles makes the summary
+// unsettled.
+TEST(ClosedLoopMetricsTest, SummaryTakesTheWorstStep) {
+  // Step k (from r_k to r_k+1 at t_k) answers with the underdamped
+  // second-order response 1 - exp(-z w t) (cos(wd t) + z/sqrt(1-z^2) sin(wd t)),
+  // whose overshoot is 100 exp(-pi z / sqrt(1 - z^2)) %.
+  const double Ts = 1e-3, w = 20.0, dwell = 2.0;
+  const double levels[] = {0.0, 10.0, 30.0, 20.0};
+  const double zetas[] = {0.9, 0.35, 0.6};  // overshoot 0.15 %, 30.9 %, 9.48 %
+  const int per = static_cast<int>(dwell / Ts);
+  const int n = 3 * per;
+  Eigen::VectorXd t(n), r(n), y(n), u = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < n; ++k) {
+    const int s = k / per;
+    const double z = zetas[s], wd = w * std::sqrt(1 - z * z), tt = (k - s * per) * Ts;
+    const double unit = 1 - std::exp(-z * w * tt) *
+                                (std::cos(wd * tt) + z / std::sqrt(1 - z * z) * std::sin(wd * tt));
+    t(k) = k * Ts;
+    r(k) = levels[s + 1];
+    y(k) = levels[s] + (levels[s + 1] - levels[s]) * unit;
+  }
+  ClosedLoopOptions o;
+  const ClosedLoopMetrics m = ComputeClosedLoopMetrics(t, r, y, u, 0.0, 0.0, o);
+  ASSERT_EQ(m.steps.size(), 3u);
+  auto overshoot = [](double z) { return 100.0 * std::exp(-M_PI * z / std::sqrt(1 - z * z)); };
+  EXPECT_NEAR(m.steps[0].overshoot_percent, overshoot(0.9), 0.01);
+  EXPECT_NEAR(m.steps[1].overshoot_percent, overshoot(0.35), 0.05);
+  EXPECT_NEAR(m.steps[2].overshoot_percent, overshoot(0.6), 0.05);
+  EXPECT_NEAR(m.overshoot_percent, overshoot(0.35), 0.05);
+  EXPECT_EQ(m.worst_overshoot_step, 1);
+  // The lightly damped step settles last (about 4 / (z w) for a 2 % band).
+  EXPECT_TRUE(m.settled);
+  EXPECT_EQ(m.worst_settling_step, 1);
+  EXPECT_EQ(m.settling_time, m.steps[1].settling_time);
+  EXPECT_GT(m.settling_time, m.steps[0].settling_time);
+  EXPECT_GT(m.settling_time, m.steps[2].settling_time);
+  EXPECT_NEAR(m.settling_time, 4.0 / (0.35 * w), 0.1);
+  EXPECT_EQ(m.settling_band, m.steps[1].settling_band);
+  EXPECT_EQ(m.rise_time, m.steps[0].rise_time);
+  const nlohmann::ordered_json j = m.ToJson();
+  EXPECT_EQ(j["worst_overshoot_step"], 1);
+  EXPECT_EQ(j["steps"][0]["overshoot_percent"], m.steps[0].overshoot_percent);
+
+  // The last step now never reaches its set-point (it stops 10 % short):
+  // the summary is unsettled, with no settling time, and names that step.
+  Eigen::VectorXd y_short = y;
+  for (int k = 2 * per; k < n; ++k) y_short(k) = 30.0 + (y(k) - 30.0) * 0.9;
+  const ClosedLoopMetrics bad = ComputeClosedLoopMetrics(t, r, y_short, u, 0.0, 0.0, o);
+  EXPECT_FALSE(bad.settled);
+  EXPECT_TRUE(std::isnan(bad.settling_time));
+  EXPECT_EQ(bad.worst_settling_step, 2);
+  EXPECT_TRUE(bad.steps[1].settled);
+}
+
 // A load step inside a set-point segment ends the step's window: the dip it
 // causes is the load response, not overshoot of the set-point step.
 TEST(ClosedLoopMetricsTest, LoadStepEndsTheStepWindow) {
@@ -133,7 +189,8 @@ TEST(ClosedLoopMetricsTest, LoadStepEndsTheStepWindow) {
   Eigen::VectorXd t(n), r = Eigen::VectorXd::Constant(n, 100.0), y(n), u = Eigen::VectorXd::Zero(n);
   for (int k = 0; k < n; ++k) {
     t[k] = 0.01 * k;
-    y[k] = 100.0 * (1.0 - std::exp(-t[k] / 0.1)) - (t[k] >= 2.0 ? 30.0 * std::exp(-(t[k] - 2.0) / 0.1) : 0.0);
+    y[k] = 100.0 * (1.0 - std::exp(-t[k] / 0.1)) -
+           (t[k] >= 2.0 ? 30.0 * std::exp(-(t[k] - 2.0) / 0.1) : 0.0);
   }
   ClosedLoopOptions o;
   o.duration = 4.0;

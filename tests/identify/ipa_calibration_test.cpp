@@ -322,6 +322,23 @@ TEST(IpaCalibration, ATwinThatDoesNotReproduceTheDataIsFlagged) {
   EXPECT_THROW(CalibrateIpa({{step, "n.csv"}}, invalid), InvalidArgument);
 }
 
+TEST(IpaCalibration, AFlatEndPointIsNotReportedAsConvergence) {
+  // A rig whose inlet valve is 12 times slower than the default twin's and
+  // a 17.8 mm bore, calibrated with the default free set from the default
+  // twin: the first Levenberg-Marquardt step lengthens the valve delay past
+  // the PWM pulses, no valve opens and the simulated force is constant. Ceres
+  // sees a zero gradient there; the summary must not call it convergence.
+  IpaParameters rig;
+  SetIpaParameter(rig, "bore", 0.0178);
+  SetIpaParameter(rig, "inlet_conductance", 0.086e-8);
+  const Dataset prbs = Simulated(rig, "prbs:low=10,high=90,order=7,clock=0.05,at=0.5", 4.0, 1);
+  const IpaCalibrationSummary s = CalibrateIpa({{prbs, "prbs"}}, IpaCalibrationOptions{});
+  ASSERT_EQ(s.experiments.size(), 1u);
+  EXPECT_LT(s.experiments[0].fit_percent, 0.0);  // the constant force of the flat region
+  EXPECT_EQ(s.termination, Termination::kFailure) << s.message;
+  EXPECT_THAT(s.message, HasSubstr("no longer responds to any free parameter"));
+}
+
 TEST(IpaCalibration, ProgressIsReportedPerIteration) {
   const IpaParameters p;
   IpaCalibrationOptions options;

@@ -66,6 +66,24 @@ TEST(FrequencyTest, BodeDelayPhaseIsUnwrapped) {
     const double w = b.omega[i];
     ASSERT_NEAR(b.phase_deg[i], (-std::atan(w) - w) * 180 / M_PI, 1e-9);
   }
+  // Five points four decades apart (bode --points 5): the delay turns the
+  // phase by thousands of degrees between them, and it is still the closed form.
+  Eigen::VectorXd coarse(5);
+  coarse << 0.1, 10.0, 100.0, 1000.0, 10000.0;
+  const TransferFunction fopdt = TransferFunction::Continuous({1.6}, {0.2, 1}, 0.05);
+  const BodeData c = Bode(fopdt, coarse);
+  for (int k = 0; k < 5; ++k) {
+    const double w = coarse[k];
+    EXPECT_NEAR(c.phase_deg[k], (-std::atan(0.2 * w) - 0.05 * w) * 180 / M_PI, 1e-9) << w;
+  }
+  // A discrete model on a coarse grid has the phase of the fine grid at the
+  // same frequencies (its poles' factors cross the branch cut in between).
+  Eigen::VectorXd few(3);
+  few << 1.0, 100.0, 314.0;
+  const BodeData d_few = Bode(PaperArxModel(), few);
+  const BodeData d_fine = Bode(PaperArxModel(), LogSpace(0.0, std::log10(314.0), 2001));
+  EXPECT_NEAR(d_few.phase_deg[0], d_fine.phase_deg[0], 1e-9);
+  EXPECT_NEAR(d_few.phase_deg[2], d_fine.phase_deg[2000], 1e-9);
   // Automatic grid spans the corner frequency.
   const BodeData a = Bode(g);
   EXPECT_LT(a.omega[0], 1.0);

@@ -16,9 +16,9 @@ const METHODS = [
 ];
 const DEFAULT_METHODS = ['reaction-curve', 'arx', 'fit-p1d'];
 const METRIC_KEYS: [string, string][] = [
-  ['rise_time', 'rise time [s]'],
-  ['overshoot_percent', 'overshoot [%]'],
-  ['settling_time', 'settling time [s]'],
+  ['rise_time', 'rise time, first step [s]'],
+  ['overshoot_percent', 'overshoot, worst step [%]'],
+  ['settling_time', 'settling time, worst step [s]'],
   ['steady_state_error', 'steady-state error'],
   ['iae', 'IAE'],
   ['ise', 'ISE'],
@@ -27,7 +27,7 @@ const METRIC_KEYS: [string, string][] = [
   ['first_move', 'first move'],
   ['u_min', 'u min'],
   ['u_max', 'u max'],
-  ['settled', 'settled'],
+  ['settled', 'every step settled'],
   ['load_peak_deviation', 'load: peak deviation'],
   ['load_recovery_time', 'load: recovery time [s]'],
 ];

@@ -13,12 +13,20 @@
 // operating point the run starts from.
 //
 // Metrics (errors e = r - y use the plant output without the added noise):
-//   rise_time, overshoot_percent, settling_time: of the response to the
-//     first set-point change, over the samples until the next change or a
-//     load step, whichever comes first
+//   per set-point change (`steps`): rise_time, overshoot_percent,
+//     settling_time of the response over the samples until the next change
+//     or a load step, whichever comes first
 //     (ComputeStepInfo of lti/response.hpp with y_initial = the previous
 //     set-point, y_final = the new one; times from the change), NaN when the
-//     set-point never changes or the response never settles in the window;
+//     response never settles in the window;
+//   the summary: overshoot_percent and settling_time are the WORST over the
+//     steps (the largest overshoot; the longest settling time, NaN when a step
+//     did not settle), worst_overshoot_step and worst_settling_step name the
+//     step (index into `steps`; the first unsettled one when one did not
+//     settle), settled says that every step settled, settling_band is that
+//     of the worst-settling step; rise_time and first_move are those of the
+//     first step (steps[0] holds all of the first step's metrics). All are
+//     NaN (settled false) when the set-point never changes;
 //   settling_band: the half-width of the band |y - r| <= band the settling
 //     time refers to, max(settling_threshold |step|, ripple), where the ripple
 //     is the measured ripple/noise band of the segment's last quarter (at
@@ -115,8 +123,10 @@ struct ClosedLoopMetrics {
   double settling_time = std::numeric_limits<double>::quiet_NaN();
   double steady_state_error = std::numeric_limits<double>::quiet_NaN();
   double first_move = std::numeric_limits<double>::quiet_NaN();
-  double settling_band = std::numeric_limits<double>::quiet_NaN();  ///< of the first step
-  bool settled = false;                                             ///< the first step settled
+  double settling_band = std::numeric_limits<double>::quiet_NaN();  ///< of the worst-settling step
+  bool settled = false;                                             ///< every step settled
+  int worst_overshoot_step = -1;  ///< index into steps of overshoot_percent (-1: none)
+  int worst_settling_step = -1;   ///< index into steps of settling_time / settled (-1: none)
   double iae = 0.0, ise = 0.0, itae = 0.0;
   double tv_u = 0.0;
   double u_min = 0.0, u_max = 0.0;
@@ -126,7 +136,8 @@ struct ClosedLoopMetrics {
 
   /// The metrics of `pneumid control --json` and `pneumid run --json`:
   /// rise_time, overshoot_percent, settling_time, steady_state_error,
-  /// first_move, settling_band, settled, iae, ise, itae, tv_u, u_min, u_max, load_peak_deviation,
+  /// first_move, settling_band, settled, worst_overshoot_step,
+  /// worst_settling_step, iae, ise, itae, tv_u, u_min, u_max, load_peak_deviation,
   /// load_recovery_time and steps (StepMetrics::ToJson); NaN (a quantity that
   /// does not exist in the run) is written as null.
   nlohmann::ordered_json ToJson() const;

@@ -57,6 +57,12 @@ Dataset RemoveInitialOffset(const Dataset& data, Eigen::Index n,
                             ChannelSet which = ChannelSet::kBoth,
                             OperatingPoint* removed = nullptr);
 
+/// Subtracts a given operating point (e.g. a model's u0, y0) from the
+/// channels: the deviations a linear model around that point acts on.
+/// @throws InvalidArgument when the sizes of op.u0 / op.y0 differ from the
+/// numbers of inputs / outputs.
+Dataset SubtractOperatingPoint(const Dataset& data, const OperatingPoint& op);
+
 /// A straight line per channel: value_i(t) = level_i + slope_i * (t - time).
 struct LinearTrend {
   OperatingPoint level;  ///< value at `time` (the channel mean), one per channel
