@@ -7,14 +7,18 @@
 #include <complex>
 #include <numbers>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/control/closed_loop.hpp"
+#include "pneumid/control/controller_factory.hpp"
 #include "pneumid/lti/frequency.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/linear_plant.hpp"
+#include "pneumid/plant/signal.hpp"
 
 namespace pneumid {
 namespace {
@@ -34,7 +38,46 @@ const ReviewItem* Find(const AutoTuneResult& r, const std::string& check) {
   return nullptr;
 }
 
-void ExpectMeetsSpec(const AutoTuneResult& r, double t_target, double os_max) {
+// The reported design run again, independently of the tuner's own
+// evaluation: the controller built from the reported P, M and lambda by
+// MakeController (as `pneumid control` builds it), in absolute variables
+// within the given input limits, against `plant` (a LinearPlant, exact zoh)
+// started at rest; the set-point goes to the reported step's start at t = 0,
+// where the loop settles, and steps to its end at t1. The metrics are those
+// of that set-point change (SimulateClosedLoop).
+ClosedLoopMetrics Resimulate(const AutoTuneResult& r, const TransferFunction& model,
+                             const TransferFunction& plant_model, const InputLimits& limits) {
+  ControllerSpec spec;
+  spec.type = r.controller;
+  spec.tuning.rule = TuningRule::kExplicit;
+  spec.tuning.P = r.P;
+  spec.tuning.M = r.M;
+  spec.tuning.lambda = r.lambda;
+  spec.limits = limits;
+  // DMC optimizes its moves under the limits (QDMC), as the tuner designs it.
+  spec.constrained = std::isfinite(limits.u_min) || std::isfinite(limits.u_max);
+  const BuiltController built = MakeController(model, kTs, spec);
+  EXPECT_EQ(built.tuning.P, r.P);
+  EXPECT_EQ(built.tuning.M, r.M);
+  EXPECT_EQ(built.tuning.lambda, r.lambda);
+  LinearPlant plant(plant_model, kTs);
+  const double settle = 20.0 * (r.fopdt.tau + r.fopdt.theta);
+  const double t1 = kTs * std::round(settle / kTs);
+  const auto setpoint =
+      ParseSignal(fmt::format("step:from={},to={},at={}", r.step_from, r.step_to, t1));
+  ClosedLoopOptions o;
+  o.duration = t1 + settle;
+  o.actuator = limits;
+  const ClosedLoopResult loop = SimulateClosedLoop(*built.controller, plant, *setpoint, o);
+  EXPECT_EQ(loop.metrics.steps.size(), 1u);
+  // The loop sat at the step's start when the set-point changed.
+  const Eigen::Index k1 = static_cast<Eigen::Index>(std::lround(t1 / kTs));
+  EXPECT_NEAR(loop.y[k1], r.step_from, 1e-6 * std::max(1.0, std::abs(r.step_from)));
+  return loop.metrics;
+}
+
+void ExpectMeetsSpec(const AutoTuneResult& r, const TransferFunction& model,
+                     const InputLimits& limits, double t_target, double os_max) {
   SCOPED_TRACE(Describe(r));
   EXPECT_EQ(r.termination, AutoTuneTermination::kConverged);
   EXPECT_TRUE(r.predicted.settled);
@@ -46,6 +89,34 @@ void ExpectMeetsSpec(const AutoTuneResult& r, double t_target, double os_max) {
   ASSERT_NE(Find(r, "offset-free"), nullptr);
   EXPECT_EQ(Find(r, "offset-free")->status, ReviewStatus::kOk);
   EXPECT_LE(std::abs(r.steady_state_error), 1e-3 * 0.2 * std::abs(r.step_to - r.step_from));
+
+  // Not only the tuner's word: the design meets the specification when run.
+  const ClosedLoopMetrics nominal = Resimulate(r, model, model, limits);
+  EXPECT_TRUE(nominal.settled);
+  EXPECT_TRUE(std::isfinite(nominal.settling_time));
+  EXPECT_LE(nominal.overshoot_percent, os_max + 0.05);
+  EXPECT_NEAR(nominal.rise_time / t_target, 1.0, 0.2);
+  EXPECT_LE(std::abs(nominal.steady_state_error), 1e-3 * std::abs(r.step_to - r.step_from));
+  // The tuner's prediction is that run (a linear loop from a steady state).
+  EXPECT_NEAR(nominal.rise_time, r.predicted.rise_time, 0.1 * kTs);
+  EXPECT_NEAR(nominal.overshoot_percent, r.predicted.overshoot_percent, 0.01);
+  // The robustness cases run the same way (gain +-20 %, one more sample of
+  // dead time) stay within the overshoot and response time allowed under
+  // model error (OS_rob = 3 OS + 0.05 and t_rob = 2 t* at the default knob).
+  EXPECT_NEAR(r.robust_overshoot, 3.0 * os_max + 0.05, 1e-12);
+  EXPECT_NEAR(r.robust_response_time, 2.0 * r.response_time_aimed, 1e-12);
+  const double ts_model = model.IsContinuous() ? 0.0 : kTs;
+  const TransferFunction perturbed[] = {
+      TransferFunction(model.num() * 1.2, model.den(), ts_model, model.delay()),
+      TransferFunction(model.num() * 0.8, model.den(), ts_model, model.delay()),
+      model.WithDelay(model.delay() + kTs)};
+  for (const TransferFunction& plant : perturbed) {
+    SCOPED_TRACE("plant " + plant.ToString(5));
+    const ClosedLoopMetrics m = Resimulate(r, model, plant, limits);
+    EXPECT_TRUE(m.settled);
+    EXPECT_LE(m.overshoot_percent, r.robust_overshoot);
+    EXPECT_LE(m.rise_time, r.robust_response_time);
+  }
 }
 
 struct Case {
@@ -66,7 +137,7 @@ TEST_P(PredictiveAutoTuneTest, MeetsOvershootAndResponseTimeWithRobustness) {
   // faster than the model-based target tau + theta (the open loop / 2.2).
   EXPECT_TRUE(r.fastest);
   EXPECT_LT(r.response_time_target, 0.8 * (r.fopdt.tau + r.fopdt.theta));
-  ExpectMeetsSpec(r, r.response_time_target, 5.0);
+  ExpectMeetsSpec(r, g, o.limits, r.response_time_target, 5.0);
   EXPECT_GT(r.lambda, 0.0);
   if (!c.second_order) {
     EXPECT_EQ(r.P, 126);  // Shridhar-Cooper, as tuning_test.cpp
@@ -84,7 +155,7 @@ TEST_P(PredictiveAutoTuneTest, ExplicitTargetAndLimits) {
   o.limits.u_max = 100.0;
   const TransferFunction g = c.second_order ? SecondOrder() : Fopdt();
   const AutoTuneResult r = AutoTune(g, kTs, o);
-  ExpectMeetsSpec(r, o.response_time, 2.0);
+  ExpectMeetsSpec(r, g, o.limits, o.response_time, 2.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, PredictiveAutoTuneTest,
