@@ -325,6 +325,18 @@ TEST_F(BadInputTest, MatSmallElementClaimingMoreThanItsTagIsCorrupt) {
   }
 }
 
+TEST_F(BadInputTest, MatEmptyVariableWithAHugeDimensionIsCorrupt) {
+  // Found by mat_fuzz: a 22-byte Level 4 file whose variable claims 0 x
+  // 1415643158 doubles; no data, but matio walked the columns for 11 s.
+  const std::string v4("\0\0\0\0\0\0\0\0\x16\0\x61\x54\0\0\0\0\x02\0\0\0\0\x24", 22);
+  const std::string path = Write("v4_empty.mat", v4);
+  MatReadOptions by_index;
+  by_index.time_variable = "0";
+  EXPECT_THAT([&] { ReadMat(path, by_index); },
+              ThrowsMessage<DataError>(
+                  AllOf(HasSubstr("0x1415643158"), HasSubstr("more than the file can hold"))));
+}
+
 TEST_F(BadInputTest, MatVariableListIsCappedAndLongNamesAreExcerpts) {
   std::string file = MatHeader();
   for (int i = 0; i < 30; ++i) file += DoubleMatrix(fmt::format("v{}", i), 1, 1, {1.0});
