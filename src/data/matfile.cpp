@@ -274,8 +274,8 @@ class MatReader {
     // walks its N columns: a dimension beyond what the file could hold is
     // corrupt too (a 22-byte file claiming 0 x 1.4e9 took 11 s).
     const double largest = static_cast<double>(std::max(v.dims[0], v.dims[1]));
-    if (claimed > 1100.0 * static_cast<double>(file_size_) + 1e6 ||
-        largest > 1100.0 * static_cast<double>(file_size_) + 1e6) {
+    const double limit = 1100.0 * static_cast<double>(file_size_) + 1e6;
+    if (claimed > limit || largest > limit) {
       throw DataError(
           fmt::format("{}: variable '{}' claims {} elements ({}), more than the file "
                       "can hold: the file is corrupt",
@@ -350,8 +350,11 @@ class MatReader {
 
 namespace {
 constexpr EnumName<MatVersion> kMatVersionNames[] = {
-    {MatVersion::kV5, "v5"},   {MatVersion::kV73, "v7.3"}, {MatVersion::kV5, "5"},
-    {MatVersion::kV73, "7.3"}, {MatVersion::kV73, "v73"},
+    {MatVersion::kV5, "v5"},
+    {MatVersion::kV73, "v7.3"},
+    {MatVersion::kV5, "5"},
+    {MatVersion::kV73, "7.3"},
+    {MatVersion::kV73, "v73"},
 };
 }  // namespace
 

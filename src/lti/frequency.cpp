@@ -125,19 +125,18 @@ BodeData Bode(const TransferFunction& g, const Eigen::VectorXd& omega_in) {
   // one; the delay's -w delay is exact and added afterwards.
   double previous = 0.0;  // rational phase (deg) at the last evaluated frequency
   double w_prev = -1.0;
+  auto rational_deg = [&f](double x) {
+    double mx = 0.0, px = 0.0;
+    f.Eval(x, &mx, &px);
+    return (px + x * f.delay) * kRadToDeg;
+  };
+  auto unwrap_to = [&previous](double deg) {
+    while (deg - previous > 180.0) deg -= 360.0;
+    while (deg - previous < -180.0) deg += 360.0;
+    return deg;
+  };
   for (Eigen::Index i = 0; i < omega.size(); ++i) {
     const double w = omega[i];
-    double m = 0.0, ph = 0.0;
-    auto rational_deg = [&](double x) {
-      double mx = 0.0, px = 0.0;
-      f.Eval(x, &mx, &px);
-      return (px + x * f.delay) * kRadToDeg;
-    };
-    auto unwrap_to = [&previous](double deg) {
-      while (deg - previous > 180.0) deg -= 360.0;
-      while (deg - previous < -180.0) deg += 360.0;
-      return deg;
-    };
     if (w_prev >= 0.0) {
       const double lo = std::max(w_prev, 1e-300), hi = std::max(w, 1e-300);
       const int sub =
@@ -145,8 +144,10 @@ BodeData Bode(const TransferFunction& g, const Eigen::VectorXd& omega_in) {
       for (int k = 1; k < sub; ++k)
         previous = unwrap_to(rational_deg(lo * std::pow(hi / lo, static_cast<double>(k) / sub)));
     }
+    double m = 0.0, ph = 0.0;
     f.Eval(w, &m, &ph);
-    const double rational = i == 0 ? rational_deg(w) : unwrap_to(rational_deg(w));
+    const double at_w = (ph + w * f.delay) * kRadToDeg;
+    const double rational = i == 0 ? at_w : unwrap_to(at_w);
     previous = rational;
     w_prev = w;
     b.magnitude[i] = m;
