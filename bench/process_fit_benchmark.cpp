@@ -13,12 +13,9 @@
 
 namespace {
 
-// The repository root, from this file's path (bench/process_fit_benchmark.cpp).
-std::string SourceDir() {
-  const std::string file = __FILE__;
-  const auto bench = file.rfind("/bench/");
-  return bench == std::string::npos ? std::string(".") : file.substr(0, bench);
-}
+// The repository root, given by the build (PNEUMID_SOURCE_DIR), so that the
+// benchmark runs from any working directory.
+std::string SourceDir() { return PNEUMID_SOURCE_DIR; }
 
 pneumid::Dataset Load(const std::string& name) {
   return pneumid::LoadDataset(SourceDir() + "/tests/identify/data/" + name + ".csv");

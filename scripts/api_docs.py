@@ -10,7 +10,12 @@ description. The build fails when the coverage falls below the floor in
 docs/api/coverage_floor.txt, so that new public names come documented.
 
 Python: pydoc's HTML page of the compiled module (its docstrings), written to
-OUT/python.html, when the module can be imported (PYTHONPATH=build/python).
+OUT/cpp/html/python.html, when the module can be imported (--python-path, e.g.
+build/python). Every public function and class of the module, and every public
+method and property of its classes, must then have a docstring of its own (more
+than pybind11's signature line); the names without one are listed in
+OUT/undocumented_python.txt and fail the build. A module that cannot be imported
+(not built) is reported and skipped.
 
 Usage: api_docs.py OUT [--python-path DIR]
 """
@@ -79,25 +84,42 @@ def coverage(xml_dir):
 
 
 # Public functions and classes of the module, and the public methods and
-# properties of its classes, with and without a docstring of their own.
-PYTHON_COVERAGE = """
-import inspect, pneumid
-done = total = 0
-def doc_of(obj):
-    d = getattr(obj, "__doc__", None) or ""
-    # pybind11 writes the signature first; a name documented only by it has no text.
-    lines = [l for l in d.strip().splitlines()[1:] if l.strip()] if "(" in d.split("\\n")[0] else d.strip().splitlines()
-    return bool(lines)
+# properties of its classes, with and without a docstring of their own. Prints
+# "documented total" on the first line, then the names without one.
+PYTHON_COVERAGE = r"""
+import inspect, re, pneumid
+def doc_of(name, obj):
+    d = (getattr(obj, "__doc__", None) or "").strip()
+    lines = d.splitlines()
+    # pybind11 writes the signature first (or "Overloaded function." and one
+    # signature per overload); a name documented only by it has no text.
+    if not lines or not lines[0].startswith(name + "("):
+        return bool(lines)
+    if len(lines) > 1 and lines[1].strip() == "Overloaded function.":
+        parts = re.split(r"^\d+\. " + re.escape(name) + r"\(", d, flags=re.M)[1:]
+        return bool(parts) and all(any(l.strip() for l in p.splitlines()[1:]) for p in parts)
+    return any(l.strip() for l in lines[1:])
+done, missing = 0, []
+def count(name, obj, label):
+    global done
+    if doc_of(name, obj):
+        done += 1
+    else:
+        missing.append(label)
 for name, obj in vars(pneumid).items():
     if name.startswith("_") or inspect.ismodule(obj):
         continue
-    total += 1; done += doc_of(obj)
+    count(name, obj, name)
     if inspect.isclass(obj):
         for m, v in vars(obj).items():
             if m.startswith("_"):
                 continue
-            total += 1; done += doc_of(v)
-print(done, total)
+            # A static method's own docstring is that of its function.
+            if isinstance(v, staticmethod):
+                v = v.__func__
+            count(m, v, name + "." + m)
+print(done, done + len(missing))
+print("\n".join(missing))
 """
 
 
@@ -125,6 +147,7 @@ def main():
     print(f"api_docs: C++ reference {cpp / 'html' / 'index.html'}")
     print(f"api_docs: {done} of {total} public names documented ({share:.1f} %, floor {floor} %); "
           f"the others are listed in {out / 'undocumented.txt'}")
+    failures = []
     if args.python_path:
         env = dict(os.environ, PYTHONPATH=str(pathlib.Path(args.python_path).resolve()))
         probe = subprocess.run([sys.executable, "-c", "import pneumid"], env=env,
@@ -135,14 +158,24 @@ def main():
             (out / "pneumid.html").replace(out / "cpp" / "html" / "python.html")
             print(f"api_docs: Python reference {cpp / 'html' / 'python.html'}")
             counted = subprocess.run([sys.executable, "-c", PYTHON_COVERAGE], env=env,
-                                     capture_output=True, text=True, check=True).stdout.split()
-            print(f"api_docs: Python: {counted[0]} of {counted[1]} public names have a docstring")
+                                     capture_output=True, text=True, check=True).stdout.splitlines()
+            py_done, py_total = counted[0].split()
+            py_missing = [name for name in counted[1:] if name.strip()]
+            (out / "undocumented_python.txt").write_text("".join(n + "\n" for n in py_missing))
+            print(f"api_docs: Python: {py_done} of {py_total} public names have a docstring"
+                  + (f"; the others are listed in {out / 'undocumented_python.txt'}"
+                     if py_missing else ""))
+            if py_missing:
+                failures.append(f"{len(py_missing)} public Python name(s) have no docstring: "
+                                f"{', '.join(py_missing)} (document them in python/src)")
         else:
             print(f"api_docs: Python module not importable ({probe.stderr.strip().splitlines()[-1]}); "
                   "no Python reference", file=sys.stderr)
     if share < floor:
-        sys.exit(f"api_docs: coverage {share:.1f} % is below the floor {floor} %: document the new "
-                 f"public names (listed in {out / 'undocumented.txt'})")
+        failures.append(f"coverage {share:.1f} % is below the floor {floor} %: document the new "
+                        f"public names (listed in {out / 'undocumented.txt'})")
+    if failures:
+        sys.exit("\n".join("api_docs: " + f for f in failures))
 
 
 if __name__ == "__main__":

@@ -38,9 +38,10 @@ py::dict StepInfoToDict(const StepInfo& s) {
 
 void BindData(py::module_& m) {
   py::class_<Channel>(m, "Channel", "Name and unit of one measured signal.")
-      .def(py::init<std::string, std::string>(), "name"_a = "", "unit"_a = "")
-      .def_readwrite("name", &Channel::name)
-      .def_readwrite("unit", &Channel::unit)
+      .def(py::init<std::string, std::string>(), "name"_a = "", "unit"_a = "",
+           "Channel with a name and a unit, e.g. Channel('F', 'N') or Channel('u', '%').")
+      .def_readwrite("name", &Channel::name, "Signal name, e.g. 'F' or 'u'.")
+      .def_readwrite("unit", &Channel::unit, "Unit of the signal, e.g. 'N' or '%' ('' if none).")
       .def("__repr__",
            [](const Channel& c) { return "Channel('" + c.name + "', '" + c.unit + "')"; });
 
@@ -106,13 +107,23 @@ void BindData(py::module_& m) {
       .def_property_readonly("outputs", &Dataset::outputs, "Outputs, N x ny.")
       .def("u", &Dataset::u, "i"_a = 0, "Input column i.")
       .def("y", &Dataset::y, "i"_a = 0, "Output column i.")
-      .def_property_readonly("num_inputs", &Dataset::num_inputs)
-      .def_property_readonly("num_outputs", &Dataset::num_outputs)
-      .def_property_readonly("input_channels", &Dataset::input_channels)
-      .def_property_readonly("output_channels", &Dataset::output_channels)
-      .def_property("source", &Dataset::source, &Dataset::set_source)
+      .def_property_readonly("num_inputs", &Dataset::num_inputs,
+                             "Number of input channels nu (columns of inputs).")
+      .def_property_readonly("num_outputs", &Dataset::num_outputs,
+                             "Number of output channels ny (columns of outputs).")
+      .def_property_readonly("input_channels", &Dataset::input_channels,
+                             "Name and unit of each input column (list of Channel; unnamed "
+                             "inputs are 'u', or 'u1', 'u2', ... for several).")
+      .def_property_readonly("output_channels", &Dataset::output_channels,
+                             "Name and unit of each output column (list of Channel; unnamed "
+                             "outputs are 'y', or 'y1', 'y2', ...).")
+      .def_property("source", &Dataset::source, &Dataset::set_source,
+                    "Where the data came from (the file path for loaded data, '' when "
+                    "unknown), quoted in error messages; can be set.")
       .def("sample_time", &Dataset::SampleTime, "Mean sample interval [s].")
-      .def("is_uniform", &Dataset::IsUniform, "rel_tol"_a = 1e-3)
+      .def("is_uniform", &Dataset::IsUniform, "rel_tol"_a = 1e-3,
+           "True when every sample interval is within rel_tol times the median interval from "
+           "it (always True below 3 samples). Raises InvalidArgument for rel_tol < 0.")
       .def("__len__", [](const Dataset& d) { return d.size(); })
       .def("__repr__", [](const Dataset& d) {
         return "<Dataset " + std::to_string(d.size()) + " samples, " +
@@ -127,9 +138,13 @@ void BindLti(py::module_& m) {
       "SISO transfer function, continuous (Ts = 0; coefficients in descending powers of s) "
       "or discrete (Ts > 0; coefficients in ascending powers of z^-1), with an input delay "
       "in seconds.")
-      .def(py::init<>())
+      .def(py::init<>(), "The static gain 1, continuous.")
       .def(py::init<Eigen::VectorXd, Eigen::VectorXd, double, double>(), "num"_a, "den"_a,
-           "Ts"_a = 0.0, "delay"_a = 0.0)
+           "Ts"_a = 0.0, "delay"_a = 0.0,
+           "Model from coefficients (Ts = 0: descending powers of s; Ts > 0 in s: ascending "
+           "powers of z^-1) and an input delay in s. Raises InvalidArgument for an empty or "
+           "all-zero denominator, Ts < 0, delay < 0, a discrete delay that is not a multiple "
+           "of Ts, or an improper continuous model (deg num > deg den).")
       .def_static("continuous", &TransferFunction::Continuous, "num"_a, "den"_a, "delay"_a = 0.0,
                   "Continuous model, descending powers of s, delay in s.")
       .def_static("discrete", &TransferFunction::Discrete, "num_zinv"_a, "den_zinv"_a, "Ts"_a,
@@ -139,68 +154,106 @@ void BindLti(py::module_& m) {
                   "K exp(-theta s) / (tau s + 1).")
       .def_static("sopdt", &TransferFunction::Sopdt, "K"_a, "tau1"_a, "tau2"_a, "theta"_a,
                   "K exp(-theta s) / ((tau1 s + 1)(tau2 s + 1)).")
-      .def_property_readonly("num", &TransferFunction::num)
-      .def_property_readonly("den", &TransferFunction::den)
-      .def_property_readonly("Ts", &TransferFunction::Ts)
+      .def_property_readonly("num", &TransferFunction::num,
+                             "Numerator coefficients: descending powers of s (continuous) or "
+                             "ascending powers of z^-1 (discrete, as long as den).")
+      .def_property_readonly("den", &TransferFunction::den,
+                             "Denominator coefficients, ordered as num (continuous: without "
+                             "leading zeros; discrete: den[0] != 0).")
+      .def_property_readonly("Ts", &TransferFunction::Ts,
+                             "Sample time [s]; 0 for a continuous model.")
       .def_property_readonly("delay", &TransferFunction::delay, "Input delay [s].")
-      .def("is_discrete", &TransferFunction::IsDiscrete)
-      .def("delay_samples", &TransferFunction::DelaySamples)
-      .def("with_delay", &TransferFunction::WithDelay, "delay"_a)
-      .def("order", &TransferFunction::Order)
-      .def("poles", &TransferFunction::Poles)
-      .def("zeros", &TransferFunction::Zeros)
-      .def("dc_gain", &TransferFunction::DcGain)
-      .def("is_stable", &TransferFunction::IsStable)
+      .def("is_discrete", &TransferFunction::IsDiscrete, "True for a discrete model (Ts > 0).")
+      .def("delay_samples", &TransferFunction::DelaySamples,
+           "Input delay in samples, delay / Ts. Raises InvalidArgument for a continuous model.")
+      .def("with_delay", &TransferFunction::WithDelay, "delay"_a,
+           "Copy of the model with input delay `delay` [s]. Raises InvalidArgument for a "
+           "negative delay, or one that is not a multiple of Ts for a discrete model.")
+      .def("order", &TransferFunction::Order,
+           "Number of poles: the degree of the denominator without leading zeros.")
+      .def("poles", &TransferFunction::Poles, "Roots of the denominator in s or z (complex array).")
+      .def("zeros", &TransferFunction::Zeros, "Roots of the numerator in s or z (complex array).")
+      .def("dc_gain", &TransferFunction::DcGain,
+           "Static gain G(0) (continuous) or G(1) (discrete): +-inf for a pole at s = 0 / "
+           "z = 1, NaN when numerator and denominator both vanish there.")
+      .def("is_stable", &TransferFunction::IsStable,
+           "True when every pole lies in the open left half plane (continuous) or strictly "
+           "inside the unit circle (discrete).")
       .def("evaluate", &TransferFunction::Evaluate, "point"_a,
            "Rational part at a complex s or z (no delay).")
       .def("frequency_response", &TransferFunction::FrequencyResponse, "w"_a,
            "G(jw) or G(exp(jw Ts)) with the delay, w in rad/s.")
-      .def("normalized", &TransferFunction::Normalized)
-      .def("to_string", &TransferFunction::ToString, "precision"_a = 6)
+      .def("normalized", &TransferFunction::Normalized,
+           "The same model with a monic denominator (leading coefficient 1) and, when "
+           "continuous, the leading zeros of the numerator removed.")
+      .def("to_string", &TransferFunction::ToString, "precision"_a = 6,
+           "Readable form with `precision` significant digits, e.g. '(1.6) / (0.245 s + 1) * "
+           "exp(-0.001 s)'; a discrete model in powers of z^-1 with its delay as z^-d and "
+           "', Ts = ...'.")
       .def(
           "to_dict", [](const TransferFunction& g) { return JsonToPython(ToJson(g)); },
           "{'num', 'den', 'Ts', 'delay'} as in pneumid's JSON files.")
       .def_static(
           "from_dict", [](const py::dict& d) { return TransferFunctionFromJson(PythonToJson(d)); },
-          "d"_a)
+          "d"_a,
+          "Model from the dict of to_dict ('Ts' and 'delay' default to 0). Raises "
+          "InvalidArgument naming a missing or invalid key, or as the constructor.")
       .def("__repr__", [](const TransferFunction& g) { return g.ToString(6); });
 
   py::class_<StateSpace>(m, "StateSpace",
                          "Linear state-space model; Ts = 0 continuous, Ts > 0 discrete.")
       .def(py::init<Eigen::MatrixXd, Eigen::MatrixXd, Eigen::MatrixXd, Eigen::MatrixXd, double,
                     double>(),
-           "A"_a, "B"_a, "C"_a, "D"_a, "Ts"_a = 0.0, "delay"_a = 0.0)
-      .def_property_readonly("A", &StateSpace::A)
-      .def_property_readonly("B", &StateSpace::B)
-      .def_property_readonly("C", &StateSpace::C)
-      .def_property_readonly("D", &StateSpace::D)
-      .def_property_readonly("Ts", &StateSpace::Ts)
-      .def_property_readonly("delay", &StateSpace::delay)
-      .def("poles", &StateSpace::Poles)
-      .def("is_stable", &StateSpace::IsStable)
-      .def("dc_gain", &StateSpace::DcGain);
+           "A"_a, "B"_a, "C"_a, "D"_a, "Ts"_a = 0.0, "delay"_a = 0.0,
+           "dx/dt = A x + B u(t - delay), y = C x + D u(t - delay) for Ts = 0; x[k+1] = A x[k] "
+           "+ B u[k - d], y[k] = C x[k] + D u[k - d] with d = delay / Ts for Ts > 0 (Ts and "
+           "delay in s). Raises InvalidArgument when the matrix sizes disagree, Ts < 0 or "
+           "delay < 0.")
+      .def_property_readonly("A", &StateSpace::A, "State matrix, nx x nx.")
+      .def_property_readonly("B", &StateSpace::B, "Input matrix, nx x nu.")
+      .def_property_readonly("C", &StateSpace::C, "Output matrix, ny x nx.")
+      .def_property_readonly("D", &StateSpace::D, "Feedthrough matrix, ny x nu.")
+      .def_property_readonly("Ts", &StateSpace::Ts, "Sample time [s]; 0 for a continuous model.")
+      .def_property_readonly("delay", &StateSpace::delay,
+                             "Input delay [s] (delay / Ts samples for a discrete model).")
+      .def("poles", &StateSpace::Poles, "Eigenvalues of A (complex array).")
+      .def("is_stable", &StateSpace::IsStable,
+           "True when every pole lies in the open left half plane (continuous) or strictly "
+           "inside the unit circle (discrete).")
+      .def("dc_gain", &StateSpace::DcGain,
+           "Steady-state gain matrix (ny x nu): D - C A^-1 B (continuous) or D + C (I - A)^-1 B "
+           "(discrete); every entry inf when the inverse does not exist.");
 
   m.def("parse_model_spec", &ParseModelSpec, "spec"_a,
         "Model from a spec: 'arx-paper', 'fopdt:K=1.6,tau=0.245,theta=0.001', "
         "'tf:num=1,den=1 1', or a model JSON file.");
   m.def("paper_arx_model", &PaperArxModel, "The paper's ARX(3,3,1) force model, Ts = 0.01 s.");
   m.def("paper_fopdt_model", &PaperFopdtModel, "The paper's FOPDT 1.6 exp(-0.001 s)/(0.245 s+1).");
-  m.def("to_state_space", &ToStateSpace, "g"_a);
-  m.def("to_transfer_function", &ToTransferFunction, "ss"_a, "input"_a = 0, "output"_a = 0);
+  m.def("to_state_space", &ToStateSpace, "g"_a,
+        "Controllable canonical realization of the transfer function g (same Ts and delay): A "
+        "has -a1..-an in its first row, B = e1, C = b - b0 a, D = b0.");
+  m.def("to_transfer_function", &ToTransferFunction, "ss"_a, "input"_a = 0, "output"_a = 0,
+        "Transfer function of ss from input `input` to output `output` (0-based; same Ts and "
+        "delay). Raises InvalidArgument for an index out of range.");
   m.def(
       "c2d",
       [](const TransferFunction& g, double Ts, const std::string& method, double prewarp) {
         return C2D(g, Ts, DiscretizationMethodFromString(method), prewarp);
       },
       "g"_a, "Ts"_a, "method"_a = "zoh", "prewarp"_a = 0.0,
-      "Continuous -> discrete: method 'zoh', 'foh', 'tustin', 'euler', 'backward_diff', "
-      "'matched'.");
+      "Continuous -> discrete with sample time Ts [s]: method 'zoh', 'foh', 'tustin', 'euler', "
+      "'backward_diff', 'matched'; prewarp [rad/s] for 'tustin' (0 = none). Raises "
+      "InvalidArgument for a discrete g, Ts <= 0, a prewarp for another method or not below "
+      "pi/Ts, or an unknown method.");
   m.def(
       "c2d",
       [](const StateSpace& g, double Ts, const std::string& method, double prewarp) {
         return C2D(g, Ts, DiscretizationMethodFromString(method), prewarp);
       },
-      "g"_a, "Ts"_a, "method"_a = "zoh", "prewarp"_a = 0.0);
+      "g"_a, "Ts"_a, "method"_a = "zoh", "prewarp"_a = 0.0,
+      "Continuous StateSpace -> discrete with sample time Ts [s] (methods as above; prewarp in "
+      "rad/s, 'tustin' only, 0 = none). Raises InvalidArgument for a discrete g, Ts <= 0, a "
+      "prewarp for another method or not below pi/Ts, or an unknown method.");
   m.def(
       "d2c",
       [](const TransferFunction& g, const std::string& method, double prewarp) {
@@ -213,7 +266,10 @@ void BindLti(py::module_& m) {
       [](const StateSpace& g, const std::string& method, double prewarp) {
         return D2C(g, DiscretizationMethodFromString(method), prewarp);
       },
-      "g"_a, "method"_a = "zoh", "prewarp"_a = 0.0);
+      "g"_a, "method"_a = "zoh", "prewarp"_a = 0.0,
+      "Discrete StateSpace -> continuous ('zoh' or 'tustin'). Raises InvalidArgument for "
+      "another method, a continuous g, (zoh) a pole on the closed negative real axis "
+      "including z = 0, or (tustin) a pole at z = -1.");
   m.def(
       "step",
       [](const TransferFunction& g, double t_final, double dt) {
@@ -254,7 +310,11 @@ void BindLti(py::module_& m) {
         py::gil_scoped_release release;
         return Lsim(g, u, dt, x0);
       },
-      "g"_a, "u"_a, "dt"_a, "x0"_a = Eigen::VectorXd());
+      "g"_a, "u"_a, "dt"_a, "x0"_a = Eigen::VectorXd(),
+      "StateSpace response to u (N x nu, rows held over dt [s]) from initial state x0 (nx "
+      "entries, empty: zero); returns the N x ny outputs. Raises InvalidArgument for an empty "
+      "u, dt <= 0, a non-finite input, u without nu columns, x0 of another size, or a "
+      "discrete model whose Ts differs from dt.");
   m.def(
       "compute_step_info",
       [](const Eigen::VectorXd& t, const Eigen::VectorXd& y, double settling_threshold,

@@ -80,21 +80,28 @@ void BindExtras(py::module_& m) {
   m.def("parallel", &Parallel, "g1"_a, "g2"_a, "g1 + g2.");
   m.def("feedback", &Feedback, "g"_a, "h"_a = TransferFunction(), "sign"_a = -1,
         "g / (1 - sign g h); negative feedback by default.");
-  m.def("minimal_realization", &MinimalRealization, "g"_a, "tol"_a = 1e-6);
+  m.def("minimal_realization", &MinimalRealization, "g"_a, "tol"_a = 1e-6,
+        "g without its pole-zero pairs closer than tol (relative to max(1, |pole|)), like "
+        "MATLAB minreal; the high-frequency gain is kept. Raises InvalidArgument for tol < 0.");
 
   // --- plants and experiments ----------------------------------------------
   py::class_<Plant>(m, "Plant",
                     "A sampled plant: the IPA simulator or a linear model. Per sample: "
                     "y = measure(); advance(u).")
-      .def("reset", &Plant::Reset)
+      .def("reset", &Plant::Reset,
+           "Back to the initial state at time 0: noise generators to their seed, no load "
+           "disturbance.")
       .def("measure", &Plant::Measure, "Measured output now (sensor model included).")
       .def("advance", &Plant::Advance, "u"_a, "Holds u for one sample period (zero-order hold).",
            py::call_guard<py::gil_scoped_release>())
-      .def("set_load_disturbance", &Plant::SetLoadDisturbance, "d"_a)
-      .def_property_readonly("Ts", &Plant::Ts)
-      .def_property_readonly("time", &Plant::time)
+      .def("set_load_disturbance", &Plant::SetLoadDisturbance, "d"_a,
+           "Load disturbance d added to the measured output (output units: N in force mode), "
+           "held until changed; reset() clears it.")
+      .def_property_readonly("Ts", &Plant::Ts, "Sample period [s].")
+      .def_property_readonly("time", &Plant::time, "Current time [s] since reset().")
       .def("extras", &Plant::Extras, "Extra signals, e.g. chamber pressures.")
-      .def("describe", &Plant::Describe)
+      .def("describe", &Plant::Describe,
+           "Short description for logs, e.g. 'ipa (force mode, pwm 50 Hz)'.")
       .def("__repr__", [](const Plant& p) { return "<Plant " + p.Describe() + ">"; });
   m.def(
       "make_plant",
@@ -138,7 +145,9 @@ void BindExtras(py::module_& m) {
       "Horizons and move suppression: rule 'shridhar-cooper' (conventional), "
       "'paper-modified' or 'explicit' (dict with P, M, lambda, formula).");
   py::class_<Controller>(m, "Controller", "A sampled controller (DMC, GPC, PID, MPC).")
-      .def("reset", &Controller::Reset, "u0"_a = 0.0, "y0"_a = 0.0)
+      .def("reset", &Controller::Reset, "u0"_a = 0.0, "y0"_a = 0.0,
+           "Back to rest at an operating point: input u0 applied long enough for the output to "
+           "settle at y0 (plant units, e.g. duty % and N). Clears last_fault and fault_count.")
       .def("update", &Controller::Update, "setpoint"_a, "measurement"_a,
            "One control step; returns the input to hold over the next period. A NaN or "
            "infinite measurement or set-point, or a measurement outside the guard's range, "
@@ -166,9 +175,12 @@ void BindExtras(py::module_& m) {
           "'setpoint-not-finite' or 'output-not-finite'")
       .def_property_readonly("fault_count", &Controller::fault_count,
                              "Faulty samples since the last reset.")
-      .def_property_readonly("last_input", &Controller::last_input)
-      .def_property_readonly("Ts", &Controller::Ts)
-      .def("describe", &Controller::Describe)
+      .def_property_readonly("last_input", &Controller::last_input,
+                             "The input of the last update() or applied() (the held input on a "
+                             "fault; u0 after reset).")
+      .def_property_readonly("Ts", &Controller::Ts, "Sample period [s].")
+      .def("describe", &Controller::Describe,
+           "Short description, e.g. 'dmc P=126 M=5 lambda=2.25'.")
       .def("__repr__", [](const Controller& c) { return "<Controller " + c.Describe() + ">"; });
   m.def(
       "make_controller",

@@ -86,22 +86,28 @@ void BindIdentify(py::module_& m) {
   py::class_<IdentifiedModel>(m, "IdentifiedModel",
                               "Result of an identification method: named parameters, the "
                               "model, its fit to the data.")
-      .def_readonly("method", &IdentifiedModel::method)
-      .def_readonly("structure", &IdentifiedModel::structure)
+      .def_readonly("method", &IdentifiedModel::method,
+                    "Identification method, e.g. 'reaction-curve', 'fit-p1d', 'arx'.")
+      .def_readonly("structure", &IdentifiedModel::structure,
+                    "Model structure, e.g. 'FOPDT', 'PTn', 'P2D', 'ARX'.")
       .def_property_readonly(
           "params", [](const IdentifiedModel& r) { return ParamsToPython(r.params); },
           "Named parameters (dict), e.g. {'K': 1.6, 'tau': 0.245, 'theta': 0.001}.")
-      .def_property_readonly("param_std",
-                             [](const IdentifiedModel& r) { return ParamsToPython(r.param_std); })
+      .def_property_readonly(
+          "param_std", [](const IdentifiedModel& r) { return ParamsToPython(r.param_std); },
+          "Standard deviations of the parameters where known (dict with the names of params; "
+          "empty when the method gives none).")
       .def_readonly("tf", &IdentifiedModel::tf, "Model (continuous when it exists).")
       .def_readonly("discrete", &IdentifiedModel::discrete,
                     "Discrete form of polynomial models, else None.")
       .def_readonly("fit_percent", &IdentifiedModel::fit_percent, "NRMSE fit [%].")
       .def_readonly("iae", &IdentifiedModel::iae, "Integrated absolute error [units s].")
-      .def_readonly("notes", &IdentifiedModel::notes)
+      .def_readonly("notes", &IdentifiedModel::notes,
+                    "Warnings of the method (list of str): poor excitation, not converged, ...")
       .def_readonly("u0", &IdentifiedModel::u0,
                     "Operating point: the model predicts y0 + G (u - u0) (simulate_model).")
-      .def_readonly("y0", &IdentifiedModel::y0)
+      .def_readonly("y0", &IdentifiedModel::y0,
+                    "Output level of the operating point (output units); see u0.")
       .def_property_readonly(
           "termination", [](const IdentifiedModel& r) { return ToString(r.termination); },
           "How the estimator ended: 'convergence', 'no_convergence', ...")
@@ -269,7 +275,9 @@ void BindIdentify(py::module_& m) {
         "output y (N x ny) (MATLAB findstates).");
   m.def("simulate_from_state", &SimulateFromState, "sys"_a, "u"_a, "x0"_a,
         "Output (N x ny) of the discrete StateSpace sys from initial state x0 for input u.");
-  m.def("rmse", &Rmse, "y"_a, "yhat"_a);
+  m.def("rmse", &Rmse, "y"_a, "yhat"_a,
+        "Root mean square error of yhat against y (output units). Raises InvalidArgument when "
+        "the sizes differ, y is empty or a value is not finite.");
   m.def(
       "analyze_step",
       [](const Dataset& data, int input, int output) {

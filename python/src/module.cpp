@@ -48,6 +48,12 @@ PYBIND11_MODULE(pneumid, m) {
   static py::exception<pneumid::InvalidArgument> invalid_argument(m, "InvalidArgument",
                                                                   PyExc_ValueError);
   static py::exception<pneumid::DataError> data_error(m, "DataError", PyExc_RuntimeError);
+  invalid_argument.attr("__doc__") =
+      "An argument or option violates its documented precondition (a ValueError); the message "
+      "states the violated condition and the offending values.";
+  data_error.attr("__doc__") =
+      "Input data (a file, a column, a sample) cannot be used (a RuntimeError); the message "
+      "names where the problem is, e.g. \"data.csv:12: column 'y': not a number: 'abc'\".";
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);

@@ -34,11 +34,16 @@ void BindNonlinear(py::module_& m) {
                  return StaticMap(std::move(u), std::move(y),
                                   StaticMapExtrapolationFromString(extrapolation));
                }),
-           "u"_a, "y"_a, "extrapolation"_a = "clamp")
-      .def_property_readonly("u", &StaticMap::u)
-      .def_property_readonly("y", &StaticMap::y)
-      .def_property_readonly("extrapolation",
-                             [](const StaticMap& f) { return ToString(f.extrapolation()); })
+           "u"_a, "y"_a, "extrapolation"_a = "clamp",
+           "Map through the knots (u[i], y[i]). Raises InvalidArgument for lengths that "
+           "differ, fewer than 2 knots, non-finite values, u not strictly increasing or an "
+           "unknown extrapolation.")
+      .def_property_readonly("u", &StaticMap::u, "Knot inputs, strictly increasing (list).")
+      .def_property_readonly("y", &StaticMap::y, "Values at the knots (list).")
+      .def_property_readonly(
+          "extrapolation", [](const StaticMap& f) { return ToString(f.extrapolation()); },
+          "Beyond the first and last knot: 'clamp' (the end values) or 'linear' (the end "
+          "segments continued).")
       .def("evaluate", py::overload_cast<double>(&StaticMap::Evaluate, py::const_), "u"_a,
            "f(u) for a number.")
       .def("evaluate", py::overload_cast<const Eigen::VectorXd&>(&StaticMap::Evaluate, py::const_),
@@ -46,8 +51,12 @@ void BindNonlinear(py::module_& m) {
       .def("inverse", &StaticMap::Inverse, "y"_a,
            "The input giving output y: the upper edge of a dead zone, the start of a "
            "saturation, clamped to the knots. Raises ValueError for a map that is not monotone.")
-      .def("is_monotone", &StaticMap::IsMonotone)
-      .def("direction", [](const StaticMap& f) { return ToString(f.Direction()); })
+      .def("is_monotone", &StaticMap::IsMonotone,
+           "True when y is non-decreasing or non-increasing in u and not constant (inverse is "
+           "defined).")
+      .def(
+          "direction", [](const StaticMap& f) { return ToString(f.Direction()); },
+          "'increasing', 'decreasing' (flat segments allowed), 'constant' or 'not monotone'.")
       .def(
           "dead_zone", [](const StaticMap& f, double tol) { return FlatToPython(f.DeadZone(tol)); },
           "tolerance"_a = 0.0,
@@ -56,8 +65,13 @@ void BindNonlinear(py::module_& m) {
           "saturation",
           [](const StaticMap& f, double tol) { return FlatToPython(f.Saturation(tol)); },
           "tolerance"_a = 0.0, "The flat run at the high input end, or None.")
-      .def("describe", &StaticMap::Describe, "tolerance"_a = 0.0)
-      .def("to_dict", [](const StaticMap& f) { return JsonToPython(ToJson(f)); })
+      .def("describe", &StaticMap::Describe, "tolerance"_a = 0.0,
+           "One line: direction, knots, ranges, dead zone and saturation (flat runs within "
+           "`tolerance`, output units), e.g. 'monotone increasing, 3 knots on u in [0, 2], y in "
+           "[0, 1], dead zone u in [0, 1] (y = 0)'.")
+      .def(
+          "to_dict", [](const StaticMap& f) { return JsonToPython(ToJson(f)); },
+          "{'u': [...], 'y': [...], 'extrapolation'} as in pneumid's model files.")
       .def("__repr__", [](const StaticMap& f) { return "<StaticMap " + f.Describe() + ">"; });
 
   m.def("nonlinear_methods", &NonlinearMethodNames,

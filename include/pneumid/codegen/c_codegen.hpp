@@ -66,13 +66,17 @@
 
 namespace pneumid {
 
+/// Floating-point type of the generated tables and arithmetic: C `double` or `float`
+/// (single precision for an FPU such as the Cortex-M4F's).
 enum class CodegenPrecision { kDouble, kFloat };
 /// "double", "float".
 std::string ToString(CodegenPrecision precision);
 /// Inverse of ToString; throws InvalidArgument listing the valid names.
 CodegenPrecision CodegenPrecisionFromString(const std::string& name);
 
+/// Options of GenerateC: precision, names, RAM budget, QP cap and the target's timing.
 struct CodegenOptions {
+  /// Type of the tables and the arithmetic (double reproduces the library to rounding).
   CodegenPrecision precision = CodegenPrecision::kDouble;
   /// Prefix of every exported name and of the file names: a C identifier of
   /// at most 32 characters (letters, digits, '_', not starting with a digit).
@@ -88,7 +92,7 @@ struct CodegenOptions {
   /// Ts). With a clock, the QP's iteration cap is the largest whose worst
   /// case fits in `utilization` of the period (and at most the cap above).
   double cpu_mhz = 0.0;
-  double period = 0.0;
+  double period = 0.0;  ///< control period in s for the certificate (0 = the controller's Ts)
   /// Fraction of the period the controller may take (the rest is the ADC,
   /// the PWM, communication and interrupts).
   double utilization = 0.5;
@@ -96,6 +100,9 @@ struct CodegenOptions {
   /// runs most instructions in one cycle; loads, multi-cycle FPU
   /// divisions/square roots, branches and flash wait states raise the mean.
   double cycles_per_instruction = 1.5;
+  /// True when cpu_mhz, period >= 0, utilization in (0, 1], cycles_per_instruction >= 1,
+  /// qp_max_iterations >= -1 and prefix is a C identifier of 1..32 characters; otherwise
+  /// false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -114,22 +121,26 @@ struct CodegenOptions {
 /// test tests/target/cortex_m4_test.sh checks that every scenario's measured
 /// worst step stays below the certificate.
 struct RealTimeCertificate {
+  /// Instructions per counted operation unit in single precision (measured upper bound).
   static constexpr double kInstructionsPerUnit = 6.0;
+  /// Constant allowance of instructions per step, added to the scaled units.
   static constexpr double kInstructionsFixed = 400.0;
   /// Double precision in software on the M4F's single-precision FPU (the
   /// paper's DMC: 17 times the instructions of float).
   static constexpr double kDoubleFactor = 20.0;
-  bool present = false;  ///< a clock was given
-  double cpu_mhz = 0.0;
-  double period = 0.0;  ///< s
-  double utilization = 0.0;
-  double cycles_per_instruction = 0.0;
+  bool present = false;      ///< a clock was given
+  double cpu_mhz = 0.0;      ///< target clock in MHz (CodegenOptions::cpu_mhz; 0 without one)
+  double period = 0.0;       ///< s
+  double utilization = 0.0;  ///< fraction of the period granted to the step
+  double cycles_per_instruction = 0.0;  ///< assumed mean cycles per instruction
   /// The largest number of QP iterations a step can run (0: no QP).
   int qp_max_iterations = 0;
   /// PFX_QP_MAX_ITERATIONS in the module: the design's cap (0: automatic, at
   /// most qp_max_iterations) without a clock, qp_max_iterations with one.
   int qp_define = 0;
-  double base_units = 0.0, qp_init_units = 0.0, qp_iteration_units = 0.0;
+  double base_units = 0.0,       ///< operation units of the step outside the QP (with the guard)
+      qp_init_units = 0.0,       ///< units of the QP's set-up and first scan (0: no QP)
+      qp_iteration_units = 0.0;  ///< units of one dual active-set iteration (0: no QP)
   double instructions_per_unit = 0.0;  ///< kInstructionsPerUnit, times kDoubleFactor in double
   double max_instructions = 0.0;       ///< per step, at the cap
   double max_cycles = 0.0;             ///< max_instructions * cycles_per_instruction
@@ -137,10 +148,11 @@ struct RealTimeCertificate {
   double max_time = 0.0;               ///< s, max_cycles / clock
 };
 
+/// The generated C module (texts of the files) and its resource figures.
 struct CodegenResult {
-  ControllerType type = ControllerType::kDmc;
-  CodegenPrecision precision = CodegenPrecision::kDouble;
-  std::string prefix;
+  ControllerType type = ControllerType::kDmc;  ///< the linear controller inside the layers
+  CodegenPrecision precision = CodegenPrecision::kDouble;  ///< CodegenOptions::precision
+  std::string prefix;  ///< CodegenOptions::prefix: NAME of the files and exported names
   std::string header;  ///< NAME.h
   std::string source;  ///< NAME.c
   std::string readme;  ///< README.md of the interface

@@ -23,10 +23,11 @@
 
 namespace pneumid {
 
+/// One entry of an enum's name table: a value and one of its names.
 template <typename E>
 struct EnumName {
-  E value;
-  std::string_view name;
+  E value;                ///< the enumerator
+  std::string_view name;  ///< its spelling in files, the CLI and Python (first entry = written)
 };
 
 /// The first name of `value` in `table`, or "unknown" for a value not listed.

@@ -30,8 +30,11 @@ namespace pneumid {
 ///         or "<what>: no values" for an empty list.
 std::vector<double> ParseNumberList(std::string_view what, std::string_view text);
 
+/// A parsed `kind:key=value,...` spec whose fields are consumed by Number, List, Text
+/// and checked by Finish (grammar above).
 class Spec {
  public:
+  /// How the text is split into kind, head and items.
   struct Options {
     /// Text before the first ':' is the kind (lower-cased); without ':' the
     /// whole text is the kind. When false the whole text is the body.
@@ -44,17 +47,23 @@ class Spec {
   /// @throws InvalidArgument for an item that is not key=value, a key given
   ///         twice or an empty key.
   Spec(std::string what, std::string_view text, Options options);
+  /// As above with the default Options (a kind before ':', no head).
   Spec(std::string what, std::string_view text) : Spec(std::move(what), text, Options{}) {}
 
-  const std::string& text() const { return text_; }
+  const std::string& text() const { return text_; }  ///< the whole spec, trimmed
+  /// Text before the first ':', trimmed and lower-cased (empty without has_kind).
   const std::string& kind() const { return kind_; }
+  /// The positional first item (has_head), e.g. the path of `file:PATH`; else empty.
   const std::string& head() const { return head_; }
   /// "what 'text'", the prefix of every message about this spec.
   std::string Context() const;
 
+  /// True when `key` was given; records the key as one the kind reads (for Finish's list).
   bool Has(const std::string& key);
   /// A finite number. @throws InvalidArgument when missing or not a number.
   double Number(const std::string& key);
+  /// The finite number of `key`, or `fallback` when the key is absent.
+  /// @throws InvalidArgument when present but not a finite number.
   double Number(const std::string& key, double fallback);
   /// Like Number but accepting +-inf (bounds such as min=, max=).
   double Bound(const std::string& key, double fallback);
@@ -62,6 +71,7 @@ class Spec {
   std::vector<double> List(const std::string& key);
   /// The raw text of a value (trimmed).
   std::string Text(const std::string& key);
+  /// The raw text of `key` (trimmed), or `fallback` when the key is absent.
   std::string Text(const std::string& key, const std::string& fallback);
   /// @throws InvalidArgument naming the first key that was given but never
   ///         read, and listing the keys that were read.

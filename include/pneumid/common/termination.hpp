@@ -9,6 +9,7 @@
 
 namespace pneumid {
 
+/// How a computation ended (the `termination` of every summary); see IsSuccess.
 enum class Termination {
   kConvergence,    ///< "convergence": an estimator converged (or solved in closed form)
   kNoConvergence,  ///< "no_convergence": iteration limit reached; the last iterate is returned

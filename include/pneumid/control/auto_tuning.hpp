@@ -100,10 +100,13 @@ std::string ToString(ResponseMeasure measure);
 /// Inverse of ToString; throws InvalidArgument listing the valid names.
 ResponseMeasure ResponseMeasureFromString(const std::string& name);
 
+/// Outcome of one design-review check: passed, passed with a warning (e.g. a Hessian
+/// condition number above 1e4), or failed (the termination is then not kConverged).
 enum class ReviewStatus { kOk, kWarning, kFail };
 /// "ok", "warning", "fail".
 std::string ToString(ReviewStatus status);
 
+/// How AutoTune ended.
 enum class AutoTuneTermination {
   kConverged,   ///< every check passed
   kSpecNotMet,  ///< the best design found misses the specification (review says why)
@@ -112,11 +115,14 @@ enum class AutoTuneTermination {
 /// "converged", "spec_not_met", "failure".
 std::string ToString(AutoTuneTermination termination);
 
+/// Specification of AutoTune: controller type, response time, overshoot, aggressiveness
+/// and input limits.
 struct AutoTuneOptions {
   /// mpc, dmc or pid (gpc is not tuned this way).
   ControllerType controller = ControllerType::kMpc;
   /// Target response time (s, > 0); NaN = from the model (file comment).
   double response_time = std::numeric_limits<double>::quiet_NaN();
+  /// Whether response_time is a 10-90 % rise time (default) or a 2 % settling time.
   ResponseMeasure measure = ResponseMeasure::kRise;
   /// Maximum overshoot of a set-point step (percent, >= 0).
   double max_overshoot = 5.0;
@@ -129,7 +135,9 @@ struct AutoTuneOptions {
   /// mpc: the estimator's disturbance model, used in the evaluation as in
   /// the controller it designs (mpc.hpp).
   DisturbanceModel disturbance = DisturbanceModel::kInput;
-  /// True when the options are usable; otherwise false and *error says why.
+  /// True when the options are usable (controller not gpc, response_time NaN or > 0,
+  /// max_overshoot >= 0, aggressiveness in [0, 1], valid limits with u_min < u_max, M >= 0);
+  /// otherwise false and *error says why (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -140,28 +148,35 @@ struct PredictedMetrics {
   double settling_time = std::numeric_limits<double>::quiet_NaN();      ///< s, 2 %
   /// The one the specification measures (rise or settling time).
   double response_time = std::numeric_limits<double>::quiet_NaN();
+  /// Smallest applied input (deviation from the start, input units).
   double u_min = 0.0, u_max = 0.0;  ///< applied input range (deviation from the start)
-  bool settled = false;
+  bool settled = false;  ///< the output settled in the 2 % band within the window (finite)
 };
 
+/// The evaluation step repeated on a perturbed plant (model error).
 struct RobustnessRow {
   std::string name;  ///< "gain +20%", "gain -20%", "dead time +1 sample"
-  PredictedMetrics metrics;
+  PredictedMetrics metrics;  ///< step metrics on the perturbed plant
+  /// The loop settles, overshoots at most OS_rob and responds within t_rob.
   bool pass = false;
 };
 
+/// One check of the design review.
 struct ReviewItem {
   std::string check;  ///< e.g. "nominal stability"
-  ReviewStatus status = ReviewStatus::kOk;
-  std::string message;
+  ReviewStatus status = ReviewStatus::kOk;  ///< ok, warning or fail
+  std::string message;  ///< what was measured and, for a warning or fail, why it matters
 };
 
+/// Settings chosen by AutoTune, the specification as used, the predicted closed-loop
+/// behaviour, the robustness rows and the design review.
 struct AutoTuneResult {
-  ControllerType controller = ControllerType::kMpc;
-  double Ts = 0.0;
+  ControllerType controller = ControllerType::kMpc;  ///< the type designed (mpc, dmc or pid)
+  double Ts = 0.0;  ///< sample time of the design, s
   /// mpc/dmc settings.
   int P = 0;
-  int M = 0;
+  int M = 0;  ///< control horizon, samples (mpc/dmc)
+  /// Move suppression lambda* (mpc/dmc; NaN for pid), see the file comment.
   double lambda = std::numeric_limits<double>::quiet_NaN();
   /// pid settings (Ti infinite = no integral action).
   PidGains pid;
@@ -179,21 +194,22 @@ struct AutoTuneResult {
   /// the fastest robust design (JSON specification.response_time_source).
   bool fastest = false;
   double response_time_aimed = 0.0;  ///< t* after the knob
-  ResponseMeasure measure = ResponseMeasure::kRise;
-  double max_overshoot = 0.0;
-  double aggressiveness = 0.0;
+  ResponseMeasure measure = ResponseMeasure::kRise;  ///< rise or settling time, as given
+  double max_overshoot = 0.0;   ///< OS, percent, as given
+  double aggressiveness = 0.0;  ///< a in [0, 1], as given
   double robust_overshoot = 0.0;      ///< OS_rob
   double robust_response_time = 0.0;  ///< t_rob
-  FopdtEstimate fopdt;
+  FopdtEstimate fopdt;  ///< K, tau, theta of the model (FopdtFromModel)
   /// The evaluation step (deviation from the operating point at the start).
-  double step_from = 0.0, step_to = 1.0;
-  PredictedMetrics predicted;
-  std::vector<RobustnessRow> robustness;
-  std::vector<ReviewItem> review;
+  double step_from = 0.0, step_to = 1.0;  ///< set-point after the step (output units)
+  PredictedMetrics predicted;  ///< nominal step metrics of the chosen settings
+  std::vector<RobustnessRow> robustness;  ///< gain +20 %, gain -20 %, dead time +1 sample
+  std::vector<ReviewItem> review;  ///< the checks of the design review (file comment)
   double hessian_condition = std::numeric_limits<double>::quiet_NaN();   ///< mpc/dmc
   double steady_state_error = std::numeric_limits<double>::quiet_NaN();  ///< after the load step
   int evaluations = 0;  ///< closed-loop simulations run
-  AutoTuneTermination termination = AutoTuneTermination::kFailure;
+  AutoTuneTermination termination = AutoTuneTermination::kFailure;  ///< see the review
+  /// "specification met (N closed-loop simulations)", or the failed checks.
   std::string message;
 
   /// The TuningResult of these settings (rule explicit; mpc/dmc), for

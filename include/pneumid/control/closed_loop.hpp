@@ -64,6 +64,7 @@
 
 namespace pneumid {
 
+/// A step of load disturbance added to the plant output from time `at` on.
 struct LoadStep {
   double at = 0.0;    ///< s
   double size = 0.0;  ///< output units, added to the disturbance from `at` on
@@ -78,9 +79,10 @@ double LoadAt(const std::vector<LoadStep>& steps, double t, double Ts);
 /// unknown or not a number, or at is negative or not finite.
 LoadStep ParseLoadStep(const std::string& what, const std::string& spec);
 
+/// Duration, disturbances, noise and actuator limits of a closed-loop simulation.
 struct ClosedLoopOptions {
   double duration = 1.0;  ///< s (> 0)
-  std::vector<LoadStep> load_steps;
+  std::vector<LoadStep> load_steps;  ///< load disturbance steps (none by default)
   double noise_std = 0.0;  ///< measurement noise standard deviation (output units)
   std::uint64_t seed = 1;  ///< noise seed
   /// Actuator limits applied after the controller (infinite = none).
@@ -95,20 +97,29 @@ struct ClosedLoopOptions {
   double settling_threshold = 0.02;
   /// Record the wall-clock time of every Update() call.
   bool time_updates = false;
+  /// True when duration > 0, the load steps have finite at >= 0 and size, noise_std >= 0,
+  /// u0 is finite, settling_threshold is in (0, 1) and actuator is valid; otherwise false
+  /// with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Response metrics of one set-point change (see the file comment).
 struct StepMetrics {
   double time = 0.0;  ///< s, when the set-point changed
-  double from = 0.0;
-  double to = 0.0;
+  double from = 0.0;  ///< set-point before the change (output units)
+  double to = 0.0;    ///< set-point after the change (output units)
+  /// 10-90 % rise time, s from the change (NaN when not reached).
   double rise_time = std::numeric_limits<double>::quiet_NaN();
+  /// Peak beyond `to` in percent of |to - from| (0 without overshoot).
   double overshoot_percent = std::numeric_limits<double>::quiet_NaN();
+  /// Time from the change until |y - r| stays within settling_band, s; NaN when unsettled.
   double settling_time = std::numeric_limits<double>::quiet_NaN();
   double steady_state_error = std::numeric_limits<double>::quiet_NaN();  ///< end of the segment
+  /// u_k - u_{k-1} at the change (input units): the first move the controller makes.
   double first_move = std::numeric_limits<double>::quiet_NaN();
   double settling_band = std::numeric_limits<double>::quiet_NaN();  ///< output units (see above)
   double ripple = std::numeric_limits<double>::quiet_NaN();  ///< measured ripple peak-to-peak
+  /// The output entered the band before the last 10 % of the segment and stayed in it.
   bool settled = false;
 
   /// {time, from, to, rise_time, overshoot_percent, settling_time,
@@ -117,22 +128,36 @@ struct StepMetrics {
   nlohmann::ordered_json ToJson() const;
 };
 
+/// Metrics of a whole run: the worst step, the error integrals, the input effort and the
+/// load rejection (see the file comment).
 struct ClosedLoopMetrics {
+  /// 10-90 % rise time of the first set-point step, s.
   double rise_time = std::numeric_limits<double>::quiet_NaN();
+  /// Largest overshoot over the steps, percent of the step size.
   double overshoot_percent = std::numeric_limits<double>::quiet_NaN();
+  /// Longest settling time over the steps, s (NaN when a step did not settle).
   double settling_time = std::numeric_limits<double>::quiet_NaN();
+  /// r - y averaged over the end of the final set-point segment (output units).
   double steady_state_error = std::numeric_limits<double>::quiet_NaN();
+  /// u_k - u_{k-1} at the first set-point change (input units).
   double first_move = std::numeric_limits<double>::quiet_NaN();
   double settling_band = std::numeric_limits<double>::quiet_NaN();  ///< of the worst-settling step
   bool settled = false;                                             ///< every step settled
   int worst_overshoot_step = -1;  ///< index into steps of overshoot_percent (-1: none)
   int worst_settling_step = -1;   ///< index into steps of settling_time / settled (-1: none)
-  double iae = 0.0, ise = 0.0, itae = 0.0;
-  double tv_u = 0.0;
-  double u_min = 0.0, u_max = 0.0;
+  /// IAE = sum |e| Ts (output units s), with e = r - y without the measurement noise.
+  double iae = 0.0, ise = 0.0, itae = 0.0;  ///< ITAE = sum t |e| Ts (output units s^2)
+  /// @var ise
+  /// ISE = sum e^2 Ts (output units^2 s).
+  double tv_u = 0.0;  ///< total variation of the input, sum |u_k - u_{k-1}| (input units)
+  /// Smallest applied input over the run (input units).
+  double u_min = 0.0, u_max = 0.0;  ///< largest applied input over the run (input units)
+  /// Largest |y - r| after the first load step, with its sign (output units).
   double load_peak_deviation = std::numeric_limits<double>::quiet_NaN();
+  /// Time from the first load step until |y - r| stays within max(2 % of the load,
+  /// 3 noise_std), s; NaN when it never does.
   double load_recovery_time = std::numeric_limits<double>::quiet_NaN();
-  std::vector<StepMetrics> steps;
+  std::vector<StepMetrics> steps;  ///< one per set-point change, in time order
 
   /// The metrics of `pneumid control --json` and `pneumid run --json`:
   /// rise_time, overshoot_percent, settling_time, steady_state_error,
@@ -143,6 +168,7 @@ struct ClosedLoopMetrics {
   nlohmann::ordered_json ToJson() const;
 };
 
+/// Signals of a closed-loop simulation, one entry per sample, and their metrics.
 struct ClosedLoopResult {
   Eigen::VectorXd t;               ///< s
   Eigen::VectorXd r;               ///< set-point
@@ -152,7 +178,7 @@ struct ClosedLoopResult {
   Eigen::VectorXd u_requested;     ///< the controller's input before the actuator limits
   Eigen::VectorXd d;               ///< load disturbance
   Eigen::VectorXd update_seconds;  ///< per Update() (empty unless time_updates)
-  ClosedLoopMetrics metrics;
+  ClosedLoopMetrics metrics;  ///< metrics of the run (see the file comment)
   std::string controller;  ///< controller.Describe()
   std::string plant;       ///< plant.Describe()
 };

@@ -13,6 +13,8 @@
 
 namespace pneumid {
 
+/// The feedback controllers of the toolkit: dynamic matrix control, generalized predictive
+/// control, PID, and state-space MPC with an estimator.
 enum class ControllerType { kDmc, kGpc, kPid, kMpc };
 
 /// "dmc", "gpc", "pid", "mpc".
@@ -24,8 +26,9 @@ ControllerType ControllerTypeFromString(const std::string& name);
 /// and its change per sample |u_k - u_{k-1}| <= du_max (input units; infinite
 /// values switch a limit off).
 struct InputLimits {
-  double u_min = -std::numeric_limits<double>::infinity();
-  double u_max = std::numeric_limits<double>::infinity();
+  double u_min = -std::numeric_limits<double>::infinity();  ///< lowest input (default: none)
+  double u_max = std::numeric_limits<double>::infinity();   ///< highest input (default: none)
+  /// Largest change of the input per sample, > 0 (default: none).
   double du_max = std::numeric_limits<double>::infinity();
   /// True when u_min <= u_max, du_max > 0 and nothing is NaN.
   bool IsValid(std::string* error) const;
@@ -60,7 +63,7 @@ struct MeasurementGuard {
   /// The range of measurements a working sensor gives (plant units); the
   /// default accepts every finite value.
   double y_min = -std::numeric_limits<double>::infinity();
-  double y_max = std::numeric_limits<double>::infinity();
+  double y_max = std::numeric_limits<double>::infinity();  ///< upper end of that range
   /// The input applied while the samples are faulty (e.g. the valves'
   /// vented state); NaN holds the last valid input. It is applied as is,
   /// outside the controller's limits, and the controller takes it as its own
@@ -101,6 +104,7 @@ class Controller {
 
   /// @throws InvalidArgument for an invalid guard (the message names the field).
   void SetMeasurementGuard(const MeasurementGuard& guard);
+  /// The guard in use (the default accepts every finite sample).
   const MeasurementGuard& measurement_guard() const { return guard_; }
   /// The fault of the last Update() (kNone after a valid sample).
   ControllerFault last_fault() const { return last_fault_; }

@@ -34,22 +34,25 @@
 
 namespace pneumid {
 
+/// Everything MakeController needs to design a controller, names parsed (see
+/// ControllerSettings for the user-facing form).
 struct ControllerSpec {
-  ControllerType type = ControllerType::kDmc;
+  ControllerType type = ControllerType::kDmc;  ///< which controller (default dmc)
   TuningOptions tuning;  ///< P, M, lambda (dmc, gpc, mpc)
-  InputLimits limits;
+  InputLimits limits;    ///< limits on the plant input u (default: none)
   bool constrained = false;                                 ///< dmc: QDMC with the QP solver
   double y_min = -std::numeric_limits<double>::infinity();  ///< soft output bounds (QDMC, mpc)
-  double y_max = std::numeric_limits<double>::infinity();
-  std::string t_filter = "1";  ///< gpc
-  PidTuningRule pid_rule = PidTuningRule::kSimc;
+  double y_max = std::numeric_limits<double>::infinity();   ///< upper soft output bound
+  /// gpc: T filter: "1" (none), "A" (T = A) or monic coefficients such as "1 -0.8".
+  std::string t_filter = "1";
+  PidTuningRule pid_rule = PidTuningRule::kSimc;  ///< pid tuning rule (default SIMC)
   double tau_c = 0.0;  ///< pid closed-loop time constant (s); <= 0 = rule default
   DisturbanceModel disturbance = DisturbanceModel::kInput;  ///< mpc (mpc.hpp)
   /// Tune from specifications (auto_tuning.hpp) instead of the tuning rule:
   /// mpc and dmc get P, M, lambda, pid its gains; auto_options.controller and
   /// .limits are taken from type and limits.
   bool auto_tune = false;
-  AutoTuneOptions auto_options;
+  AutoTuneOptions auto_options;  ///< the specification when auto_tune is set
   /// The actuator's static map f (a Hammerstein model's input map): the
   /// controller is designed on the linear part with input v = f(u), limits
   /// InnerLimits(f, limits), and runs behind f's inverse
@@ -79,18 +82,19 @@ struct ControllerSettings {
   int P = 0;  ///< prediction horizon override (0 = the rule's)
   int M = 0;  ///< control horizon override (0 = the rule's)
   double lambda = std::numeric_limits<double>::quiet_NaN();  ///< override (NaN = the rule's)
-  InputLimits limits;
-  bool constrained = false;
+  InputLimits limits;  ///< limits on the plant input u (default: none)
+  bool constrained = false;  ///< dmc: QDMC with the QP solver
+  /// Soft lower output bound (QDMC, mpc); -inf = none.
   double y_min = -std::numeric_limits<double>::infinity();
-  double y_max = std::numeric_limits<double>::infinity();
-  std::string t_filter = "1";
-  std::string pid_rule = "simc";
-  double tau_c = 0.0;
+  double y_max = std::numeric_limits<double>::infinity();  ///< soft upper output bound
+  std::string t_filter = "1";  ///< gpc T filter: "1", "A" or coefficients ("1 -0.8")
+  std::string pid_rule = "simc";  ///< pid tuning rule: "simc" or "imc"
+  double tau_c = 0.0;  ///< pid closed-loop time constant (s); <= 0 = the rule's default
   std::string disturbance = "input";  ///< mpc: input, output or none
   /// rule "auto": the specifications (auto_tuning.hpp; NaN = from the model).
   double response_time = std::numeric_limits<double>::quiet_NaN();
-  double overshoot = 5.0;
-  double aggressiveness = 0.5;
+  double overshoot = 5.0;        ///< rule "auto": maximum overshoot, percent (default 5)
+  double aggressiveness = 0.5;   ///< rule "auto": 0 robust .. 1 aggressive (default 0.5)
   /// A file with the actuator's static map (lti/model_io.hpp ReadStaticMap:
   /// a static-map or Hammerstein model file, or {"u", "y"}); empty = none,
   /// or the model file's own input map (WithModelInputMap).
@@ -98,8 +102,8 @@ struct ControllerSettings {
   /// The range of valid measurements (MeasurementGuard; infinite = any
   /// finite value) and the input on a faulty sample (NaN = hold).
   double y_valid_min = -std::numeric_limits<double>::infinity();
-  double y_valid_max = std::numeric_limits<double>::infinity();
-  double safe_input = std::numeric_limits<double>::quiet_NaN();
+  double y_valid_max = std::numeric_limits<double>::infinity();  ///< upper valid measurement
+  double safe_input = std::numeric_limits<double>::quiet_NaN();  ///< input on faults (NaN = hold)
 };
 
 /// The tuning rule settings ask for: the named rule when `rule` is not empty;
@@ -127,9 +131,11 @@ ControllerSpec WithModelInputMap(ControllerSpec spec, const std::string& model_s
 /// @throws as ParseModelSpec and ParseModelNarx.
 TransferFunction ParseControllerModel(const std::string& model_spec);
 
+/// A designed controller with the settings it was designed with.
 struct BuiltController {
+  /// The controller to run, wrapped in the input map, NARX or output map layers, if any.
   std::unique_ptr<Controller> controller;
-  ControllerType type = ControllerType::kDmc;
+  ControllerType type = ControllerType::kDmc;  ///< the type of the core controller
   TuningResult tuning;                            ///< horizons and lambda (dmc, gpc, mpc)
   PidTuningRule pid_rule = PidTuningRule::kSimc;  ///< (pid)
   PidGains pid_gains;                             ///< (pid)

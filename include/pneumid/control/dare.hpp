@@ -43,6 +43,7 @@
 
 namespace pneumid {
 
+/// Outcome of SolveDare.
 enum class DareStatus {
   kConverged,         ///< X found, residual small, closed loop stable
   kMaxIterations,     ///< the doubling did not converge within the cap
@@ -55,16 +56,20 @@ std::string ToString(DareStatus status);
 /// Inverse of ToString; throws InvalidArgument listing the valid names.
 DareStatus DareStatusFromString(const std::string& name);
 
+/// Stopping rule of the doubling iteration.
 struct DareOptions {
   int max_iterations = 100;  ///< doubling steps (each squares the convergence factor)
   double tolerance = 1e-13;  ///< relative change of H_k that counts as converged
+  /// True when max_iterations >= 1 and tolerance is in (0, 1); otherwise false with the
+  /// reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// How the DARE solve ended and how good the solution is.
 struct DareSummary {
-  DareStatus status = DareStatus::kNumericalFailure;
-  std::string message;
-  int iterations = 0;
+  DareStatus status = DareStatus::kNumericalFailure;  ///< see DareStatus
+  std::string message;  ///< why it did not converge (empty or a short note otherwise)
+  int iterations = 0;   ///< doubling steps taken
   /// ||X - (right-hand side of (1))||_F / max(1, ||X||_F).
   double residual = 0.0;
   /// Spectral radius of A - B K.
@@ -73,10 +78,11 @@ struct DareSummary {
   std::string BriefReport() const;
 };
 
+/// Solution of the DARE with its feedback gain and the solve's summary.
 struct DareResult {
   Eigen::MatrixXd X;  ///< solution (n x n, symmetric); the last iterate unless converged
   Eigen::MatrixXd K;  ///< (R + B'XB)^-1 B'XA (m x n)
-  DareSummary summary;
+  DareSummary summary;  ///< status, iterations, residual and closed-loop spectral radius
 };
 
 /// Solves (1) by the SDA. Numerical failure is reported in the summary.

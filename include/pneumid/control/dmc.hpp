@@ -48,6 +48,7 @@
 
 namespace pneumid {
 
+/// Horizons, weights, limits and (QDMC) constraint settings of the dynamic matrix controller.
 struct DmcOptions {
   int P = 126;           ///< prediction horizon (samples)
   int M = 5;             ///< control horizon (samples), 1 <= M <= P
@@ -67,14 +68,20 @@ struct DmcOptions {
   bool constrained = false;
   /// Soft output bounds (constrained only; infinite = none).
   double y_min = -std::numeric_limits<double>::infinity();
-  double y_max = std::numeric_limits<double>::infinity();
+  double y_max = std::numeric_limits<double>::infinity();  ///< soft upper output bound
   /// Slack penalty rho1 e + rho2/2 e^2 (output units; rho1 >= 0, rho2 > 0).
   double slack_linear_weight = 1e4;
-  double slack_quadratic_weight = 1e2;
-  QpSolverOptions qp;
+  double slack_quadratic_weight = 1e2;  ///< rho2 of the slack penalty (> 0, default 100)
+  QpSolverOptions qp;  ///< the active-set QP solver's settings (constrained only)
+  /// True when 1 <= M <= P, lambda is finite and >= 0, the weight vectors are empty or of
+  /// sizes P and M with positive entries, model_horizon >= 0, limits are valid, y_min <=
+  /// y_max, the slack weights are as stated and qp is valid; otherwise false with the
+  /// reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Dynamic matrix control (DMC, or QDMC when constrained) on the step response of a
+/// stable model, with the output-disturbance feedback of the prediction.
 class DmcController : public Controller {
  public:
   /// Design from a sampled model (no further discretization).
@@ -91,7 +98,7 @@ class DmcController : public Controller {
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
 
-  const DmcOptions& options() const { return options_; }
+  const DmcOptions& options() const { return options_; }  ///< The options as designed.
   /// s_0..s_N.
   const Eigen::VectorXd& step_coefficients() const { return step_; }
   /// A (P x M).

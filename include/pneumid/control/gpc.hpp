@@ -47,6 +47,7 @@
 
 namespace pneumid {
 
+/// Horizons, move weighting, observer polynomial and input limits of GPC.
 struct GpcOptions {
   int N1 = 1;            ///< first predicted sample (>= 1)
   int N2 = 126;          ///< last predicted sample (>= N1)
@@ -61,6 +62,9 @@ struct GpcOptions {
   /// Input limits: the computed input is clipped to them and the histories
   /// record the input really applied.
   InputLimits limits;
+  /// True when 1 <= N1 <= N2, 1 <= Nu <= N2, lambda is finite and >= 0, a given
+  /// t_polynomial is monic and finite (unless t_equals_a) and limits are valid; otherwise
+  /// false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -68,7 +72,7 @@ struct GpcOptions {
 struct CarimaModel {
   Eigen::VectorXd A;  ///< monic denominator 1 + a1 q^-1 + ...
   Eigen::VectorXd B;  ///< numerator of u(t-1): b0 + b1 q^-1 + ... (delay as leading zeros)
-  double Ts = 0.0;
+  double Ts = 0.0;    ///< sample time, s
 };
 
 /// CARIMA form of a sampled model.
@@ -79,6 +83,8 @@ CarimaModel ToCarima(const PredictionModel& model);
 /// direct feedthrough.
 CarimaModel ToCarima(const TransferFunction& model, double Ts);
 
+/// Generalized predictive control on the CARIMA form of a sampled model (unconstrained;
+/// the input is clipped to the limits).
 class GpcController : public Controller {
  public:
   /// Design from a sampled model (no further discretization).
@@ -91,14 +97,15 @@ class GpcController : public Controller {
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
 
-  const GpcOptions& options() const { return options_; }
-  const CarimaModel& carima() const { return model_; }
+  const GpcOptions& options() const { return options_; }  ///< The options as designed.
+  const CarimaModel& carima() const { return model_; }    ///< The CARIMA model A, B, Ts.
   /// Dynamic matrix G ((N2-N1+1) x Nu).
   const Eigen::MatrixXd& dynamic_matrix() const { return G_; }
   /// Rows F_j (j = N1..N2) acting on y_f(t), y_f(t-1), ...
   const Eigen::MatrixXd& f_matrix() const { return F_; }
   /// Rows Gamma_j acting on Delta u_f(t-1), Delta u_f(t-2), ...
   const Eigen::MatrixXd& gamma_matrix() const { return Gamma_; }
+  /// k' (1 x (N2-N1+1)), the first row of (G'G + lambda I)^-1 G'.
   const Eigen::RowVectorXd& gain() const { return gain_; }
   /// Sum of the entries of k' (the set-point's gain).
   double gain_sum() const { return gain_sum_; }
@@ -106,8 +113,10 @@ class GpcController : public Controller {
   const Eigen::VectorXd& t_polynomial() const { return T_; }
   /// Lengths of the stored histories of y_f and Delta u_f.
   Eigen::Index y_history_length() const { return yf_hist_.size(); }
-  Eigen::Index move_history_length() const { return duf_hist_.size(); }
+  Eigen::Index move_history_length() const { return duf_hist_.size(); }  ///< See above.
+  /// Free response f = F y_f + Gamma Delta u_f (N2-N1+1 entries) of the last Update().
   const Eigen::VectorXd& free_response() const { return free_; }
+  /// Delta u of the last Update() as applied (clipped, corrected by Applied()), input units.
   double last_move() const { return last_du_; }
 
  protected:

@@ -39,6 +39,7 @@ namespace pneumid {
 /// not monotone or invalid limits.
 InputLimits InnerLimits(const StaticMap& map, const InputLimits& limits);
 
+/// A linear controller designed on G driving a Hammerstein plant through f^-1 (file comment).
 class InverseMapController : public Controller {
  public:
   /// `inner` designed on the linear part G, with limits InnerLimits(map,
@@ -53,8 +54,8 @@ class InverseMapController : public Controller {
   /// [a, b])".
   std::string Describe() const override;
 
-  const Controller& inner() const { return *inner_; }
-  const StaticMap& map() const { return map_; }
+  const Controller& inner() const { return *inner_; }  ///< The controller designed on G.
+  const StaticMap& map() const { return map_; }  ///< The actuator's static map f (u -> v).
   /// The actuator's limits on u.
   const InputLimits& limits() const { return limits_; }
   /// v of the last Update() (the inner controller's request).
@@ -96,7 +97,7 @@ class OutputMapController : public Controller {
   /// The inner controller's description + " on the inverse output map (N knots)".
   std::string Describe() const override;
 
-  const Controller& inner() const { return *inner_; }
+  const Controller& inner() const { return *inner_; }  ///< The controller designed on G.
   /// The monotone envelope of the output map that is inverted.
   const StaticMap& map() const { return map_; }
 

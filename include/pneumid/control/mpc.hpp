@@ -81,6 +81,7 @@ std::string ToString(DisturbanceModel model);
 /// Inverse of ToString; throws InvalidArgument listing the valid names.
 DisturbanceModel DisturbanceModelFromString(const std::string& name);
 
+/// Horizons, weights, bounds, disturbance model and estimator noise of the state-space MPC.
 struct MpcOptions {
   int P = 126;                 ///< prediction horizon (samples)
   int M = 5;                   ///< control horizon (samples), 1 <= M <= P
@@ -91,10 +92,10 @@ struct MpcOptions {
   InputLimits limits;
   /// Soft output bounds (infinite = none); a finite one makes it solve a QP.
   double y_min = -std::numeric_limits<double>::infinity();
-  double y_max = std::numeric_limits<double>::infinity();
+  double y_max = std::numeric_limits<double>::infinity();  ///< soft upper output bound
   /// Slack penalty rho1 e + rho2/2 e^2 (rho1 >= 0, rho2 > 0).
   double slack_linear_weight = 1e4;
-  double slack_quadratic_weight = 1e2;
+  double slack_quadratic_weight = 1e2;  ///< rho2 of the slack penalty (> 0, default 100)
   /// The input model is the default: an actuator's model errors (a dead
   /// band, a gain that varies with the operating point, a bias) act at its
   /// input, where this model estimates them; the output model (MATLAB's
@@ -108,20 +109,23 @@ struct MpcOptions {
   /// the disturbance estimate follows the output (1: gain 0.62 per sample on
   /// d for the output model; larger is faster, as DMC's bias at the limit).
   double measurement_noise = 1.0;
-  double state_noise = 0.0;
+  double state_noise = 0.0;  ///< process noise variance on each model state (>= 0, default 0)
+  /// Process noise variance on the disturbance d (> 0 with a disturbance model, default 1).
   double disturbance_noise = 1.0;
-  DareOptions dare;
-  QpSolverOptions qp;
-  /// True when the options are usable; otherwise false and *error says why.
+  DareOptions dare;    ///< the estimator DARE's stopping rule
+  QpSolverOptions qp;  ///< the QP solver's settings (constrained form)
+  /// True when the options are usable (1 <= M <= P, output_weight > 0, lambda and
+  /// input_weight >= 0, valid limits, y_min <= y_max, slack weights and noises as stated,
+  /// valid dare and qp); otherwise false and *error says why (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
 /// Unconstrained first move du_0 = K_r r + K_s u_s - K_z z_k|k - K_u u_{k-1}.
 struct MpcGain {
-  double K_r = 0.0;
-  double K_s = 0.0;
-  Eigen::RowVectorXd K_z;
-  double K_u = 0.0;
+  double K_r = 0.0;        ///< gain on the set-point r (input units per output unit)
+  double K_s = 0.0;        ///< gain on the target input u_s
+  Eigen::RowVectorXd K_z;  ///< gain on the state estimate z_k|k (1 x nz)
+  double K_u = 0.0;        ///< gain on the previous input u_{k-1}
 };
 
 /// The discrete model of `model` at Ts with its input delay as states: a
@@ -135,6 +139,8 @@ StateSpace SampledStateSpace(const TransferFunction& model, double Ts);
 /// @throws InvalidArgument for a continuous model.
 StateSpace DelayAsStates(const StateSpace& model);
 
+/// State-space MPC with a steady-state Kalman filter, an integrating disturbance model and
+/// (with finite bounds) a QP per sample (file comment).
 class MpcController : public Controller {
  public:
   /// Design from a discrete SISO state space (input delay as extra states).
@@ -152,23 +158,25 @@ class MpcController : public Controller {
   /// e.g. "mpc P=126 M=5 lambda=2.25 disturbance=output" (+ " constrained").
   std::string Describe() const override;
 
-  const MpcOptions& options() const { return options_; }
+  const MpcOptions& options() const { return options_; }  ///< The options as designed.
   /// Augmented model Az, Bz, Cz (file comment); nz = nx + delay + 1 (0 for none).
   const Eigen::MatrixXd& Az() const { return Az_; }
-  const Eigen::VectorXd& Bz() const { return Bz_; }
-  const Eigen::RowVectorXd& Cz() const { return Cz_; }
+  const Eigen::VectorXd& Bz() const { return Bz_; }     ///< Input vector Bz (nz).
+  const Eigen::RowVectorXd& Cz() const { return Cz_; }  ///< Output row Cz (1 x nz).
   /// Static gain G of the plant model.
   double static_gain() const { return G_; }
   /// Kalman gain L (nz) and the DARE behind it (X the a priori covariance).
   const Eigen::VectorXd& kalman_gain() const { return L_; }
+  /// X (nz x nz), the a priori error covariance of the estimator's DARE.
   const Eigen::MatrixXd& estimator_covariance() const { return X_; }
+  /// How the estimator's DARE was solved (status, iterations, residual).
   const DareSummary& dare_summary() const { return dare_summary_; }
   /// Unconstrained first-move gain.
   const MpcGain& gain() const { return gain_; }
   /// H (M x M), Theta (P x M), Psi (P x nz).
   const Eigen::MatrixXd& hessian() const { return H_; }
-  const Eigen::MatrixXd& dynamic_matrix() const { return Theta_; }
-  const Eigen::MatrixXd& free_response_matrix() const { return Psi_; }
+  const Eigen::MatrixXd& dynamic_matrix() const { return Theta_; }  ///< Theta (P x M).
+  const Eigen::MatrixXd& free_response_matrix() const { return Psi_; }  ///< Psi (P x nz).
   /// Ups_1..Ups_P, the response of y^ to u_{k-1} (P).
   const Eigen::VectorXd& input_response() const { return Ups_; }
   /// (I - A)^-1 B of the model with its delay states (nx): the steady state per unit input.
@@ -177,15 +185,15 @@ class MpcController : public Controller {
   int num_model_states() const { return nx_; }
   /// The QP's linear term g = Gz z + Gu u_{k-1} + Gr r + Gs u_s: Gz (M x nz), Gu, Gr, Gs (M).
   const Eigen::MatrixXd& gradient_state() const { return Gz_; }
-  const Eigen::VectorXd& gradient_input() const { return Gu_; }
-  const Eigen::VectorXd& gradient_setpoint() const { return Gr_; }
-  const Eigen::VectorXd& gradient_target() const { return Gs_; }
+  const Eigen::VectorXd& gradient_input() const { return Gu_; }     ///< Gu (M), on u_{k-1}.
+  const Eigen::VectorXd& gradient_setpoint() const { return Gr_; }  ///< Gr (M), on r.
+  const Eigen::VectorXd& gradient_target() const { return Gs_; }    ///< Gs (M), on u_s.
   /// The unconstrained moves -H^-1 g = Fz z + Fu u_{k-1} + Fr r + Fs u_s: Fz (M x nz), Fu, Fr, Fs
   /// (M).
   const Eigen::MatrixXd& moves_state() const { return Fz_; }
-  const Eigen::VectorXd& moves_input() const { return Fu_; }
-  const Eigen::VectorXd& moves_setpoint() const { return Fr_; }
-  const Eigen::VectorXd& moves_target() const { return Fs_; }
+  const Eigen::VectorXd& moves_input() const { return Fu_; }     ///< Fu (M), on u_{k-1}.
+  const Eigen::VectorXd& moves_setpoint() const { return Fr_; }  ///< Fr (M), on r.
+  const Eigen::VectorXd& moves_target() const { return Fs_; }    ///< Fs (M), on u_s.
   /// The QP solver of the constrained form (not set up when unconstrained).
   const QpSolver& qp_solver() const { return *qp_; }
   /// True when Update() solves a QP (a finite bound on u, du or y).

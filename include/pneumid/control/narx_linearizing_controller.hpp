@@ -60,15 +60,16 @@ class InputAffineNarx {
   double Map(double u) const;
   /// The inverse of f's monotone envelope (v itself without a map).
   double InverseMap(double v) const;
-  double Ts() const { return Ts_; }
+  double Ts() const { return Ts_; }  ///< Sample time of the NARX model, s.
+  /// The input map f as given (none: f(u) = u).
   const std::optional<StaticMap>& map() const { return map_; }
   /// The monotone envelope of the map that InverseMap inverts (none without a map).
   const std::optional<StaticMap>& envelope() const { return envelope_; }
   /// Coefficients of F and G in powers of z = y / y_scale (Drift(y) =
   /// y_scale sum_k drift_k z^k, evaluated by Horner's rule).
   const std::vector<double>& drift_coefficients() const { return drift_; }
-  const std::vector<double>& gain_coefficients() const { return gain_; }
-  double y_scale() const { return y_scale_; }
+  const std::vector<double>& gain_coefficients() const { return gain_; }  ///< G(y), as F(y)
+  double y_scale() const { return y_scale_; }  ///< Output scale of z = y / y_scale.
   /// The steady output for a constant input u: the fixed point of
   /// y = F(y) + G(y) f(u) reached from y0 (NaN when the model does not settle).
   double SteadyOutput(double u, double y0 = 0.0) const;
@@ -86,10 +87,13 @@ class InputAffineNarx {
   std::optional<StaticMap> map_, envelope_;
 };
 
+/// Reference model of the NARX linearization.
 struct NarxLinearizingOptions {
   /// Time constant of the reference model H, s; <= 0 or NaN: the model's
   /// TypicalTimeConstant over the input limits.
   double time_constant = 0.0;
+  /// True unless time_constant is infinite (finite or NaN are accepted); otherwise false
+  /// with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -103,6 +107,8 @@ double ReferenceTimeConstant(const InputAffineNarx& model, const InputLimits& li
 /// u_min and u_max (clipped to the map's input range), no rate limit.
 InputLimits NarxInnerLimits(const InputAffineNarx& model, const InputLimits& limits);
 
+/// A linear controller designed on the reference model H, driving the plant through the
+/// exact linearization of an input-affine NARX model (file comment).
 class NarxLinearizingController : public Controller {
  public:
   /// `inner` designed on H (unit gain, time constant `time_constant`, the
@@ -117,9 +123,9 @@ class NarxLinearizingController : public Controller {
   /// (tau = .. s)".
   std::string Describe() const override;
 
-  const Controller& inner() const { return *inner_; }
-  double time_constant() const { return tau_; }
-  const InputAffineNarx& model() const { return model_; }
+  const Controller& inner() const { return *inner_; }  ///< The controller designed on H.
+  double time_constant() const { return tau_; }  ///< tau of the reference model H, s.
+  const InputAffineNarx& model() const { return model_; }  ///< The model linearized.
   /// The actuator's limits on u.
   const InputLimits& limits() const { return limits_; }
   /// w of the last Update() (the inner controller's request).

@@ -34,12 +34,15 @@
 
 namespace pneumid {
 
+/// PID tuning rule from an FOPDT model: Skogestad's SIMC (PI) or IMC (PID), file comment.
 enum class PidTuningRule { kSimc, kImc };
 /// "simc", "imc".
 std::string ToString(PidTuningRule rule);
 /// Inverse of ToString; throws InvalidArgument listing the valid names.
 PidTuningRule PidTuningRuleFromString(const std::string& name);
 
+/// Gains of the ideal PID form Kc (e + 1/Ti int e dt + Td de/dt); the discrete law (file
+/// comment) weights the set-point in P and differentiates y only.
 struct PidGains {
   double Kc = 1.0;  ///< proportional gain (input units per output unit)
   double Ti = std::numeric_limits<double>::infinity();  ///< integral time (s); inf = none
@@ -53,15 +56,21 @@ struct PidGains {
 PidGains TunePid(double K, double tau, double theta, double Ts, PidTuningRule rule,
                  double tau_c = 0.0);
 
+/// Gains, set-point weight, derivative filter, anti-windup and limits of the discrete PID.
 struct PidOptions {
-  PidGains gains;
+  PidGains gains;  ///< Kc, Ti, Td (default P-only with Kc = 1)
   double setpoint_weight = 1.0;     ///< b in P = Kc (b r - y), in [0, 1]
   double derivative_filter = 10.0;  ///< N: derivative filter time Td / N
   double tracking_time = 0.0;       ///< Tt (s) for anti-windup; 0 = automatic (file comment)
-  InputLimits limits;
+  InputLimits limits;  ///< saturation and rate limit of u (sat in the file comment)
+  /// True when Kc is finite, Ti > 0 (inf allowed), Td finite and >= 0, setpoint_weight in
+  /// [0, 1], derivative_filter > 0, tracking_time >= 0 and limits are valid; otherwise
+  /// false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Discrete PID with set-point weighting, filtered derivative on y and back-calculation
+/// anti-windup (file comment).
 class PidController : public Controller {
  public:
   /// @throws InvalidArgument for invalid options or Ts <= 0.
@@ -69,7 +78,7 @@ class PidController : public Controller {
 
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
-  const PidOptions& options() const { return options_; }
+  const PidOptions& options() const { return options_; }  ///< The options as designed.
   /// Tracking time Tt (s) of the back-calculation actually used (0: none).
   double tracking_time() const { return Tt_; }
 

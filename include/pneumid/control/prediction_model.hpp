@@ -31,6 +31,8 @@
 
 namespace pneumid {
 
+/// A model sampled once at the controller's period Ts, with its step response, model
+/// horizon and dynamic matrix (file comment).
 class PredictionModel {
  public:
   /// Samples `model` at Ts (the only discretization of a design): zoh for a

@@ -52,6 +52,7 @@ std::string ToString(QpStatus status);
 /// Inverse of ToString; throws InvalidArgument listing the valid names.
 QpStatus QpStatusFromString(const std::string& name);
 
+/// Iteration cap, feasibility tolerance and warm start of the Goldfarb-Idnani solver.
 struct QpSolverOptions {
   /// Cap on active-set changes per Solve(); 0 chooses 10 (n + number of
   /// finite one-sided constraints) + 10.
@@ -61,12 +62,14 @@ struct QpSolverOptions {
   double feasibility_tolerance = 1e-9;
   /// Try the previously active constraints first (see the file comment).
   bool warm_start = true;
-  /// True when the options are usable; otherwise false and *error says why.
+  /// True when the options are usable (max_iterations >= 0, feasibility_tolerance finite
+  /// and > 0); otherwise false and *error says why (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Outcome of the last Setup() or Solve().
 struct QpSummary {
-  QpStatus status = QpStatus::kNotSetUp;
+  QpStatus status = QpStatus::kNotSetUp;  ///< see QpStatus
   /// Static text describing the status (no allocation in Solve()).
   std::string_view message = "not set up";
   int iterations = 0;    ///< constraint additions plus removals
@@ -76,8 +79,11 @@ struct QpSummary {
   std::string BriefReport() const;
 };
 
+/// Dense strictly convex QP solver (dual active set, Goldfarb-Idnani) set up once and
+/// solved repeatedly with new g and bounds (file comment).
 class QpSolver {
  public:
+  /// A solver with `options`, not yet set up (status kNotSetUp until Setup()).
   explicit QpSolver(const QpSolverOptions& options = {});
 
   /// Sets the Hessian H (n x n, symmetric positive definite; only the lower
@@ -103,6 +109,7 @@ class QpSolver {
   /// Forgets the active set remembered for warm starting.
   void ClearWarmStart();
 
+  /// Solution (n) of the last Solve(): the minimizer when solved, else the last iterate.
   const Eigen::VectorXd& x() const { return x_; }
   /// Multipliers of C x: positive when the lower side is active, negative
   /// when the upper side is, zero when inactive. With them the KKT
@@ -110,23 +117,24 @@ class QpSolver {
   const Eigen::VectorXd& y_constraints() const { return y_c_; }
   /// Multipliers of the simple bounds, same sign convention.
   const Eigen::VectorXd& y_bounds() const { return y_x_; }
-  const QpSummary& summary() const { return summary_; }
-  int num_variables() const { return n_; }
-  const QpSolverOptions& options() const { return options_; }
+  const QpSummary& summary() const { return summary_; }  ///< Summary of the last call.
+  int num_variables() const { return n_; }  ///< n, set by Setup() (0 before).
+  const QpSolverOptions& options() const { return options_; }  ///< The options in use.
   /// The data fixed at Setup(): H, C, the Cholesky factor L of H = L L'
   /// (lower triangle, zeros above), J0 = L^-T, and the norms of the rows of
   /// C (0 replaced by 1) used to scale violations.
   const Eigen::MatrixXd& hessian() const { return H_; }
-  const Eigen::MatrixXd& constraint_matrix() const { return C_; }
+  const Eigen::MatrixXd& constraint_matrix() const { return C_; }  ///< C (m x n).
+  /// L (n x n) with H = L L', lower triangular; allocates (not for the control loop).
   Eigen::MatrixXd cholesky_factor() const { return llt_.matrixL().toDenseMatrix(); }
-  const Eigen::MatrixXd& initial_basis() const { return J0_; }
+  const Eigen::MatrixXd& initial_basis() const { return J0_; }  ///< J0 = L^-T (n x n).
   /// Row norms of C (m); the bounds' normals have norm 1.
   Eigen::VectorXd row_norms() const {
     Eigen::VectorXd r(m_);
     for (int i = 0; i < m_; ++i) r(i) = row_norm_(2 * i);
     return r;
   }
-  int num_constraints() const { return m_; }
+  int num_constraints() const { return m_; }  ///< m, rows of C (0 before Setup()).
 
  private:
   // One-sided constraint k: n_k' x >= b_k. k < 2m: row k/2 of C (side k%2:

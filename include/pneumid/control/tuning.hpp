@@ -49,6 +49,7 @@
 
 namespace pneumid {
 
+/// How P, M and lambda of a predictive controller are chosen (file comment).
 enum class TuningRule { kShridharCooper, kPaperModified, kExplicit };
 /// "shridhar-cooper", "paper-modified", "explicit".
 std::string ToString(TuningRule rule);
@@ -66,33 +67,40 @@ struct FopdtEstimate : FopdtParams {
 /// @throws InvalidArgument for an unstable model or a zero static gain.
 FopdtEstimate FopdtFromModel(const TransferFunction& model);
 
+/// The tuning rule and the settings that override it.
 struct TuningOptions {
-  TuningRule rule = TuningRule::kShridharCooper;
+  TuningRule rule = TuningRule::kShridharCooper;  ///< default shridhar-cooper
   /// Control horizon; 0 = the rule's default (5 for shridhar-cooper, 10 for
   /// paper-modified; required for explicit).
   int M = 0;
   /// Explicit settings (rule explicit only; also override P or lambda of the
   /// other rules when set): P > 0, lambda >= 0 (NaN = unset).
   int P = 0;
+  /// Move suppression (>= 0); NaN (default) = the rule's.
   double lambda = std::numeric_limits<double>::quiet_NaN();
   /// Significant digits tau is rounded to in the P formula (0 = no rounding).
   int tau_significant_digits = 2;
   /// Target condition number of A'A + lambda I.
   double target_condition = 500.0;
+  /// True when M, P >= 0 with M <= P when both are set, lambda is NaN or finite and >= 0,
+  /// explicit has P, M and lambda, tau_significant_digits >= 0 and target_condition > 1;
+  /// otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Settings of a predictive controller from a tuning rule, with the values behind them.
 struct TuningResult {
-  TuningRule rule = TuningRule::kShridharCooper;
-  int P = 0;
-  int M = 0;
+  TuningRule rule = TuningRule::kShridharCooper;  ///< the rule applied
+  int P = 0;  ///< prediction horizon, samples
+  int M = 0;  ///< control horizon, samples
   double lambda = 0.0;  ///< the value used
   /// Both Shridhar-Cooper move suppressions (NaN for other rules).
   double lambda_condition = std::numeric_limits<double>::quiet_NaN();
+  /// Closed-form (M/500) K^2 (3.5 tau/Ts + 2 - (M-1)/2) (NaN for other rules).
   double lambda_formula = std::numeric_limits<double>::quiet_NaN();
   double P_unrounded = 0.0;  ///< 5 tau'/Ts + theta/Ts + 1 before rounding
   double tau_used = 0.0;     ///< tau after rounding, as used for P
-  FopdtEstimate fopdt;
+  FopdtEstimate fopdt;  ///< K, tau, theta the rule started from, and how they were found
   /// Human-readable statement of the formulas used, with their values.
   std::string formula;
   double Ts = 0.0;  ///< controller sample time the settings are for (s)

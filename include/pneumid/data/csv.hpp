@@ -36,8 +36,9 @@ namespace pneumid {
 /// a header row longer than kCsvMaxHeaderBytes or with more than kCsvMaxColumns
 /// columns is rejected with a DataError.
 inline constexpr std::size_t kCsvMaxHeaderBytes = 1 << 20;
-inline constexpr std::size_t kCsvMaxColumns = 10000;
+inline constexpr std::size_t kCsvMaxColumns = 10000;  ///< columns of a header row, at most
 
+/// How ReadCsv and ReadCsvBlocks parse a delimited text file and pick its columns.
 struct CsvReadOptions {
   /// Cell delimiter; `'\0'` detects it from the header row among comma, semicolon and tab
   /// (and runs of blanks when none of them occurs). ' ' means runs of blanks.
@@ -94,16 +95,19 @@ Eigen::Index ReadCsvBlocks(const std::string& path, const CsvReadOptions& option
 
 /// One extra column written by WriteCsv beside the dataset's own columns.
 struct CsvColumn {
-  Channel channel;
+  Channel channel;         ///< header name and unit of the column ("name [unit]")
   Eigen::VectorXd values;  ///< one value per sample of the dataset
 };
 
+/// How WriteCsv formats the file.
 struct CsvWriteOptions {
   /// Cell delimiter: ',' (default), ';', a tab or ' '.
   char delimiter = ',';
   /// Optional comment lines written before the header, each prefixed by "# ".
   std::vector<std::string> comments;
 
+  /// True for a delimiter of ',', ';', tab or ' ' and comments without a newline;
+  /// otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 

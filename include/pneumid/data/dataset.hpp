@@ -23,16 +23,20 @@ namespace pneumid {
 
 /// Name and unit of one measured signal, e.g. {"F", "N"} or {"u", "%"}.
 struct Channel {
-  std::string name;
-  std::string unit;
+  std::string name;  ///< signal name as in a file header, e.g. "F"
+  std::string unit;  ///< unit symbol, e.g. "N", "%", "s"; empty when unknown
 };
 
+/// Sampled input/output record of one experiment: time in s, N x nu inputs, N x ny
+/// outputs, channel names and units, and the source file for messages.
 class Dataset {
  public:
+  /// An empty dataset: no samples, no channels, time channel {"t", "s"}.
   Dataset() = default;
 
-  /// Builds a dataset from columns. Throws InvalidArgument when lengths differ,
-  /// a value is not finite, or time is not strictly increasing.
+  /// Builds a dataset from columns. Unnamed channels are called u, y (u1, u2, ... for
+  /// several). Throws InvalidArgument when lengths differ, the channel names do not
+  /// match the columns, a value is not finite, or time is not strictly increasing.
   Dataset(Eigen::VectorXd time, Eigen::MatrixXd inputs, Eigen::MatrixXd outputs,
           std::vector<Channel> input_channels = {}, std::vector<Channel> output_channels = {});
 
@@ -41,16 +45,19 @@ class Dataset {
                              double t0 = 0.0, Channel input = {"u", ""},
                              Channel output = {"y", ""});
 
-  Eigen::Index size() const { return time().size(); }
-  int num_inputs() const { return static_cast<int>(inputs().cols()); }
-  int num_outputs() const { return static_cast<int>(outputs().cols()); }
+  Eigen::Index size() const { return time().size(); }                     ///< number of samples N
+  int num_inputs() const { return static_cast<int>(inputs().cols()); }    ///< nu
+  int num_outputs() const { return static_cast<int>(outputs().cols()); }  ///< ny
 
+  /// Sample instants in s (N, strictly increasing).
   const Eigen::VectorXd& time() const { return samples().time; }
+  /// Input samples, N x nu, one column per input channel.
   const Eigen::MatrixXd& inputs() const { return samples().inputs; }
+  /// Output samples, N x ny, one column per output channel.
   const Eigen::MatrixXd& outputs() const { return samples().outputs; }
   /// Column i of the inputs / outputs (throws InvalidArgument when out of range).
   Eigen::VectorXd u(int i = 0) const;
-  Eigen::VectorXd y(int i = 0) const;
+  Eigen::VectorXd y(int i = 0) const;  ///< column i of the outputs (a copy); same check
 
   /// The dataset restricted to the given input and output channels (in that
   /// order), with their names, the time channel, source and line map. Selecting
@@ -58,14 +65,18 @@ class Dataset {
   /// @throws InvalidArgument when a channel index is out of range.
   Dataset SelectChannels(const std::vector<int>& inputs, const std::vector<int>& outputs) const;
 
+  /// Name and unit of each input column (nu entries).
   const std::vector<Channel>& input_channels() const { return input_channels_; }
+  /// Name and unit of each output column (ny entries).
   const std::vector<Channel>& output_channels() const { return output_channels_; }
+  /// Name and unit of the time column (default {"t", "s"}), as written to files.
   Channel time_channel() const { return time_channel_; }
+  /// Renames the time column (e.g. the header a file used); the samples stay in s.
   void set_time_channel(Channel c) { time_channel_ = std::move(c); }
 
   /// Where the data came from (file name), used in error messages.
   const std::string& source() const { return source_; }
-  void set_source(std::string s) { source_ = std::move(s); }
+  void set_source(std::string s) { source_ = std::move(s); }  ///< sets source()
 
   /// Mean sample interval (t_end - t_0) / (N - 1) in seconds; throws when N < 2.
   double SampleTime() const;
@@ -89,7 +100,7 @@ class Dataset {
   /// of values near 1e308 are infinite; below 1e-150 they underflow to zero, so
   /// a step of that size is indistinguishable from no step.
   static constexpr double kMaxMagnitude = 1e150;
-  static constexpr double kMinSpread = 1e-150;
+  static constexpr double kMinSpread = 1e-150;  ///< smallest nonzero spread (see above)
   /// Throws DataError naming the source, the column and its value range when a
   /// column (time, inputs, outputs) holds a value of magnitude above
   /// kMaxMagnitude (overflow risk) or varies by less than kMinSpread without

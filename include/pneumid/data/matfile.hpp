@@ -29,6 +29,7 @@ MatVersion MatVersionFromString(const std::string& s);
 /// True when the installed matio can read and write v7.3 (HDF5) files.
 bool MatHasV73();
 
+/// Variable selection and time base of ReadMat.
 struct MatReadOptions {
   /// Time variable (seconds); ignored when sample_time > 0.
   std::string time_variable = "t";
@@ -38,8 +39,11 @@ struct MatReadOptions {
   std::vector<std::string> output_variables = {"y"};
   /// When > 0, no time variable is read and t = start_time + k * sample_time.
   double sample_time = 0.0;
-  double start_time = 0.0;
+  double start_time = 0.0;  ///< first time instant in s when sample_time > 0
 
+  /// True for sample_time >= 0, a finite start_time, a time variable or sample_time > 0,
+  /// at least one input or output variable and no empty name; otherwise false with
+  /// the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -51,15 +55,18 @@ struct MatReadOptions {
 ///         sample index), time not strictly increasing, no samples.
 Dataset ReadMat(const std::string& path, const MatReadOptions& options = {});
 
+/// File version, compression and variable names of WriteMat.
 struct MatWriteOptions {
-  MatVersion version = MatVersion::kV5;
+  MatVersion version = MatVersion::kV5;  ///< v7.3 needs a matio with HDF5 (MatHasV73())
   /// zlib compression of the variables (v5 and v7.3).
   bool compress = false;
   /// Variable names for time, inputs (N x nu matrix) and outputs (N x ny).
   std::string time_variable = "t";
-  std::string input_variable = "u";
-  std::string output_variable = "y";
+  std::string input_variable = "u";   ///< name of the N x nu input matrix
+  std::string output_variable = "y";  ///< name of the N x ny output matrix
 
+  /// True when the three names are distinct valid MATLAB names (a letter, then
+  /// letters, digits or '_', at most 63); otherwise false with the reason in *error.
   bool IsValid(std::string* error) const;
 };
 

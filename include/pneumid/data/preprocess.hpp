@@ -80,6 +80,7 @@ struct LinearTrend {
 Dataset Detrend(const Dataset& data, ChannelSet which = ChannelSet::kBoth,
                 LinearTrend* removed = nullptr);
 
+/// How DetectStep searches an input channel for a step.
 struct StepDetectOptions {
   /// Input channel searched for the step. Default 0.
   int input = 0;
@@ -93,6 +94,8 @@ struct StepDetectOptions {
   /// Minimum absolute jump in input units (default 0: only the ratio counts).
   double min_size = 0.0;
 
+  /// True for input >= 0, window >= 0 and finite min_significance, min_size >= 0;
+  /// otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -134,6 +137,7 @@ Dataset RemoveInitialOffset(const Dataset& data, const StepEvent& step,
 Dataset Resample(const Dataset& data, double Ts,
                  double start = std::numeric_limits<double>::quiet_NaN());
 
+/// Anti-alias filter of Decimate.
 struct DecimateOptions {
   /// Order of the Butterworth low-pass (even, 2..16). Default 8.
   int order = 8;
@@ -143,6 +147,8 @@ struct DecimateOptions {
   /// Relative tolerance on uniform sampling (Dataset::RequireUniform).
   double uniform_tolerance = 1e-3;
 
+  /// True for an even order in [2, 16], cutoff in (0, 1) and uniform_tolerance >= 0;
+  /// otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -180,9 +186,9 @@ FilterKind FilterKindFromString(const std::string& s);
 /// and backward (Filter), the magnitude response is |H|^2: -6 dB at the
 /// cutoffs, slope 2 * 20 N dB/decade, no phase shift.
 struct FilterSpec {
-  static constexpr int kDefaultOrder = 5;
+  static constexpr int kDefaultOrder = 5;  ///< Butterworth order when none is written
 
-  FilterKind kind = FilterKind::kLowpass;
+  FilterKind kind = FilterKind::kLowpass;  ///< low-pass (high_hz) or band-pass (low_hz..high_hz)
   /// Band-pass: lower edge F1 in Hz, 0 < F1 < F2. Unused for a low-pass.
   double low_hz = 0.0;
   /// Low-pass: cutoff F in Hz (> 0). Band-pass: upper edge F2 in Hz.
@@ -219,8 +225,8 @@ Dataset Filter(const Dataset& data, const FilterSpec& spec, ChannelSet which = C
 /// A time window [start, end] in seconds, written "T0:T1"; either side may be
 /// left empty ("5:" from 5 s to the end, ":9" up to 9 s).
 struct TimeWindow {
-  double start = -std::numeric_limits<double>::infinity();
-  double end = std::numeric_limits<double>::infinity();
+  double start = -std::numeric_limits<double>::infinity();  ///< s; -inf: from the first sample
+  double end = std::numeric_limits<double>::infinity();     ///< s; +inf: to the last sample
 
   /// True when at least one side is bounded.
   bool IsSet() const;
@@ -263,7 +269,7 @@ struct PreprocessOptions {
   DetrendKind detrend = DetrendKind::kNone;  ///< not together with remove_initial
   std::optional<FilterSpec> filter;          ///< none by default
   int decimate = 1;                          ///< factor >= 1; 1: keep all samples
-  DecimateOptions decimate_options;
+  DecimateOptions decimate_options;          ///< anti-alias filter of the decimation
   /// Channels the offsets, trends and the filter apply to.
   ChannelSet channels = ChannelSet::kBoth;
 
@@ -286,20 +292,20 @@ struct PreprocessRecord {
   double resample_ts = 0.0;  ///< 0: not resampled
   /// "none", "initial" (remove_initial) or ToString(DetrendKind).
   std::string offsets = "none";
-  OperatingPoint level;     ///< level_i, one value per channel (0 where untouched)
-  OperatingPoint slope;     ///< slope_i per second (zero unless linear detrend)
-  double trend_time = 0.0;  ///< time origin of the slope, s (mean time of the data)
-  std::optional<FilterSpec> filter;
-  ChannelSet channels = ChannelSet::kBoth;
-  int decimate = 1;
-  DecimateOptions decimate_options;
+  OperatingPoint level;                     ///< level_i, one value per channel (0 where untouched)
+  OperatingPoint slope;                     ///< slope_i per second (zero unless linear detrend)
+  double trend_time = 0.0;                  ///< time origin of the slope, s (mean time of the data)
+  std::optional<FilterSpec> filter;         ///< zero-phase filter applied (none: not filtered)
+  ChannelSet channels = ChannelSet::kBoth;  ///< channels offsets, trends and filter applied to
+  int decimate = 1;                         ///< decimation factor (1: all samples kept)
+  DecimateOptions decimate_options;         ///< anti-alias filter used when decimate > 1
   /// One line per step applied, for reports and model notes, e.g.
   /// "remove initial offset: mean of the 120 samples before the step at t = 1.2 s".
   std::vector<std::string> steps;
 
   /// Offsets removed from the inputs / outputs at time t (level + slope term).
   Eigen::VectorXd InputOffsetAt(double t) const;
-  Eigen::VectorXd OutputOffsetAt(double t) const;
+  Eigen::VectorXd OutputOffsetAt(double t) const;  ///< see InputOffsetAt; one per output
   /// True when nothing was done.
   bool IsIdentity() const;
 };

@@ -17,6 +17,8 @@
 
 namespace pneumid {
 
+/// The object above; window, resample_ts, slopes and decimation keys are written only
+/// when used (levels are always written, u0/y0 in the channels' units).
 nlohmann::json ToJson(const PreprocessRecord& record);
 /// @throws InvalidArgument naming the key when a value has the wrong type or
 ///         is invalid (e.g. "preprocessing: key 'filter': filter 'x': ...").

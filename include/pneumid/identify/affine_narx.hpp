@@ -49,6 +49,8 @@
 
 namespace pneumid {
 
+/// Settings of EstimateAffineNarx: polynomial degree, delay, knots of the input map f
+/// and the stopping rule of the alternating least squares.
 struct AffineNarxOptions {
   int degree = 2;  ///< degree d of a(z) and b(z), 1..3
   int nk = 1;      ///< input delay in samples (>= 0; 0: u(t) acts on z(t))
@@ -65,9 +67,13 @@ struct AffineNarxOptions {
   /// means the loss is still falling.
   int max_iterations = 1000;
   double tolerance = 1e-9;  ///< relative decrease of the loss that ends the iteration
+  /// True when degree is 1..3, nk >= 0, num_knots is 0 or >= 2, given knots are >= 2, finite
+  /// and strictly increasing, max_iterations >= 1 and tolerance in (0, 1); otherwise false
+  /// with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Input-affine NARX estimated by EstimateAffineNarx: the NARX part, the input map and fits.
 struct AffineNarxResult {
   NarxModel narx;  ///< in the mapped input v = f(u) (see above)
   StaticMap map;   ///< f, clamped beyond its knots

@@ -25,8 +25,14 @@
 
 namespace pneumid {
 
+/// Characteristic areas A0..A3 of a step response and the area-method FOPDT.
 struct AreaResult {
+  /// A0 = K, the static gain (output units per input unit).
   double A0 = 0.0, A1 = 0.0, A2 = 0.0, A3 = 0.0;  ///< characteristic areas (K s^k)
+  /// @var A1
+  /// First area, K T_ar (gain units times s): the integral of A0 - h(t).
+  /// @var A2
+  /// Second area (gain units times s^2), the integral of A1 - y1(t).
   double T_ar = 0.0;                              ///< average residence time A1 / A0, s
   FopdtParams fopdt;                              ///< Astrom-Hagglund area-method FOPDT
 };

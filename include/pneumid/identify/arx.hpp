@@ -37,6 +37,7 @@
 
 namespace pneumid {
 
+/// Orders, delays and numerical thresholds of an ARX least-squares fit.
 struct ArxOptions {
   int na = 3;                 ///< number of A coefficients (>= 0)
   std::vector<int> nb = {3};  ///< B coefficients per input (>= 0; 0 drops the input)
@@ -46,6 +47,9 @@ struct ArxOptions {
   double excitation_warning_condition = 1e4;
   /// Singular values of R11 below rank_tolerance * sigma_max count as zero.
   double rank_tolerance = 1e-13;
+  /// True when na >= 0, nb and nk have one non-negative entry per input, na + sum nb > 0,
+  /// excitation_warning_condition > 1 and rank_tolerance is in (0, 1); otherwise false with
+  /// the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
   /// Total number of parameters na + sum nb.
   int NumParameters() const;
@@ -53,8 +57,13 @@ struct ArxOptions {
   int FirstRow() const;
 };
 
+/// Estimated ARX model and how the least-squares solve went.
 struct ArxResult {
+  /// Structure "ARX": a, b per input (nk leading zeros), Ts, noise variance rho^2 / (N - d)
+  /// and the parameter covariance.
   PolynomialModel model;
+  /// Termination (kFailure with fewer rows than parameters), rows, loss, condition
+  /// numbers and warnings such as poor excitation.
   EstimationSummary summary;
 };
 

@@ -16,10 +16,11 @@
 
 namespace pneumid {
 
+/// File columns, sample time and block size of EstimateArxFromFile.
 struct StreamingArxOptions {
   ArxOptions arx;  ///< orders (SISO: one nb, one nk)
-  std::string input_column = "u";
-  std::string output_column = "y";
+  std::string input_column = "u";   ///< input column: header name or 0-based index
+  std::string output_column = "y";  ///< output column: header name or 0-based index
   /// Time column used to find the sample time when sample_time is 0.
   std::string time_column = "t";
   double sample_time = 0.0;  ///< seconds; 0 = from the first two time values
@@ -28,11 +29,14 @@ struct StreamingArxOptions {
   std::size_t block_rows = 1 << 16;
   /// Called after each block with the fraction of the file read (0..1].
   std::function<void(double)> progress;
+  /// True when `arx` is valid and single-input, sample_time >= 0, block_rows >= 1 and the
+  /// column names are not empty; otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
+/// ARX fit of a streamed file with the amount of data read.
 struct StreamingArxResult {
-  ArxResult arx;
+  ArxResult arx;  ///< model and summary, equal to the in-memory fit of the same data
   long long num_samples = 0;  ///< samples (data rows) read
   double bytes = 0.0;         ///< file size
 };

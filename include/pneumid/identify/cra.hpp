@@ -25,13 +25,17 @@
 
 namespace pneumid {
 
+/// Lags, prewhitening and confidence level of the correlation analysis.
 struct CraOptions {
   int num_lags = 50;            ///< M, impulse-response length - 1 (>= 1, < N / 4)
   int prewhitening_order = 10;  ///< n of the AR input model (0 = no prewhitening)
   double confidence = 0.99;     ///< of the bound, in (0, 1)
+  /// True when num_lags >= 1, prewhitening_order >= 0 and confidence is in (0, 1); otherwise
+  /// false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Impulse and step response estimated by correlation analysis, with the confidence bound.
 struct CraResult {
   Eigen::VectorXd lags;     ///< 0 .. M (samples)
   Eigen::VectorXd t;        ///< lags * Ts, seconds
@@ -39,6 +43,7 @@ struct CraResult {
   Eigen::VectorXd step;     ///< cumulative sum of g: response to a unit step
   double bound = 0.0;       ///< confidence bound on each g(k)
   double Ts = 1.0;          ///< seconds
+  /// {t, impulse, step, bound, Ts} (the lags are not written; t = lags * Ts).
   nlohmann::json ToJson() const;
 };
 

@@ -33,9 +33,10 @@
 
 namespace pneumid {
 
+/// FOPDT and SOPDT approximations of a model by Skogestad's half rule.
 struct HalfRuleResult {
-  FopdtParams fopdt;
-  SopdtParams sopdt;
+  FopdtParams fopdt;  ///< K, tau = tau_10 + tau_20 / 2, theta with the half-rule delay (s)
+  SopdtParams sopdt;  ///< K, tau1 = tau_10, tau2 = tau_20 + tau_30 / 2, theta (s)
   std::vector<std::string> notes;  ///< approximations applied (complex pairs, zeros)
 };
 

@@ -77,6 +77,8 @@
 
 namespace pneumid {
 
+/// Orders, map knots and refinement settings of the Hammerstein, Wiener and
+/// Hammerstein-Wiener estimators.
 struct BlockModelOptions {
   int na = 2;  ///< A coefficients (>= 0)
   int nb = 2;  ///< B coefficients (>= 1)
@@ -97,8 +99,11 @@ struct BlockModelOptions {
   bool refine = true;
   int max_iterations = 100;           ///< Levenberg-Marquardt iterations (>= 1)
   double function_tolerance = 1e-10;  ///< Ceres' relative cost change to stop
-  double gradient_tolerance = 1e-12;
-  double parameter_tolerance = 1e-10;
+  double gradient_tolerance = 1e-12;   ///< Ceres' gradient tolerance to stop (> 0)
+  double parameter_tolerance = 1e-10;  ///< Ceres' relative parameter step to stop (> 0)
+  /// True when na >= 0, nb >= 1, nk >= 0, num_knots is 0 or >= 2, given knots are >= 2,
+  /// finite and strictly increasing, max_iterations >= 1 and the tolerances positive;
+  /// otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 

@@ -37,12 +37,15 @@ using ParamValue = std::variant<double, int, std::vector<double>, std::vector<in
 /// Named parameters of an identified model, ordered by name.
 class ModelParams {
  public:
-  using Map = std::map<std::string, ParamValue>;
+  using Map = std::map<std::string, ParamValue>;  ///< storage: name -> value, sorted by name
+  /// No parameters.
   ModelParams() = default;
+  /// From {name, value} pairs, e.g. {{"K", 2.0}, {"tau", 1.5}, {"theta", 0.2}}.
   ModelParams(std::initializer_list<Map::value_type> values) : values_(values) {}
 
   /// The parameter `name`, inserted (as 0.0) when missing.
   ParamValue& operator[](const std::string& name) { return values_[name]; }
+  /// True when a parameter `name` exists (of any type).
   bool contains(const std::string& name) const { return values_.count(name) > 0; }
   /// @throws InvalidArgument naming the parameter and the available ones when missing.
   const ParamValue& at(const std::string& name) const;
@@ -55,10 +58,11 @@ class ModelParams {
   /// @throws InvalidArgument when missing or not a vector of reals.
   const std::vector<double>& Vector(const std::string& name) const;
 
-  bool empty() const { return values_.empty(); }
-  std::size_t size() const { return values_.size(); }
+  bool empty() const { return values_.empty(); }         ///< True when there are no parameters.
+  std::size_t size() const { return values_.size(); }    ///< Number of parameters.
+  /// First (name, value) pair in name order, for range-for over the parameters.
   Map::const_iterator begin() const { return values_.begin(); }
-  Map::const_iterator end() const { return values_.end(); }
+  Map::const_iterator end() const { return values_.end(); }  ///< Past the last pair.
   bool operator==(const ModelParams&) const = default;
 
  private:
@@ -74,14 +78,16 @@ enum class ModelFlag {
   kNoConvergence,     ///< "no_convergence": the iterative estimator did not converge
   kResidualsNotWhite  ///< "residuals_not_white": residual whiteness test failed
 };
+/// The flag's name as written in JSON and reports: "not_finite", "unstable", "nyquist_pole",
+/// "no_convergence", "residuals_not_white".
 std::string ToString(ModelFlag f);
 /// Inverse of ToString. @throws InvalidArgument listing the valid names.
 ModelFlag ModelFlagFromString(const std::string& name);
 
 /// A flag and the measured reason ("pole at z = -0.962, 0.038 from -1").
 struct ModelFlagNote {
-  ModelFlag flag = ModelFlag::kNotFinite;
-  std::string reason;
+  ModelFlag flag = ModelFlag::kNotFinite;  ///< what is wrong with the model
+  std::string reason;                      ///< measured evidence, in words and numbers
   bool operator==(const ModelFlagNote&) const = default;
 };
 
@@ -92,10 +98,12 @@ struct ModelFlagNote {
 /// ...). Confidence bands of responses are computed from it
 /// (model_uncertainty.hpp).
 struct ParameterCovariance {
-  std::vector<std::string> names;
-  Eigen::MatrixXd matrix;
+  std::vector<std::string> names;  ///< parameter names, one per row/column of `matrix`
+  Eigen::MatrixXd matrix;          ///< covariance, in squared units of the parameters
 };
 
+/// A model from one identification method: its parameters, transfer function,
+/// operating point, fit on the data and the reasons not to trust it.
 struct IdentifiedModel {
   std::string method;     ///< e.g. "reaction-curve", "fit-p1d", "arx"
   std::string structure;  ///< e.g. "FOPDT", "PTn", "P2D", "ARX"
@@ -112,7 +120,7 @@ struct IdentifiedModel {
   /// estimate y0), the polynomial and state-space methods model the signals
   /// as they are (0, 0), the correlation methods their means.
   double u0 = 0.0;
-  double y0 = 0.0;
+  double y0 = 0.0;  ///< output of the operating point (output units); see u0
   /// How the estimator ended (kNoConvergence: the last iterate is returned).
   Termination termination = Termination::kConvergence;
   /// NRMSE fit on held-out validation data (NaN when none were given); the
@@ -133,8 +141,8 @@ struct IdentifiedModel {
   /// f of a Hammerstein model or a static map (yhat from f(u) through
   /// `discrete`), the output map of a Wiener model, a polynomial NARX model.
   std::optional<StaticMap> input_map;
-  std::optional<StaticMap> output_map;
-  std::optional<NarxModel> narx;
+  std::optional<StaticMap> output_map;  ///< Wiener: g applied to the linear part's output
+  std::optional<NarxModel> narx;        ///< NARX and affine NARX: the polynomial model
 };
 
 /// The operating point (u0, y0) the polynomial and state-space methods (arx,
@@ -164,12 +172,21 @@ struct IdentifyRequest {
   int input = 0;               ///< input column
   int output = 0;              ///< output column
   int order = 2;               ///< PTn / Strejc order n
-  int na = 3, nb = 3, nk = 1;  ///< polynomial orders
-  int nc = 1, nd = 1, nf = 3;  ///< ARMAX/BJ/OE orders
+  /// na: A order (0..50) of arx, iv4, armax, oe, bj; the order of n4sid, the linear part of
+  /// hammerstein/wiener and the output lags of narx.
+  int na = 3, nb = 3, nk = 1;  ///< nk: input delay in samples (0..1000)
+  /// nc: C order (noise numerator) of armax and bj (0..50).
+  int nc = 1, nd = 1, nf = 3;  ///< nf: F order of oe and bj (0..50)
+  /// @var nb
+  /// Number of B coefficients (1..50); the input lags of narx.
+  /// @var nd
+  /// D order (noise denominator) of bj (0..50).
   bool feedthrough = false;    ///< n4sid: estimate the D term (subspace.hpp)
   SubspaceWeighting n4sid_weight = SubspaceWeighting::kMoesp;  ///< n4sid: W1/W2 weighting
   /// Operating point of arx, iv4, armax, oe, bj, n4sid (see OperatingPointKind).
   OperatingPointKind operating_point = OperatingPointKind::kAuto;
+  /// True when the columns are >= 0 and the orders in the ranges above (order 1..20);
+  /// otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 

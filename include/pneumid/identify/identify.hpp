@@ -54,6 +54,8 @@ struct IdentifyOptions {
   /// Worker threads of IdentifyModels (methods run side by side); 0 = one per
   /// hardware thread. Results do not depend on it.
   int num_threads = 0;
+  /// True when step, quality and nonlinear are valid, split is 0 or in (0, 1) and
+  /// num_threads >= 0; otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -91,7 +93,7 @@ struct IdentificationSummary {
   Eigen::Index validation_samples = 0;  ///< held-out samples scored (0: none)
   /// kSuccess: every method gave a model; kPartial: some failed; kFailure: none gave one.
   Termination termination = Termination::kFailure;
-  std::string message;
+  std::string message;  ///< e.g. "all 22 methods produced a model", "2 of 22 methods failed"
   /// One line: "identify success: 22 model(s), 0 failed, best fit-p2d (99.1 %)".
   std::string BriefReport() const;
 };

@@ -62,13 +62,14 @@ CalibrationInitialState CalibrationInitialStateFromString(const std::string& nam
 /// One measured experiment: input 0 is the PWM duty in %, output 0 the force
 /// in N (force mode) or position in m (position mode), uniformly sampled.
 struct CalibrationExperiment {
-  Dataset data;
+  Dataset data;  ///< duty (%) in input 0, force (N) or position (m) in output 0
   std::string name;  ///< shown in reports; empty: data.source()
   /// Weight w_e > 0 of the experiment's term in the cost (default 1): its
   /// residuals are multiplied by sqrt(w_e).
   double weight = 1.0;
 };
 
+/// What CalibrateIpa estimates, from where, and how the Levenberg-Marquardt solve runs.
 struct IpaCalibrationOptions {
   /// Starting values of the free parameters and values of all the others
   /// (mode and PWM mode included).
@@ -78,6 +79,7 @@ struct IpaCalibrationOptions {
   std::vector<std::string> free;
   /// Bounds that replace the physical range of a parameter, by name.
   std::map<std::string, std::pair<double, double>> bounds;
+  /// How each experiment's simulation starts (default: from the measured first sample).
   CalibrationInitialState initial_state = CalibrationInitialState::kMeasured;
   double warmup = 2.0;  ///< s of constant first input before the record (steady)
   /// Relative and absolute odeint tolerance of the calibration's simulations
@@ -98,48 +100,62 @@ struct IpaCalibrationOptions {
   /// Called after every iteration with its number and cost (may be empty).
   std::function<void(int iteration, double cost)> progress;
 
+  /// True when `start` is valid, warmup is in 0..1e4 s, integration_tolerance in
+  /// 1e-14..1e-3, relative_step in (0, 0.1], max_iterations in 0..100000, the stop
+  /// tolerances >= 0, num_threads in 1..256, correlation_threshold in (0, 1] and
+  /// fit_warning_percent <= 100; otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
 /// One estimated parameter, physical units.
 struct CalibratedParameter {
   std::string name;  ///< TOML key
-  std::string unit;
-  double value = 0.0;
+  std::string unit;   ///< physical unit of value, std, start and the bounds
+  double value = 0.0;  ///< calibrated value
   double std = 0.0;  ///< standard deviation; NaN when the covariance is not available
-  double start = 0.0;
-  double lower = 0.0, upper = 0.0;
+  double start = 0.0;  ///< value in IpaCalibrationOptions::start
+  /// Lower end of the search range: the parameter's physical range or the given bound.
+  double lower = 0.0, upper = 0.0;  ///< upper end of the search range
   bool at_bound = false;   ///< ended within 1e-6 of the range width from a bound
   bool determined = true;  ///< false: the data do not determine it (see the header comment)
 };
 
+/// A pair of calibrated parameters whose estimates are strongly correlated: the data
+/// determine mainly a combination of the two.
 struct ParameterCorrelation {
-  std::string first, second;
-  double correlation = 0.0;
+  /// TOML key of the first parameter of the pair.
+  std::string first, second;  ///< TOML key of the second parameter
+  double correlation = 0.0;   ///< correlation coefficient rho of the two estimates, -1..1
 };
 
+/// How well the twin reproduces one experiment before and after the calibration.
 struct CalibrationExperimentFit {
-  std::string name;
-  Eigen::Index samples = 0;
+  std::string name;          ///< CalibrationExperiment::name, or the data's source
+  Eigen::Index samples = 0;  ///< samples of the experiment in the cost
   double initial_fit_percent = 0.0;  ///< with the starting parameters
   double fit_percent = 0.0;          ///< with the calibrated parameters
   Eigen::VectorXd simulated;         ///< calibrated twin's output on the samples
 };
 
+/// Result of CalibrateIpa: the calibrated parameters, their uncertainty and the fits.
 struct IpaCalibrationSummary {
   /// convergence, no_convergence (iteration limit; last iterate kept) or
   /// failure (no usable result: the simulation failed at the start, ...).
   Termination termination = Termination::kFailure;
-  std::string message;
+  std::string message;  ///< Ceres' message, or why no usable result was obtained
   IpaParameters parameters;  ///< start with the free parameters replaced
-  std::vector<CalibratedParameter> estimates;
-  std::vector<CalibrationExperimentFit> experiments;
+  std::vector<CalibratedParameter> estimates;  ///< one per free parameter, in their order
+  std::vector<CalibrationExperimentFit> experiments;  ///< one per experiment, in input order
   std::vector<ParameterCorrelation> correlations;  ///< |rho| >= correlation_threshold
   std::vector<std::string> warnings;               ///< undetermined parameters, bounds reached, ...
-  int iterations = 0;
-  double initial_cost = 0.0, final_cost = 0.0;
+  int iterations = 0;  ///< Levenberg-Marquardt iterations
+  /// Cost at the start: 1/2 sum_e w_e (1 - fit_e / 100)^2 (Ceres' cost of the residuals
+  /// (yhat - y) sqrt(w_e) / |y - mean y| of each experiment), dimensionless.
+  double initial_cost = 0.0, final_cost = 0.0;  ///< cost at the calibrated parameters
   long long simulations = 0;  ///< simulator runs of whole experiments
   double seconds = 0.0;       ///< wall time of the solve
+  /// One line: "IPA calibration: convergence, 12 iterations, cost 0.08 -> 0.002, 250
+  /// simulations, 3.10 s; step fit 95.20 %" (one fit per experiment).
   std::string BriefReport() const;
 };
 

@@ -27,15 +27,22 @@
 
 namespace pneumid {
 
+/// Orders of the IV4 estimate (the ARX structure A y = B u + e).
 struct IvOptions {
   int na = 3;  ///< A order (>= 0)
   int nb = 3;  ///< B coefficients (>= 1)
   int nk = 1;  ///< input delay, samples (>= 0)
+  /// True when na >= 0, nb >= 1 and nk >= 0; otherwise false with the reason in *error
+  /// (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// IV4 model and how the four stages went.
 struct IvResult {
   PolynomialModel model;  ///< structure "ARX" estimated by IV4
+  /// kConvergence, or kFailure when the least-squares start or an instrument matrix is
+  /// singular (then `model` is the default or the stage-2 IV estimate); loss, initial_loss (the
+  /// least-squares loss), warnings.
   EstimationSummary summary;
 };
 

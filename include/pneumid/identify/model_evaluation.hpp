@@ -61,6 +61,7 @@ enum class InitialCondition {
   kZero,      ///< "zero": at rest at the operating point (the default everywhere)
   kEstimate,  ///< "estimate": the state that best explains the measured output
 };
+/// "zero" or "estimate".
 std::string ToString(InitialCondition c);
 /// Parses "zero" or "estimate"; @throws InvalidArgument listing them.
 InitialCondition InitialConditionFromString(const std::string& name);
@@ -96,6 +97,8 @@ FitMetrics ScoreSimulation(const Dataset& data, int output, const Eigen::VectorX
 /// Sets model->fit_percent and model->iae from EvaluateModel on all samples.
 void ScoreModel(const Dataset& data, int input, int output, IdentifiedModel* model);
 
+/// Thresholds of the checks AssessModel flags a model by (pole near z = -1, whiteness
+/// of the residuals).
 struct ModelQualityOptions {
   /// A discrete pole p with |p + 1| <= nyquist_distance is flagged. Default
   /// 0.05; 0 disables the test. In [0, 1).
@@ -104,6 +107,8 @@ struct ModelQualityOptions {
   double confidence = 0.99;
   /// Largest lag M of the whiteness test (MATLAB's default 25), >= 1.
   int max_lag = 25;
+  /// True when nyquist_distance is in [0, 1), confidence in (0, 1) and max_lag >= 1;
+  /// otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 

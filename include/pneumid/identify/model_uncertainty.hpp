@@ -40,12 +40,15 @@
 
 namespace pneumid {
 
+/// How parameter covariance is propagated to response uncertainty (finite differences).
 struct UncertaintyOptions {
   /// Relative finite-difference step h_i / max(|theta_i|, sd_i), in (0, 0.1] (default 1e-5).
   double relative_step = 1e-5;
   /// Propagate through the discrete form (IdentifiedModel::discrete) instead of
   /// "tf" when the model has one (what `pneumid report` plots).
   bool discrete = false;
+  /// True when relative_step is in (0, 0.1]; otherwise false with the reason in *error
+  /// (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -77,8 +80,8 @@ Eigen::VectorXd StepResponseStd(const IdentifiedModel& model, const Eigen::Vecto
 
 /// Standard deviations of the Bode magnitude (dB) and phase (deg).
 struct BodeStd {
-  Eigen::VectorXd magnitude_db;
-  Eigen::VectorXd phase_deg;
+  Eigen::VectorXd magnitude_db;  ///< standard deviation of 20 log10 |G(jw)|, dB, one per w
+  Eigen::VectorXd phase_deg;     ///< standard deviation of arg G(jw), degrees, one per w
 };
 
 /// Standard deviations at frequencies w (rad/s, > 0; below pi/Ts for a

@@ -52,6 +52,7 @@
 
 namespace pneumid {
 
+/// Lags, degree and term-selection stop rule of the polynomial NARX estimate (FROLS).
 struct NarxOptions {
   int ny = 2;      ///< output lags (>= 0)
   int nu = 2;      ///< input lags (>= 1)
@@ -65,6 +66,8 @@ struct NarxOptions {
   int max_terms = 10;  ///< at most this many terms (>= 1)
   /// Normalise the signals (see above); false: u_offset = 0, scales 1.
   bool normalise = true;
+  /// True when ny >= 0, nu >= 1, nk >= 0, degree is 1..3, err_tolerance is in (0, 1) and
+  /// max_terms >= 1; otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -72,7 +75,10 @@ struct NarxOptions {
 /// and regressor index).
 std::vector<NarxTerm> NarxCandidates(int ny, int nu, int degree);
 
+/// Polynomial NARX model chosen by FROLS and its fits.
 struct NarxResult {
+  /// Selected terms with their coefficients theta and ERR, the lags, Ts and the
+  /// normalisation (u_offset, u_scale, y_scale).
   NarxModel model;
   /// termination (kConvergence), num_parameters = terms chosen, loss = mean
   /// squared one-step error, message naming the stopping rule.

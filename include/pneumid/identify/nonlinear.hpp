@@ -37,7 +37,7 @@ namespace pneumid {
 
 /// Settings of the nonlinear methods beyond the request's orders.
 struct NonlinearOptions {
-  StaticMapFitOptions static_map;
+  StaticMapFitOptions static_map;  ///< level detection and map fit of static-map
   /// Knots (or their number), refinement and tolerances of hammerstein and
   /// wiener; na, nb, nk here are ignored (the request's orders are used).
   BlockModelOptions block;
@@ -57,13 +57,19 @@ struct NonlinearOptions {
   /// narx: the largest lag ny = nu and the most terms the structure search
   /// tries (>= 1; defaults 8 and 60).
   int max_narx_lag = 8;
-  int max_narx_terms = 60;
+  int max_narx_terms = 60;  ///< narx structure search: most terms (>= 1, default 60)
+  /// True when structure_split is in (0, 1), max_narx_lag and max_narx_terms >= 1,
+  /// max_delay is in 0..1000 and static_map, block and narx are valid (their orders
+  /// aside); otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
 /// One candidate of the structure search and its held-out simulation fit.
 struct StructureCandidate {
-  int na = 0, nb = 0, nk = 0;
+  /// A order (narx: the output lags ny).
+  int na = 0, nb = 0, nk = 0;  ///< input delay in samples
+  /// @var nb
+  /// B coefficients (narx: the input lags nu).
   int terms = 0;             ///< narx: terms of the candidate
   double fit_percent = 0.0;  ///< held-out fit; -inf when the estimate failed
   /// Simulation fit on the estimation part; -inf when the estimate failed.
@@ -84,9 +90,12 @@ struct StructureCandidate {
 /// the last 1 - structure_split of `data` (estimated on the first part,
 /// simulated over the whole record, scored on the rest).
 struct StructureChoice {
-  int na = 1, nb = 1, nk = 1;
+  /// Chosen A order (narx: the lags, na = nb).
+  int na = 1, nb = 1, nk = 1;  ///< chosen input delay in samples
+  /// @var nb
+  /// Chosen number of B coefficients (narx: the lags, na = nb).
   int terms = 0;  ///< narx: terms chosen (0 for the block models)
-  double fit_percent = 0.0;
+  double fit_percent = 0.0;  ///< held-out simulation fit of the choice, NRMSE %
   std::string held_out;                        ///< "the last 30 % of the data" or the file
   std::vector<StructureCandidate> candidates;  ///< in the order tried
   /// "na = 1, nb = 1, nk = 2 (held-out fit 98.7 % on ...); tried: ...".
@@ -110,6 +119,7 @@ StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& d
 
 /// "static-map", "hammerstein", "wiener", "hw", "narx", "affine-narx".
 const std::vector<std::string>& NonlinearMethodNames();
+/// True when `name` is one of NonlinearMethodNames().
 bool IsNonlinearMethod(const std::string& name);
 
 /// True when the model has a nonlinear part (input_map, output_map or narx).

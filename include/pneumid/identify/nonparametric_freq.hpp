@@ -32,6 +32,7 @@
 
 namespace pneumid {
 
+/// Nonparametric frequency response G(e^{i w Ts}) on a grid of frequencies (spa, etfe).
 struct FrequencyResponseEstimate {
   Eigen::VectorXd omega;           ///< rad/s
   Eigen::VectorXcd response;       ///< G(e^{i w Ts})
@@ -39,18 +40,25 @@ struct FrequencyResponseEstimate {
   Eigen::VectorXd phase_deg;       ///< arg G, degrees, unwrapped
   Eigen::VectorXd noise_spectrum;  ///< Phi_v (spa only; empty for etfe)
   Eigen::VectorXd magnitude_std;   ///< standard deviation of |G| (spa only)
-  double Ts = 1.0;
+  double Ts = 1.0;  ///< sample time of the data, seconds
+  /// {omega, magnitude, phase_deg, Ts}, plus noise_spectrum and magnitude_std when present.
   nlohmann::json ToJson() const;
 };
 
+/// Lag window and frequency grid of the Blackman-Tukey estimate (Spa).
 struct SpaOptions {
   int lag_window = 0;         ///< M (0 = min(30, N / 10)); must be < N
   int num_frequencies = 128;  ///< K
+  /// True when lag_window >= 0 and num_frequencies >= 1; otherwise false with the reason in
+  /// *error (when error is not null). M < N is checked against the data by Spa.
   bool IsValid(std::string* error) const;
 };
 
+/// Frequency resolution of the empirical transfer-function estimate (Etfe).
 struct EtfeOptions {
   int num_frequencies = 0;  ///< 0 = every DFT bin 1 .. N/2; otherwise that many bands
+  /// True when num_frequencies >= 0; otherwise false with the reason in *error (when error
+  /// is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -58,6 +66,9 @@ struct EtfeOptions {
 /// @throws InvalidArgument for invalid options, sizes or a constant input.
 FrequencyResponseEstimate Spa(const Eigen::VectorXd& y, const Eigen::VectorXd& u, double Ts,
                               const SpaOptions& options = {});
+/// Spa of output column `output` against input column `input` of `data`, at its sample time.
+/// @throws InvalidArgument for a column out of range, and as above; DataError for
+///         non-uniform sampling.
 FrequencyResponseEstimate Spa(const Dataset& data, const SpaOptions& options = {}, int input = 0,
                               int output = 0);
 
@@ -65,6 +76,9 @@ FrequencyResponseEstimate Spa(const Dataset& data, const SpaOptions& options = {
 /// @throws InvalidArgument for invalid options, sizes or a constant input.
 FrequencyResponseEstimate Etfe(const Eigen::VectorXd& y, const Eigen::VectorXd& u, double Ts,
                                const EtfeOptions& options = {});
+/// Etfe of output column `output` against input column `input` of `data`, at its sample
+/// time. @throws InvalidArgument for a column out of range, and as above; DataError for
+///         non-uniform sampling.
 FrequencyResponseEstimate Etfe(const Dataset& data, const EtfeOptions& options = {}, int input = 0,
                                int output = 0);
 

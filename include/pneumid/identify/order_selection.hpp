@@ -28,43 +28,61 @@ namespace pneumid {
 
 /// Inclusive integer range min..max.
 struct OrderRange {
-  int min = 1;
-  int max = 5;
+  int min = 1;  ///< smallest value tried
+  int max = 5;  ///< largest value tried (>= min)
   /// Parses "3" or "1:5". @throws InvalidArgument naming the text.
   static OrderRange Parse(const std::string& text);
+  /// "min:max", e.g. "1:5" (also for a single value: "3:3").
   std::string ToString() const;
 };
 
+/// Criterion by which the best candidate is chosen: the loss V alone, or AIC, AICc, FPE,
+/// MDL (formulas above; smaller is better for all).
 enum class OrderCriterion { kLoss, kAic, kAicc, kFpe, kMdl };
 /// "loss", "aic", "aicc", "fpe", "mdl".
 std::string ToString(OrderCriterion c);
 /// Inverse of ToString; throws InvalidArgument listing the valid names.
 OrderCriterion OrderCriterionFromString(const std::string& name);
 
+/// Ranges of the ARX orders and delay swept by SelectArxOrders, and the data columns.
 struct OrderSelectionOptions {
   OrderRange na{1, 5};  ///< >= 0
   OrderRange nb{1, 5};  ///< >= 1
   OrderRange nk{0, 3};  ///< >= 0
-  int input = 0;
-  int output = 0;
+  int input = 0;   ///< input column (>= 0)
+  int output = 0;  ///< output column (>= 0)
+  /// True when each range has min <= max within the bounds above and the columns are >= 0;
+  /// otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// One ARX(na, nb, nk) of the sweep with its loss and information criteria.
 struct OrderCandidate {
-  int na = 0, nb = 0, nk = 0;
-  int num_parameters = 0;
+  /// A order.
+  int na = 0, nb = 0, nk = 0;  ///< input delay in samples
+  /// @var nb
+  /// Number of B coefficients.
+  /// @var aicc
+  /// AICc = AIC + 2 d (d + 1) / (N - d - 1); infinity when N <= d + 1.
+  /// @var fpe
+  /// FPE = V (1 + d/N) / (1 - d/N), in output units^2; infinity when d >= N.
+  int num_parameters = 0;  ///< d = na + nb
   double loss = 0.0;  ///< V
-  double aic = 0.0, aicc = 0.0, fpe = 0.0, mdl = 0.0;
+  /// AIC = N ln V + 2 d.
+  double aic = 0.0, aicc = 0.0, fpe = 0.0, mdl = 0.0;  ///< MDL = N ln V + d ln N
   /// Value of criterion c.
   double Value(OrderCriterion c) const;
 };
 
+/// Result of SelectArxOrders: every candidate, comparable on the same N rows.
 struct OrderSelection {
   std::vector<OrderCandidate> candidates;  ///< in sweep order (na, nb, nk nested)
   long long num_rows = 0;                  ///< N used by every candidate
   bool validation = false;                 ///< losses measured on validation data
   /// Index of the best candidate by criterion c (the first one on ties).
   std::size_t Best(OrderCriterion c) const;
+  /// {num_rows, loss_on ("estimation" or "validation"), candidates: [{na, nb, nk,
+  /// num_parameters, loss, aic, aicc, fpe, mdl}], best: {criterion name: {na, nb, nk}}}.
   nlohmann::json ToJson() const;
 };
 

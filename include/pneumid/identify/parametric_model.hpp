@@ -47,10 +47,10 @@ inline EstimationTermination EstimationTerminationFromString(const std::string& 
 
 /// Outcome of a parametric estimator (after Ceres' Solver::Summary).
 struct EstimationSummary {
-  EstimationTermination termination = EstimationTermination::kFailure;
+  EstimationTermination termination = EstimationTermination::kFailure;  ///< how it ended
   std::string message;     ///< human-readable reason for `termination`
   long long num_rows = 0;  ///< number of prediction errors in the criterion
-  int num_parameters = 0;
+  int num_parameters = 0;  ///< number of estimated parameters d
   int iterations = 0;         ///< solver iterations (0 for direct least squares)
   double loss = 0.0;          ///< mean squared prediction error, sum eps^2 / N
   double initial_loss = 0.0;  ///< loss of the initial model (iterative methods)
@@ -58,13 +58,16 @@ struct EstimationSummary {
   /// of R), and of the regressor with its columns scaled to unit norm (the excitation
   /// measure that does not depend on the units of the signals).
   double condition_number = 0.0;
-  double scaled_condition_number = 0.0;
+  double scaled_condition_number = 0.0;  ///< condition number with unit-norm columns
   std::vector<std::string> warnings;  ///< poor excitation, unstable model, ...
   /// One line: "ARX: convergence, N = 999, 6 parameters, loss 1.2e-3, cond 45".
   std::string BriefReport() const;
+  /// True unless termination is kFailure (a non-converged or rank-deficient estimate is usable).
   bool IsSolutionUsable() const { return termination != EstimationTermination::kFailure; }
 };
 
+/// Discrete polynomial model A y = B/F u + C/D e (q^-1 polynomials, the family of ARX,
+/// ARMAX, OE, BJ), with its sample time, noise variance and parameter covariance.
 struct PolynomialModel {
   double Ts = 1.0;                               ///< sample time, seconds
   Eigen::VectorXd a = Eigen::VectorXd::Ones(1);  ///< [1 a1 .. a_na]
@@ -78,12 +81,13 @@ struct PolynomialModel {
   Eigen::MatrixXd covariance;
   std::string structure = "ARX";  ///< "ARX", "ARMAX", "OE", "BJ", "IV4"
 
-  int num_inputs() const { return static_cast<int>(b.size()); }
-  int na() const { return static_cast<int>(a.size()) - 1; }
+  int num_inputs() const { return static_cast<int>(b.size()); }  ///< Number of inputs (B's).
+  int na() const { return static_cast<int>(a.size()) - 1; }  ///< Order of A.
   /// Number of estimated coefficients of B_i (without the leading zeros).
   int nb(int input = 0) const;
-  int nc() const { return static_cast<int>(c.size()) - 1; }
-  int nd() const { return static_cast<int>(d.size()) - 1; }
+  int nc() const { return static_cast<int>(c.size()) - 1; }  ///< Order of C.
+  int nd() const { return static_cast<int>(d.size()) - 1; }  ///< Order of D.
+  /// Order of F_input (0 when f is empty, i.e. F = 1).
   int nf(int input = 0) const;
 
   /// Names of the free parameters: a1.., b1.. (b1_1.. for several inputs), c1.., d1.., f1..

@@ -32,6 +32,8 @@
 
 namespace pneumid {
 
+/// Member of the polynomial family to estimate: ARX (A y = B u + e), ARMAX (A y = B u + C e),
+/// OE (y = B/F u + e) or BJ (y = B/F u + C/D e).
 enum class PolynomialStructure { kArx, kArmax, kOe, kBj };
 /// "arx", "armax", "oe", "bj".
 std::string ToString(PolynomialStructure s);
@@ -48,19 +50,27 @@ struct PemOrders {
   int nk = 1;  ///< input delay, samples
 };
 
+/// Levenberg-Marquardt settings of the prediction-error refinement and its initialisation.
 struct PemOptions {
-  int max_iterations = 100;           ///< Levenberg-Marquardt iterations
-  double function_tolerance = 1e-10;  ///< relative change of V to stop
-  double gradient_tolerance = 1e-12;
-  double parameter_tolerance = 1e-10;
+  int max_iterations = 100;            ///< Levenberg-Marquardt iterations
+  double function_tolerance = 1e-10;   ///< relative change of V to stop
+  double gradient_tolerance = 1e-12;   ///< Ceres' gradient tolerance to stop (> 0)
+  double parameter_tolerance = 1e-10;  ///< Ceres' relative parameter step to stop (> 0)
   /// Order of the high-order ARX model of the ARMAX / BJ initialisation
   /// (0 = automatic: max(20, 2 (na + nb + nc)), limited by the data length).
   int initial_arx_order = 0;
+  /// True when max_iterations >= 0, the three tolerances are > 0 and initial_arx_order >= 0;
+  /// otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Model estimated by EstimatePolynomial and how the minimisation went.
 struct PemResult {
+  /// Structure "ARMAX", "OE" or "BJ" (or "ARX"), with noise variance N V / (N - d) and the
+  /// covariance lambda (J'J)^-1 (none when J is singular at the optimum).
   PolynomialModel model;
+  /// termination (kFailure when N <= 2 d samples), iterations, loss V and
+  /// initial_loss, condition number of J, warnings (initialisation, no convergence).
   EstimationSummary summary;
 };
 

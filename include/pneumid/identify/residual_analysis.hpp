@@ -29,12 +29,17 @@
 
 namespace pneumid {
 
+/// Largest lag and confidence level of the residual tests.
 struct ResidualAnalysisOptions {
   int max_lag = 25;          ///< M (MATLAB's default); >= 1 and < N / 2
   double confidence = 0.99;  ///< in (0, 1)
+  /// True when max_lag >= 1 and confidence is in (0, 1); otherwise false with the reason in
+  /// *error (when error is not null). M < N / 2 is checked against the data.
   bool IsValid(std::string* error) const;
 };
 
+/// Correlation tests of model residuals: whiteness (autocorrelation) and independence from
+/// the input (cross-correlation), with the portmanteau statistics.
 struct ResidualAnalysis {
   Eigen::VectorXd residuals;            ///< eps(t), N samples
   Eigen::VectorXd lags_auto;            ///< 0 .. M
@@ -48,11 +53,14 @@ struct ResidualAnalysis {
   double whiteness_threshold = 0.0;     ///< chi2 quantile, M degrees of freedom
   double independence_statistic = 0.0;  ///< Q_eu
   double independence_threshold = 0.0;  ///< chi2 quantile, 2M+1 degrees of freedom
-  bool whiteness_passed = false;
-  bool independence_passed = false;
+  bool whiteness_passed = false;     ///< whiteness_statistic < whiteness_threshold
+  bool independence_passed = false;  ///< independence_statistic < independence_threshold
+  /// True when both the whiteness and the independence test passed.
   bool passed() const { return whiteness_passed && independence_passed; }
   /// e.g. "residuals white: pass (Q = 21.3 < 44.3), independent of input: fail (...)".
   std::string BriefReport() const;
+  /// {bound, autocorrelation: {lags, values, outside}, crosscorrelation: {lags, values,
+  /// outside}, whiteness and independence: {statistic, threshold, passed}, passed}.
   nlohmann::json ToJson() const;
 };
 

@@ -24,12 +24,17 @@
 
 namespace pneumid {
 
+/// Forgetting factor and initial covariance of recursive least squares.
 struct RlsOptions {
   double forgetting_factor = 0.99;  ///< lambda in (0, 1]
   double initial_covariance = 1e4;  ///< P0 = initial_covariance * I (> 0)
+  /// True when forgetting_factor is in (0, 1] and initial_covariance > 0; otherwise false
+  /// with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Recursive least squares with exponential forgetting for y(t) = phi(t)' theta + e(t)
+/// (update equations above); allocation-free per update.
 class RecursiveLeastSquares {
  public:
   /// @throws InvalidArgument for num_parameters < 1 or invalid options.
@@ -39,10 +44,12 @@ class RecursiveLeastSquares {
   /// One update with regressor phi and measurement y; returns the a-priori error.
   /// phi must have num_parameters() entries (checked only in debug builds).
   double Update(const Eigen::Ref<const Eigen::VectorXd>& phi, double y);
-  const Eigen::VectorXd& theta() const { return theta_; }
+  const Eigen::VectorXd& theta() const { return theta_; }  ///< Current estimate theta(t).
+  /// Current matrix P(t), symmetric; times the noise variance it approximates cov(theta).
   const Eigen::MatrixXd& P() const { return P_; }
+  /// Number of parameters (size of theta and phi).
   int num_parameters() const { return static_cast<int>(theta_.size()); }
-  long long num_updates() const { return updates_; }
+  long long num_updates() const { return updates_; }  ///< Updates since construction or Reset.
 
  private:
   RlsOptions options_;
@@ -62,6 +69,7 @@ class RecursiveArx {
   double Update(double u, double y);
   /// Current estimate as a polynomial model with sample time Ts seconds.
   PolynomialModel Model(double Ts) const;
+  /// The underlying estimator; theta is [a1 .. a_na, b1 .. b_nb].
   const RecursiveLeastSquares& rls() const { return rls_; }
 
  private:

@@ -26,8 +26,9 @@
 
 namespace pneumid {
 
+/// SOPDT of the three-point method with the measured ratio R.
 struct ThreePointSopdtResult {
-  SopdtParams params;
+  SopdtParams params;  ///< K, tau1 >= tau2 (s), theta >= 0 (s)
   double ratio = 0.0;    ///< R measured
   bool clamped = false;  ///< R outside [1.541, 1.949], q set to the nearest end
 };

@@ -47,12 +47,14 @@ enum class StaticMapSource {
   kStaircase,  ///< "staircase": segments of constant input
   kRamp,       ///< "ramp": a slow ramp, binned
 };
+/// "auto", "staircase" or "ramp".
 std::string ToString(StaticMapSource s);
 /// Inverse of ToString. @throws InvalidArgument listing the valid names.
 StaticMapSource StaticMapSourceFromString(const std::string& name);
 
+/// How FitStaticMap finds the steady states and shapes the map.
 struct StaticMapFitOptions {
-  StaticMapSource source = StaticMapSource::kAuto;
+  StaticMapSource source = StaticMapSource::kAuto;  ///< kind of experiment (default: detect)
   /// Fraction of each segment, at its end, averaged for the steady output;
   /// in (0, 1]. Default 0.5.
   double settle_fraction = 0.5;
@@ -70,9 +72,13 @@ struct StaticMapFitOptions {
   int ramp_bins = 20;
   /// How the map extrapolates (default clamp: saturated beyond the levels).
   StaticMapExtrapolation extrapolation = StaticMapExtrapolation::kClamp;
+  /// True when settle_fraction is in (0, 1], min_segment_duration and level_tolerance are
+  /// finite and >= 0, smoothing_passes >= 0 and ramp_bins >= 2; otherwise false with the
+  /// reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// What FitStaticMap used and how much monotonicity and smoothing changed the levels.
 struct StaticMapFitSummary {
   StaticMapSource source = StaticMapSource::kStaircase;  ///< what was used
   int segments_used = 0;     ///< settled segments (staircase) or filled bins (ramp)
@@ -80,18 +86,22 @@ struct StaticMapFitSummary {
   int levels_pooled = 0;     ///< levels merged by PAVA into a neighbour's value
   /// Largest |value - level mean| that PAVA and smoothing introduced (output units).
   double max_adjustment = 0.0;
-  Termination termination = Termination::kConvergence;
-  std::string message;
+  Termination termination = Termination::kConvergence;  ///< kConvergence (failures throw)
+  std::string message;  ///< e.g. "11 knots from 11 settled segment(s), ..." with the map
   /// One line: "static-map convergence: staircase, 11 levels, 2 pooled (max change 0.8)".
   std::string BriefReport() const;
 };
 
+/// Fitted static map y = f(u) and the measured steady states it goes through.
 struct StaticMapFitResult {
+  /// Piecewise linear through (level_u, adjusted level_y), extrapolated as the options say.
   StaticMap map;
   /// The measured steady states before PAVA / smoothing, with their weights
-  /// (samples averaged), sorted by level.
-  std::vector<double> level_u, level_y, weight;
-  StaticMapFitSummary summary;
+  /// (samples averaged), sorted by level: level_u the input levels (input units).
+  std::vector<double> level_u, level_y, weight;  ///< samples averaged for each level
+  /// @var level_y
+  /// Mean steady output at each input level (output units), before PAVA / smoothing.
+  StaticMapFitSummary summary;  ///< source used, segments, pooling and message
 };
 
 /// Fits the map from input u and output y sampled every Ts seconds.
@@ -124,6 +134,7 @@ std::vector<double> PlaceMapKnots(const Eigen::VectorXd& u, int num_knots = 0, i
 /// the intervals beside it with no data inside: the data leave the map
 /// undetermined there (a jump may lie anywhere between the two knots).
 struct MapGap {
+  /// Lower knot of the gap (input units).
   double u_lo = 0.0, u_hi = 0.0;  ///< the knots around the gap
   double change = 0.0;            ///< f(u_hi) - f(u_lo)
   std::string Describe() const;   ///< "between u = 85 and 95 the map changes by 58 (...)"

@@ -48,6 +48,7 @@
 
 namespace pneumid {
 
+/// Thresholds by which AnalyzeStep finds the step, the settled tail and the noise band.
 struct StepAnalysisOptions {
   /// Fraction of the record used as the settled tail (default 0.1).
   double tail_fraction = 0.1;
@@ -70,6 +71,10 @@ struct StepAnalysisOptions {
   /// departure back to the baseline (default 0.3).
   double departure_fit_upper = 0.3;
 
+  /// True when tail_fraction is in (0, 0.5), min_tail_samples >= 3, settle_tolerance > 0,
+  /// min_snr >= 0, input_tolerance and band_min_fraction are in (0, 0.5), band_sigmas >= 0,
+  /// band_hold_samples >= 1 and departure_fit_upper is in (band_min_fraction, 1);
+  /// otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -79,7 +84,10 @@ struct StepAnalysis {
   Eigen::Index step_index = 0;          ///< k_s, first sample at the new input level
   double step_time = 0.0;               ///< t_s, absolute (data time axis), s
   double Ts = 0.0;                      ///< mean sample interval, s
+  /// Input level before the step (input units).
   double u0 = 0.0, u1 = 0.0, du = 0.0;  ///< input before / after, step size
+  /// @var u1
+  /// Input level after the step (input units); du = u1 - u0.
   double y0 = 0.0;                      ///< baseline (output units)
   double y_final = 0.0;                 ///< settled final value
   double y_final_std = 0.0;             ///< standard error of y_final
@@ -109,10 +117,10 @@ StepAnalysis AnalyzeStep(const Dataset& data, int input = 0, int output = 0,
 /// Second-order-plus-dead-time model K exp(-theta s) / ((tau1 s + 1)(tau2 s + 1)),
 /// tau1 >= tau2 >= 0 (seconds).
 struct SopdtParams {
-  double K = 0.0;
-  double tau1 = 0.0;
-  double tau2 = 0.0;
-  double theta = 0.0;
+  double K = 0.0;      ///< static gain, output units per input unit
+  double tau1 = 0.0;   ///< larger time constant, s
+  double tau2 = 0.0;   ///< smaller time constant, s (0: first order)
+  double theta = 0.0;  ///< dead time, s
 };
 
 }  // namespace pneumid

@@ -36,10 +36,12 @@ namespace pneumid {
 
 /// Settings of the step-response methods beyond IdentifyRequest.
 struct StepMethodOptions {
-  StepAnalysisOptions step;
-  TangentOptions tangent;
+  StepAnalysisOptions step;  ///< how the step, the tail and the noise band are found
+  TangentOptions tangent;    ///< inflection-tangent settings of the tangent-based methods
   /// Options of the fit-* methods (structure and zero are set from the method name).
   ProcessFitOptions fit;
+  /// True when step, tangent and fit are all valid; otherwise false with the first reason
+  /// in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 

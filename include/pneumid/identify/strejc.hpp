@@ -20,6 +20,7 @@
 
 namespace pneumid {
 
+/// Strejc's model K exp(-Td s) / (T s + 1)^n from the inflection tangent's Tu and Tn.
 struct StrejcResult {
   int n = 1;           ///< number of equal lags
   double K = 0.0;      ///< gain

@@ -60,6 +60,7 @@ std::string ToString(SubspaceWeighting w);
 /// @throws InvalidArgument naming the valid values.
 SubspaceWeighting SubspaceWeightingFromString(const std::string& name);
 
+/// Order, horizon and weighting of the subspace estimate (n4sid family).
 struct SubspaceOptions {
   /// Model order n; 0 chooses it at the largest gap of log singular values
   /// among the first max_order.
@@ -68,15 +69,20 @@ struct SubspaceOptions {
   /// Block rows s (past and future horizon); 0 = max(2 n_max, 10). Must exceed the order.
   int horizon = 0;
   bool feedthrough = false;  ///< estimate D (otherwise D = 0)
-  SubspaceWeighting weighting = SubspaceWeighting::kMoesp;
+  SubspaceWeighting weighting = SubspaceWeighting::kMoesp;  ///< W1/W2 (default PO-MOESP)
+  /// True when order >= 0, max_order >= 1, horizon >= 0 and a given horizon exceeds the
+  /// (maximum) order; otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Discrete state-space model from the subspace method, with its order decision.
 struct SubspaceResult {
   StateSpace model;                 ///< discrete, Ts of the data
   Eigen::VectorXd singular_values;  ///< of the weighted matrix M, for the order decision
   Eigen::VectorXd x0;               ///< estimated initial state
-  int order = 0;
+  int order = 0;  ///< state dimension n used (given, or chosen from singular_values)
+  /// kConvergence, or kFailure for non-finite matrices; message "PO-MOESP, order n, horizon
+  /// s"; loss (one-step error power), warnings (unstable model).
   EstimationSummary summary;
 };
 

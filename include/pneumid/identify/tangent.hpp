@@ -31,13 +31,16 @@
 
 namespace pneumid {
 
+/// Smoothing of the step response before its inflection tangent is drawn.
 struct TangentOptions {
   /// Savitzky-Golay half-width m (window 2m + 1 samples); 0 chooses
   /// m = clamp(round(n63 / 8), 2, 50) with n63 the samples to 63.2 % (default 0).
   int half_width = 0;
+  /// True when half_width >= 0; otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Inflection point of the normalized step response and its tangent's delay and lag times.
 struct TangentResult {
   double inflection_time = 0.0;   ///< t_i, s after the step
   double inflection_value = 0.0;  ///< r_i, fraction of the step

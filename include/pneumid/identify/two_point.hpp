@@ -22,6 +22,7 @@
 
 namespace pneumid {
 
+/// Two-point FOPDT method: its response fractions and formulas are in the table above.
 enum class TwoPointMethod { kSmith, kSundaresanKrishnaswamy, kBroida };
 
 /// "smith", "sundaresan", "broida" (the `pneumid identify` method names).

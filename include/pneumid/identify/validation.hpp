@@ -22,6 +22,7 @@
 
 namespace pneumid {
 
+/// Prediction horizon, skipped samples and columns of a model-versus-data comparison.
 struct CompareOptions {
   /// Prediction horizon k in samples; 0 means infinity (pure simulation).
   int horizon = 0;
@@ -29,15 +30,19 @@ struct CompareOptions {
   int skip = 0;
   int input = 0;   ///< input column (SISO models)
   int output = 0;  ///< output column
+  /// True when horizon, skip, input and output are >= 0; otherwise false with the reason in
+  /// *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Measured and simulated (or k-step predicted) output and the fit measures.
 struct CompareResult {
   Eigen::VectorXd t;     ///< seconds
   Eigen::VectorXd y;     ///< measured output
   Eigen::VectorXd yhat;  ///< simulated or predicted output
+  /// NRMSE fit over the samples after `skip`, %; -inf when yhat is not finite.
   double fit_percent = 0.0;
-  double rmse = 0.0;
+  double rmse = 0.0;  ///< root-mean-square error over the same samples (output units)
   int horizon = 0;  ///< 0 = simulation
 };
 

@@ -40,6 +40,7 @@
 
 namespace pneumid {
 
+/// Continuous <-> discrete mapping of C2D / D2C (the methods in the file comment).
 enum class DiscretizationMethod { kZoh, kFoh, kTustin, kEuler, kBackwardDiff, kMatched };
 
 /// "zoh", "foh", "tustin", "euler", "backward_diff", "matched".
@@ -65,6 +66,8 @@ TransferFunction ToTransferFunction(const StateSpace& ss, int input = 0, int out
 TransferFunction C2D(const TransferFunction& g, double Ts,
                      DiscretizationMethod method = DiscretizationMethod::kZoh,
                      double prewarp = 0.0);
+/// State-space C2D with the same methods and checks; under zoh a fractional delay adds
+/// the previous input as states. matched needs a SISO model (else InvalidArgument).
 StateSpace C2D(const StateSpace& g, double Ts,
                DiscretizationMethod method = DiscretizationMethod::kZoh, double prewarp = 0.0);
 
@@ -75,6 +78,7 @@ StateSpace C2D(const StateSpace& g, double Ts,
 TransferFunction D2C(const TransferFunction& g,
                      DiscretizationMethod method = DiscretizationMethod::kZoh,
                      double prewarp = 0.0);
+/// State-space D2C (zoh or tustin) with the same checks.
 StateSpace D2C(const StateSpace& g, DiscretizationMethod method = DiscretizationMethod::kZoh,
                double prewarp = 0.0);
 

@@ -31,7 +31,7 @@ struct FopdtParams {
 
 /// The response fractions of Smith's method: 28.3 % and 63.2 % (1 - 1/e).
 inline constexpr double kSmithLevel1 = 0.283;
-inline constexpr double kSmithLevel2 = 0.632;
+inline constexpr double kSmithLevel2 = 0.632;  ///< 63.2 % crossing, at theta + tau
 
 /// Smith's two-point FOPDT (see the file comment) from the gain K and the
 /// times t1 < t2 (s after the step) of the 28.3 % and 63.2 % crossings.

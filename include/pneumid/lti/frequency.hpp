@@ -7,6 +7,7 @@
 
 namespace pneumid {
 
+/// Frequency response of a transfer function at the frequencies `omega` (Bode).
 struct BodeData {
   Eigen::VectorXd omega;         ///< rad/s
   Eigen::VectorXd magnitude;     ///< absolute (not dB)
@@ -26,9 +27,10 @@ Eigen::VectorXd LogSpace(double lo, double hi, int n);
 ///   pi/Ts for a discrete model.
 BodeData Bode(const TransferFunction& g, const Eigen::VectorXd& omega = Eigen::VectorXd());
 
+/// Gain and phase margins of an open loop and their crossover frequencies.
 struct Margins {
-  double gain_margin = 0.0;  ///< absolute; +inf when the phase never crosses -180
-  double gain_margin_db = 0.0;
+  double gain_margin = 0.0;      ///< absolute; +inf when the phase never crosses -180
+  double gain_margin_db = 0.0;   ///< 20 log10 gain_margin, dB
   double phase_crossover = 0.0;  ///< rad/s where phase = -180 deg (NaN if none)
   double phase_margin = 0.0;     ///< degrees; +inf when |G| never crosses 1
   double gain_crossover = 0.0;   ///< rad/s where |G| = 1 (NaN if none)

@@ -51,7 +51,8 @@ StaticMap ReadStaticMap(const std::string& spec);
 /// A NARX model of a model file with its input map (affine-narx models carry
 /// one; lti/narx_model.hpp).
 struct NarxWithMap {
-  NarxModel narx;
+  NarxModel narx;  ///< the polynomial NARX, driven by the mapped input v = f(u) with a map
+  /// Static input map v = f(u) run before the NARX (affine-narx); std::nullopt without one.
   std::optional<StaticMap> input_map;
 };
 /// The NARX model of a model file spec (the "narx" of the selected model,
@@ -67,6 +68,7 @@ TransferFunction TransferFunctionFromJson(const nlohmann::json& j);
 
 /// The paper's models (docs/paper.md, reference values 2-4).
 TransferFunction PaperArxModel();
+/// 1.6 exp(-0.001 s) / (0.245 s + 1): the paper's FOPDT (reaction curve, Eq. 2).
 TransferFunction PaperFopdtModel();
 
 }  // namespace pneumid

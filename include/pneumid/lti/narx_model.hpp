@@ -34,14 +34,20 @@ namespace pneumid {
 /// y(t-1-r), r >= ny for u(t-nk-(r-ny)); empty = the constant 1.
 using NarxTerm = std::vector<int>;
 
+/// Polynomial NARX model y(t) = sum_i theta_i p_i(t) in normalised signals (see above).
 struct NarxModel {
-  int ny = 1, nu = 1, nk = 1, degree = 2;
-  double Ts = 1.0;
-  /// Normalisation (see above): u enters as (u - u_offset) / u_scale, y as y / y_scale.
-  double u_offset = 0.0, u_scale = 1.0, y_scale = 1.0;
-  std::vector<NarxTerm> terms;
-  std::vector<double> theta;  ///< one per term
-  std::vector<double> err;    ///< ERR of each term when it was selected (fraction of y'y)
+  int ny = 1,       ///< output lags y(t-1) .. y(t-ny)
+      nu = 1,       ///< input lags u(t-nk) .. u(t-nk-nu+1)
+      nk = 1,       ///< input delay in samples
+      degree = 2;   ///< largest number of regressors multiplied in one term
+  double Ts = 1.0;  ///< sample time, s
+  // Normalisation (see above): u enters as (u - u_offset) / u_scale, y as y / y_scale.
+  double u_offset = 0.0,        ///< subtracted from the input before u_scale (input units)
+      u_scale = 1.0,            ///< divisor of the input after u_offset (input units)
+      y_scale = 1.0;            ///< divisor of the output; the model output is multiplied by it
+  std::vector<NarxTerm> terms;  ///< selected monomials, one per theta
+  std::vector<double> theta;    ///< one per term
+  std::vector<double> err;      ///< ERR of each term when it was selected (fraction of y'y)
   /// First sample with a complete regressor, max(ny, nk + nu - 1).
   int FirstSample() const;
   /// "1", "y(t-1)", "y(t-2)^2", "u(t-1)*y(t-2)".

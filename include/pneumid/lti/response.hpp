@@ -17,6 +17,7 @@
 
 namespace pneumid {
 
+/// A sampled response y(t) of a model (Step, Impulse).
 struct TimeResponse {
   Eigen::VectorXd t;  ///< seconds
   Eigen::VectorXd y;  ///< output at t
@@ -65,24 +66,27 @@ Eigen::MatrixXd Lsim(const StateSpace& g, const Eigen::MatrixXd& u, double dt,
 ///   undershoot     percent below y0 in the opposite direction
 ///   peak, peak_time  max |y| and when it occurs
 struct StepInfo {
-  double rise_time = 0.0;
-  double settling_time = 0.0;
-  double settling_min = 0.0;
-  double settling_max = 0.0;
-  double overshoot = 0.0;   ///< percent
-  double undershoot = 0.0;  ///< percent
-  double peak = 0.0;
-  double peak_time = 0.0;
-  double steady_state = 0.0;  ///< y_final used
+  double rise_time = 0.0;      ///< s, rise_low to rise_high of the step (NaN if not reached)
+  double settling_time = 0.0;  ///< s from t[0] (NaN when not settled by the last sample)
+  double settling_min = 0.0;   ///< min of y once it reached rise_high (whole record if never)
+  double settling_max = 0.0;   ///< max of y once it reached rise_high (whole record if never)
+  double overshoot = 0.0;      ///< percent
+  double undershoot = 0.0;     ///< percent
+  double peak = 0.0;           ///< max |y|, output units
+  double peak_time = 0.0;      ///< s from t[0] to the peak
+  double steady_state = 0.0;   ///< y_final used
 };
 
+/// Levels and reference values of ComputeStepInfo.
 struct StepInfoOptions {
   double settling_threshold = 0.02;  ///< fraction of the step
   double rise_low = 0.1;             ///< fraction
   double rise_high = 0.9;            ///< fraction
   /// Initial value y0 and final value; NaN means y(0) / last sample.
   double y_initial = std::numeric_limits<double>::quiet_NaN();
-  double y_final = std::numeric_limits<double>::quiet_NaN();
+  double y_final = std::numeric_limits<double>::quiet_NaN();  ///< final value; NaN: last y
+  /// True for settling_threshold in (0, 1), 0 <= rise_low < rise_high <= 1 and y_initial,
+  /// y_final finite or NaN; otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 

@@ -51,23 +51,26 @@ enum class StaticMapExtrapolation {
   kClamp,   ///< "clamp": the end values y_0, y_{n-1} (saturation)
   kLinear,  ///< "linear": the first / last segment continued
 };
-std::string ToString(StaticMapExtrapolation e);
+std::string ToString(StaticMapExtrapolation e);  ///< "clamp", "linear"
 /// Inverse of ToString. @throws InvalidArgument listing the valid names.
 StaticMapExtrapolation StaticMapExtrapolationFromString(const std::string& name);
 
 /// Direction of a map: kIncreasing / kDecreasing allow flat segments (not
 /// strictly monotone); kConstant: all values equal; kNone: not monotone.
 enum class Monotonicity { kIncreasing, kDecreasing, kConstant, kNone };
+/// "increasing", "decreasing", "constant", "not monotone".
 std::string ToString(Monotonicity m);
 
 /// A flat run of knots [u_from, u_to] on which the map is constant at y.
 struct FlatSegment {
-  double u_from = 0.0;
-  double u_to = 0.0;
-  double y = 0.0;
+  double u_from = 0.0;  ///< first input of the run, input units
+  double u_to = 0.0;    ///< last input of the run (u_from < u_to)
+  double y = 0.0;       ///< output on the run: y_0 (dead zone) or y_{n-1} (saturation)
   bool operator==(const FlatSegment&) const = default;
 };
 
+/// Piecewise-linear static map y = f(u) through knots, with extrapolation and the
+/// inverse of a monotone map (see above).
 class StaticMap {
  public:
   /// The identity through (0, 0) and (1, 1) with linear extrapolation.
@@ -78,12 +81,13 @@ class StaticMap {
   StaticMap(std::vector<double> u, std::vector<double> y,
             StaticMapExtrapolation extrapolation = StaticMapExtrapolation::kClamp);
 
-  const std::vector<double>& u() const { return u_; }
-  const std::vector<double>& y() const { return y_; }
-  std::size_t size() const { return u_.size(); }
+  const std::vector<double>& u() const { return u_; }  ///< knot inputs, strictly increasing
+  const std::vector<double>& y() const { return y_; }  ///< knot outputs f(u_i)
+  std::size_t size() const { return u_.size(); }       ///< number of knots n (>= 2)
+  /// Behaviour of Evaluate outside [u_min(), u_max()].
   StaticMapExtrapolation extrapolation() const { return extrapolation_; }
-  double u_min() const { return u_.front(); }
-  double u_max() const { return u_.back(); }
+  double u_min() const { return u_.front(); }  ///< first knot u_0
+  double u_max() const { return u_.back(); }   ///< last knot u_{n-1}
 
   /// f(u) (see above); NaN gives NaN.
   double Evaluate(double u) const;
@@ -93,6 +97,7 @@ class StaticMap {
   /// beyond the range 0 when clamping, the end slope when extrapolating).
   double Slope(double u) const;
 
+  /// Monotonicity of the knot values (computed at construction).
   Monotonicity Direction() const { return direction_; }
   /// Non-decreasing or non-increasing and not constant: Inverse is defined.
   bool IsMonotone() const {

@@ -24,6 +24,8 @@
 
 namespace pneumid {
 
+/// SISO transfer function, continuous (Ts = 0) or discrete, with an input delay in s
+/// (storage conventions above).
 class TransferFunction {
  public:
   /// The static gain 1, continuous.
@@ -45,11 +47,13 @@ class TransferFunction {
   /// K exp(-theta s) / ((tau1 s + 1)(tau2 s + 1)).
   static TransferFunction Sopdt(double K, double tau1, double tau2, double theta);
 
+  /// Numerator: descending powers of s, or ascending powers of z^-1 (see above).
   const Eigen::VectorXd& num() const { return num_; }
+  /// Denominator, same convention as num() (same length as num() when discrete).
   const Eigen::VectorXd& den() const { return den_; }
-  double Ts() const { return Ts_; }
-  bool IsDiscrete() const { return Ts_ > 0.0; }
-  bool IsContinuous() const { return Ts_ == 0.0; }
+  double Ts() const { return Ts_; }                 ///< sample time in s; 0 for continuous
+  bool IsDiscrete() const { return Ts_ > 0.0; }     ///< Ts > 0
+  bool IsContinuous() const { return Ts_ == 0.0; }  ///< Ts == 0
   /// Input delay in seconds.
   double delay() const { return delay_; }
   /// Input delay in samples (discrete models only; throws otherwise).
@@ -61,7 +65,7 @@ class TransferFunction {
   int Order() const;
   /// Roots of the denominator / numerator in s or z.
   Eigen::VectorXcd Poles() const;
-  Eigen::VectorXcd Zeros() const;
+  Eigen::VectorXcd Zeros() const;  ///< roots of the numerator (see Poles)
   /// G(0) continuous, G(1) discrete; +-inf for a pole at the origin / at 1.
   double DcGain() const;
   /// All poles in the open left half plane / strictly inside the unit circle.
@@ -93,8 +97,11 @@ namespace poly {
 Eigen::VectorXcd Roots(const Eigen::VectorXd& p);
 /// Monic real polynomial with the given roots (complex roots in conjugate pairs).
 Eigen::VectorXd FromRoots(const Eigen::VectorXcd& roots);
+/// Product a b (convolution of the coefficients); [0] when either is empty.
 Eigen::VectorXd Multiply(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+/// Sum a + b, the shorter aligned at the constant term (zero-padded in front).
 Eigen::VectorXd Add(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+/// p(x) by Horner's rule; 0 for an empty p.
 std::complex<double> Evaluate(const Eigen::VectorXd& p, std::complex<double> x);
 /// Drops leading coefficients whose magnitude is <= tol * max|p|.
 Eigen::VectorXd TrimLeading(const Eigen::VectorXd& p, double tol = 0.0);

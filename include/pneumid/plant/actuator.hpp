@@ -23,19 +23,24 @@
 
 namespace pneumid {
 
+/// Description of a plant's actuator for the real-time loop: signals, input range and
+/// the names and meanings of its hold and release safe states.
 struct Actuator {
   Channel input{"u", ""};   ///< name and unit of the input
   Channel output{"y", ""};  ///< name and unit of the measured output
   /// Words for a status line, e.g. "duty" and "force".
   std::string input_label = "u";
-  std::string output_label = "y";
+  std::string output_label = "y";  ///< word for the output, e.g. "force"
   /// Physical input range (input units; infinite = unbounded).
   double u_min = -std::numeric_limits<double>::infinity();
-  double u_max = std::numeric_limits<double>::infinity();
+  double u_max = std::numeric_limits<double>::infinity();  ///< upper end, e.g. 100 % duty
   /// The plant's names and meanings of the hold and release safe states.
   std::string hold_name = "hold";
+  /// What the hold state does, for logs and messages.
   std::string hold_meaning = "the input is no longer applied; the plant keeps its state";
+  /// The plant's name of the release state, e.g. "exhaust-open".
   std::string release_name = "release";
+  /// What the release state does, for logs and messages.
   std::string release_meaning = "the actuator is driven to rest (input 0)";
 };
 

@@ -17,14 +17,17 @@
 
 namespace pneumid {
 
+/// Options of RunExperiment: reset, channel names and a progress callback.
 struct ExperimentOptions {
   /// Reset the plant before the run (default true).
   bool reset = true;
   /// Channel names and units of the recorded input and output.
   Channel input_channel{"u", ""};
-  Channel output_channel{"y", ""};
+  Channel output_channel{"y", ""};  ///< e.g. {"F", "N"} for the IPA's force
   /// Called now and then with the fraction done (0..1), e.g. for a progress bar.
   std::function<void(double)> progress;
+  /// True when both channel names are non-empty; otherwise false with the reason in
+  /// *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -32,10 +35,10 @@ struct ExperimentOptions {
 /// signals of the plant, one column per Extras() entry ("p_a [Pa]" becomes the
 /// channel {"p_a", "Pa"}).
 struct Experiment {
-  Dataset data;
-  std::vector<CsvColumn> extras;
-  std::string plant;   ///< plant.Describe()
-  std::string signal;  ///< signal.ToString()
+  Dataset data;                   ///< time (s), the applied input and the measured output
+  std::vector<CsvColumn> extras;  ///< the plant's Extras() per sample, e.g. chamber pressures
+  std::string plant;              ///< plant.Describe()
+  std::string signal;             ///< signal.ToString()
 };
 
 /// Runs the experiment described above for `duration` seconds.

@@ -87,14 +87,16 @@ IpaMode IpaModeFromString(const std::string& name);
 enum class PwmMode { kSwitching, kAveraged };
 /// "switching" (also accepted: "pwm"), "averaged".
 std::string ToString(PwmMode mode);
+/// Inverse of ToString (accepts "pwm" for switching); throws InvalidArgument listing
+/// the valid names.
 PwmMode PwmModeFromString(const std::string& name);
 
 /// All physical parameters of the IPA. Defaults: the calibrated actuator of
 /// docs/simulator.md (config/ipa_default.toml lists the same values).
 /// Pressures are absolute unless named gauge.
 struct IpaParameters {
-  IpaMode mode = IpaMode::kForce;
-  PwmMode pwm_mode = PwmMode::kSwitching;
+  IpaMode mode = IpaMode::kForce;          ///< output force in N, or position in m
+  PwmMode pwm_mode = PwmMode::kSwitching;  ///< valve switching simulated, or averaged flows
 
   // [cylinder]
   double bore = 0.020266;  ///< m, piston diameter (effective; calibrated)
@@ -110,7 +112,7 @@ struct IpaParameters {
   double atmospheric_pressure = 101325.0;   ///< Pa
   double temperature = 293.15;              ///< K, supply (and chamber) gas temperature
   double supply_line_conductance = 1.0e-8;  ///< m^3/(s Pa), regulator + line to chamber B
-  double supply_line_critical_ratio = 0.3;  ///< -
+  double supply_line_critical_ratio = 0.3;  ///< -, ISO 6358 b of that supply line
 
   // [gas]
   double gas_constant = 287.0;  ///< J/(kg K), air
@@ -164,11 +166,11 @@ struct IpaParameters {
 
   // [simulation]
   double relative_tolerance = 1e-6;  ///< odeint error control (states scaled to bar, mm, g)
-  double absolute_tolerance = 1e-6;
+  double absolute_tolerance = 1e-6;  ///< odeint absolute error bound (same scaled states)
 
   /// Derived areas (m^2).
   double AreaA() const;
-  double AreaB() const;
+  double AreaB() const;  ///< chamber B annulus: pi/4 (bore^2 - rod^2), m^2
 
   /// False (with a message naming the parameter and its value) when a value is
   /// out of its physical range.
@@ -188,10 +190,10 @@ IpaParameters LoadIpaParameters(const std::string& path);
 /// outside it are not rejected by IsValid, which checks only what the
 /// equations need.
 struct IpaParameterInfo {
-  std::string key;   ///< "section.name" as in config/ipa_default.toml
-  std::string unit;  ///< SI unit, "" for ratios
-  double lower = 0.0;
-  double upper = 0.0;
+  std::string key;     ///< "section.name" as in config/ipa_default.toml
+  std::string unit;    ///< SI unit, "" for ratios
+  double lower = 0.0;  ///< lower end of the physical range, in `unit`
+  double upper = 0.0;  ///< upper end of the physical range, in `unit`
   /// False for numerical settings and sensor scaling (tolerances, ADC range,
   /// noise) that a calibration does not estimate.
   bool calibratable = true;
@@ -251,7 +253,7 @@ class IpaSimulator final : public Plant {
   /// bypassing the PWM generator; valve delays still apply.
   void AdvanceValves(bool inlet_open, bool exhaust_open);
 
-  const IpaParameters& parameters() const { return p_; }
+  const IpaParameters& parameters() const { return p_; }  ///< as given at construction
   /// True (noise-free) state now.
   double pressure_a() const;  ///< Pa absolute
   double pressure_b() const;  ///< Pa absolute
@@ -268,7 +270,7 @@ class IpaSimulator final : public Plant {
   /// Mass that has flowed into / out of chamber A since Reset (kg): through its
   /// valves, or through the tube when there is one.
   double mass_in_a() const;
-  double mass_out_a() const;
+  double mass_out_a() const;  ///< kg vented from chamber A since Reset (see mass_in_a)
   /// Number of odeint steps taken since Reset (for benchmarks).
   long long steps() const { return steps_; }
 

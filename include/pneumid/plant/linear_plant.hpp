@@ -24,6 +24,7 @@
 
 namespace pneumid {
 
+/// A TransferFunction run as a sampled plant with seeded output noise (see above).
 class LinearPlant final : public Plant {
  public:
   /// `noise_sigma`: standard deviation of the output noise in output units.

@@ -15,6 +15,7 @@
 
 namespace pneumid {
 
+/// A sampled plant: Measure() the output, then Advance(u) one period (protocol above).
 class Plant {
  public:
   virtual ~Plant() = default;

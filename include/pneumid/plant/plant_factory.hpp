@@ -21,6 +21,7 @@
 
 namespace pneumid {
 
+/// Options of MakePlant common to every plant kind: seed, noise, IPA configuration.
 struct PlantOptions {
   /// Seed of every noise generator of the plant (runs are reproducible).
   std::uint64_t seed = 1;
@@ -34,6 +35,8 @@ struct PlantOptions {
   /// Overrides the IPA's PWM simulation mode when set (spec pwm= wins).
   std::optional<PwmMode> pwm_mode;
 
+  /// True unless noise_sigma is set and not a finite value >= 0; otherwise false with
+  /// the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -47,7 +50,7 @@ std::unique_ptr<Plant> MakePlant(const std::string& spec, double Ts,
 /// {"u","%"} and {"y","N"} or {"y","m"} for the IPA, unit-less otherwise
 /// (PlantActuator(plant).input and .output, plant/actuator.hpp).
 Channel PlantInputChannel(const Plant& plant);
-Channel PlantOutputChannel(const Plant& plant);
+Channel PlantOutputChannel(const Plant& plant);  ///< output channel, see PlantInputChannel
 
 /// Help text for the CLI's --plant option.
 std::string PlantSpecHelp();

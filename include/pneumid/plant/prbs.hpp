@@ -26,7 +26,7 @@ class MaxLengthSequenceGenerator {
   MaxLengthSequenceGenerator(int order, std::uint64_t seed);
   /// Next bit (0 or 1).
   std::uint8_t Next();
-  int order() const { return order_; }
+  int order() const { return order_; }  ///< register length n (2..32)
   /// 2^order - 1.
   std::uint64_t period() const { return (std::uint64_t{1} << order_) - 1; }
 

@@ -20,6 +20,7 @@
 
 namespace pneumid {
 
+/// An input or set-point signal of time (s), parsed from a spec (see above).
 class Signal {
  public:
   virtual ~Signal() = default;

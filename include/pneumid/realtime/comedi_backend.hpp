@@ -31,33 +31,37 @@ namespace pneumid {
 
 /// Analog reference of the input, as in comedi (AREF_GROUND, ...).
 enum class AnalogReference { kGround = 0, kCommon = 1, kDiff = 2, kOther = 3 };
-const char* ToString(AnalogReference a);
+const char* ToString(AnalogReference a);  ///< "ground", "common", "diff", "other"
 /// "ground", "common", "diff", "other". @throws InvalidArgument.
 AnalogReference AnalogReferenceFromString(const std::string& s);
 
+/// Device, channels and signal-chain constants of ComediBackend (chain above).
 struct ComediConfig {
-  std::string device = "/dev/comedi0";
+  std::string device = "/dev/comedi0";  ///< absolute path of the comedi device node
   // Analog input: pressure transducer.
-  int ai_subdevice = 0;  ///< M-series: subdevice 0 is AI
-  int ai_channel = 0;
-  int ai_range = 0;  ///< range index (PCI-6221 AI range 0: +-10 V)
-  AnalogReference ai_aref = AnalogReference::kDiff;
-  double v_min = 0.0;  ///< plausible transducer output window (V); outside -> out of range
-  double v_max = 10.0;
-  double pressure_gain = 1e5;    ///< Pa per V (e.g. 0-10 V for 0-1 MPa)
+  int ai_subdevice = 0;                              ///< M-series: subdevice 0 is AI
+  int ai_channel = 0;                                ///< AI channel of the pressure transducer
+  int ai_range = 0;                                  ///< range index (PCI-6221 AI range 0: +-10 V)
+  AnalogReference ai_aref = AnalogReference::kDiff;  ///< AI reference (default differential)
+  double v_min = 0.0;          ///< plausible transducer output window (V); outside -> out of range
+  double v_max = 10.0;         ///< upper end of that window (V), > v_min
+  double pressure_gain = 1e5;  ///< Pa per V (e.g. 0-10 V for 0-1 MPa)
   double pressure_offset = 0.0;  ///< Pa
   double force_gain = 1.0;       ///< N per Pa
   double force_offset = 0.0;     ///< N
   // Analog outputs: valve drivers.
-  int ao_subdevice = 1;  ///< M-series: subdevice 1 is AO
-  int inlet_channel = 0;
-  int exhaust_channel = 1;
-  int ao_range = 0;                   ///< PCI-6221 AO range 0: +-10 V
-  double v_closed = 0.0;              ///< V commanding a closed valve / 0 % duty
-  double v_open = 5.0;                ///< V commanding an open valve / 100 % duty
+  int ao_subdevice = 1;     ///< M-series: subdevice 1 is AO
+  int inlet_channel = 0;    ///< AO channel of the inlet valve driver
+  int exhaust_channel = 1;  ///< AO channel of the exhaust valve driver (not inlet_channel)
+  int ao_range = 0;         ///< PCI-6221 AO range 0: +-10 V
+  double v_closed = 0.0;    ///< V commanding a closed valve / 0 % duty
+  double v_open = 5.0;      ///< V commanding an open valve / 100 % duty
   bool exhaust_complementary = true;  ///< exhaust = 100 - u (else kept closed)
   bool use_calibration = true;        ///< use the card's calibration polynomials when present
 
+  /// True for an absolute device path, indices >= 0, distinct valve channels,
+  /// v_min < v_max, finite gains, offsets and levels, pressure_gain != 0 and
+  /// v_open != v_closed; otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
   /// Force (N) and pressure (Pa, in *pressure if not null) for a transducer voltage.
   double VoltsToForce(double volts, double* pressure = nullptr) const;
@@ -72,6 +76,8 @@ struct ComediConfig {
 /// True when libcomedi support was compiled in (PNEUMID_HAVE_COMEDI).
 bool ComediAvailable();
 
+/// IoBackend on a comedi data-acquisition card: reads the pressure transducer and
+/// drives the inlet and exhaust valves of the paper's rig (see above).
 class ComediBackend : public IoBackend {
  public:
   /// @throws InvalidArgument on an invalid configuration.
@@ -88,7 +94,7 @@ class ComediBackend : public IoBackend {
   std::string Describe() const override;
   /// The paper's rig: the IPA in force mode (IpaActuator()).
   Actuator actuator() const override { return IpaActuator(); }
-  const ComediConfig& config() const { return config_; }
+  const ComediConfig& config() const { return config_; }  ///< as given at construction
 
  private:
   struct Impl;

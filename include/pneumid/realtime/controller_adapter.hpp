@@ -12,6 +12,7 @@
 
 namespace pneumid {
 
+/// A pneumid::Controller as the real-time loop's LoopController (see above).
 class ControllerAdapter : public LoopController {
  public:
   /// `u0` and `y0` are the operating point the controller is reset to before the run.
@@ -22,7 +23,7 @@ class ControllerAdapter : public LoopController {
   double Update(std::int64_t k, double r, double y) noexcept override;
   void Applied(double u) noexcept override;
   std::string Describe() const override { return controller_->Describe(); }
-  Controller& controller() { return *controller_; }
+  Controller& controller() { return *controller_; }  ///< the wrapped controller
 
  private:
   std::unique_ptr<Controller> controller_;

@@ -28,6 +28,7 @@ struct Measurement {
   double aux = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// Plant I/O of the real-time loop: read y, write u, enter a safe state (see above).
 class IoBackend {
  public:
   virtual ~IoBackend() = default;
@@ -54,14 +55,15 @@ class IoBackend {
 
 /// Backend kinds selectable with --io.
 enum class IoKind { kSim, kComedi, kUdp };
-const char* ToString(IoKind k);
+const char* ToString(IoKind k);  ///< "sim", "comedi", "udp"
 
 /// Parsed --io value: "sim", "comedi" or "comedi:/dev/comediN", "udp://HOST:PORT".
 struct IoSpec {
-  IoKind kind = IoKind::kSim;
+  IoKind kind = IoKind::kSim;           ///< which backend
   std::string device = "/dev/comedi0";  ///< comedi device path
   std::string host = "127.0.0.1";       ///< udp server host
   int port = 0;                         ///< udp server port
+  /// The spec back: "sim", "comedi:DEVICE" or "udp://HOST:PORT".
   std::string ToString() const;
 };
 

@@ -40,17 +40,17 @@ namespace pneumid {
 
 /// One logged sample (trivially copyable, pushed from the loop thread).
 struct LogRecord {
-  std::int64_t k = 0;
-  double t = 0.0;
-  double u = 0.0;
-  double y = 0.0;
-  double r = 0.0;
-  double u_ctrl = 0.0;
-  double aux = 0.0;
-  double jitter_us = 0.0;
-  double compute_us = 0.0;
-  std::uint32_t flags = 0;
-  Fault fault = Fault::kNone;
+  std::int64_t k = 0;          ///< sample index from 0
+  double t = 0.0;              ///< scheduled time k * period, s
+  double u = 0.0;              ///< input after the safety layer (NaN: sensor/controller fault)
+  double y = 0.0;              ///< measured output (actuator units, IPA: force N)
+  double r = 0.0;              ///< set point, output units
+  double u_ctrl = 0.0;         ///< controller output before the safety layer (IPA: duty %)
+  double aux = 0.0;            ///< auxiliary measurement (IPA: chamber pressure, Pa) or NaN
+  double jitter_us = 0.0;      ///< wake-up lateness after the deadline, microseconds
+  double compute_us = 0.0;     ///< wake-up to end of the step (read, control, write), us
+  std::uint32_t flags = 0;     ///< LogFlag bits
+  Fault fault = Fault::kNone;  ///< fault raised at this sample (kNone: none)
 };
 
 /// Bits of LogRecord::flags.
@@ -62,19 +62,21 @@ enum LogFlag : std::uint32_t {
   kLogSafeState = 1u << 4,
 };
 
+/// File format of a LogWriter.
 enum class LogFormat {
   kCsv,      ///< all columns, CSV with '#' header
   kDataset,  ///< t,u,y only (CSV with '#' header), for `pneumid identify`
   kMat,      ///< MATLAB .mat (v5) written at Close()
 };
-const char* ToString(LogFormat f);
+const char* ToString(LogFormat f);  ///< "csv", "dataset", "mat"
 /// "csv", "dataset", "mat". @throws InvalidArgument.
 LogFormat LogFormatFromString(const std::string& name);
 
+/// Format, buffering and flushing of a LogWriter.
 struct LogWriterOptions {
-  LogFormat format = LogFormat::kCsv;
-  std::size_t capacity = 1 << 16;  ///< ring buffer records (65 s at 1 kHz)
-  double flush_interval = 1.0;     ///< seconds between flushes to the OS
+  LogFormat format = LogFormat::kCsv;  ///< file format (see LogFormat)
+  std::size_t capacity = 1 << 16;      ///< ring buffer records (65 s at 1 kHz)
+  double flush_interval = 1.0;         ///< seconds between flushes to the OS
   /// Also keep every record in memory (writer thread) for records() after Close().
   bool keep_in_memory = false;
   /// Also offer every record to this ring buffer (not owned; may be null), e.g. for
@@ -82,9 +84,13 @@ struct LogWriterOptions {
   /// blocking or allocating, and drops it (uncounted) when the ring is full. Its
   /// single consumer must keep draining it while the writer lives.
   SpscRingBuffer<LogRecord>* live = nullptr;
+  /// True for capacity in [16, 2^26] and flush_interval in (0, 60] s; otherwise false
+  /// with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Writes the real-time loop's records from a writer thread (see above): the loop
+/// thread only pushes into a lock-free ring buffer.
 class LogWriter {
  public:
   /// Opens `path` (truncating; empty with keep_in_memory: no file), writes the header lines (key,
@@ -94,7 +100,7 @@ class LogWriter {
             LogWriterOptions options = {});
   /// Closes if still open (errors ignored).
   ~LogWriter();
-  LogWriter(const LogWriter&) = delete;
+  LogWriter(const LogWriter&) = delete;  ///< not copyable: owns the file and the thread
   LogWriter& operator=(const LogWriter&) = delete;
 
   /// Loop thread: queues a record. Never blocks or allocates; when the buffer is
@@ -108,8 +114,10 @@ class LogWriter {
   /// @throws DataError on a write error.
   void Close(const std::string& timing_line = "", const std::string& stop_line = "");
 
-  const std::string& path() const { return path_; }
+  const std::string& path() const { return path_; }  ///< the log file (empty: none)
+  /// Records formatted by the writer thread so far (any thread may ask).
   std::int64_t written() const { return written_.load(); }
+  /// Records lost because the ring buffer was full (any thread may ask).
   std::int64_t dropped() const { return dropped_.load(); }
   /// Records written, when keep_in_memory or the .mat format (valid after Close()).
   const std::vector<LogRecord>& records() const { return mat_records_; }

@@ -18,6 +18,7 @@
 
 namespace pneumid {
 
+/// Socket, fault drill and load disturbances of a PlantServer.
 struct PlantServerOptions {
   std::string bind_address = "127.0.0.1";  ///< numeric IPv4/IPv6 address to listen on
   int port = 5000;                         ///< UDP port (0: any free port, see port())
@@ -27,25 +28,29 @@ struct PlantServerOptions {
   /// Load disturbances on the plant's output (closed_loop.hpp), by plant time
   /// since the session's Hello (the plant's Reset).
   std::vector<LoadStep> load_steps;
+  /// True for a port in 0..65535 and a numeric IPv4/IPv6 bind_address; otherwise false
+  /// with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
+/// Counters of a PlantServer since construction.
 struct PlantServerStats {
-  std::int64_t requests = 0;     ///< valid requests received
-  std::int64_t steps = 0;        ///< plant steps taken
-  std::int64_t sessions = 0;     ///< Hello requests
-  std::int64_t bad_packets = 0;  ///< datagrams rejected (size, magic, version, type)
-  std::int64_t safe_requests = 0;
-  int last_safe_state = -1;  ///< SafeState of the last Safe request (-1: none)
+  std::int64_t requests = 0;       ///< valid requests received
+  std::int64_t steps = 0;          ///< plant steps taken
+  std::int64_t sessions = 0;       ///< Hello requests
+  std::int64_t bad_packets = 0;    ///< datagrams rejected (size, magic, version, type)
+  std::int64_t safe_requests = 0;  ///< Safe requests (their state: last_safe_state)
+  int last_safe_state = -1;        ///< SafeState of the last Safe request (-1: none)
 };
 
+/// Serves a Plant over UDP (udp_protocol.hpp), one plant period per Step request.
 class PlantServer {
  public:
   /// Binds the socket. @throws InvalidArgument on bad options or null plant, DataError
   /// when the address cannot be bound (e.g. port in use).
   PlantServer(std::unique_ptr<Plant> plant, PlantServerOptions options);
   ~PlantServer();
-  PlantServer(const PlantServer&) = delete;
+  PlantServer(const PlantServer&) = delete;  ///< not copyable: owns the socket
   PlantServer& operator=(const PlantServer&) = delete;
 
   /// The bound port.
@@ -58,7 +63,7 @@ class PlantServer {
   bool Handle(const std::uint8_t* data, std::size_t size, udp::Packet* reply);
   /// Counters (read them while Serve is not running).
   PlantServerStats stats() const { return stats_; }
-  std::string Describe() const { return plant_->Describe(); }
+  std::string Describe() const { return plant_->Describe(); }  ///< the plant's Describe()
 
  private:
   std::unique_ptr<Plant> plant_;

@@ -26,14 +26,15 @@
 
 namespace pneumid {
 
+/// Every setting of a real-time run, by TOML section (see above).
 struct RealtimeConfig {
-  LoopOptions loop;
-  SafetyOptions safety;
+  LoopOptions loop;           ///< [loop]: period, duration, scheduling
+  SafetyOptions safety;       ///< [safety]: limits, fault detection, safe state
   std::string io = "sim";     ///< --io spec
   std::string plant = "ipa";  ///< plant of the sim backend (MakePlant spec)
-  UdpBackendOptions udp;
-  ComediConfig comedi;
-  LogWriterOptions log;
+  UdpBackendOptions udp;      ///< [udp]: used by a udp:// backend (host, port from io)
+  ComediConfig comedi;        ///< [comedi]: used by a comedi backend (device from io)
+  LogWriterOptions log;       ///< [log]: flushing and buffer capacity
 };
 
 /// Reads a configuration file. @throws DataError naming the file, line and column

@@ -64,6 +64,7 @@ class OpenLoopInput : public LoopController {
   std::string description_;
 };
 
+/// Timing and scheduling of RunLoop.
 struct LoopOptions {
   double period = 0.01;    ///< s; default 10 ms (the paper's Ts), allowed 1e-4 .. 10 s
   double duration = 10.0;  ///< s; number of samples = round(duration / period)
@@ -73,6 +74,8 @@ struct LoopOptions {
   bool realtime = true;  ///< try SCHED_FIFO + mlockall + pinning (default true)
   int priority = 80;     ///< SCHED_FIFO priority 1..99
   int cpu = -1;          ///< CPU to pin to; -1: the last allowed CPU; -2: no pinning
+  /// True for period in [1e-4, 10] s, a finite duration > 0 of at most 1e9 samples,
+  /// priority 1..99 and cpu >= -2; otherwise false with the reason in *error (if not null).
   bool IsValid(std::string* error) const;
   /// round(duration / period).
   std::int64_t Samples() const;
@@ -84,23 +87,25 @@ struct LoopOptions {
 /// earlier versions wrote "completed" and "fault").
 using LoopTermination = Termination;
 
+/// How a run of RunLoop ended, with its timing statistics.
 struct LoopSummary {
-  LoopTermination termination = LoopTermination::kSuccess;
-  Fault fault = Fault::kNone;
-  int signal = 0;            ///< signal number when stopped by a signal
-  std::string message;       ///< what happened, e.g. "sensor-nan at t = 1.230 s (sample 123) ..."
-  std::string scheduling;    ///< one line: real-time scheduling obtained or why not
-  std::int64_t samples = 0;  ///< samples run (rows logged)
-  std::int64_t log_dropped = 0;  ///< records the log could not take (ring buffer full)
-  SafeState safe_state = SafeState::kHold;
+  LoopTermination termination = LoopTermination::kSuccess;  ///< success, stopped or failure
+  Fault fault = Fault::kNone;  ///< the safety fault that ended the run (kNone: none)
+  int signal = 0;              ///< signal number when stopped by a signal
+  std::string message;         ///< what happened, e.g. "sensor-nan at t = 1.230 s (sample 123) ..."
+  std::string scheduling;      ///< one line: real-time scheduling obtained or why not
+  std::int64_t samples = 0;    ///< samples run (rows logged)
+  std::int64_t log_dropped = 0;             ///< records the log could not take (ring buffer full)
+  SafeState safe_state = SafeState::kHold;  ///< safe state the outputs were left in
   /// The actuator's name of safe_state (IoBackend::actuator()), e.g. "valves-closed".
   std::string safe_state_name = "hold";
   IoStatus safe_state_status = IoStatus::kOk;  ///< result of EnterSafeState
-  TimingReport timing;
-  double wall_time = 0.0;  ///< s from the first to the last sample
+  TimingReport timing;                         ///< jitter, compute-time and overrun statistics
+  double wall_time = 0.0;                      ///< s from the first to the last sample
 
   /// 0 when completed, 128 + signal when stopped by a signal, 3 on a fault.
   int ExitStatus() const;
+  /// One line: "TERMINATION: message; " and TimingReport::BriefReport().
   std::string BriefReport() const;
   /// timing keys of TimingReport::ToJson plus termination, fault, message, samples,
   /// scheduling, safe_state, log_dropped, wall_time.
@@ -109,10 +114,13 @@ struct LoopSummary {
 
 /// Live values published by the loop (relaxed atomics) for a status line.
 struct LoopStatus {
-  std::atomic<std::int64_t> k{-1};
-  std::atomic<double> r{0.0}, y{0.0}, u{0.0}, jitter_us{0.0};
-  std::atomic<std::int64_t> overruns{0};
-  std::atomic<bool> running{false};
+  std::atomic<std::int64_t> k{-1};        ///< last sample done (-1: none yet)
+  std::atomic<double> r{0.0},             ///< set point of sample k (output units)
+      y{0.0},                             ///< measured output of sample k (IPA: force N)
+      u{0.0},                             ///< applied input of sample k (IPA: duty %)
+      jitter_us{0.0};                     ///< wake-up lateness of sample k, microseconds
+  std::atomic<std::int64_t> overruns{0};  ///< deadline overruns so far
+  std::atomic<bool> running{false};       ///< true while the loop thread runs its periods
 };
 
 /// Runs the loop (blocking until it ends). `setpoint` holds r_k per sample (the last

@@ -12,11 +12,12 @@
 
 namespace pneumid {
 
+/// Everything RunSession needs besides the backend, controller and set point.
 struct SessionOptions {
-  LoopOptions loop;
-  SafetyOptions safety;
+  LoopOptions loop;      ///< period, duration and scheduling of the loop
+  SafetyOptions safety;  ///< limits and fault detection (a SafetyMonitor is built from them)
   std::string log_path;  ///< empty: no log file
-  LogWriterOptions log;
+  LogWriterOptions log;  ///< format and buffering of the log
   /// Header lines (key, value) recorded in the log besides the automatic ones
   /// (io, controller, period, duration, safety).
   std::vector<std::pair<std::string, std::string>> header;
@@ -27,9 +28,10 @@ struct SessionOptions {
   bool keep_records = false;
 };
 
+/// Outcome of RunSession.
 struct SessionResult {
-  LoopSummary summary;
-  std::int64_t log_rows = 0;
+  LoopSummary summary;             ///< how the loop ended, with its timing statistics
+  std::int64_t log_rows = 0;       ///< records written to the log (LogWriter::written(); 0: none)
   std::vector<LogRecord> records;  ///< when keep_records
 };
 

@@ -59,17 +59,19 @@ enum class IoStatus : std::uint8_t {
   kError,       ///< the call failed
   kTimeout,     ///< too many consecutive stale samples
 };
-const char* ToString(IoStatus s);
+const char* ToString(IoStatus s);  ///< "ok", "stale", "out-of-range", "error", "timeout"
 
+/// Limits and fault detection of the SafetyMonitor (input and output in the actuator's
+/// units: duty % and force N for the IPA).
 struct SafetyOptions {
   /// Output clamp (input units of the actuator). Default 0..100, the range of
   /// a duty cycle in % (the IPA's input, IpaActuator()).
   double u_min = 0.0;
-  double u_max = 100.0;
+  double u_max = 100.0;  ///< upper end of the output clamp, > u_min (IPA: 100 % duty)
   /// Maximum output rate (input units per second; 0 or infinity disables). Default: disabled.
   double rate_max = 0.0;
   double y_min = -1e300;  ///< measurement range (output units, e.g. N); outside -> fault
-  double y_max = 1e300;
+  double y_max = 1e300;   ///< upper end of the measurement range, > y_min
   /// Fault when the measurement stays within frozen_tolerance of the same value for this
   /// many consecutive samples (0 disables; default 0 because a noise-free simulator
   /// legitimately settles to a constant).
@@ -79,6 +81,8 @@ struct SafetyOptions {
   int max_overruns = 10;
   SafeState safe_state = SafeState::kHold;  ///< default: hold (IPA: both valves closed)
 
+  /// True for finite u_min < u_max, rate_max >= 0, y_min < y_max, frozen_samples >= 0 and
+  /// frozen_tolerance >= 0; otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -87,7 +91,7 @@ class SafetyMonitor {
  public:
   /// @throws InvalidArgument when options are invalid (message from IsValid).
   explicit SafetyMonitor(const SafetyOptions& options);
-  const SafetyOptions& options() const { return options_; }
+  const SafetyOptions& options() const { return options_; }  ///< as given at construction
 
   /// Back to the initial state; `u0` is the output the rate limiter starts from.
   void Reset(double u0 = 0.0) noexcept;
@@ -99,7 +103,7 @@ class SafetyMonitor {
   /// Counts one deadline overrun; returns kDeadlineOverruns once the count exceeds
   /// max_overruns.
   Fault OnOverrun() noexcept;
-  std::int64_t overruns() const { return overruns_; }
+  std::int64_t overruns() const { return overruns_; }  ///< overruns counted since Reset
 
  private:
   SafetyOptions options_;

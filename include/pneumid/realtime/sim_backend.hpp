@@ -25,6 +25,7 @@
 
 namespace pneumid {
 
+/// A Plant behind the IoBackend interface (see above); may run faster than real time.
 class SimBackend : public IoBackend {
  public:
   /// Takes ownership of the plant. @throws InvalidArgument when plant is null.
@@ -40,13 +41,13 @@ class SimBackend : public IoBackend {
   std::string Describe() const override;
   Actuator actuator() const override { return PlantActuator(*plant_); }
 
-  Plant& plant() { return *plant_; }
+  Plant& plant() { return *plant_; }  ///< the simulated plant (owned by the backend)
   /// Load disturbances on the plant's output (closed_loop.hpp) by plant time
   /// since Open(), applied after every Write().
   void SetLoadSteps(std::vector<LoadStep> steps);
   /// True once EnterSafeState was called; which state.
   bool in_safe_state() const { return in_safe_state_; }
-  SafeState safe_state() const { return safe_state_; }
+  SafeState safe_state() const { return safe_state_; }  ///< the last state entered
 
  private:
   std::unique_ptr<Plant> plant_;

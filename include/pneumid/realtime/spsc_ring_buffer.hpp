@@ -22,6 +22,8 @@
 
 namespace pneumid {
 
+/// Lock-free ring buffer of trivially copyable records for one producer thread and one
+/// consumer thread (see above).
 template <typename T>
 class SpscRingBuffer {
   static_assert(std::is_trivially_copyable_v<T>, "SpscRingBuffer holds trivially copyable records");
@@ -38,7 +40,7 @@ class SpscRingBuffer {
     slots_ = std::make_unique<T[]>(capacity_);
   }
 
-  SpscRingBuffer(const SpscRingBuffer&) = delete;
+  SpscRingBuffer(const SpscRingBuffer&) = delete;  ///< not copyable (shared by two threads)
   SpscRingBuffer& operator=(const SpscRingBuffer&) = delete;
 
   /// Producer side: copies `value` in; returns false (and drops it) when full.
@@ -72,7 +74,7 @@ class SpscRingBuffer {
     return static_cast<std::size_t>(head_.load(std::memory_order_acquire) -
                                     tail_.load(std::memory_order_acquire));
   }
-  bool empty() const noexcept { return size() == 0; }
+  bool empty() const noexcept { return size() == 0; }  ///< size() == 0, same caveat
 
  private:
   std::size_t capacity_ = 0;

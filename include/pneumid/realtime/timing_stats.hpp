@@ -38,6 +38,7 @@ struct TimingReport {
   nlohmann::json ToJson() const;
 };
 
+/// Allocation-free collector of a loop's jitter, compute time and overruns (see above).
 class TimingStats {
  public:
   /// `period_s` is the nominal period (s); `histogram_range_us` the span of the
@@ -50,11 +51,14 @@ class TimingStats {
   /// Forgets all samples.
   void Clear() noexcept;
 
-  std::int64_t samples() const { return samples_; }
-  std::int64_t overruns() const { return overruns_; }
+  std::int64_t samples() const { return samples_; }    ///< steps recorded (since Clear())
+  std::int64_t overruns() const { return overruns_; }  ///< steps flagged as overruns
   /// q-quantile (0 <= q <= 1) of the jitter / compute time in microseconds, to 1 us.
+  /// Nearest rank on the histogram (0 without samples); @throws InvalidArgument for q
+  /// outside [0, 1].
   double JitterQuantileUs(double q) const;
-  double ComputeQuantileUs(double q) const;
+  double ComputeQuantileUs(double q) const;  ///< as JitterQuantileUs, for the compute time
+  /// The statistics so far: counts, p50/p99/max/mean in microseconds.
   TimingReport Report() const;
 
  private:

@@ -16,16 +16,21 @@
 
 namespace pneumid {
 
+/// Server address and timeouts of a UdpBackend.
 struct UdpBackendOptions {
-  std::string host = "127.0.0.1";
-  int port = 5000;
-  int max_missed = 3;          ///< consecutive missing replies before a timeout fault (>= 1)
-  double reply_wait = 0.25;    ///< fraction of the period Read() may wait for a late reply
-  double hello_timeout = 1.0;  ///< s to wait for the server's answer to Hello (per attempt)
-  int hello_attempts = 3;
+  std::string host = "127.0.0.1";  ///< plant server host name or address (not empty)
+  int port = 5000;                 ///< plant server UDP port, 1..65535
+  int max_missed = 3;              ///< consecutive missing replies before a timeout fault (>= 1)
+  double reply_wait = 0.25;        ///< fraction of the period Read() may wait for a late reply
+  double hello_timeout = 1.0;      ///< s to wait for the server's answer to Hello (per attempt)
+  int hello_attempts = 3;          ///< Hello requests sent before Open() gives up (>= 1)
+  /// True for a non-empty host, port 1..65535, max_missed >= 1, reply_wait in [0, 0.9],
+  /// hello_timeout in (0, 60] s and hello_attempts >= 1; otherwise false with the reason
+  /// in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
+/// IoBackend talking to a plant server over UDP, one Step exchange per period (see above).
 class UdpBackend : public IoBackend {
  public:
   /// @throws InvalidArgument on invalid options.
@@ -44,6 +49,7 @@ class UdpBackend : public IoBackend {
   /// The plant server's protocol carries the IPA's duty (%) and force (N): IpaActuator().
   Actuator actuator() const override { return IpaActuator(); }
 
+  /// Periods whose reply had not arrived in time (last value repeated) since Open().
   std::int64_t stale_samples() const { return stale_total_; }
   /// Round-trip time of the last reply (us).
   double last_rtt_us() const { return last_rtt_us_; }

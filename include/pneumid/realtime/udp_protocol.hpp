@@ -32,12 +32,14 @@
 
 namespace pneumid::udp {
 
-inline constexpr std::uint32_t kMagic = 0x444D4E50u;  // bytes "PNMD" on the wire
-inline constexpr std::uint16_t kVersion = 1;
-inline constexpr std::size_t kPacketSize = 64;
-inline constexpr std::uint16_t kReplyBit = 0x80;
+inline constexpr std::uint32_t kMagic = 0x444D4E50u;  ///< first field; bytes "PNMD" on the wire
+inline constexpr std::uint16_t kVersion = 1;          ///< protocol version written and accepted
+inline constexpr std::size_t kPacketSize = 64;        ///< bytes of every datagram
+inline constexpr std::uint16_t kReplyBit = 0x80;      ///< set in the type field of a reply
 
+/// Kind of exchange (semantics above).
 enum class PacketType : std::uint16_t { kHello = 1, kStep = 2, kSafe = 3, kBye = 4 };
+/// Server's verdict on a request, in the reply.
 enum class PacketStatus : std::uint32_t {
   kOk = 0,
   kBadVersion = 1,
@@ -45,28 +47,32 @@ enum class PacketStatus : std::uint32_t {
   kBadTs = 3,
   kNoSession = 4,  ///< Step before Hello
 };
+/// "ok", "bad-version", "bad-type", "bad-Ts", "no-session".
 const char* ToString(PacketStatus s);
 
+/// One datagram as sent on the wire (layout above).
 using Packet = std::array<std::uint8_t, kPacketSize>;
 
+/// A client -> server datagram, decoded.
 struct Request {
-  PacketType type = PacketType::kStep;
-  std::uint32_t sequence = 0;
-  std::uint32_t arg = 0;
-  std::int64_t client_time_ns = 0;
-  double u = 0.0;
-  double Ts = 0.0;
+  PacketType type = PacketType::kStep;  ///< Hello, Step, Safe or Bye
+  std::uint32_t sequence = 0;           ///< request number; a repeated Step is not re-applied
+  std::uint32_t arg = 0;                ///< SafeState for Safe, else 0
+  std::int64_t client_time_ns = 0;      ///< client's monotonic clock at sending, ns (echoed)
+  double u = 0.0;                       ///< input to hold for one period (Step), duty %
+  double Ts = 0.0;                      ///< client's sample period (Hello), s
 };
 
+/// A server -> client datagram, decoded.
 struct Reply {
-  PacketType type = PacketType::kStep;
-  std::uint32_t sequence = 0;
-  PacketStatus status = PacketStatus::kOk;
-  std::int64_t client_time_ns = 0;
-  std::int64_t server_time_ns = 0;
-  double plant_time = 0.0;
-  double y = 0.0;
-  double aux = std::numeric_limits<double>::quiet_NaN();
+  PacketType type = PacketType::kStep;      ///< type of the request answered
+  std::uint32_t sequence = 0;               ///< sequence of the request answered
+  PacketStatus status = PacketStatus::kOk;  ///< kOk, or why the request was refused
+  std::int64_t client_time_ns = 0;          ///< the request's client time (round-trip time)
+  std::int64_t server_time_ns = 0;          ///< server's monotonic clock at replying, ns
+  double plant_time = 0.0;                  ///< plant time after the request, s
+  double y = 0.0;                           ///< measured output (IPA: force N)
+  double aux = std::numeric_limits<double>::quiet_NaN();  ///< chamber pressure, Pa, or NaN
 };
 
 /// Result of decoding a datagram.
@@ -79,13 +85,16 @@ enum class DecodeResult {
   kNotReply,
   kNotRequest
 };
+/// "ok", "wrong size", "bad magic", "unsupported version", "unknown type", "not a reply",
+/// "not a request".
 const char* ToString(DecodeResult r);
 
 /// Serialization (allocation-free, usable on the loop thread).
 Packet Encode(const Request& r) noexcept;
-Packet Encode(const Reply& r) noexcept;
+Packet Encode(const Reply& r) noexcept;  ///< sets kReplyBit in the type field
 /// Decodes `size` bytes at `data`.
 DecodeResult DecodeRequest(const std::uint8_t* data, std::size_t size, Request* out) noexcept;
+/// Decodes a reply (`size` bytes at `data`); *out is written only when kOk.
 DecodeResult DecodeReply(const std::uint8_t* data, std::size_t size, Reply* out) noexcept;
 
 }  // namespace pneumid::udp

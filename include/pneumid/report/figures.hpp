@@ -41,7 +41,9 @@ namespace pneumid {
 
 /// A model with the name it has in a legend.
 struct NamedModel {
+  /// An unnamed static gain 1 without operating point or covariance.
   NamedModel() = default;
+  /// Sets every field (see below); u0_, y0_ NaN: levels taken from the data.
   NamedModel(std::string label_, TransferFunction model_,
              double u0_ = std::numeric_limits<double>::quiet_NaN(),
              double y0_ = std::numeric_limits<double>::quiet_NaN(),
@@ -52,12 +54,12 @@ struct NamedModel {
         y0(y0_),
         identified(std::move(identified_)) {}
 
-  std::string label;
-  TransferFunction model;
+  std::string label;       ///< legend entry, e.g. "FOPDT"
+  TransferFunction model;  ///< the linear model drawn (continuous or discrete)
   /// Operating point for simulations on data (IdentifiedModel::u0, y0):
   /// y0 + G (u - u0). NaN (default): the levels before the first input change.
   double u0 = std::numeric_limits<double>::quiet_NaN();
-  double y0 = std::numeric_limits<double>::quiet_NaN();
+  double y0 = std::numeric_limits<double>::quiet_NaN();  ///< output level of the point (see u0)
   /// The identified model `model` was drawn from, for confidence bands: its
   /// parameter covariance propagated to the response (model_uncertainty.hpp)
   /// in the form of `model` (discrete or continuous). None: no band.
@@ -66,21 +68,24 @@ struct NamedModel {
 
 /// Labels shared by the figures (with units).
 struct SignalLabels {
-  std::string time = "Time t [s]";
-  std::string output = "Force F [N]";
-  std::string input = "Duty cycle u [%]";
+  std::string time = "Time t [s]";         ///< time axis label
+  std::string output = "Force F [N]";      ///< output axis label
+  std::string input = "Duty cycle u [%]";  ///< input axis label
 };
 
+/// Step (and impulse) figure settings.
 struct StepFigureOptions {
   double amplitude = 1.0;  ///< height of the input step (input units)
   double t_final = 0.0;    ///< seconds; 0 = the longest automatic horizon of the models
   double dt = 0.0;         ///< sample interval of continuous responses; 0 = automatic
-  std::string title = "Step response";
-  SignalLabels labels;
+  std::string title = "Step response";  ///< figure title
+  SignalLabels labels;                  ///< axis labels (time and output used)
   /// Confidence band of +-confidence standard deviations (shaded, in the
   /// model's colour, "label ±K sd") around each model with a covariance
   /// (NamedModel::identified); 0 = none (default). Step figures only.
   double confidence = 0.0;
+  /// True for a finite non-zero amplitude, finite t_final, dt, confidence >= 0 and at
+  /// most 1e7 samples t_final / dt; otherwise false with the reason in *error (if not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -98,12 +103,14 @@ Figure StepResponseFigure(const std::vector<NamedModel>& models,
 Figure ImpulseResponseFigure(const std::vector<NamedModel>& models,
                              const StepFigureOptions& options = {});
 
+/// Settings of ModelComparisonFigure.
 struct ComparisonFigureOptions {
-  std::string title = "Model comparison";
-  SignalLabels labels;
-  bool show_input = true;     ///< second subplot with the input
-  bool show_fit = true;       ///< append "(fit xx.x %)" to each legend label
-  int input = 0, output = 0;  ///< dataset channels
+  std::string title = "Model comparison";  ///< figure title
+  SignalLabels labels;                     ///< axis labels
+  bool show_input = true;                  ///< second subplot with the input
+  bool show_fit = true;                    ///< append "(fit xx.x %)" to each legend label
+  int input = 0,                           ///< dataset input channel driving the simulations
+      output = 0;                          ///< dataset output channel compared with the models
 };
 
 /// Data and models simulated on its input on one time axis (Figure 5);
@@ -117,9 +124,9 @@ Figure ModelComparisonFigure(const Dataset& data, const std::vector<NamedModel>&
 /// A model's static input map, labelled; `normalised` for maps scaled to
 /// 0..1 (an input-affine NARX's valve map) rather than in output units.
 struct NamedStaticMap {
-  std::string label;
-  StaticMap map;
-  bool normalised = false;
+  std::string label;        ///< legend entry
+  StaticMap map;            ///< the map f(u), u in input units
+  bool normalised = false;  ///< values scaled to 0..1 (drawn on their own axes)
 };
 
 /// The static maps f(u) over their input ranges: maps in output units on one
@@ -135,9 +142,9 @@ struct ResidualCorrelation {
   Eigen::VectorXd cross_lags;  ///< -max_lag..max_lag
   Eigen::VectorXd crosscorr;   ///< r_ue(k) / sqrt(r_ee(0) r_uu(0)), u leading e by k
   double bound = 0.0;          ///< confidence bound z / sqrt(N)
-  double confidence = 0.99;
-  /// Fraction of lags (k >= 1 for the autocorrelation) outside the bound.
-  double auto_outside = 0.0, cross_outside = 0.0;
+  double confidence = 0.99;    ///< confidence level of `bound`, in (0, 1)
+  double auto_outside = 0.0,   ///< fraction of autocorrelation lags k >= 1 outside the bound
+      cross_outside = 0.0;     ///< fraction of cross-correlation lags outside the bound
 };
 
 /// Residual correlations of residuals e against input u (same length N, with
@@ -164,14 +171,15 @@ Figure BodeFigure(const std::vector<NamedModel>& models,
 
 /// One closed-loop run: output y and input u on the common time axis.
 struct ClosedLoopTrace {
-  std::string label;
-  Eigen::VectorXd y;
-  Eigen::VectorXd u;
+  std::string label;  ///< legend entry, e.g. the controller
+  Eigen::VectorXd y;  ///< output per sample of t (output units, e.g. N)
+  Eigen::VectorXd u;  ///< input per sample of t (input units, e.g. duty %)
 };
 
+/// Settings of ClosedLoopFigure.
 struct ClosedLoopFigureOptions {
-  std::string title = "Closed-loop response";
-  SignalLabels labels;
+  std::string title = "Closed-loop response";  ///< figure title
+  SignalLabels labels;                         ///< axis labels
   /// Time at which a load disturbance enters (drawn as a dotted marker line); NaN = none.
   double disturbance_time = std::numeric_limits<double>::quiet_NaN();
 };

@@ -19,9 +19,9 @@ namespace pneumid {
 
 /// A table of strings; every row must have header.size() cells.
 struct Table {
-  std::string caption;
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
+  std::string caption;                         ///< text above the table (plain, escaped)
+  std::vector<std::string> header;             ///< column titles, with units where needed
+  std::vector<std::vector<std::string>> rows;  ///< cells, row by row (plain text, escaped)
   /// False (with a message) when a row's length differs from the header's or
   /// the header is empty.
   bool IsValid(std::string* error) const;
@@ -30,6 +30,8 @@ struct Table {
 /// Escapes &, <, >, " and ' for HTML text and attribute values.
 std::string HtmlEscape(const std::string& text);
 
+/// A self-contained HTML page built block by block: headings, text, tables, inline
+/// SVG figures and command listings.
 class HtmlDocument {
  public:
   /// A document with the given `<title>` and top-level heading.
@@ -50,8 +52,8 @@ class HtmlDocument {
   /// A block of shell commands, one per line (escaped, monospace).
   void AddCommands(const std::vector<std::string>& lines);
 
-  int num_figures() const { return num_figures_; }
-  int num_tables() const { return num_tables_; }
+  int num_figures() const { return num_figures_; }  ///< figures added so far
+  int num_tables() const { return num_tables_; }    ///< tables added so far
 
   /// The complete page (`<!DOCTYPE html> ... </html>`).
   std::string Render() const;

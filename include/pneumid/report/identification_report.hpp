@@ -35,13 +35,14 @@
 
 namespace pneumid {
 
+/// Methods, channels and figure settings of WriteIdentificationReport.
 struct ReportOptions {
   /// Methods in table order (default: the paper's three).
   std::vector<std::string> methods = {"reaction-curve", "ptn", "arx"};
-  IdentifyRequest request;  ///< channels and orders (default ARX(3,3,1), PTn n = 2)
-  std::string title;        ///< default "Identification report: <data source>"
-  int residual_max_lag = 25;
-  double residual_confidence = 0.99;
+  IdentifyRequest request;            ///< channels and orders (default ARX(3,3,1), PTn n = 2)
+  std::string title;                  ///< default "Identification report: <data source>"
+  int residual_max_lag = 25;          ///< largest lag of the residual figure, 1..10000
+  double residual_confidence = 0.99;  ///< level of the residual band, in (0, 1)
   /// Bands of +-confidence standard deviations on the step and Bode figures
   /// around models with a parameter covariance (model_uncertainty.hpp); 0 = none.
   double confidence = 0.0;
@@ -52,6 +53,8 @@ struct ReportOptions {
   /// How the data were preprocessed before the report (listed in the data
   /// table and stored with each model in models.json); none by default.
   std::optional<PreprocessRecord> preprocessing;
+  /// True for known, non-empty methods, a valid request, residual settings in range and
+  /// confidence >= 0; otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -59,17 +62,19 @@ struct ReportOptions {
 /// common/termination.hpp).
 using ReportTermination = Termination;
 
+/// What WriteIdentificationReport produced.
 struct ReportSummary {
   /// kSuccess: every method gave a model; kPartial: some failed;
   /// kFailure: none did (the report is still written, listing the errors).
   ReportTermination termination = ReportTermination::kSuccess;
-  std::string message;
-  std::vector<IdentifiedModel> models;
+  std::string message;                  ///< e.g. "2 of 3 methods failed"
+  std::vector<IdentifiedModel> models;  ///< the models identified, ranked best first
   std::vector<std::pair<std::string, std::string>> failures;  ///< method, error
-  std::string html_path;
-  std::string models_path;
-  int num_figures = 0;
-  int num_tables = 0;
+  std::string html_path;                                      ///< DIR/report.html
+  std::string models_path;                                    ///< DIR/models.json
+  int num_figures = 0;                                        ///< figures in the page
+  int num_tables = 0;                                         ///< tables in the page
+  /// One line: termination, models, failures, figures, tables and the page's path.
   std::string BriefReport() const;
 };
 

@@ -44,6 +44,7 @@
 
 namespace pneumid {
 
+/// Settings of RunPaper: the step test, the PRBS experiment and the Figure 6 loop.
 struct PaperOptions {
   double Ts = 0.01;            ///< s, sample time of the paper
   double step_time = 0.5;      ///< s, when the duty steps from u_initial to u_final
@@ -57,14 +58,16 @@ struct PaperOptions {
   /// spec skips it. The ARX is estimated after `prbs_skip` s, with the means
   /// removed (the model has no offset term).
   std::string prbs = "prbs:low=0.61,high=82,order=8,clock=0.05";
-  double prbs_duration = 60.0;
-  double prbs_skip = 2.0;
-  double loop_duration = 6.0;  ///< s, Figure 6 run
+  double prbs_duration = 60.0;  ///< s, length of the PRBS experiment (100 Ts .. 3600 s)
+  double prbs_skip = 2.0;       ///< s, initial transient left out of the ARX estimation
+  double loop_duration = 6.0;   ///< s, Figure 6 run
   /// Figure 6 set-point levels (N), each held `loop_dwell` s.
   std::vector<double> loop_levels = {0.0, 100.0, 60.0, 60.0};
   double loop_dwell = 1.5;   ///< s
   double load_time = 5.0;    ///< s, load disturbance step (NaN = none)
   double load_size = -15.0;  ///< N
+  /// True when the times, duties (distinct, 0..100 %), levels and PRBS settings are in
+  /// range; otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -80,17 +83,19 @@ struct PaperRow {
 /// kSuccess or kPartial ("success", "partial"; common/termination.hpp).
 using PaperTermination = Termination;
 
+/// Everything RunPaper obtained: the comparison rows, data, models and figures.
 struct PaperResult {
   /// kPartial when a step failed numerically (listed in `problems`); the
   /// rows that could be computed are still filled.
   PaperTermination termination = PaperTermination::kSuccess;
-  std::vector<std::string> problems;
-  std::vector<PaperRow> rows;
-  Dataset step_test;
-  Dataset prbs_test;  ///< the twin's PRBS experiment (empty when skipped)
+  std::vector<std::string> problems;      ///< steps that failed, with their error
+  std::vector<PaperRow> rows;             ///< the side-by-side table, in workflow order
+  Dataset step_test;                      ///< the simulated step test (duty %, force N)
+  Dataset prbs_test;                      ///< the twin's PRBS experiment (empty when skipped)
   std::vector<IdentifiedModel> models;    ///< reaction-curve, ptn, arx (those that succeeded)
   std::vector<Figure> figures;            ///< Figure 4, 5, 6 (those that could be drawn)
   std::vector<std::string> figure_names;  ///< "fig4", "fig5", "fig6"
+  /// One line: termination, number of quantities (with a note), figures and problems.
   std::string BriefReport() const;
   /// {"rows": [{"quantity", "paper", "pneumid", "note", "section"}], ...}
   nlohmann::json ToJson() const;

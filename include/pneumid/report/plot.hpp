@@ -48,7 +48,9 @@ ImageFormat ImageFormatFromPath(const std::string& path);
 
 /// An RGB colour, components 0..255.
 struct Color {
-  int r = 0, g = 0, b = 0;
+  int r = 0,  ///< red, 0..255
+      g = 0,  ///< green, 0..255
+      b = 0;  ///< blue, 0..255
 };
 /// The i-th colour of the default palette (Tableau 10; wraps around).
 Color PaletteColor(int i);
@@ -57,33 +59,33 @@ Color PaletteColor(int i);
 /// (Named Curve, not Series: pneumid::Series is the series connection of two
 /// transfer functions, pneumid/lti/interconnect.hpp.)
 struct Curve {
-  Eigen::VectorXd x;
-  Eigen::VectorXd y;
-  std::string label;
-  LineStyle style = LineStyle::kSolid;
-  std::optional<Color> color;  ///< default: next palette colour of its axes
-  double width = 2.0;          ///< line width in PLplot units (about pixels / 1)
-  bool stairs = false;         ///< drawn as a zero-order-hold staircase
+  Eigen::VectorXd x;                    ///< abscissae in x-axis units (e.g. s), same length as y
+  Eigen::VectorXd y;                    ///< ordinates in y-axis units (e.g. N)
+  std::string label;                    ///< legend entry; empty: not listed
+  LineStyle style = LineStyle::kSolid;  ///< solid, dashed or dotted
+  std::optional<Color> color;           ///< default: next palette colour of its axes
+  double width = 2.0;                   ///< line width in PLplot units (about pixels / 1)
+  bool stairs = false;                  ///< drawn as a zero-order-hold staircase
 };
 
 /// A horizontal reference line at y (set-point, confidence limit, ...).
 struct HorizontalLine {
-  double y = 0.0;
-  std::string label;
-  LineStyle style = LineStyle::kDashed;
-  Color color{90, 90, 90};
+  double y = 0.0;                        ///< level, y-axis units
+  std::string label;                     ///< legend entry; empty: not listed
+  LineStyle style = LineStyle::kDashed;  ///< line style (dashed by default)
+  Color color{90, 90, 90};               ///< line colour (grey by default)
 };
 
 /// A band lower(x) <= y <= upper(x): a translucent shaded area (`shaded`) or
 /// two dashed bounds.
 struct Band {
-  Eigen::VectorXd x;
-  Eigen::VectorXd lower;
-  Eigen::VectorXd upper;
-  std::string label;
-  bool shaded = true;
-  Color color{31, 119, 180};
-  double alpha = 0.25;  ///< fill opacity 0..1 (shaded bands)
+  Eigen::VectorXd x;          ///< abscissae, same length as lower and upper
+  Eigen::VectorXd lower;      ///< lower bound at each x, y-axis units
+  Eigen::VectorXd upper;      ///< upper bound at each x, y-axis units
+  std::string label;          ///< legend entry; empty: not listed
+  bool shaded = true;         ///< filled area; false: two dashed bound lines
+  Color color{31, 119, 180};  ///< fill or line colour (palette blue by default)
+  double alpha = 0.25;        ///< fill opacity 0..1 (shaded bands)
 };
 
 /// Legend placement inside the axes.
@@ -91,18 +93,21 @@ enum class LegendPosition { kNone, kTopRight, kBottomRight, kTopLeft, kBottomLef
 
 /// One subplot.
 struct Axes {
-  std::string title;
+  std::string title;   ///< subplot title; empty: none
   std::string xlabel;  ///< with unit, e.g. "Time t [s]"
   std::string ylabel;  ///< with unit, e.g. "Force F [N]"
-  bool grid = true;
+  bool grid = true;    ///< draw grid lines at the major ticks
   bool log_x = false;  ///< logarithmic x axis (Bode plots); x values must be > 0
-  LegendPosition legend = LegendPosition::kBottomRight;
+  LegendPosition legend = LegendPosition::kBottomRight;  ///< kNone: no legend
   /// Axis limits; unset = data range (y with a 5 % margin).
-  std::optional<double> xmin, xmax, ymin, ymax;
+  std::optional<double> xmin,
+      xmax,  ///< upper x limit; unset = data range
+      ymin,  ///< lower y limit; unset = data range with a 5 % margin
+      ymax;  ///< upper y limit; unset = data range with a 5 % margin
 
-  std::vector<Curve> series;
-  std::vector<HorizontalLine> hlines;
-  std::vector<Band> bands;
+  std::vector<Curve> series;           ///< curves, drawn in order
+  std::vector<HorizontalLine> hlines;  ///< horizontal reference lines
+  std::vector<Band> bands;             ///< bands, drawn beneath the curves
 
   /// Adds a line. Throws InvalidArgument when x and y differ in length or are
   /// empty. Returns the new series for further styling.
@@ -123,20 +128,23 @@ struct FigureOptions {
   int width = 960;          ///< pixels (PNG) / points (SVG)
   int height_per_axes = 0;  ///< pixels per subplot; 0 = 420 for one, 330 for more
   double font_scale = 1.0;  ///< multiplies PLplot's default character height
+  /// True for width in [200, 8000], height_per_axes 0 or in [100, 4000] and font_scale
+  /// in (0.1, 10); otherwise false with the reason in *error (when not null).
   bool IsValid(std::string* error) const;
 };
 
+/// A figure of 1..3 stacked subplots (Axes), written as PNG or SVG through PLplot.
 class Figure {
  public:
   /// A figure with `rows` stacked subplots (1..3). Throws InvalidArgument otherwise.
   explicit Figure(int rows = 1, FigureOptions options = {});
 
-  int rows() const { return static_cast<int>(axes_.size()); }
+  int rows() const { return static_cast<int>(axes_.size()); }  ///< number of subplots
   /// Subplot i (0 = top). Throws InvalidArgument when out of range.
   Axes& axes(int i);
-  const Axes& axes(int i) const;
-  FigureOptions& options() { return options_; }
-  const FigureOptions& options() const { return options_; }
+  const Axes& axes(int i) const;                             ///< read-only axes(i)
+  FigureOptions& options() { return options_; }              ///< page size and font scale
+  const FigureOptions& options() const { return options_; }  ///< page size and font scale
 
   /// Figure title drawn above the first subplot.
   std::string title;
