@@ -33,6 +33,7 @@ namespace {
 struct CodegenCli {
   ControllerSettings controller;
   std::string model;
+  std::string config;
   std::string plant;
   double Ts = 0.01;
   std::string precision = "double";
@@ -136,8 +137,11 @@ const Registrar reg(
       auto c = std::make_shared<CodegenCli>();
       app.add_option("--model", c->model,
                      "Controller's model: fopdt-paper, arx-paper, fopdt:K=..,tau=..,theta=.., "
-                     "tf:..., FILE.json")
-          ->required();
+                     "tf:..., FILE.json (required unless --config has [controller] model)");
+      app.add_option("--config", c->config,
+                     "Controller configuration (TOML, e.g. the controller.toml of `pneumid "
+                     "commission`): its [controller] section and [loop] period; flags given "
+                     "override it");
       app.add_option("--plant", c->plant,
                      "Plant whose input range bounds the input when --u-min/--u-max are not "
                      "given (ipa: 0..100 % duty); default: none")
@@ -197,7 +201,17 @@ const Registrar reg(
                      "Also write the model as a linear plant module NAME.h/NAME.c (closed-loop "
                      "runs on a board or an emulator)");
       app.add_flag("--json", c->json, "Print the result (sizes, files, design) as JSON");
-      app.callback([c] { Execute(*c); });
+      app.callback([c, &app] {
+        if (!c->config.empty()) {
+          const RealtimeConfig config = LoadRealtimeConfig(c->config);
+          if (config.controller)
+            ApplyControllerConfig(app, *config.controller, c->model, c->controller);
+          if (app.count("--Ts") == 0) c->Ts = config.loop.period;
+        }
+        PNEUMID_CHECK(!c->model.empty(),
+                      "--model is required (or a --config file with [controller] model)");
+        Execute(*c);
+      });
     });
 
 }  // namespace

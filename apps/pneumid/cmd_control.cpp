@@ -29,6 +29,7 @@
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
+#include "pneumid/realtime/realtime_config.hpp"
 #include "pneumid/report/figures.hpp"
 #include "validators.hpp"
 
@@ -180,6 +181,7 @@ std::vector<ControlRun> SimulateControl(const ControlCli& c) {
   ControllerSettings settings = c.controller;
   ApplyPlantInputRange(*MakePlant(plant_spec, c.Ts, po), settings.limits.u_min,
                        settings.limits.u_max);
+  ApplyPlantInputGaps(*MakePlant(plant_spec, c.Ts, po), settings.input_gaps);
   cl.actuator.u_min = settings.limits.u_min;
   cl.actuator.u_max = settings.limits.u_max;
   const ControllerSpec base = WithModelInputMap(ToControllerSpec(settings), c.model);
@@ -243,8 +245,11 @@ const Registrar reg(
       auto c = std::make_shared<ControlCli>();
       app.add_option("--model", c->model,
                      "Controller's model: fopdt-paper, arx-paper, fopdt:K=..,tau=..,theta=.., "
-                     "tf:..., FILE.json")
-          ->required();
+                     "tf:..., FILE.json (required unless --config has [controller] model)");
+      app.add_option("--config", c->config,
+                     "Controller configuration (TOML, e.g. the controller.toml of `pneumid "
+                     "commission`): its [controller] section, [loop] period and [io] plant; "
+                     "flags given override it");
       app.add_option("--plant", c->plant,
                      "Plant: ipa, ipa-position, or any model spec (default: the model itself)");
       app.add_option("--Ts,--sample-time", c->Ts, "Sample time in s")
@@ -284,6 +289,15 @@ const Registrar reg(
           ->expected(0, 1);
       app.callback([c, &app] {
         c->compare_given = app.count("--compare") > 0;
+        if (!c->config.empty()) {
+          const RealtimeConfig config = LoadRealtimeConfig(c->config);
+          if (config.controller)
+            ApplyControllerConfig(app, *config.controller, c->model, c->controller);
+          if (app.count("--Ts") == 0) c->Ts = config.loop.period;
+          if (app.count("--plant") == 0 && config.io == "sim") c->plant = config.plant;
+        }
+        PNEUMID_CHECK(!c->model.empty(),
+                      "--model is required (or a --config file with [controller] model)");
         Execute(*c);
       });
     });

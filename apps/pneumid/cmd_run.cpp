@@ -141,8 +141,10 @@ RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
 
 namespace {
 
-void Run(const RunOptions& o, CLI::App& app) {
-  RealtimeConfig config = ResolveRealtimeConfig(o.rt, app);
+void Run(const RunOptions& options, CLI::App& app) {
+  RealtimeConfig config = ResolveRealtimeConfig(options.rt, app);
+  RunOptions o = options;
+  if (config.controller) ApplyControllerConfig(app, *config.controller, o.model, o.controller);
   ApplySafetyFlags(o, config);
   const RunOutcome out = RunRealtime(o, config);
   const LoopSummary& sum = out.summary;

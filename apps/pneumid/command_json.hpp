@@ -29,6 +29,7 @@ namespace pneumid::cli {
 struct ControlCli {
   ControllerSettings controller;  // --controller, --rule, --P, ..., --u-min, --t-filter, --tau-c
   std::string model;
+  std::string config;  // --config FILE.toml ([controller], [loop] period, [io] plant)
   std::string plant;
   double Ts = 0.01;
   std::string setpoint;

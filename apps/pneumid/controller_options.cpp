@@ -1,6 +1,10 @@
 #include "controller_options.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
+#include <tuple>
+#include <vector>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/plant/actuator.hpp"
@@ -55,6 +59,19 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
   app.add_option("--safe-input", s.safe_input,
                  "Input applied on a faulty sample instead of holding the last one (e.g. the "
                  "valves' vented duty)");
+  app.add_option("--input-gaps", s.input_gaps,
+                 "Inputs the actuator cannot hold, LO:HI[,LO:HI] (IPA: 0:15,85:100), or 'plant' "
+                 "for the simulated plant's own: the input is sigma-delta modulated across them, "
+                 "so that their outputs are reached on average instead of by a limit cycle");
+}
+
+void ApplyPlantInputGaps(const Plant& plant, std::string& input_gaps) {
+  if (input_gaps != "plant") return;
+  const Actuator actuator = PlantActuator(plant);
+  PNEUMID_CHECK(!actuator.input_gaps.empty(),
+                "--input-gaps plant: the plant '{}' has no known input gaps (give LO:HI)",
+                plant.Describe());
+  input_gaps = InputGapsToString(actuator.input_gaps);
 }
 
 void ApplyPlantInputRange(const Plant& plant, double& u_min, double& u_max) {
@@ -64,6 +81,47 @@ void ApplyPlantInputRange(const Plant& plant, double& u_min, double& u_max) {
   PNEUMID_CHECK(u_min <= u_max,
                 "--u-min {} is above --u-max {} (the plant's input range is {} .. {})", u_min,
                 u_max, actuator.u_min, actuator.u_max);
+}
+
+}  // namespace pneumid::cli
+
+namespace pneumid::cli {
+
+void ApplyControllerConfig(const CLI::App& app, const ControllerConfig& file, std::string& model,
+                           ControllerSettings& s) {
+  const ControllerSettings& f = file.settings;
+  // key in the file -> (flag, copy)
+  const std::vector<std::tuple<std::string, std::string, std::function<void()>>> table = {
+      {"model", "--model", [&] { model = file.model; }},
+      {"type", "--controller", [&] { s.controller = f.controller; }},
+      {"rule", "--rule", [&] { s.rule = f.rule; }},
+      {"P", "--P", [&] { s.P = f.P; }},
+      {"M", "--M", [&] { s.M = f.M; }},
+      {"lambda", "--lambda", [&] { s.lambda = f.lambda; }},
+      {"overshoot", "--overshoot", [&] { s.overshoot = f.overshoot; }},
+      {"aggressiveness", "--aggressiveness", [&] { s.aggressiveness = f.aggressiveness; }},
+      {"response_time", "--response-time", [&] { s.response_time = f.response_time; }},
+      {"u_min", "--u-min", [&] { s.limits.u_min = f.limits.u_min; }},
+      {"u_max", "--u-max", [&] { s.limits.u_max = f.limits.u_max; }},
+      {"du_max", "--du-max", [&] { s.limits.du_max = f.limits.du_max; }},
+      {"y_min", "--y-min", [&] { s.y_min = f.y_min; }},
+      {"y_max", "--y-max", [&] { s.y_max = f.y_max; }},
+      {"constrained", "--constrained", [&] { s.constrained = f.constrained; }},
+      {"disturbance", "--disturbance", [&] { s.disturbance = f.disturbance; }},
+      {"t_filter", "--t-filter", [&] { s.t_filter = f.t_filter; }},
+      {"tau_c", "--tau-c", [&] { s.tau_c = f.tau_c; }},
+      {"pid_rule", "--pid-rule", [&] { s.pid_rule = f.pid_rule; }},
+      {"input_map", "--input-map", [&] { s.input_map = f.input_map; }},
+      {"input_gaps", "--input-gaps", [&] { s.input_gaps = f.input_gaps; }},
+      {"y_valid_min", "--y-valid-min", [&] { s.y_valid_min = f.y_valid_min; }},
+      {"y_valid_max", "--y-valid-max", [&] { s.y_valid_max = f.y_valid_max; }},
+      {"safe_input", "--safe-input", [&] { s.safe_input = f.safe_input; }},
+  };
+  for (const auto& [key, flag, copy] : table) {
+    if (std::find(file.keys.begin(), file.keys.end(), key) == file.keys.end()) continue;
+    const CLI::Option* option = app.get_option_no_throw(flag);
+    if (option == nullptr || option->count() == 0) copy();
+  }
 }
 
 }  // namespace pneumid::cli

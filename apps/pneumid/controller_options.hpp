@@ -16,6 +16,7 @@
 
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/plant/plant.hpp"
+#include "pneumid/realtime/realtime_config.hpp"
 
 namespace pneumid::cli {
 
@@ -27,5 +28,13 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& settings);
 /// the plant's physical input range (IPA: duty 0..100 %).
 /// @throws InvalidArgument when u_min > u_max, naming the plant's range.
 void ApplyPlantInputRange(const Plant& plant, double& u_min, double& u_max);
+/// Replaces the --input-gaps value "plant" by the plant's known gaps
+/// (PlantActuator(plant).input_gaps). @throws InvalidArgument when it has none.
+void ApplyPlantInputGaps(const Plant& plant, std::string& input_gaps);
+/// The [controller] section of a --config file (realtime_config.hpp) applied
+/// to `model` and `settings`: each key the file gives, unless its flag was
+/// given on the command line (flags override the file).
+void ApplyControllerConfig(const CLI::App& app, const ControllerConfig& file, std::string& model,
+                           ControllerSettings& settings);
 
 }  // namespace pneumid::cli

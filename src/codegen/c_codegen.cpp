@@ -18,6 +18,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/enum_names.hpp"
 #include "pneumid/control/dmc.hpp"
+#include "pneumid/control/duty_modulator.hpp"
 #include "pneumid/control/gpc.hpp"
 #include "pneumid/control/inverse_map_controller.hpp"
 #include "pneumid/control/mpc.hpp"
@@ -845,6 +846,41 @@ void PFX_applied(PFX_state* s, PFX_real u) {{
                          stem, map);
 }
 
+// ModulatedController: first-order sigma-delta across the input gaps
+// (duty_modulator.hpp), the gaps as literals.
+void GenerateModulator(const ModulatedController& c, Module& m, const std::string& stem) {
+  const DutyModulator& mod = c.modulator();
+  m.Member({Field::kReal, stem + "err", 0, "carried modulation error (input units)"});
+  m.Member({Field::kReal, stem + "v", 0, "inner controller's request v"});
+  std::string chain;
+  for (const InputGap& g : mod.gaps()) {
+    chain += fmt::format("{0}if (w > {1} && w < {2}) a = (w - {1} < {2} - w) ? {1} : {2};\n",
+                         chain.empty() ? "  " : "  else ", m.Literal(g.lo), m.Literal(g.hi));
+  }
+  m.code_ += fmt::format(R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
+  s->{0}err = PFX_ZERO;
+  s->{0}v = u0;
+  PFX_{0}reset(s, u0, y0);
+}}
+
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
+  PFX_real w, a, e;
+  s->{0}v = PFX_{0}step(s, setpoint, measurement);
+  if (!PFX_ISFINITE(s->{0}v)) return s->{0}v;
+  w = s->{0}v + s->{0}err;
+  a = w;
+{1}  e = w - a;
+  s->{0}err = e < -{2} ? -{2} : ({2} < e ? {2} : e);
+  return a;
+}}
+
+void PFX_applied(PFX_state* s, PFX_real u) {{
+  if (PFX_ISFINITE(u) && PFX_FABS(u - s->{0}v) > {2}) PFX_{0}applied(s, u);
+}}
+)C",
+                         stem, chain, m.Literal(mod.max_error()));
+}
+
 // OutputMapController: the inner controller on g^-1(r), g^-1(y).
 void GenerateOutputMap(const OutputMapController& c, Module& m, const std::string& stem) {
   const std::string map = stem + "omap";
@@ -1058,6 +1094,9 @@ void AddStepCost(const Controller& controller, StepCost* cost) {
   } else if (const auto* im = dynamic_cast<const InverseMapController*>(&controller)) {
     cost->base += 3.0 * map_cost(im->map()) + 10.0;
     AddStepCost(im->inner(), cost);
+  } else if (const auto* sd = dynamic_cast<const ModulatedController*>(&controller)) {
+    cost->base += 4.0 * static_cast<double>(sd->modulator().gaps().size()) + 20.0;
+    AddStepCost(sd->inner(), cost);
   } else if (const auto* om = dynamic_cast<const OutputMapController*>(&controller)) {
     cost->base += 2.0 * map_cost(om->map()) + 10.0;
     AddStepCost(om->inner(), cost);
@@ -1165,6 +1204,11 @@ void GenerateLayers(const Controller& controller, Module& m, int depth, CodegenR
     HideEntryPoints(m, stem);
     GenerateInverseMap(*im, m, stem);
     result->layers.insert(result->layers.begin(), "input-map");
+  } else if (const auto* sd = dynamic_cast<const ModulatedController*>(&controller)) {
+    GenerateLayers(sd->inner(), m, depth + 1, result);
+    HideEntryPoints(m, stem);
+    GenerateModulator(*sd, m, stem);
+    result->layers.insert(result->layers.begin(), "sigma-delta");
   } else if (const auto* om = dynamic_cast<const OutputMapController*>(&controller)) {
     GenerateLayers(om->inner(), m, depth + 1, result);
     HideEntryPoints(m, stem);
@@ -1178,7 +1222,7 @@ void GenerateLayers(const Controller& controller, Module& m, int depth, CodegenR
   } else {
     PNEUMID_CHECK(false,
                   "code generation supports the dmc, gpc, pid and mpc controllers, alone or "
-                  "behind an input map, an output map or a NARX linearization, not '{}'",
+                  "behind an input map, an output map, a NARX linearization or a sigma-delta modulator, not '{}'",
                   controller.Describe());
   }
 }

@@ -54,6 +54,7 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   spec.guard.safe_input = settings.safe_input;
   std::string error;
   PNEUMID_CHECK(spec.guard.IsValid(&error), "{}", error);
+  spec.input_gaps = ParseInputGaps(settings.input_gaps);
   return spec;
 }
 
@@ -331,15 +332,21 @@ BuiltController BuildController(const PredictionModel& model, const ControllerSp
 
 // The guard goes on the outermost controller only: behind an output map the
 // inner controller sees g^-1(y), and behind an input map its input is v.
+// So does the modulator over the input gaps: it acts on the input that
+// reaches the actuator.
 BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec) {
   BuiltController b = BuildController(model, Ts, spec);
+  if (!spec.input_gaps.empty())
+    b.controller = std::make_unique<ModulatedController>(std::move(b.controller), spec.input_gaps);
   b.controller->SetMeasurementGuard(spec.guard);
   return b;
 }
 
 BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec) {
   BuiltController b = BuildController(model, spec);
+  if (!spec.input_gaps.empty())
+    b.controller = std::make_unique<ModulatedController>(std::move(b.controller), spec.input_gaps);
   b.controller->SetMeasurementGuard(spec.guard);
   return b;
 }

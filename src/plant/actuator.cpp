@@ -18,8 +18,12 @@ Actuator IpaActuator(IpaMode mode) {
 }
 
 Actuator PlantActuator(const Plant& plant) {
-  if (const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant))
-    return IpaActuator(ipa->parameters().mode);
+  if (const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant)) {
+    Actuator a = IpaActuator(ipa->parameters().mode);
+    const double w = 100.0 * ipa->parameters().min_pulse_width * ipa->parameters().pwm_frequency;
+    if (w > 0.0 && w < 50.0) a.input_gaps = {{0.0, w}, {100.0 - w, 100.0}};
+    return a;
+  }
   return Actuator{};
 }
 

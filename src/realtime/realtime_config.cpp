@@ -1,6 +1,7 @@
 #include "pneumid/realtime/realtime_config.hpp"
 
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -37,9 +38,8 @@ struct Reader {
       if (!n->is_integer()) Fail(*n, fmt::format("[{}] {} must be an integer", section, key));
       const std::int64_t v = n->as_integer()->get();
       if (!std::in_range<T>(v)) {
-        Fail(*n, fmt::format("[{}] {} = {} is out of range (at most {}, at least {})", section,
-                             key, v, std::numeric_limits<T>::max(),
-                             std::numeric_limits<T>::min()));
+        Fail(*n, fmt::format("[{}] {} = {} is out of range (at most {}, at least {})", section, key,
+                             v, std::numeric_limits<T>::max(), std::numeric_limits<T>::min()));
       }
       *out = static_cast<T>(v);
     } else {
@@ -74,6 +74,65 @@ struct Reader {
   }
 };
 
+// [controller]: the model and the settings of ControllerSettings under the
+// names of the command-line flags (with '_' for '-').
+void ParseControllerSection(const Reader& r, const toml::table& t, RealtimeConfig& c) {
+  r.CheckKeys(
+      t, "controller",
+      {"model",     "type",           "rule",          "P",           "M",           "lambda",
+       "overshoot", "aggressiveness", "response_time", "u_min",       "u_max",       "du_max",
+       "y_min",     "y_max",          "constrained",   "disturbance", "t_filter",    "tau_c",
+       "pid_rule",  "input_map",      "input_gaps",    "y_valid_min", "y_valid_max", "safe_input"});
+  ControllerConfig cc;
+  ControllerSettings& s = cc.settings;
+  r.Get(t, "controller", "model", &cc.model);
+  r.Get(t, "controller", "type", &s.controller);
+  r.Get(t, "controller", "rule", &s.rule);
+  r.Get(t, "controller", "P", &s.P);
+  r.Get(t, "controller", "M", &s.M);
+  r.Get(t, "controller", "lambda", &s.lambda);
+  r.Get(t, "controller", "overshoot", &s.overshoot);
+  r.Get(t, "controller", "aggressiveness", &s.aggressiveness);
+  r.Get(t, "controller", "response_time", &s.response_time);
+  r.Get(t, "controller", "u_min", &s.limits.u_min);
+  r.Get(t, "controller", "u_max", &s.limits.u_max);
+  r.Get(t, "controller", "du_max", &s.limits.du_max);
+  r.Get(t, "controller", "y_min", &s.y_min);
+  r.Get(t, "controller", "y_max", &s.y_max);
+  r.Get(t, "controller", "constrained", &s.constrained);
+  r.Get(t, "controller", "disturbance", &s.disturbance);
+  r.Get(t, "controller", "t_filter", &s.t_filter);
+  r.Get(t, "controller", "tau_c", &s.tau_c);
+  r.Get(t, "controller", "pid_rule", &s.pid_rule);
+  r.Get(t, "controller", "input_map", &s.input_map);
+  r.Get(t, "controller", "input_gaps", &s.input_gaps);
+  r.Get(t, "controller", "y_valid_min", &s.y_valid_min);
+  r.Get(t, "controller", "y_valid_max", &s.y_valid_max);
+  r.Get(t, "controller", "safe_input", &s.safe_input);
+  for (const auto& [k, v] : t) cc.keys.emplace_back(k.str());
+  // A model file named relative to the configuration is found beside it.
+  const auto hash = cc.model.find('#');
+  const std::filesystem::path file = cc.model.substr(0, hash);
+  const std::filesystem::path dir = std::filesystem::path(r.source).parent_path();
+  if (!file.empty() && file.is_relative() && !dir.empty() && std::filesystem::exists(dir / file))
+    cc.model = (dir / file).string() + (hash == std::string::npos ? "" : cc.model.substr(hash));
+  if (const toml::node* n = t.get("type")) {
+    try {
+      (void)ControllerTypeFromString(s.controller);
+    } catch (const InvalidArgument& e) {
+      r.Fail(*n, e.what());
+    }
+  }
+  if (const toml::node* n = t.get("input_gaps")) {
+    try {
+      (void)ParseInputGaps(s.input_gaps);
+    } catch (const InvalidArgument& e) {
+      r.Fail(*n, e.what());
+    }
+  }
+  c.controller = cc;
+}
+
 }  // namespace
 
 RealtimeConfig ParseRealtimeConfig(const std::string& text, const std::string& source) {
@@ -89,9 +148,9 @@ RealtimeConfig ParseRealtimeConfig(const std::string& text, const std::string& s
   for (const auto& [k, v] : root) {
     const std::string name(k.str());
     if (!v.is_table())
-      r.Fail(v,
-             fmt::format("'{}' must be a section ([loop], [io], [safety], [udp], [comedi], [log])",
-                         name));
+      r.Fail(v, fmt::format("'{}' must be a section ([controller], [loop], [io], [safety], [udp], "
+                            "[comedi], [log])",
+                            name));
     const toml::table& t = *v.as_table();
     if (name == "loop") {
       r.CheckKeys(t, "loop", {"period", "duration", "realtime", "priority", "cpu", "fast"});
@@ -154,13 +213,16 @@ RealtimeConfig ParseRealtimeConfig(const std::string& text, const std::string& s
       r.Get(t, "comedi", "v_open", &m.v_open);
       r.Get(t, "comedi", "exhaust_complementary", &m.exhaust_complementary);
       r.Get(t, "comedi", "use_calibration", &m.use_calibration);
+    } else if (name == "controller") {
+      ParseControllerSection(r, t, c);
     } else if (name == "log") {
       r.CheckKeys(t, "log", {"flush_interval", "capacity"});
       r.Get(t, "log", "flush_interval", &c.log.flush_interval);
       r.Get(t, "log", "capacity", &c.log.capacity);
     } else {
-      r.Fail(v,
-             fmt::format("unknown section [{}] (known: loop, io, safety, udp, comedi, log)", name));
+      r.Fail(v, fmt::format(
+                    "unknown section [{}] (known: controller, loop, io, safety, udp, comedi, log)",
+                    name));
     }
   }
   // Value checks, reported against the file.

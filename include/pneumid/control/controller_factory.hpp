@@ -24,6 +24,7 @@
 
 #include "pneumid/control/auto_tuning.hpp"
 #include "pneumid/control/controller.hpp"
+#include "pneumid/control/duty_modulator.hpp"
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/narx_linearizing_controller.hpp"
 #include "pneumid/control/pid.hpp"
@@ -71,6 +72,10 @@ struct ControllerSpec {
   /// The measurements the controller accepts and its input on the others
   /// (controller.hpp), set on the outermost controller.
   MeasurementGuard guard;
+  /// Inputs the actuator cannot hold (duty_modulator.hpp); not empty: the
+  /// controller's input goes through a sigma-delta modulator over them
+  /// (ModulatedController, outermost).
+  std::vector<InputGap> input_gaps;
 };
 
 /// Controller settings as a user states them (command line, configuration,
@@ -104,6 +109,9 @@ struct ControllerSettings {
   double y_valid_min = -std::numeric_limits<double>::infinity();
   double y_valid_max = std::numeric_limits<double>::infinity();  ///< upper valid measurement
   double safe_input = std::numeric_limits<double>::quiet_NaN();  ///< input on faults (NaN = hold)
+  /// Sigma-delta modulation over the actuator's input gaps, "LO:HI[,LO:HI]"
+  /// (duty_modulator.hpp ParseInputGaps; IPA: "0:15,85:100"); empty = none.
+  std::string input_gaps;
 };
 
 /// The tuning rule settings ask for: the named rule when `rule` is not empty;

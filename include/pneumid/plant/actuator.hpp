@@ -16,6 +16,7 @@
 
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
@@ -25,6 +26,14 @@ namespace pneumid {
 
 /// Description of a plant's actuator for the real-time loop: signals, input range and
 /// the names and meanings of its hold and release safe states.
+/// An open interval (lo, hi) of inputs the actuator cannot hold; inputs in
+/// it act as lo or hi. Input units (IPA: duty in %).
+struct InputGap {
+  double lo = 0.0;  ///< lower end: the nearest input below the gap that acts as itself
+  double hi = 0.0;  ///< upper end: the nearest input above the gap that acts as itself
+  bool operator==(const InputGap&) const = default;  ///< same ends
+};
+
 struct Actuator {
   Channel input{"u", ""};   ///< name and unit of the input
   Channel output{"y", ""};  ///< name and unit of the measured output
@@ -34,6 +43,11 @@ struct Actuator {
   /// Physical input range (input units; infinite = unbounded).
   double u_min = -std::numeric_limits<double>::infinity();
   double u_max = std::numeric_limits<double>::infinity();  ///< upper end, e.g. 100 % duty
+  /// Inputs the actuator cannot hold (IPA: a PWM pulse shorter than the valves'
+  /// minimum width does not open them, so duties below 100 min_pulse_width
+  /// pwm_frequency % act as 0 and those as far below 100 % act as 100 %);
+  /// empty = none known. control/duty_modulator.hpp modulates across them.
+  std::vector<InputGap> input_gaps;
   /// The plant's names and meanings of the hold and release safe states.
   std::string hold_name = "hold";
   /// What the hold state does, for logs and messages.

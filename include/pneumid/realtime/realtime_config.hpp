@@ -14,9 +14,20 @@
 //             inlet_channel, exhaust_channel, ao_range, v_closed, v_open,
 //             exhaust_complementary, use_calibration
 //   [log]     flush_interval (s), capacity (records)
+//   [controller] model (spec or FILE.json#METHOD, relative to the file's folder),
+//             type (dmc, gpc, pid, mpc), rule, P, M, lambda, overshoot,
+//             aggressiveness, response_time, u_min, u_max, du_max, y_min, y_max,
+//             constrained, disturbance, t_filter, tau_c, pid_rule, input_map,
+//             input_gaps, y_valid_min, y_valid_max, safe_input: the flags of
+//             control/run/codegen (controller_factory.hpp ControllerSettings),
+//             which override them (`pneumid commission` writes this section)
 #pragma once
 
+#include <optional>
 #include <string>
+#include <vector>
+
+#include "pneumid/control/controller_factory.hpp"
 
 #include "pneumid/realtime/comedi_backend.hpp"
 #include "pneumid/realtime/log_writer.hpp"
@@ -27,6 +38,13 @@
 namespace pneumid {
 
 /// Every setting of a real-time run, by TOML section (see above).
+/// The [controller] section: a controller as control, run and codegen build it.
+struct ControllerConfig {
+  std::string model;              ///< the --model spec
+  ControllerSettings settings;    ///< the settings the file gives (the others at their defaults)
+  std::vector<std::string> keys;  ///< the keys the file gives (the flags override only these)
+};
+
 struct RealtimeConfig {
   LoopOptions loop;           ///< [loop]: period, duration, scheduling
   SafetyOptions safety;       ///< [safety]: limits, fault detection, safe state
@@ -35,6 +53,7 @@ struct RealtimeConfig {
   UdpBackendOptions udp;      ///< [udp]: used by a udp:// backend (host, port from io)
   ComediConfig comedi;        ///< [comedi]: used by a comedi backend (device from io)
   LogWriterOptions log;       ///< [log]: flushing and buffer capacity
+  std::optional<ControllerConfig> controller;  ///< [controller], when the file has it
 };
 
 /// Reads a configuration file. @throws DataError naming the file, line and column

@@ -1,0 +1,307 @@
+// pneumid commission: from a plant to a verified controller in one command
+// (workflow/commission.hpp): experiment, identification, design to a
+// specification, verification on the plant, and the files to run it.
+//
+//   pneumid commission --plant ipa -o out/ [--range 10:180] [--budget 120]
+//       [--controller mpc] [--spec overshoot=5,settling=0.5] [--json]
+//
+// DIR receives data.csv (the whole experiment), models.json (every model,
+// ranked on the held-out part), controller.toml (a complete configuration
+// that control, run and codegen take with --config), verification.csv and
+// the plots experiment.png and verification.png.
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/common/spec.hpp"
+#include "pneumid/data/csv.hpp"
+#include "pneumid/plant/actuator.hpp"
+#include "pneumid/plant/ipa_simulator.hpp"
+#include "pneumid/plant/plant_factory.hpp"
+#include "pneumid/report/figures.hpp"
+#include "pneumid/workflow/commission.hpp"
+#include "progress.hpp"
+#include "validators.hpp"
+
+namespace pneumid::cli {
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void OnStopSignal(int) { g_stop.store(true); }
+
+struct CommissionCli {
+  std::string plant = "ipa";
+  std::string plant_config;
+  double Ts = 0.01;
+  std::uint64_t seed = 1;
+  std::optional<double> noise;
+  std::string range;
+  std::string spec;
+  std::string methods;
+  CommissionOptions options;
+  std::string directory;
+  bool json = false;
+  bool progress = false;
+};
+
+// "LO:HI" -> the two numbers.
+void ParseRange(const std::string& text, double& lo, double& hi) {
+  const auto colon = text.find(':');
+  PNEUMID_CHECK(colon != std::string::npos, "--range: expected LO:HI, got '{}'", text);
+  try {
+    std::size_t used = 0;
+    const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+    lo = std::stod(a, &used);
+    PNEUMID_CHECK(used == a.size(), "--range: '{}' is not a number", a);
+    hi = std::stod(b, &used);
+    PNEUMID_CHECK(used == b.size(), "--range: '{}' is not a number", b);
+  } catch (const std::logic_error&) {
+    throw InvalidArgument(fmt::format("--range: expected LO:HI with numbers, got '{}'", text));
+  }
+  PNEUMID_CHECK(std::isfinite(lo) && std::isfinite(hi) && lo < hi,
+                "--range: LO must be below HI, got '{}'", text);
+}
+
+// "overshoot=5,settling=0.5" -> the specification.
+void ParseSpecification(const std::string& text, CommissionOptions& o) {
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const auto eq = item.find('=');
+    PNEUMID_CHECK(eq != std::string::npos, "--spec: expected KEY=VALUE, got '{}'", item);
+    const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+    double v = 0.0;
+    try {
+      std::size_t used = 0;
+      v = std::stod(value, &used);
+      PNEUMID_CHECK(used == value.size(), "--spec: {}: '{}' is not a number", key, value);
+    } catch (const std::logic_error&) {
+      throw InvalidArgument(fmt::format("--spec: {}: '{}' is not a number", key, value));
+    }
+    if (key == "overshoot")
+      o.overshoot = v;
+    else if (key == "settling")
+      o.settling = v;
+    else
+      throw InvalidArgument(
+          fmt::format("--spec: unknown key '{}' (expected overshoot, settling)", key));
+  }
+}
+
+std::string TomlString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+// controller.toml: model, controller and its settings, limits, loop, I/O, safety.
+void WriteControllerToml(const std::string& path, const CommissionResult& r,
+                         const CommissionCli& c) {
+  std::ofstream out(path);
+  const ControllerSettings& s = r.settings;
+  const auto& ex = r.experiment;
+  out << "# Controller configuration written by `pneumid commission` (" << r.message << ").\n"
+      << "# Use: pneumid control --config " << path << " --setpoint ... --duration ...\n"
+      << "#      pneumid run --config " << path << "\n"
+      << "#      pneumid codegen --config " << path << " -o DIR\n\n";
+  out << "[controller]\n"
+      << "model = " << TomlString(std::filesystem::absolute(r.controller_model).string()) << "\n"
+      << "type = " << TomlString(s.controller) << "\n"
+      << "rule = \"auto\"\n"
+      << fmt::format("overshoot = {}\n", s.overshoot)
+      << fmt::format("aggressiveness = {}\n", s.aggressiveness)
+      << fmt::format("u_min = {}\nu_max = {}\n", s.limits.u_min, s.limits.u_max);
+  if (!s.input_gaps.empty()) out << "input_gaps = " << TomlString(s.input_gaps) << "\n";
+  out << "\n[loop]\n"
+      << fmt::format("period = {}\n", c.Ts)
+      << fmt::format("duration = {}\n\n", r.attempts.back().result.t.size() * c.Ts);
+  out << "[io]\nbackend = \"sim\"\n"
+      << "plant = "
+      << TomlString(c.plant_config.empty()
+                        ? c.plant
+                        : c.plant + ":config=" + std::filesystem::absolute(c.plant_config).string())
+      << "\n\n";
+  const double span = ex.reachable_max - ex.reachable_min;
+  out << "[safety]\n"
+      << fmt::format("u_min = {}\nu_max = {}\n", s.limits.u_min, s.limits.u_max)
+      << fmt::format("y_min = {}\ny_max = {}\n", ex.reachable_min - 0.5 * span,
+                     ex.reachable_max + 0.5 * span);
+  if (!out) throw DataError(fmt::format("{}: cannot write", path));
+}
+
+void WriteVerificationCsv(const std::string& path, const ClosedLoopResult& cl) {
+  std::ofstream out(path);
+  out << "t,r,y,u,d\n";
+  for (Eigen::Index k = 0; k < cl.t.size(); ++k)
+    out << fmt::format("{:.6g},{},{},{},{}\n", cl.t(k), cl.r(k), cl.y(k), cl.u(k), cl.d(k));
+  if (!out) throw DataError(fmt::format("{}: cannot write", path));
+}
+
+void PrintSummary(const CommissionResult& r, const std::string& dir) {
+  const auto& ex = r.experiment;
+  std::cout << fmt::format("commission {}: {}\n", ToString(r.termination), r.message);
+  std::cout << fmt::format(
+      "experiment: {:.1f} s of plant time; probe K = {:.4g}, tau = {:.3g} s, theta = {:.3g} s; "
+      "reachable {:.4g}..{:.4g}, range {:.4g}..{:.4g}; {} + {} levels of {:.3g} s\n",
+      ex.duration, ex.gain, ex.time_constant, ex.dead_time, ex.reachable_min, ex.reachable_max,
+      ex.range_min, ex.range_max, ex.estimation_levels.size(), ex.validation_levels.size(),
+      ex.dwell);
+  if (!r.identification.models.empty()) {
+    std::cout << "models (ranked on the held-out part):\n";
+    for (const IdentifiedModel& m : r.identification.models)
+      std::cout << fmt::format("  {:<14} estimation {:7.2f} %  held-out {:7.2f} %{}\n", m.method,
+                               m.fit_percent, m.validation_fit_percent,
+                               m.method == r.chosen_model ? "  <- chosen" : "");
+  }
+  if (!r.chosen_model.empty()) std::cout << "chosen: " << r.chosen_reason << "\n";
+  for (const CommissionAttempt& a : r.attempts) {
+    const ClosedLoopMetrics& m = a.result.metrics;
+    std::cout << fmt::format(
+        "verification (aggressiveness {:g}): worst overshoot {:.2f} %, worst settling {:.3f} s, "
+        "IAE {:.4g}: {}\n",
+        a.aggressiveness, m.overshoot_percent, m.settling_time, m.iae, a.passed ? "pass" : "fail");
+    for (const std::string& f : a.failures) std::cout << "  - " << f << "\n";
+  }
+  for (const std::string& l : r.limits) std::cout << "limit: " << l << "\n";
+  for (const std::string& s : r.suggestions) std::cout << "try: " << s << "\n";
+  std::cout << fmt::format("plant time {:.1f} s; files in {}\n", r.plant_time, dir);
+}
+
+void Run(CommissionCli& c) {
+  PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
+  CommissionOptions& o = c.options;
+  if (!c.range.empty()) ParseRange(c.range, o.range_min, o.range_max);
+  if (!c.spec.empty()) ParseSpecification(c.spec, o);
+  if (!c.methods.empty()) o.methods = ParseMethodList(c.methods);
+  std::filesystem::create_directories(c.directory);
+  o.directory = c.directory;
+  PlantOptions po;
+  po.seed = c.seed;
+  po.noise_sigma = c.noise;
+  po.config_path = c.plant_config;
+  auto plant = MakePlant(c.plant, c.Ts, po);
+  PNEUMID_CHECK(c.plant_config.empty() || dynamic_cast<IpaSimulator*>(plant.get()),
+                "--plant-config applies to the ipa plant only, not to '{}'", c.plant);
+  ProgressBar bar("commission", c.progress || StderrIsTerminal());
+  o.progress = [&bar](const std::string& stage, double f) { bar(f, stage); };
+  g_stop.store(false);
+  o.stop = &g_stop;
+  std::signal(SIGINT, OnStopSignal);
+  std::signal(SIGTERM, OnStopSignal);
+  const CommissionResult r = Commission(*plant, o);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+
+  const std::filesystem::path dir(c.directory);
+  const Actuator act = PlantActuator(*plant);
+  if (r.experiment.data.size() > 0) {
+    WriteCsv(r.experiment.data, (dir / "data.csv").string());
+  }
+  // The experiment with the chosen model simulated on it (held-out part last).
+  for (const IdentifiedModel& m : r.identification.models) {
+    if (m.method != r.chosen_model) continue;
+    NamedModel nm{m.method + " (" + m.structure + ")", m.discrete ? *m.discrete : m.tf, m.u0, m.y0,
+                  std::make_shared<const IdentifiedModel>(m)};
+    ComparisonFigureOptions fo;
+    fo.labels.output = act.output.unit == "N" ? "Force F [N]" : "Output y";
+    fo.labels.input = act.input.unit == "%" ? "Duty cycle u [%]" : "Input u";
+    fo.title = "commission: estimation sequence and the chosen model";
+    ModelComparisonFigure(r.experiment.estimation, {nm}, fo)
+        .Save((dir / "experiment.png").string());
+    fo.title = "commission: held-out sequence and the chosen model";
+    ModelComparisonFigure(r.experiment.validation, {nm}, fo)
+        .Save((dir / "validation.png").string());
+  }
+  if (!r.attempts.empty()) {
+    const ClosedLoopResult& cl = r.attempts.back().result;
+    WriteVerificationCsv((dir / "verification.csv").string(), cl);
+    WriteControllerToml((dir / "controller.toml").string(), r, c);
+    ClosedLoopFigureOptions options;
+    options.labels.time = "Time t [s]";
+    options.labels.output = act.output.unit == "N" ? "Force F [N]" : "Output y";
+    options.labels.input = act.input.unit == "%" ? "Duty cycle u [%]" : "Input u";
+    options.title = fmt::format("verification: {} on {} ({})", r.settings.controller,
+                                PlotLiteral(r.chosen_model), r.passed() ? "pass" : "fail");
+    ClosedLoopFigure(cl.t, cl.r, {{r.settings.controller, cl.y, cl.u}}, options)
+        .Save((dir / "verification.png").string());
+  }
+  if (c.json) {
+    nlohmann::ordered_json j = r.ToJson();
+    j["directory"] = c.directory;
+    std::cout << j.dump(2) << "\n";
+  } else {
+    PrintSummary(r, c.directory);
+  }
+  if (r.termination == Termination::kStopped) throw ExitCode{130};
+  if (r.termination == Termination::kFailure) {
+    std::cerr << "pneumid commission: error: " << r.message << "\n";
+    throw ExitCode{1};
+  }
+  if (!r.passed()) throw ExitCode{4};
+}
+
+const Registrar reg(
+    "commission",
+    "From a plant to a verified controller: experiment, identification, design, verification",
+    [](CLI::App& app) {
+      auto c = std::make_shared<CommissionCli>();
+      app.add_option("--plant", c->plant, "Plant: ipa, ipa:config=FILE.toml or a model spec")
+          ->capture_default_str();
+      app.add_option("--plant-config", c->plant_config,
+                     "IPA parameter file (TOML, see config/ipa_default.toml)");
+      app.add_option("--Ts,--sample-time", c->Ts, "Sample period in s")
+          ->capture_default_str()
+          ->check(Positive());
+      app.add_option("--range", c->range,
+                     "Output range LO:HI the controller must serve (default: the reachable "
+                     "range found by the sweep, less 5 % at each end)");
+      app.add_option("--budget", c->options.budget,
+                     "Plant time in s the identification experiment may take")
+          ->capture_default_str()
+          ->check(Positive());
+      app.add_option("--controller", c->options.controller, "Controller: mpc, dmc, gpc or pid")
+          ->capture_default_str()
+          ->check(CLI::IsMember({"mpc", "dmc", "gpc", "pid"}));
+      app.add_option("--spec", c->spec,
+                     "Specification: overshoot=PERCENT,settling=SECONDS (default "
+                     "overshoot=5,settling=0.5)");
+      app.add_option("--aggressiveness", c->options.aggressiveness,
+                     "First design's aggressiveness, 0 robust .. 1 aggressive")
+          ->capture_default_str();
+      app.add_option("--methods", c->methods,
+                     "Candidate identification methods (default arx,oe,n4sid,hammerstein,"
+                     "affine-narx)");
+      app.add_option("--u-min", c->options.u_min, "Lowest input (default: the plant's range)");
+      app.add_option("--u-max", c->options.u_max, "Highest input (default: the plant's range)");
+      app.add_option("--y-min", c->options.y_min, "Safety: lowest output allowed");
+      app.add_option("--y-max", c->options.y_max, "Safety: highest output allowed");
+      app.add_option("--seed", c->seed, "Seed of the plant's noise and of the level order")
+          ->capture_default_str();
+      app.add_option("--noise", c->noise, "Measurement noise of the simulated plant")
+          ->check(NonNegative());
+      app.add_option("-o,--output", c->directory,
+                     "Directory for data.csv, models.json, controller.toml, verification.csv "
+                     "and the plots")
+          ->required();
+      app.add_flag("--json", c->json, "Print the result as JSON");
+      app.add_flag("--progress", c->progress,
+                   "Draw the progress bar even when stderr is not a terminal");
+      app.callback([c] {
+        c->options.seed = c->seed;
+        Run(*c);
+      });
+    });
+
+}  // namespace
+}  // namespace pneumid::cli

@@ -1,0 +1,177 @@
+// Commissioning: from a plant to a verified controller in one call
+// (`pneumid commission`). The stages, all on the plant itself:
+//
+//   1. probe      the plant rests at the lowest input, then one step to the middle
+//                 of the input range, extended until the output settles: the
+//                 static gain K, time constant tau and dead time theta
+//                 (reaction curve, reaction_curve.hpp); a plant whose output does
+//                 not move is "not responding", one whose output does not settle
+//                 within a quarter of the budget is integrating or unstable.
+//   2. sweep      the highest input, held for theta + 5 tau: with the rest level,
+//                 the reachable output range. A requested range outside it is an
+//                 error that names the measured range.
+//   3. excitation a multi-level sequence over the inputs that cover the asked
+//                 range (levels from the three measured points, shuffled, so the
+//                 output moves both ways by large and small steps), dwell
+//                 theta + 4 tau (at least 10 samples), filling what is left of
+//                 the budget; a second sequence on levels between the first's
+//                 (30 % of the time) is held out for validation.
+//   4. identify   the candidate methods (linear and nonlinear) on the first
+//                 sequence, ranked by their simulation fit on the held-out one
+//                 (IdentifyModels); the model is the best-ranked one a
+//                 controller can be built from.
+//   5. design     the controller tuned to the specification (rule "auto",
+//                 auto_tuning.hpp), behind the model's input map when it has one.
+//                 When the actuator has input gaps (a PWM valve's minimum
+//                 pulse: IPA duties in (0, 15) and (85, 100) %), the input is
+//                 sigma-delta modulated across them (duty_modulator.hpp), in
+//                 the experiment and in the controller alike, so the models
+//                 see the actuator as the controller will drive it.
+//   6. verify     a staircase across the range in both directions (levels at
+//                 0, 25, 60, 85, 100, 70, 35, 10 and 0 % of the range, dwell
+//                 max(2 s, 4 x the settling specification)) and a load step
+//                 (-8 % of the range) half-way through the last level, closed
+//                 loop on the plant. Pass: the worst step's overshoot within
+//                 the specification, every step settled within the settling
+//                 specification, ripple at most 2 % of the set-point and
+//                 |steady-state error| at most 0.5 % of the range at every
+//                 level. On an overshoot failure the design is repeated with a
+//                 less aggressive setting (up to `retunes` times); what limits
+//                 the loop (saturation, dead time, model error, ripple) is
+//                 stated with what to try.
+//
+// Plant time is counted and reported for every stage. A stop request (the
+// `stop` flag, set by SIGINT) or an output beyond the safety limits ends the
+// experiment with the plant at its lowest input (the IPA's vented state) and
+// the data recorded so far kept in the result.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pneumid/common/termination.hpp"
+#include "pneumid/control/closed_loop.hpp"
+#include "pneumid/control/controller_factory.hpp"
+#include "pneumid/data/dataset.hpp"
+#include "pneumid/identify/identify.hpp"
+#include "pneumid/plant/plant.hpp"
+
+namespace pneumid {
+
+/// Settings of Commission (defaults: the IPA's force loop).
+struct CommissionOptions {
+  /// Output range the controller must serve (output units); NaN = the
+  /// reachable range measured by the sweep, less 5 % at each end.
+  double range_min = std::numeric_limits<double>::quiet_NaN();
+  double range_max = std::numeric_limits<double>::quiet_NaN();
+  /// Plant time in s the identification experiment may take (probe, sweep
+  /// and excitation; verification comes on top).
+  double budget = 120.0;
+  /// Input limits (input units); NaN = the plant's physical range (IPA 0..100 %).
+  double u_min = std::numeric_limits<double>::quiet_NaN();
+  double u_max = std::numeric_limits<double>::quiet_NaN();
+  /// Output safety limits: leaving them stops the experiment (infinite = none).
+  double y_min = -std::numeric_limits<double>::infinity();
+  double y_max = std::numeric_limits<double>::infinity();
+  /// Controller to design: mpc, dmc, gpc or pid.
+  std::string controller = "mpc";
+  /// Specification: worst-step overshoot in %, settling time (2 % band or the
+  /// measured ripple) in s.
+  double overshoot = 5.0;
+  double settling = 0.5;
+  /// Aggressiveness of the first design (auto_tuning.hpp, 0..1).
+  double aggressiveness = 0.5;
+  /// Modulate the input across the actuator's input gaps (Actuator::input_gaps,
+  /// duty_modulator.hpp) in the experiment and in the controller, so that the
+  /// outputs between the gaps' ends are reachable without a limit cycle.
+  bool modulate = true;
+  /// Redesigns with a less aggressive setting after an overshoot failure.
+  int retunes = 2;
+  /// Candidate identification methods (identify.hpp names).
+  std::vector<std::string> methods = {"arx", "oe", "n4sid", "hammerstein", "affine-narx"};
+  /// Dwell of the verification staircase in s; NaN = max(2 s, 4 x settling).
+  double verification_dwell = std::numeric_limits<double>::quiet_NaN();
+  /// Load step of the verification in output units; NaN = -8 % of the range.
+  double load_step = std::numeric_limits<double>::quiet_NaN();
+  /// Directory the model file is written to (the controller refers to it as
+  /// DIR/models.json\#METHOD); must exist.
+  std::string directory = ".";
+  /// Seed of the level order of the excitation.
+  std::uint64_t seed = 1;
+  /// Called with the stage ("probe", "sweep", "excitation", "identify",
+  /// "design", "verify") and the fraction of that stage done (0..1).
+  std::function<void(const std::string& stage, double fraction)> progress;
+  /// When set and true, the experiment stops at the next sample (plant left
+  /// at u_min, data kept, termination kStopped).
+  const std::atomic<bool>* stop = nullptr;
+  /// True when the settings are consistent; else false with the reason.
+  bool IsValid(std::string* error) const;
+};
+
+/// What the experiment measured.
+struct CommissionExperiment {
+  Dataset data;           ///< the whole record (t, u, y), every stage in order
+  Dataset estimation;     ///< the excitation the models are estimated on
+  Dataset validation;     ///< the held-out excitation they are ranked on
+  double duration = 0.0;  ///< plant time of the experiment in s
+  double gain = std::numeric_limits<double>::quiet_NaN();           ///< probe step: K
+  double time_constant = std::numeric_limits<double>::quiet_NaN();  ///< probe step: tau in s
+  double dead_time = std::numeric_limits<double>::quiet_NaN();      ///< probe step: theta in s
+  double reachable_min = std::numeric_limits<double>::quiet_NaN();  ///< output at u_min
+  double reachable_max = std::numeric_limits<double>::quiet_NaN();  ///< output at u_max
+  double range_min = std::numeric_limits<double>::quiet_NaN();      ///< range served
+  double range_max = std::numeric_limits<double>::quiet_NaN();
+  double dwell = 0.0;                     ///< s per excitation level
+  std::vector<double> estimation_levels;  ///< inputs of the estimation sequence
+  std::vector<double> validation_levels;  ///< inputs of the held-out sequence
+  /// {duration, probe, sweep, range, dwell, levels, samples}.
+  nlohmann::ordered_json ToJson() const;
+};
+
+/// One design and its closed-loop check on the plant.
+struct CommissionAttempt {
+  double aggressiveness = 0.5;
+  std::string design;  ///< BuiltController::Summary()
+  nlohmann::ordered_json settings;
+  ClosedLoopResult result;
+  bool passed = false;
+  std::vector<std::string> failures;  ///< the specification items not met
+};
+
+struct CommissionResult {
+  /// kSuccess: a controller passed the verification; kPartial: a controller
+  /// was designed but failed it (see limits); kStopped: stopped on request;
+  /// kFailure: no controller (the reason in message).
+  Termination termination = Termination::kFailure;
+  std::string message;
+  CommissionExperiment experiment;
+  IdentificationSummary identification;
+  std::string model_file;    ///< DIR/models.json
+  std::string chosen_model;  ///< method name of the model the controller uses
+  std::string chosen_reason;
+  std::string controller_model;             ///< DIR/models.json\#METHOD
+  ControllerSettings settings;              ///< the final design's settings (rule auto resolved)
+  std::vector<CommissionAttempt> attempts;  ///< every verification, the final last
+  std::vector<std::string> limits;          ///< what limits the final loop
+  std::vector<std::string> suggestions;     ///< what to try when it fails
+  double plant_time = 0.0;                  ///< s of plant time in all stages
+  bool passed() const { return !attempts.empty() && attempts.back().passed; }
+  /// {termination, message, experiment, models, chosen_model, controller,
+  /// verification (the keys of control --json), passed, limits, suggestions,
+  /// plant_time}.
+  nlohmann::ordered_json ToJson() const;
+};
+
+/// Runs the stages above on `plant`.
+/// @throws InvalidArgument for invalid options (naming the field and value).
+/// Problems of the plant (no response, a range it cannot reach, a budget too
+/// short for its time scale, no settling) end with kFailure and the message.
+CommissionResult Commission(Plant& plant, const CommissionOptions& options);
+
+}  // namespace pneumid

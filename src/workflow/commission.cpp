@@ -1,0 +1,627 @@
+#include "pneumid/workflow/commission.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/control/duty_modulator.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/plant/actuator.hpp"
+#include "pneumid/plant/signal.hpp"
+
+namespace pneumid {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Thrown inside the experiment when it must end early: a stop request or the
+// output beyond its safety limits (the plant is then back at u_min).
+struct ExperimentEnded {
+  Termination termination;
+  std::string message;
+};
+
+// Drives the plant sample by sample and records t, u, y (y measured before u
+// is applied, as RunExperiment does); counts plant time.
+class Recorder {
+ public:
+  Recorder(Plant& plant, const CommissionOptions& o, double u_safe, std::vector<InputGap> gaps)
+      : plant_(plant), o_(o), u_safe_(u_safe), Ts_(plant.Ts()), modulator_(std::move(gaps)) {}
+
+  double Ts() const { return Ts_; }
+  double time() const { return static_cast<double>(u_.size()) * Ts_; }
+  std::size_t size() const { return u_.size(); }
+
+  // Holds u for `seconds` (at least one sample).
+  void Hold(double u, double seconds) {
+    const auto n = std::max<long>(1, std::lround(seconds / Ts_));
+    for (long k = 0; k < n; ++k) Step(u);
+  }
+
+  void Step(double u) {
+    if (o_.stop != nullptr && o_.stop->load()) {
+      Safe();
+      throw ExperimentEnded{Termination::kStopped,
+                            fmt::format("stopped on request after {:.2f} s of plant time; the "
+                                        "plant is at u = {:g}",
+                                        time(), u_safe_)};
+    }
+    const double y = plant_.Measure();
+    if (!std::isfinite(y) || y < o_.y_min || y > o_.y_max) {
+      Safe();
+      throw ExperimentEnded{
+          Termination::kFailure,
+          fmt::format("output y = {:g} at t = {:.2f} s is outside the safety limits [{:g}, {:g}]; "
+                      "the plant is at u = {:g}",
+                      y, time(), o_.y_min, o_.y_max, u_safe_)};
+    }
+    u_.push_back(u);
+    y_.push_back(y);
+    plant_.Advance(modulator_.Next(u));  // u itself outside the gaps
+  }
+
+  // Mean output of samples [from, to).
+  double MeanY(std::size_t from, std::size_t to) const {
+    double s = 0.0;
+    for (std::size_t k = from; k < to; ++k) s += y_[k];
+    return to > from ? s / static_cast<double>(to - from) : kNaN;
+  }
+  double StdY(std::size_t from, std::size_t to) const {
+    const double m = MeanY(from, to);
+    double s = 0.0;
+    for (std::size_t k = from; k < to; ++k) s += (y_[k] - m) * (y_[k] - m);
+    return to > from + 1 ? std::sqrt(s / static_cast<double>(to - from - 1)) : 0.0;
+  }
+  double y(std::size_t k) const { return y_[k]; }
+
+  Dataset Slice(std::size_t from, std::size_t to, const Channel& in, const Channel& out) const {
+    Eigen::VectorXd u(static_cast<Eigen::Index>(to - from)), y(u.size());
+    for (std::size_t k = from; k < to; ++k) {
+      u(static_cast<Eigen::Index>(k - from)) = u_[k];
+      y(static_cast<Eigen::Index>(k - from)) = y_[k];
+    }
+    return Dataset::FromUniform(Ts_, u, y, static_cast<double>(from) * Ts_, in, out);
+  }
+
+  // One sample at the safe input (the experiment's end, or its abort).
+  void Safe() { plant_.Advance(u_safe_); }
+
+ private:
+  Plant& plant_;
+  const CommissionOptions& o_;
+  double u_safe_;
+  double Ts_;
+  DutyModulator modulator_;
+  std::vector<double> u_, y_;
+};
+
+// Time at which the response (y - y0) / dy first reaches `fraction`, from
+// sample `from` on (NaN when it never does).
+double CrossingTime(const Recorder& rec, std::size_t from, std::size_t to, double y0, double dy,
+                    double fraction) {
+  for (std::size_t k = from; k < to; ++k)
+    if ((rec.y(k) - y0) / dy >= fraction) return static_cast<double>(k - from) * rec.Ts();
+  return kNaN;
+}
+
+// Piecewise-linear interpolation through (x, y) points sorted by x.
+double Interpolate(const std::vector<std::pair<double, double>>& pts, double x) {
+  if (x <= pts.front().first) return pts.front().second;
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    if (x <= pts[i].first) {
+      const double w = (x - pts[i - 1].first) / (pts[i].first - pts[i - 1].first);
+      return pts[i - 1].second + w * (pts[i].second - pts[i - 1].second);
+    }
+  }
+  return pts.back().second;
+}
+
+// Fisher-Yates with the engine's raw output, the same order on every platform.
+void Shuffle(std::vector<double>& v, std::mt19937_64& engine) {
+  for (std::size_t i = v.size(); i > 1; --i) std::swap(v[i - 1], v[engine() % i]);
+}
+
+std::string LevelList(const std::vector<double>& levels) {
+  std::string s;
+  for (double l : levels) s += (s.empty() ? "" : " ") + fmt::format("{:.6g}", l);
+  return s;
+}
+
+void Report(const CommissionOptions& o, const std::string& stage, double fraction) {
+  if (o.progress) o.progress(stage, std::clamp(fraction, 0.0, 1.0));
+}
+
+struct Probe {
+  double y_rest = 0.0, y_mid = 0.0, y_high = 0.0, noise = 0.0;
+  double u_mid = 0.0;
+};
+
+// Stages 1 and 2: the probe step and the sweep. Returns an empty string on
+// success, else the reason the plant cannot be commissioned.
+std::string ProbeAndSweep(Recorder& rec, const CommissionOptions& o, double u_lo, double u_hi,
+                          CommissionExperiment& ex, Probe& p) {
+  const double Ts = rec.Ts();
+  Report(o, "probe", 0.0);
+  rec.Hold(u_lo, std::max(1.0, 20 * Ts));
+  const std::size_t rest_end = rec.size();
+  const std::size_t rest_from = rest_end - std::max<std::size_t>(2, rest_end / 5);
+  p.y_rest = rec.MeanY(rest_from, rest_end);
+  p.noise = rec.StdY(rest_from, rest_end);
+  p.u_mid = u_lo + 0.5 * (u_hi - u_lo);
+
+  // The step, in chunks, until the chunk means agree to 2 % of the change.
+  const double chunk = std::max(0.5, 50 * Ts);
+  const double cap = 0.25 * o.budget;
+  double previous = kNaN, current = kNaN;
+  bool settled = false;
+  while (rec.time() - rest_end * Ts < cap) {
+    const std::size_t from = rec.size();
+    rec.Hold(p.u_mid, chunk);
+    previous = current;
+    current = rec.MeanY(from + (rec.size() - from) / 2, rec.size());
+    Report(o, "probe", (rec.time() - rest_end * Ts) / cap);
+    const double change = current - p.y_rest;
+    if (std::isfinite(previous) && std::abs(current - previous) <= 0.02 * std::abs(change) &&
+        std::abs(change) > 5 * p.noise) {
+      settled = true;
+      break;
+    }
+  }
+  const double dy = current - p.y_rest;
+  const double scale = std::max({std::abs(p.y_rest), std::abs(current), 1e-12});
+  if (std::abs(dy) <= std::max(6 * p.noise, 1e-6 * scale)) {
+    return fmt::format(
+        "the plant does not respond: a step of the input from {:g} to {:g} moved the output by "
+        "{:.3g} (noise {:.3g}) in {:.1f} s; is the sensor connected and the supply on?",
+        u_lo, p.u_mid, dy, p.noise, rec.time() - rest_end * Ts);
+  }
+  if (!settled) {
+    return fmt::format(
+        "the output did not settle within {:.1f} s (a quarter of the budget) after an input step "
+        "from {:g} to {:g}: the plant is integrating or unstable, or slower than a budget of "
+        "{:g} s allows (last change {:.3g} per {:g} s)",
+        cap, u_lo, p.u_mid, o.budget, current - previous, chunk);
+  }
+  p.y_mid = current;
+  // Two-point method (Smith): tau = 1.5 (t63 - t28), theta = t63 - tau.
+  const double t28 = CrossingTime(rec, rest_end, rec.size(), p.y_rest, dy, 0.283);
+  const double t63 = CrossingTime(rec, rest_end, rec.size(), p.y_rest, dy, 0.632);
+  ex.gain = dy / (p.u_mid - u_lo);
+  ex.time_constant = std::max(1.5 * (t63 - t28), Ts);
+  ex.dead_time = std::max(t63 - ex.time_constant, 0.0);
+
+  // The sweep: the highest input, held until it settles.
+  Report(o, "sweep", 0.0);
+  const double settle = ex.dead_time + 5 * ex.time_constant;
+  const std::size_t high_from = rec.size();
+  rec.Hold(u_hi, std::max(settle, 0.5));
+  p.y_high = rec.MeanY(high_from + (rec.size() - high_from) * 9 / 10, rec.size());
+  Report(o, "sweep", 1.0);
+  ex.reachable_min = std::min(p.y_rest, p.y_high);
+  ex.reachable_max = std::max(p.y_rest, p.y_high);
+  return "";
+}
+
+// The checks of the verification against the specification.
+std::vector<std::string> Judge(const ClosedLoopMetrics& m, const CommissionOptions& o,
+                               double range) {
+  std::vector<std::string> failures;
+  for (std::size_t i = 0; i < m.steps.size(); ++i) {
+    const StepMetrics& s = m.steps[i];
+    if (s.time <= 0.0) continue;  // the start from rest is not a step of the staircase
+    const std::string step =
+        fmt::format("step {} ({:g} -> {:g} at {:g} s)", i, s.from, s.to, s.time);
+    if (std::isfinite(s.overshoot_percent) && s.overshoot_percent > o.overshoot)
+      failures.push_back(
+          fmt::format("overshoot {:.2f} % > {:g} % on {}", s.overshoot_percent, o.overshoot, step));
+    if (!s.settled || !(s.settling_time <= o.settling))
+      failures.push_back(fmt::format(
+          "settling {} > {:g} s on {}",
+          s.settled ? fmt::format("{:.3f} s", s.settling_time) : std::string("not reached"),
+          o.settling, step));
+    if (std::isfinite(s.ripple) && s.ripple > 0.02 * std::abs(s.to))
+      failures.push_back(
+          fmt::format("ripple {:.3g} peak to peak > 2 % of the set-point {:g}", s.ripple, s.to));
+    if (std::isfinite(s.steady_state_error) && std::abs(s.steady_state_error) > 0.005 * range)
+      failures.push_back(
+          fmt::format("steady-state error {:.3g} > {:.3g} (0.5 % of the range) on {}",
+                      s.steady_state_error, 0.005 * range, step));
+  }
+  return failures;
+}
+
+// What limits a loop that failed, and what to try.
+void Diagnose(CommissionResult& r) {
+  const CommissionAttempt& a = r.attempts.back();
+  const ClosedLoopResult& cl = a.result;
+  Eigen::Index at_limit = 0;
+  for (Eigen::Index k = 0; k < cl.u.size(); ++k)
+    if (cl.u(k) <= r.settings.limits.u_min + 1e-9 || cl.u(k) >= r.settings.limits.u_max - 1e-9)
+      ++at_limit;
+  const double share = cl.u.size() > 0 ? 100.0 * at_limit / static_cast<double>(cl.u.size()) : 0;
+  if (share > 10.0) {
+    r.limits.push_back(
+        fmt::format("actuator saturation: the input is at a limit {:.0f} % of the time", share));
+    r.suggestions.push_back("a slower specification (--spec settling=...) or a narrower --range");
+  }
+  const double ratio = r.experiment.dead_time / r.experiment.time_constant;
+  if (ratio > 0.5) {
+    r.limits.push_back(
+        fmt::format("dead time: theta = {:.3g} s is {:.2f} tau", r.experiment.dead_time, ratio));
+    r.suggestions.push_back("a settling specification of at least 4 (theta + tau)");
+  }
+  for (const IdentifiedModel& m : r.identification.models) {
+    if (m.method != r.chosen_model) continue;
+    if (!(m.validation_fit_percent >= 85.0)) {
+      r.limits.push_back(fmt::format("model error: the model fits the held-out data by {:.1f} %",
+                                     m.validation_fit_percent));
+      r.suggestions.push_back("a longer --budget (more levels), or other nonlinear methods");
+    }
+  }
+  bool ripple = false, overshoot = false, settling = false;
+  for (const std::string& f : a.failures) {
+    ripple = ripple || f.rfind("ripple", 0) == 0;
+    overshoot = overshoot || f.rfind("overshoot", 0) == 0;
+    settling = settling || f.rfind("settling", 0) == 0;
+  }
+  if (ripple) {
+    r.limits.push_back(
+        "ripple: the loop cycles at some levels (the actuator has no steady input there, e.g. a "
+        "valve pulse below its minimum width)");
+    r.suggestions.push_back("avoid those levels, or a less aggressive design (--aggressiveness)");
+  }
+  if (overshoot)
+    r.suggestions.push_back(
+        fmt::format("a lower --aggressiveness than {:g}, or --controller dmc", a.aggressiveness));
+  if (settling) r.suggestions.push_back("a longer settling specification, or a faster design");
+  if (r.limits.empty() && !a.failures.empty())
+    r.limits.push_back("model error at some levels (the design predicted the specification)");
+}
+
+nlohmann::ordered_json NullIfNaN(double v) {
+  return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
+}
+
+}  // namespace
+
+bool CommissionOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error != nullptr) *error = m;
+    return false;
+  };
+  if (!(budget > 0.0) || !std::isfinite(budget))
+    return fail(fmt::format("budget must be positive, got {}", budget));
+  if (std::isfinite(range_min) != std::isfinite(range_max) ||
+      (std::isfinite(range_min) && !(range_min < range_max)))
+    return fail(fmt::format("range must be LO:HI with LO < HI, got {}:{}", range_min, range_max));
+  if (std::isfinite(u_min) && std::isfinite(u_max) && !(u_min < u_max))
+    return fail(fmt::format("u_min must be below u_max, got {} and {}", u_min, u_max));
+  if (!(y_min < y_max))
+    return fail(fmt::format("y_min must be below y_max, got {} and {}", y_min, y_max));
+  if (!(overshoot >= 0.0) || !std::isfinite(overshoot))
+    return fail(fmt::format("overshoot must be >= 0 %, got {}", overshoot));
+  if (!(settling > 0.0) || !std::isfinite(settling))
+    return fail(fmt::format("settling must be positive, got {}", settling));
+  if (!(aggressiveness >= 0.0 && aggressiveness <= 1.0))
+    return fail(fmt::format("aggressiveness must lie in [0, 1], got {}", aggressiveness));
+  if (retunes < 0) return fail(fmt::format("retunes must be >= 0, got {}", retunes));
+  if (methods.empty()) return fail("methods: no identification method given");
+  for (const std::string& m : methods)
+    if (!IsIdentifyMethod(m)) return fail(fmt::format("methods: unknown method '{}'", m));
+  if (!std::isnan(verification_dwell) && !(verification_dwell > 0.0))
+    return fail(fmt::format("verification_dwell must be positive, got {}", verification_dwell));
+  const std::string c = controller;
+  if (c != "mpc" && c != "dmc" && c != "gpc" && c != "pid")
+    return fail(fmt::format("controller must be mpc, dmc, gpc or pid, got '{}'", c));
+  return true;
+}
+
+nlohmann::ordered_json CommissionExperiment::ToJson() const {
+  nlohmann::ordered_json j;
+  j["duration"] = duration;
+  j["samples"] = data.size();
+  j["probe"] = {{"gain", NullIfNaN(gain)},
+                {"time_constant", NullIfNaN(time_constant)},
+                {"dead_time", NullIfNaN(dead_time)}};
+  j["sweep"] = {{"reachable_min", NullIfNaN(reachable_min)},
+                {"reachable_max", NullIfNaN(reachable_max)}};
+  j["range"] = {NullIfNaN(range_min), NullIfNaN(range_max)};
+  j["dwell"] = dwell;
+  j["estimation_levels"] = estimation_levels;
+  j["validation_levels"] = validation_levels;
+  j["estimation_samples"] = estimation.size();
+  j["validation_samples"] = validation.size();
+  return j;
+}
+
+nlohmann::ordered_json CommissionResult::ToJson() const {
+  nlohmann::ordered_json j;
+  j["termination"] = ToString(termination);
+  j["message"] = message;
+  j["passed"] = passed();
+  j["plant_time"] = plant_time;
+  j["experiment"] = experiment.ToJson();
+  j["models"] = nlohmann::ordered_json::array();
+  for (const IdentifiedModel& m : identification.models) {
+    nlohmann::ordered_json mj;
+    mj["method"] = m.method;
+    mj["fit_percent"] = NullIfNaN(m.fit_percent);
+    mj["validation_fit_percent"] = NullIfNaN(m.validation_fit_percent);
+    mj["flags"] = nlohmann::ordered_json::array();
+    for (const auto& f : m.flags) mj["flags"].push_back(ToString(f.flag));
+    j["models"].push_back(mj);
+  }
+  j["model_failures"] = nlohmann::ordered_json::object();
+  for (const auto& [method, reason] : identification.failures) j["model_failures"][method] = reason;
+  j["model_file"] = model_file;
+  j["chosen_model"] = chosen_model;
+  j["chosen_reason"] = chosen_reason;
+  if (!attempts.empty()) {
+    const CommissionAttempt& a = attempts.back();
+    j["controller"] = {{"type", settings.controller},
+                       {"model", controller_model},
+                       {"aggressiveness", a.aggressiveness},
+                       {"settings", a.settings},
+                       {"design", a.design}};
+    nlohmann::ordered_json v = a.result.metrics.ToJson();
+    v["passed"] = a.passed;
+    v["failures"] = a.failures;
+    v["duration"] = a.result.t.size() > 0 ? a.result.t(a.result.t.size() - 1) : 0.0;
+    j["verification"] = v;
+    j["attempts"] = nlohmann::ordered_json::array();
+    for (const CommissionAttempt& b : attempts) {
+      j["attempts"].push_back({{"aggressiveness", b.aggressiveness},
+                               {"passed", b.passed},
+                               {"overshoot_percent", NullIfNaN(b.result.metrics.overshoot_percent)},
+                               {"settling_time", NullIfNaN(b.result.metrics.settling_time)},
+                               {"iae", b.result.metrics.iae},
+                               {"failures", b.failures}});
+    }
+  } else {
+    j["controller"] = nullptr;
+    j["verification"] = nullptr;
+  }
+  j["limits"] = limits;
+  j["suggestions"] = suggestions;
+  return j;
+}
+
+CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgument("commission: " + error);
+  const CommissionOptions& o = options;
+  PNEUMID_CHECK(std::filesystem::is_directory(o.directory),
+                "commission: directory '{}' does not exist", o.directory);
+  const Actuator act = PlantActuator(plant);
+  const double u_lo = std::isfinite(o.u_min) ? o.u_min : act.u_min;
+  const double u_hi = std::isfinite(o.u_max) ? o.u_max : act.u_max;
+  PNEUMID_CHECK(std::isfinite(u_lo) && std::isfinite(u_hi) && u_lo < u_hi,
+                "commission: the input range must be finite (give u_min and u_max), got [{}, {}]",
+                u_lo, u_hi);
+  CommissionResult r;
+  CommissionExperiment& ex = r.experiment;
+  plant.Reset();
+  const std::vector<InputGap> gaps = o.modulate ? act.input_gaps : std::vector<InputGap>{};
+  Recorder rec(plant, o, u_lo, gaps);
+  const double Ts = rec.Ts();
+  auto finish_data = [&] {
+    ex.data = rec.size() > 0 ? rec.Slice(0, rec.size(), act.input, act.output) : Dataset();
+    ex.duration = rec.time();
+    r.plant_time = ex.duration;
+  };
+
+  // ---- stages 1-3: the experiment
+  Probe p;
+  std::size_t est_from = 0, est_to = 0, val_to = 0;
+  try {
+    error = ProbeAndSweep(rec, o, u_lo, u_hi, ex, p);
+    if (error.empty()) {
+      if (std::isfinite(o.range_min)) {
+        const double tol = 0.01 * (ex.reachable_max - ex.reachable_min);
+        if (o.range_min < ex.reachable_min - tol || o.range_max > ex.reachable_max + tol) {
+          error = fmt::format(
+              "the range {:g}..{:g} cannot be reached: the output reaches {:.4g}..{:.4g} between "
+              "the inputs {:g} and {:g}",
+              o.range_min, o.range_max, ex.reachable_min, ex.reachable_max, u_lo, u_hi);
+        }
+        ex.range_min = o.range_min;
+        ex.range_max = o.range_max;
+      } else {
+        const double span = ex.reachable_max - ex.reachable_min;
+        ex.range_min = ex.reachable_min + 0.05 * span;
+        ex.range_max = ex.reachable_max - 0.05 * span;
+      }
+    }
+    ex.dwell = std::max(ex.dead_time + 4 * ex.time_constant, 10 * Ts);
+    ex.dwell = std::ceil(ex.dwell / Ts - 1e-9) * Ts;
+    const double left = o.budget - rec.time();
+    if (error.empty() && left < 11 * ex.dwell) {
+      error = fmt::format(
+          "the budget of {:g} s is too short for the time scale found (tau = {:.3g} s, theta = "
+          "{:.3g} s: {:.3g} s per level): the probe and sweep took {:.1f} s and the excitation "
+          "needs at least {:.1f} s more (a budget of {:.0f} s or more)",
+          o.budget, ex.time_constant, ex.dead_time, ex.dwell, rec.time(), 11 * ex.dwell,
+          std::ceil(rec.time() + 11 * ex.dwell));
+    }
+    if (!error.empty()) {
+      rec.Hold(u_lo, Ts);
+      finish_data();
+      r.message = error;
+      return r;
+    }
+    // The inputs that cover the range (monotone interpolation through the
+    // three measured points; the whole input range when they are not monotone).
+    std::vector<std::pair<double, double>> map = {
+        {p.y_rest, u_lo}, {p.y_mid, p.u_mid}, {p.y_high, u_hi}};
+    std::sort(map.begin(), map.end());
+    const bool monotone = (p.y_mid - p.y_rest) * (p.y_high - p.y_mid) > 0;
+    const double span = ex.range_max - ex.range_min;
+    double ua = u_lo, ub = u_hi;
+    if (monotone) {
+      ua = Interpolate(map, ex.range_min - 0.05 * span);
+      ub = Interpolate(map, ex.range_max + 0.05 * span);
+      if (ua > ub) std::swap(ua, ub);
+    }
+    const int n_est = std::max(8, static_cast<int>(0.7 * left / ex.dwell));
+    const int n_val = std::max(3, static_cast<int>((left - n_est * ex.dwell) / ex.dwell));
+    std::mt19937_64 engine(o.seed);
+    for (int i = 0; i < n_est; ++i)
+      ex.estimation_levels.push_back(ua + (ub - ua) * i / (n_est - 1));
+    for (int i = 0; i < n_val; ++i)
+      ex.validation_levels.push_back(ua + (ub - ua) * (i + 0.5) / n_val);
+    Shuffle(ex.estimation_levels, engine);
+    Shuffle(ex.validation_levels, engine);
+    Report(o, "excitation", 0.0);
+    const double total = (n_est + n_val) * ex.dwell;
+    est_from = rec.size();
+    for (double u : ex.estimation_levels) {
+      rec.Hold(u, ex.dwell);
+      Report(o, "excitation", (rec.size() - est_from) * Ts / total);
+    }
+    est_to = rec.size();
+    for (double u : ex.validation_levels) {
+      rec.Hold(u, ex.dwell);
+      Report(o, "excitation", (rec.size() - est_from) * Ts / total);
+    }
+    val_to = rec.size();
+    rec.Safe();
+  } catch (const ExperimentEnded& e) {
+    finish_data();
+    r.termination = e.termination;
+    r.message = e.message;
+    return r;
+  }
+  finish_data();
+  ex.estimation = rec.Slice(est_from, est_to, act.input, act.output);
+  ex.validation = rec.Slice(est_to, val_to, act.input, act.output);
+
+  // ---- stage 4: identification, ranked on the held-out sequence
+  Report(o, "identify", 0.0);
+  IdentifyOptions io;
+  io.nonlinear.choose_structure = true;
+  r.identification = IdentifyModels(
+      o.methods, ex.estimation, IdentifyRequest{}, io, &ex.validation,
+      [&](std::size_t done, std::size_t total, const std::string&) {
+        Report(o, "identify", static_cast<double>(done) / static_cast<double>(total));
+      });
+  if (r.identification.models.empty()) {
+    r.message = "no model could be identified: " + r.identification.message;
+    return r;
+  }
+  r.model_file = (std::filesystem::path(o.directory) / "models.json").string();
+  {
+    nlohmann::json file;
+    file["models"] = nlohmann::json::array();
+    for (const IdentifiedModel& m : r.identification.models) file["models"].push_back(ToJson(m));
+    file["best"] = r.identification.models.front().method;
+    file["ranked_by"] = "validation_fit_percent";
+    std::ofstream out(r.model_file);
+    out << file.dump(2) << "\n";
+    if (!out) throw DataError(fmt::format("{}: cannot write", r.model_file));
+  }
+
+  // ---- stage 5: the design on the best-ranked model a controller can use
+  Report(o, "design", 0.0);
+  ControllerSettings settings;
+  settings.controller = o.controller;
+  settings.rule = "auto";
+  settings.overshoot = o.overshoot;
+  settings.limits.u_min = u_lo;
+  settings.limits.u_max = u_hi;
+  settings.input_gaps = InputGapsToString(gaps);
+  std::vector<std::string> skipped;
+  TransferFunction model;
+  for (const IdentifiedModel& m : r.identification.models) {
+    const std::string spec = r.model_file + "#" + m.method;
+    try {
+      model = ParseControllerModel(spec);
+      ControllerSettings s = settings;
+      s.aggressiveness = o.aggressiveness;
+      (void)MakeController(model, Ts, WithModelInputMap(ToControllerSpec(s), spec));
+      r.chosen_model = m.method;
+      r.controller_model = spec;
+      r.chosen_reason = fmt::format(
+          "best held-out fit ({:.1f} %, estimation {:.1f} %) among the models a {} can use",
+          m.validation_fit_percent, m.fit_percent, o.controller);
+      if (!skipped.empty()) {
+        std::string list;
+        for (const std::string& s2 : skipped) list += (list.empty() ? "" : "; ") + s2;
+        r.chosen_reason += " (ranked above it but not usable: " + list + ")";
+      }
+      break;
+    } catch (const std::exception& e) {
+      skipped.push_back(m.method + ": " + e.what());
+    }
+  }
+  if (r.chosen_model.empty()) {
+    r.message = "no identified model can be used by a controller";
+    for (const std::string& s : skipped) r.message += "; " + s;
+    return r;
+  }
+
+  // ---- stage 6: verification on the plant, redesigned on overshoot
+  const double range = ex.range_max - ex.range_min;
+  std::vector<double> levels;
+  for (double f : {0.0, 0.25, 0.6, 0.85, 1.0, 0.7, 0.35, 0.1, 0.0})
+    levels.push_back(ex.range_min + f * range);
+  const double dwell =
+      std::isnan(o.verification_dwell) ? std::max(2.0, 4 * o.settling) : o.verification_dwell;
+  const double load = std::isnan(o.load_step) ? -0.08 * range : o.load_step;
+  const auto setpoint =
+      ParseSignal(fmt::format("staircase:levels={},dwell={:g}", LevelList(levels), dwell));
+  ClosedLoopOptions cl;
+  cl.duration = static_cast<double>(levels.size()) * dwell;
+  cl.load_steps.push_back({(static_cast<double>(levels.size()) - 0.5) * dwell, load});
+  cl.actuator.u_min = u_lo;
+  cl.actuator.u_max = u_hi;
+  double aggressiveness = o.aggressiveness;
+  for (int attempt = 0; attempt <= o.retunes; ++attempt) {
+    Report(o, "verify", static_cast<double>(attempt) / (o.retunes + 1));
+    if (o.stop != nullptr && o.stop->load()) {
+      r.termination = Termination::kStopped;
+      r.message = "stopped on request before the verification";
+      return r;
+    }
+    settings.aggressiveness = aggressiveness;
+    CommissionAttempt a;
+    a.aggressiveness = aggressiveness;
+    BuiltController built = MakeController(
+        model, Ts, WithModelInputMap(ToControllerSpec(settings), r.controller_model));
+    a.design = built.Summary();
+    a.settings = built.SettingsToJson();
+    a.result = SimulateClosedLoop(*built.controller, plant, *setpoint, cl);
+    plant.Advance(u_lo);  // the safe state after the run
+    r.plant_time += cl.duration;
+    a.failures = Judge(a.result.metrics, o, range);
+    a.passed = a.failures.empty();
+    r.attempts.push_back(std::move(a));
+    r.settings = settings;
+    const bool overshoot_failed =
+        std::any_of(r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
+                    [](const std::string& f) { return f.rfind("overshoot", 0) == 0; });
+    if (r.attempts.back().passed || !overshoot_failed) break;
+    aggressiveness *= 0.5;
+  }
+  Report(o, "verify", 1.0);
+  if (r.passed()) {
+    r.termination = Termination::kSuccess;
+    r.message = fmt::format(
+        "the {} on {} meets the specification (overshoot <= {:g} %, settling "
+        "<= {:g} s) across {:.4g}..{:.4g}",
+        o.controller, r.chosen_model, o.overshoot, o.settling, ex.range_min, ex.range_max);
+  } else {
+    r.termination = Termination::kPartial;
+    Diagnose(r);
+    r.message = fmt::format("the {} on {} does not meet the specification: {}", o.controller,
+                            r.chosen_model, r.attempts.back().failures.front());
+  }
+  return r;
+}
+
+}  // namespace pneumid
