@@ -26,6 +26,9 @@
 #include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/plant_factory.hpp"
+#include "pneumid/realtime/io_factory.hpp"
+#include "pneumid/realtime/io_plant.hpp"
+#include "pneumid/realtime/realtime_config.hpp"
 #include "pneumid/report/figures.hpp"
 #include "pneumid/workflow/commission.hpp"
 #include "progress.hpp"
@@ -38,6 +41,10 @@ std::atomic<bool> g_stop{false};
 extern "C" void OnStopSignal(int) { g_stop.store(true); }
 
 struct CommissionCli {
+  std::string io = "sim";
+  std::string config;
+  bool fast = false;
+  std::string input_gaps = "plant";
   std::string plant = "ipa";
   std::string plant_config;
   double Ts = 0.01;
@@ -126,12 +133,17 @@ void WriteControllerToml(const std::string& path, const CommissionResult& r,
   out << "\n[loop]\n"
       << fmt::format("period = {}\n", c.Ts)
       << fmt::format("duration = {}\n\n", r.attempts.back().result.t.size() * c.Ts);
-  out << "[io]\nbackend = \"sim\"\n"
-      << "plant = "
-      << TomlString(c.plant_config.empty()
-                        ? c.plant
-                        : c.plant + ":config=" + std::filesystem::absolute(c.plant_config).string())
-      << "\n\n";
+  if (c.io == "sim") {
+    out << "[io]\nbackend = \"sim\"\n"
+        << "plant = "
+        << TomlString(c.plant_config.empty()
+                          ? c.plant
+                          : c.plant +
+                                ":config=" + std::filesystem::absolute(c.plant_config).string())
+        << "\n\n";
+  } else {
+    out << "[io]\nbackend = " << TomlString(c.io) << "\n\n";
+  }
   const double span = ex.reachable_max - ex.reachable_min;
   out << "[safety]\n"
       << fmt::format("u_min = {}\nu_max = {}\n", s.limits.u_min, s.limits.u_max)
@@ -190,9 +202,31 @@ void Run(CommissionCli& c) {
   po.seed = c.seed;
   po.noise_sigma = c.noise;
   po.config_path = c.plant_config;
-  auto plant = MakePlant(c.plant, c.Ts, po);
-  PNEUMID_CHECK(c.plant_config.empty() || dynamic_cast<IpaSimulator*>(plant.get()),
-                "--plant-config applies to the ipa plant only, not to '{}'", c.plant);
+  // The plant: the simulator itself, or one behind an I/O backend (--io).
+  const IoSpec io = ParseIoSpec(c.io);
+  std::unique_ptr<Plant> plant;
+  if (io.kind == IoKind::kSim) {
+    plant = MakePlant(c.plant, c.Ts, po);
+    PNEUMID_CHECK(c.plant_config.empty() || dynamic_cast<IpaSimulator*>(plant.get()),
+                  "--plant-config applies to the ipa plant only, not to '{}'", c.plant);
+  } else {
+    PNEUMID_CHECK(!c.fast || io.kind == IoKind::kUdp,
+                  "--fast needs --io sim or udp://HOST:PORT (a plant server steps on request); "
+                  "a comedi card runs in real time");
+    RealtimeConfig config = c.config.empty() ? RealtimeConfig{} : LoadRealtimeConfig(c.config);
+    config.loop.period = c.Ts;
+    auto io_plant = std::make_unique<IoPlant>(MakeIoBackend(io, config, po), c.Ts, !c.fast);
+    o.actuator = io_plant->actuator();
+    plant = std::move(io_plant);
+  }
+  // The input gaps: the plant's own ("plant"), none, or LO:HI,...
+  if (c.input_gaps == "none") {
+    o.modulate = false;
+  } else if (c.input_gaps != "plant") {
+    Actuator a = o.actuator ? *o.actuator : PlantActuator(*plant);
+    a.input_gaps = ParseInputGaps(c.input_gaps);
+    o.actuator = a;
+  }
   ProgressBar bar("commission", c.progress || StderrIsTerminal());
   o.progress = [&bar](const std::string& stage, double f) { bar(f, stage); };
   g_stop.store(false);
@@ -204,7 +238,7 @@ void Run(CommissionCli& c) {
   std::signal(SIGTERM, SIG_DFL);
 
   const std::filesystem::path dir(c.directory);
-  const Actuator act = PlantActuator(*plant);
+  const Actuator act = o.actuator ? *o.actuator : PlantActuator(*plant);
   if (r.experiment.data.size() > 0) {
     WriteCsv(r.experiment.data, (dir / "data.csv").string());
   }
@@ -256,7 +290,21 @@ const Registrar reg(
     "From a plant to a verified controller: experiment, identification, design, verification",
     [](CLI::App& app) {
       auto c = std::make_shared<CommissionCli>();
-      app.add_option("--plant", c->plant, "Plant: ipa, ipa:config=FILE.toml or a model spec")
+      app.add_option("--plant", c->plant,
+                     "Plant of the simulator (--io sim): ipa, ipa:config=FILE.toml or a model "
+                     "spec")
+          ->capture_default_str();
+      app.add_option("--io", c->io,
+                     "Where the plant is: sim (the simulator, --plant), udp://HOST:PORT (a plant "
+                     "server) or comedi[:/dev/comediN] (the rig)")
+          ->capture_default_str();
+      app.add_option("--config", c->config,
+                     "Real-time configuration (TOML) of the udp or comedi backend");
+      app.add_flag("--fast", c->fast,
+                   "udp: step the plant server as fast as it answers instead of in real time");
+      app.add_option("--input-gaps", c->input_gaps,
+                     "Inputs the actuator cannot hold, modulated across: plant (the plant's own, "
+                     "IPA 0:15,85:100 from its valves), none, or LO:HI[,LO:HI]")
           ->capture_default_str();
       app.add_option("--plant-config", c->plant_config,
                      "IPA parameter file (TOML, see config/ipa_default.toml)");
@@ -279,7 +327,7 @@ const Registrar reg(
       app.add_option("--aggressiveness", c->options.aggressiveness,
                      "First design's aggressiveness, 0 robust .. 1 aggressive")
           ->capture_default_str();
-      app.add_option("--methods", c->methods,
+      app.add_option("-m,--method,--methods", c->methods,
                      "Candidate identification methods (default arx,oe,n4sid,hammerstein,"
                      "affine-narx)");
       app.add_option("--u-min", c->options.u_min, "Lowest input (default: the plant's range)");

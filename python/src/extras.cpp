@@ -19,6 +19,7 @@
 #include "pneumid/plant/plant.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
+#include "pneumid/workflow/commission.hpp"
 
 namespace py = pybind11;
 using namespace py::literals;
@@ -232,6 +233,57 @@ void BindExtras(py::module_& m) {
       "u_max"_a = std::numeric_limits<double>::infinity(), "u0"_a = 0.0, "seed"_a = 1,
       "Closed loop of controller and plant through a set-point signal spec; load_steps = "
       "[(at_s, size), ...]. Returns t, r, y, u, ... and metrics (dict).");
+  m.def(
+      "commission",
+      [](Plant& plant, const std::string& directory, std::optional<std::pair<double, double>> range,
+         double budget, const std::string& controller, double overshoot, double settling,
+         double aggressiveness, std::optional<std::vector<std::string>> methods,
+         std::optional<double> u_min, std::optional<double> u_max, bool modulate,
+         std::uint64_t seed) {
+        CommissionOptions o;
+        if (range) {
+          o.range_min = range->first;
+          o.range_max = range->second;
+        }
+        o.budget = budget;
+        o.controller = controller;
+        o.overshoot = overshoot;
+        o.settling = settling;
+        o.aggressiveness = aggressiveness;
+        if (methods) o.methods = *methods;
+        if (u_min) o.u_min = *u_min;
+        if (u_max) o.u_max = *u_max;
+        o.modulate = modulate;
+        o.directory = directory;
+        o.seed = seed;
+        CommissionResult r;
+        {
+          py::gil_scoped_release release;
+          r = Commission(plant, o);
+        }
+        py::dict d = JsonToPython(r.ToJson());
+        d["data"] = py::cast(r.experiment.data);
+        if (!r.attempts.empty()) {
+          const ClosedLoopResult& cl = r.attempts.back().result;
+          d["trace"] =
+              py::dict("t"_a = cl.t, "r"_a = cl.r, "y"_a = cl.y, "u"_a = cl.u, "d"_a = cl.d);
+        }
+        return d;
+      },
+      "plant"_a, "directory"_a, "range"_a = py::none(), "budget"_a = 120.0, "controller"_a = "mpc",
+      "overshoot"_a = 5.0, "settling"_a = 0.5, "aggressiveness"_a = 0.5, "methods"_a = py::none(),
+      "u_min"_a = py::none(), "u_max"_a = py::none(), "modulate"_a = true, "seed"_a = 1,
+      "From a plant to a verified controller, as `pneumid commission` (docs/commission.md): a "
+      "probe step, a sweep of the reachable range, a shuffled multi-level excitation with a "
+      "held-out part, models ranked on it, a design to the specification (overshoot in %, "
+      "settling in s) and a closed-loop verification across `range` (lo, hi in output units; "
+      "None = the reachable range less 5 % at each end) on the plant. `budget` is the plant "
+      "time in s of the experiment; u_min/u_max default to the plant's input range (IPA 0..100 "
+      "%, needed for a linear plant). models.json goes to `directory` (which must exist). "
+      "Returns the dict of `commission --json` (termination, message, experiment, models, "
+      "chosen_model, controller, verification, passed, limits, suggestions, plant_time) with "
+      "'data' (the experiment as a Dataset) and 'trace' (the verification's t, r, y, u, d "
+      "arrays). Raises InvalidArgument for invalid settings.");
 }
 
 }  // namespace pneumid::python

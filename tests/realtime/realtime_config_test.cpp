@@ -70,3 +70,34 @@ TEST(RealtimeConfig, IntegersOutOfRangeAreRejectedNotWrapped) {
 
 }  // namespace
 }  // namespace pneumid
+
+namespace pneumid {
+namespace {
+
+TEST(RealtimeConfig, TheControllerSectionHoldsAController) {
+  const RealtimeConfig c = ParseRealtimeConfig(
+      "[controller]\nmodel = \"fopdt:K=1,tau=1,theta=0.1\"\ntype = \"mpc\"\nrule = \"auto\"\n"
+      "aggressiveness = 0.25\nP = 40\nu_min = 0\nu_max = 100\ninput_gaps = \"0:15,85:100\"\n",
+      "c.toml");
+  ASSERT_TRUE(c.controller.has_value());
+  EXPECT_EQ(c.controller->model, "fopdt:K=1,tau=1,theta=0.1");
+  EXPECT_EQ(c.controller->settings.controller, "mpc");
+  EXPECT_EQ(c.controller->settings.rule, "auto");
+  EXPECT_DOUBLE_EQ(c.controller->settings.aggressiveness, 0.25);
+  EXPECT_EQ(c.controller->settings.P, 40);
+  EXPECT_DOUBLE_EQ(c.controller->settings.limits.u_max, 100.0);
+  EXPECT_EQ(c.controller->settings.input_gaps, "0:15,85:100");
+  EXPECT_EQ(c.controller->keys.size(), 8u);
+  EXPECT_FALSE(ParseRealtimeConfig("[loop]\nperiod = 0.01\n", "n.toml").controller.has_value());
+}
+
+TEST(RealtimeConfig, ControllerSectionErrorsNameTheLine) {
+  auto message = [](const std::string& text) { return ParseError(text, "c.toml"); };
+  EXPECT_THAT(message("[controller]\ntype = \"fuzzy\"\n"), HasSubstr("c.toml:2:"));
+  EXPECT_THAT(message("[controller]\ninput_gaps = \"15:0\"\n"), HasSubstr("c.toml:2:"));
+  EXPECT_THAT(message("[controller]\nhorizon = 3\n"), HasSubstr("unknown key 'horizon'"));
+  EXPECT_THAT(message("[controller]\nP = \"ten\"\n"), HasSubstr("must be an integer"));
+}
+
+}  // namespace
+}  // namespace pneumid

@@ -24,8 +24,6 @@
 
 namespace pneumid {
 
-/// Description of a plant's actuator for the real-time loop: signals, input range and
-/// the names and meanings of its hold and release safe states.
 /// An open interval (lo, hi) of inputs the actuator cannot hold; inputs in
 /// it act as lo or hi. Input units (IPA: duty in %).
 struct InputGap {
@@ -34,6 +32,8 @@ struct InputGap {
   bool operator==(const InputGap&) const = default;  ///< same ends
 };
 
+/// Description of a plant's actuator for the real-time loop: signals, input range, input
+/// gaps and the names and meanings of its hold and release safe states.
 struct Actuator {
   Channel input{"u", ""};   ///< name and unit of the input
   Channel output{"y", ""};  ///< name and unit of the measured output

@@ -37,7 +37,6 @@
 
 namespace pneumid {
 
-/// Every setting of a real-time run, by TOML section (see above).
 /// The [controller] section: a controller as control, run and codegen build it.
 struct ControllerConfig {
   std::string model;              ///< the --model spec
@@ -45,6 +44,7 @@ struct ControllerConfig {
   std::vector<std::string> keys;  ///< the keys the file gives (the flags override only these)
 };
 
+/// Every setting of a real-time run, by TOML section (see above).
 struct RealtimeConfig {
   LoopOptions loop;           ///< [loop]: period, duration, scheduling
   SafetyOptions safety;       ///< [safety]: limits, fault detection, safe state

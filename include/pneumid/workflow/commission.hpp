@@ -2,12 +2,14 @@
 // (`pneumid commission`). The stages, all on the plant itself:
 //
 //   1. probe      the plant rests at the lowest input, then one step to the middle
-//                 of the input range, extended until the output settles: the
-//                 static gain K, time constant tau and dead time theta
-//                 (reaction curve, reaction_curve.hpp); a plant whose output does
+//                 of the input range, extended in 0.5 s chunks until the
+//                 means of two successive chunks agree to 0.5 % of the change:
+//                 the static gain K, time constant tau and dead time theta by
+//                 the two-point method (Smith 1972: tau = 1.5 (t63 - t28),
+//                 theta = t63 - tau); a plant whose output does
 //                 not move is "not responding", one whose output does not settle
 //                 within a quarter of the budget is integrating or unstable.
-//   2. sweep      the highest input, held for theta + 5 tau: with the rest level,
+//   2. sweep      the highest input, held for theta + 6 tau: with the rest level,
 //                 the reachable output range. A requested range outside it is an
 //                 error that names the measured range.
 //   3. excitation a multi-level sequence over the inputs that cover the asked
@@ -18,7 +20,9 @@
 //                 (30 % of the time) is held out for validation.
 //   4. identify   the candidate methods (linear and nonlinear) on the first
 //                 sequence, ranked by their simulation fit on the held-out one
-//                 (IdentifyModels); the model is the best-ranked one a
+//                 (IdentifyModels; the polynomial models' input delay nk from
+//                 the probe's dead time, floor(theta / Ts), at least 1); the
+//                 model is the best-ranked one a
 //                 controller can be built from.
 //   5. design     the controller tuned to the specification (rule "auto",
 //                 auto_tuning.hpp), behind the model's input map when it has one.
@@ -33,7 +37,9 @@
 //                 (-8 % of the range) half-way through the last level, closed
 //                 loop on the plant. Pass: the worst step's overshoot within
 //                 the specification, every step settled within the settling
-//                 specification, ripple at most 2 % of the set-point and
+//                 specification, ripple at most 2 % of the set-point (or
+//                 twice the output's peak to peak at rest, the sensor's
+//                 noise, when that is larger) and
 //                 |steady-state error| at most 0.5 % of the range at every
 //                 level. On an overshoot failure the design is repeated with a
 //                 less aggressive setting (up to `retunes` times); what limits
@@ -50,6 +56,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,6 +67,7 @@
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/identify.hpp"
+#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/plant.hpp"
 
 namespace pneumid {
@@ -69,24 +77,28 @@ struct CommissionOptions {
   /// Output range the controller must serve (output units); NaN = the
   /// reachable range measured by the sweep, less 5 % at each end.
   double range_min = std::numeric_limits<double>::quiet_NaN();
-  double range_max = std::numeric_limits<double>::quiet_NaN();
+  double range_max = std::numeric_limits<double>::quiet_NaN();  ///< upper end of that range
   /// Plant time in s the identification experiment may take (probe, sweep
   /// and excitation; verification comes on top).
   double budget = 120.0;
   /// Input limits (input units); NaN = the plant's physical range (IPA 0..100 %).
   double u_min = std::numeric_limits<double>::quiet_NaN();
-  double u_max = std::numeric_limits<double>::quiet_NaN();
+  double u_max = std::numeric_limits<double>::quiet_NaN();  ///< highest input (NaN = the plant's)
   /// Output safety limits: leaving them stops the experiment (infinite = none).
   double y_min = -std::numeric_limits<double>::infinity();
-  double y_max = std::numeric_limits<double>::infinity();
+  double y_max = std::numeric_limits<double>::infinity();  ///< highest output allowed
   /// Controller to design: mpc, dmc, gpc or pid.
   std::string controller = "mpc";
   /// Specification: worst-step overshoot in %, settling time (2 % band or the
   /// measured ripple) in s.
   double overshoot = 5.0;
-  double settling = 0.5;
+  double settling = 0.5;  ///< settling time of the specification in s
   /// Aggressiveness of the first design (auto_tuning.hpp, 0..1).
   double aggressiveness = 0.5;
+  /// The actuator's description (input range, input gaps, channels); unset =
+  /// PlantActuator(plant). Set it for a plant behind an I/O backend
+  /// (realtime/io_plant.hpp: IoPlant::actuator()).
+  std::optional<Actuator> actuator;
   /// Modulate the input across the actuator's input gaps (Actuator::input_gaps,
   /// duty_modulator.hpp) in the experiment and in the controller, so that the
   /// outputs between the gaps' ends are reachable without a limit cycle.
@@ -126,41 +138,47 @@ struct CommissionExperiment {
   double reachable_min = std::numeric_limits<double>::quiet_NaN();  ///< output at u_min
   double reachable_max = std::numeric_limits<double>::quiet_NaN();  ///< output at u_max
   double range_min = std::numeric_limits<double>::quiet_NaN();      ///< range served
-  double range_max = std::numeric_limits<double>::quiet_NaN();
+  double range_max = std::numeric_limits<double>::quiet_NaN();      ///< its upper end
+  /// Peak-to-peak output at rest (the last 80 % of the first second): the
+  /// sensor's noise, the floor of the ripple criterion.
+  double noise_peak_to_peak = 0.0;
   double dwell = 0.0;                     ///< s per excitation level
   std::vector<double> estimation_levels;  ///< inputs of the estimation sequence
   std::vector<double> validation_levels;  ///< inputs of the held-out sequence
-  /// {duration, probe, sweep, range, dwell, levels, samples}.
+  /// {duration, samples, probe, sweep, range, noise_peak_to_peak, dwell,
+  /// estimation_levels, validation_levels, estimation_samples, validation_samples}.
   nlohmann::ordered_json ToJson() const;
 };
 
 /// One design and its closed-loop check on the plant.
 struct CommissionAttempt {
-  double aggressiveness = 0.5;
-  std::string design;  ///< BuiltController::Summary()
-  nlohmann::ordered_json settings;
-  ClosedLoopResult result;
-  bool passed = false;
+  double aggressiveness = 0.5;        ///< the design's aggressiveness (auto_tuning.hpp)
+  std::string design;                 ///< BuiltController::Summary()
+  nlohmann::ordered_json settings;    ///< BuiltController::SettingsToJson()
+  ClosedLoopResult result;            ///< the verification run on the plant
+  bool passed = false;                ///< every item of the specification met
   std::vector<std::string> failures;  ///< the specification items not met
 };
 
+/// What Commission did and found (after Ceres' Solver::Summary).
 struct CommissionResult {
   /// kSuccess: a controller passed the verification; kPartial: a controller
   /// was designed but failed it (see limits); kStopped: stopped on request;
   /// kFailure: no controller (the reason in message).
   Termination termination = Termination::kFailure;
-  std::string message;
-  CommissionExperiment experiment;
-  IdentificationSummary identification;
-  std::string model_file;    ///< DIR/models.json
-  std::string chosen_model;  ///< method name of the model the controller uses
-  std::string chosen_reason;
-  std::string controller_model;             ///< DIR/models.json\#METHOD
-  ControllerSettings settings;              ///< the final design's settings (rule auto resolved)
+  std::string message;                   ///< one line: what was met, or why not
+  CommissionExperiment experiment;       ///< the experiment's data and measurements
+  IdentificationSummary identification;  ///< the models, ranked on the held-out part
+  std::string model_file;                ///< DIR/models.json
+  std::string chosen_model;              ///< method name of the model the controller uses
+  std::string chosen_reason;     ///< why that model (its fits, the better-ranked ones skipped)
+  std::string controller_model;  ///< DIR/models.json\#METHOD
+  ControllerSettings settings;   ///< the final design's settings (rule auto resolved)
   std::vector<CommissionAttempt> attempts;  ///< every verification, the final last
   std::vector<std::string> limits;          ///< what limits the final loop
   std::vector<std::string> suggestions;     ///< what to try when it fails
   double plant_time = 0.0;                  ///< s of plant time in all stages
+  /// True when the final verification met the specification.
   bool passed() const { return !attempts.empty() && attempts.back().passed; }
   /// {termination, message, experiment, models, chosen_model, controller,
   /// verification (the keys of control --json), passed, limits, suggestions,

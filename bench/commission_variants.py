@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""`pneumid commission` on IPA twin variants, measured on the targets' scenario.
+
+For each variant (valves +-30 %, dead volume +-20 %, supply 0.5 MPa, sensor
+filter 0 and 0.25 s, one sample of transport delay, the chamber-lag twin and
+the default twin) the script writes the variant's TOML from
+config/ipa_default.toml, runs `pneumid commission --plant ipa --plant-config
+VARIANT -o DIR --json` (wall time measured), then runs the written
+controller.toml with `pneumid control --config` on a staircase across
+10..180 N in both directions (dwell 2 s) with a -15 N load step at 17 s, and
+the paper's DMC (fopdt-paper, shridhar-cooper) on the same scenario. It
+prints one table row per variant: worst-step overshoot, the slowest step's
+settling time, the largest steady-state ripple (peak to peak, % of the
+set-point, and at levels of 20 N and above), the largest |steady-state
+error|, IAE over the DMC's, commission's wall time and plant time.
+
+Usage: /usr/bin/python3 bench/commission_variants.py build/pneumid [--only NAME]
+"""
+import argparse
+import json
+import pathlib
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+SCENARIO = ["--setpoint", "staircase:levels=10 50 100 150 180 120 60 10,dwell=2",
+            "--duration", "18", "--load-step", "at=17,size=-15"]
+
+# name -> {key: factor or ("=", value)} applied to config/ipa_default.toml
+VARIANTS = {
+    "default": {},
+    "valves +30 %": {"inlet_conductance": 1.3, "exhaust_conductance": 1.3},
+    "valves -30 %": {"inlet_conductance": 0.7, "exhaust_conductance": 0.7},
+    "dead volume +20 %": {"dead_volume_a": 1.2, "dead_volume_b": 1.2},
+    "dead volume -20 %": {"dead_volume_a": 0.8, "dead_volume_b": 0.8},
+    "supply 0.5 MPa": {"pressure": ("=", 0.5e6)},
+    "sensor filter 0 s": {"pressure_filter_time_constant": ("=", 0.0)},
+    "sensor filter 0.25 s": {"pressure_filter_time_constant": ("=", 0.25)},
+    "delay 1 sample": {"transport_delay_samples": ("=", 1)},
+    "chamber-lag twin": "config/ipa_chamber_lag.toml",
+}
+
+
+def write_variant(spec, path):
+    if isinstance(spec, str):
+        path.write_text((ROOT / spec).read_text())
+        return
+    text = (ROOT / "config/ipa_default.toml").read_text()
+    for key, change in spec.items():
+        pattern = re.compile(rf"^({re.escape(key)}\s*=\s*)([-+0-9.eE]+)", re.M)
+        m = pattern.search(text)
+        if not m:
+            sys.exit(f"commission_variants: no key {key} in config/ipa_default.toml")
+        value = change[1] if isinstance(change, tuple) else float(m.group(2)) * change
+        text = pattern.sub(lambda mm: mm.group(1) + repr(value), text, count=1)
+    path.write_text(text)
+
+
+def metrics(j):
+    steps = [s for s in j["steps"] if s["time"] > 0]
+    ripple = [100 * s["ripple"] / abs(s["to"]) for s in steps if s["ripple"] is not None]
+    ripple20 = [100 * s["ripple"] / abs(s["to"]) for s in steps
+                if s["ripple"] is not None and abs(s["to"]) >= 20]
+    settle = [s["settling_time"] if s["settled"] else float("inf") for s in steps]
+    return {
+        "overshoot": max(s["overshoot_percent"] for s in steps),
+        "settling": max(settle),
+        "ripple": max(ripple),
+        "ripple20": max(ripple20),
+        "sse": max(abs(s["steady_state_error"]) for s in steps),
+        "iae": j["iae"],
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("pneumid")
+    ap.add_argument("--only", default="")
+    args = ap.parse_args()
+    print("| twin | chosen model | worst overshoot % | slowest settling s | ripple % (>= 20 N) "
+          "| max abs sse N | IAE / DMC | commission wall s | plant time s | verdict |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, spec in VARIANTS.items():
+            if args.only and args.only != name:
+                continue
+            work = pathlib.Path(tmp) / f"{len(list(pathlib.Path(tmp).iterdir()))}"
+            work.mkdir()
+            toml = work / "twin.toml"
+            write_variant(spec, toml)
+            start = time.monotonic()
+            c = subprocess.run([args.pneumid, "commission", "--plant", "ipa", "--plant-config",
+                                str(toml), "-o", str(work / "c"), "--json"],
+                               capture_output=True, text=True)
+            wall = time.monotonic() - start
+            if c.returncode not in (0, 4):
+                print(f"| {name} | - | commission exit {c.returncode}: {c.stderr.strip()[:120]} |")
+                continue
+            cj = json.loads(c.stdout)
+            run = subprocess.run([args.pneumid, "control", "--config",
+                                  str(work / "c" / "controller.toml"), *SCENARIO, "--json"],
+                                 capture_output=True, text=True, check=True)
+            dmc = subprocess.run([args.pneumid, "control", "--controller", "dmc", "--model",
+                                  "fopdt-paper", "--rule", "shridhar-cooper", "--plant",
+                                  f"ipa:config={toml}", *SCENARIO, "--json"],
+                                 capture_output=True, text=True, check=True)
+            m = metrics(json.loads(run.stdout))
+            iae_dmc = json.loads(dmc.stdout)["iae"]
+            ok = (m["overshoot"] <= 5 and m["settling"] <= 0.5 and m["ripple"] <= 2
+                  and m["sse"] <= 0.5 and m["iae"] <= 0.7 * iae_dmc)
+            print(f"| {name} | {cj['chosen_model']} | {m['overshoot']:.2f} | {m['settling']:.3f} "
+                  f"| {m['ripple']:.2f} ({m['ripple20']:.2f}) | {m['sse']:.2f} "
+                  f"| {m['iae'] / iae_dmc:.3f} | {wall:.1f} | {cj['plant_time']:.1f} "
+                  f"| {'all targets met' if ok else 'missed'} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,118 @@
+#!/usr/bin/env bash
+# pneumid commission: the default twin end to end (files, JSON keys, the
+# controller.toml that control, run and codegen take with --config), a
+# variant twin, and the errors of a range out of reach and a short budget.
+# Usage: bash commission_test.sh PNEUMID
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
+
+"$PNEUMID" commission --help | grep -q -- "--budget" || fail "--help"
+
+"$PNEUMID" commission --plant ipa -o "$TMP/c" --json > "$TMP/c.json"
+rc=$?
+# 0: the specification is met; 4: a controller that misses it (stated).
+[ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission exited $rc"
+for f in data.csv models.json controller.toml verification.csv experiment.png verification.png; do
+  [ -s "$TMP/c/$f" ] || fail "commission did not write $f"
+done
+$PY - "$TMP/c.json" <<'PYEOF' || fail "commission JSON"
+import json, sys
+j = json.load(open(sys.argv[1]))
+for k in ("experiment", "models", "chosen_model", "controller", "verification", "passed",
+          "limits", "suggestions", "plant_time"):
+    assert k in j, k
+e = j["experiment"]
+assert e["duration"] <= 120.0 + 0.02, e["duration"]
+# The default twin: tau about 0.21 s behind its sensor filter, range about 0..192 N.
+assert 0.1 < e["probe"]["time_constant"] < 0.4, e["probe"]
+assert 150 < e["sweep"]["reachable_max"] < 250, e["sweep"]
+v = j["verification"]
+for k in ("overshoot_percent", "settling_time", "iae", "steps", "worst_overshoot_step"):
+    assert k in v, k
+assert len(v["steps"]) >= 8, len(v["steps"])
+# The chosen model is the best held-out fit among the usable ones, and it holds.
+fits = {m["method"]: m["validation_fit_percent"] for m in j["models"]}
+assert fits[j["chosen_model"]] > 90.0, fits
+# Modulation across the valves' dead bands: worst overshoot within 8 %
+# (the specification is 5 %; JSON says pass or which step fails).
+assert v["overshoot_percent"] < 8.0, v["overshoot_percent"]
+PYEOF
+
+# The configuration runs as written: control, codegen and run.
+"$PNEUMID" control --config "$TMP/c/controller.toml" --setpoint "staircase:levels=10 50 100 150 180 120 60 10,dwell=2" \
+  --duration 18 --load-step at=17,size=-15 --json > "$TMP/ctl.json" || fail "control --config"
+$PY - "$TMP/ctl.json" <<'PYEOF' || fail "control --config metrics"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert "sigma-delta" in j["controller"], j["controller"]
+assert j["overshoot_percent"] < 8.0, j["overshoot_percent"]
+assert all(s["settled"] for s in j["steps"]), j["steps"]
+PYEOF
+"$PNEUMID" codegen --config "$TMP/c/controller.toml" -o "$TMP/gen" > "$TMP/gen.txt" || fail "codegen --config"
+grep -q "sigma-delta" "$TMP/gen.txt" "$TMP"/gen/*.c 2>/dev/null || fail "codegen: no modulator layer"
+"$PNEUMID" run --config "$TMP/c/controller.toml" --fast --duration 2 --setpoint "step:from=0,to=100,at=0.2" --json \
+  > "$TMP/run.json" || fail "run --config"
+
+# A twin of other valves and supply: the same command, no hand tuning.
+sed -e 's/^inlet_conductance = .*/inlet_conductance = 0.8e-8/' -e 's/^pressure = 0.6e6 /pressure = 0.5e6 /' \
+  "$SRC/config/ipa_default.toml" > "$TMP/variant.toml"
+"$PNEUMID" commission --plant ipa --plant-config "$TMP/variant.toml" -o "$TMP/v" --json > "$TMP/v.json"
+rc=$?
+[ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission on the variant exited $rc"
+$PY -c 'import json,sys; j=json.load(open(sys.argv[1])); assert j["verification"]["steps"], j' "$TMP/v.json" \
+  || fail "variant JSON"
+
+# Errors: a range out of reach names the reachable one; a short budget says what it needs.
+out=$("$PNEUMID" commission --plant ipa --range 10:400 -o "$TMP/e1" 2>&1)
+[ $? -eq 1 ] || fail "unreachable range: exit status"
+echo "$out" | grep -q "cannot be reached: the output reaches" || fail "unreachable range: $out"
+out=$("$PNEUMID" commission --plant ipa --budget 5 -o "$TMP/e2" 2>&1)
+[ $? -eq 1 ] || fail "short budget: exit status"
+echo "$out" | grep -q "too short" || fail "short budget: $out"
+out=$("$PNEUMID" commission --plant ipa --spec overshoot=x -o "$TMP/e3" 2>&1)
+[ $? -ne 0 ] || fail "bad --spec accepted"
+echo "$out" | grep -q "overshoot" || fail "bad --spec message: $out"
+
+# Over UDP against a plant server (the same twin in another process), stepped
+# as fast as it answers: the same stages, the same kind of result.
+SERVER_PID=""
+cleanup() { [ -n "$SERVER_PID" ] && kill "$SERVER_PID" 2>/dev/null; }
+: > "$TMP/server.txt"
+"$PNEUMID" plant-server --plant ipa --port 0 > "$TMP/server.txt" 2>&1 &
+SERVER_PID=$!
+PORT=""
+for _ in $(seq 50); do
+  PORT=$(sed -n 's/.*udp:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$TMP/server.txt")
+  [ -n "$PORT" ] && break
+  sleep 0.1
+done
+[ -n "$PORT" ] || fail "plant-server did not start: $(cat "$TMP/server.txt")"
+"$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --fast --input-gaps 0:15,85:100 -o "$TMP/u" --json \
+  > "$TMP/u.json"
+rc=$?
+[ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission over udp exited $rc"
+$PY - "$TMP/u.json" "$TMP/c.json" <<'PYEOF' || fail "commission over udp JSON"
+import json, sys
+u, s = (json.load(open(p)) for p in sys.argv[1:3])
+# The same twin: the probe's time constant and the reachable range agree with the simulator's.
+assert abs(u["experiment"]["probe"]["time_constant"] - s["experiment"]["probe"]["time_constant"]) < 0.03
+assert abs(u["experiment"]["sweep"]["reachable_max"] - s["experiment"]["sweep"]["reachable_max"]) < 5
+assert u["verification"]["steps"], u
+PYEOF
+grep -q 'backend = "udp://127.0.0.1:' "$TMP/u/controller.toml" || fail "udp controller.toml: no backend"
+kill "$SERVER_PID"; wait "$SERVER_PID" 2>/dev/null; SERVER_PID=""
+
+# Ctrl-C in the middle of the experiment: exit 130, the plant at its lowest
+# input, the data so far written.
+"$PNEUMID" commission --plant ipa --plant-config "$SRC/config/ipa_slow_valves.toml" --budget 600 \
+  --io sim -o "$TMP/s" > "$TMP/s.txt" 2>&1 &
+pid=$!
+sleep 0.5
+kill -INT "$pid"
+wait "$pid"
+rc=$?
+[ "$rc" -eq 130 ] || [ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "Ctrl-C: exit $rc"
+if [ "$rc" -eq 130 ]; then
+  [ -s "$TMP/s/data.csv" ] || fail "Ctrl-C: no data.csv"
+  grep -q "stopped on request" "$TMP/s.txt" || fail "Ctrl-C: $(cat "$TMP/s.txt")"
+fi
+finish

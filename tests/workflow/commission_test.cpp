@@ -1,0 +1,157 @@
+// Commission (workflow/commission.hpp) on plants whose answers are known in
+// closed form: a first-order plant with dead time (the probe's estimates),
+// plants that cannot be commissioned (no response, integrating, a range out
+// of reach, a budget too short) and a stop request.
+#include "pneumid/workflow/commission.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/plant/plant_factory.hpp"
+
+namespace pneumid {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string TempDir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("pneumid_commission_" + name);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+CommissionOptions Options(const std::string& name) {
+  CommissionOptions o;
+  o.directory = TempDir(name);
+  o.u_min = 0.0;
+  o.u_max = 10.0;
+  o.budget = 60.0;
+  o.methods = {"arx", "oe"};
+  return o;
+}
+
+// y = c (constant sensor), or an integrator y += k u Ts.
+class TestPlant : public Plant {
+ public:
+  TestPlant(double gain, bool integrating) : gain_(gain), integrating_(integrating) {}
+  void Reset() override { y_ = 0.0, t_ = 0.0; }
+  double Measure() override { return y_; }
+  void Advance(double u) override {
+    if (integrating_) y_ += gain_ * u * Ts();
+    t_ += Ts();
+  }
+  double Ts() const override { return 0.01; }
+  double time() const override { return t_; }
+  std::string Describe() const override { return "test plant"; }
+
+ private:
+  double gain_;
+  bool integrating_;
+  double y_ = 0.0, t_ = 0.0;
+};
+
+TEST(Commission, TheProbeMeasuresAFirstOrderPlantWithDeadTime) {
+  // K = 2, tau = 0.5 s, theta = 0.1 s: the two-point method is exact on a
+  // FOPDT up to the sampling (one sample, 0.01 s).
+  auto plant = MakePlant("fopdt:K=2,tau=0.5,theta=0.1", 0.01);
+  CommissionOptions o = Options("fopdt");
+  o.range_min = 2.0;
+  o.range_max = 18.0;
+  o.settling = 2.0;  // tau = 0.5 s, theta = 0.1 s: about 4 (tau + theta)
+  const CommissionResult r = Commission(*plant, o);
+  EXPECT_NEAR(r.experiment.gain, 2.0, 0.01);
+  EXPECT_NEAR(r.experiment.time_constant, 0.5, 0.015);
+  EXPECT_NEAR(r.experiment.dead_time, 0.1, 0.015);
+  EXPECT_NEAR(r.experiment.reachable_min, 0.0, 1e-6);
+  EXPECT_NEAR(r.experiment.reachable_max, 20.0, 0.1);
+  EXPECT_LE(r.experiment.duration, o.budget + 0.02);
+  EXPECT_GT(r.experiment.estimation.size(), 0);
+  EXPECT_GT(r.experiment.validation.size(), 0);
+  // A linear plant: the linear models fit the held-out part almost exactly,
+  // and the loop meets the specification.
+  ASSERT_FALSE(r.identification.models.empty());
+  EXPECT_GT(r.identification.models.front().validation_fit_percent, 99.0);
+  ASSERT_FALSE(r.attempts.empty());
+  EXPECT_EQ(r.termination, Termination::kSuccess) << r.message;
+  EXPECT_LE(r.attempts.back().result.metrics.overshoot_percent, 5.0);
+  EXPECT_TRUE(std::filesystem::exists(r.model_file));
+  const auto j = r.ToJson();
+  EXPECT_EQ(j["termination"], "success");
+  EXPECT_TRUE(j["verification"].contains("steps"));
+  EXPECT_TRUE(j["experiment"].contains("duration"));
+}
+
+TEST(Commission, APlantThatDoesNotRespondIsNamed) {
+  TestPlant plant(0.0, false);
+  const CommissionResult r = Commission(plant, Options("dead"));
+  EXPECT_EQ(r.termination, Termination::kFailure);
+  EXPECT_THAT(r.message, HasSubstr("does not respond"));
+  EXPECT_GT(r.experiment.data.size(), 0);  // the data so far are kept
+}
+
+TEST(Commission, AnIntegratingPlantDoesNotSettle) {
+  TestPlant plant(1.0, true);
+  const CommissionResult r = Commission(plant, Options("integrating"));
+  EXPECT_EQ(r.termination, Termination::kFailure);
+  EXPECT_THAT(r.message, HasSubstr("did not settle"));
+  EXPECT_LE(r.plant_time, 0.25 * 60.0 + 2.0);
+}
+
+TEST(Commission, ARangeOutOfReachNamesTheReachableRange) {
+  auto plant = MakePlant("fopdt:K=2,tau=0.5,theta=0.1", 0.01);
+  CommissionOptions o = Options("range");
+  o.range_min = 5.0;
+  o.range_max = 50.0;
+  const CommissionResult r = Commission(*plant, o);
+  EXPECT_EQ(r.termination, Termination::kFailure);
+  EXPECT_THAT(r.message, HasSubstr("cannot be reached"));
+  EXPECT_THAT(r.message, HasSubstr("reaches 0..19.9"));  // up to K u_max = 20 after theta + 6 tau
+}
+
+TEST(Commission, ABudgetTooShortForTheTimeScaleSaysWhatItNeeds) {
+  auto plant = MakePlant("fopdt:K=2,tau=0.5,theta=0.1", 0.01);
+  CommissionOptions o = Options("budget");
+  o.budget = 12.0;
+  const CommissionResult r = Commission(*plant, o);
+  EXPECT_EQ(r.termination, Termination::kFailure);
+  EXPECT_THAT(r.message, HasSubstr("too short"));
+}
+
+TEST(Commission, AStopRequestEndsAtTheSafeInputWithTheData) {
+  auto plant = MakePlant("fopdt:K=2,tau=0.5,theta=0.1", 0.01);
+  CommissionOptions o = Options("stop");
+  std::atomic<bool> stop{false};
+  o.stop = &stop;
+  o.progress = [&](const std::string& stage, double) {
+    if (stage == "sweep") stop = true;
+  };
+  const CommissionResult r = Commission(*plant, o);
+  EXPECT_EQ(r.termination, Termination::kStopped);
+  EXPECT_GT(r.experiment.data.size(), 0);
+  EXPECT_TRUE(r.attempts.empty());
+}
+
+TEST(Commission, InvalidOptionsNameTheField) {
+  auto plant = MakePlant("fopdt:K=2,tau=0.5,theta=0.1", 0.01);
+  CommissionOptions o = Options("invalid");
+  o.budget = -1.0;
+  EXPECT_THROW(Commission(*plant, o), InvalidArgument);
+  o = Options("invalid");
+  o.controller = "fuzzy";
+  try {
+    Commission(*plant, o);
+    FAIL();
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("fuzzy"));
+  }
+  o = Options("invalid");
+  o.u_min = o.u_max = std::numeric_limits<double>::quiet_NaN();  // a linear plant has no range
+  EXPECT_THROW(Commission(*plant, o), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace pneumid
