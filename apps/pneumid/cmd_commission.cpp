@@ -7,8 +7,9 @@
 //
 // DIR receives data.csv (the whole experiment), models.json (every model,
 // ranked on the held-out part), controller.toml (a complete configuration
-// that control, run and codegen take with --config), verification.csv and
-// the plots experiment.png and verification.png.
+// that control, run and codegen take with --config), verification.csv, the
+// plots experiment.png, validation.png and verification.png, and c/ (the
+// controller as C99, as `pneumid codegen --config DIR/controller.toml`).
 #include <atomic>
 #include <csignal>
 #include <filesystem>
@@ -20,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "pneumid/codegen/c_codegen.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/spec.hpp"
 #include "pneumid/data/csv.hpp"
@@ -270,12 +272,28 @@ void Run(CommissionCli& c) {
     ClosedLoopFigure(cl.t, cl.r, {{r.settings.controller, cl.y, cl.u}}, options)
         .Save((dir / "verification.png").string());
   }
+  // The C module of the final design (pneumid codegen): DIR/c.
+  std::string c_module;
+  if (!r.attempts.empty()) {
+    try {
+      const BuiltController built =
+          MakeController(ParseControllerModel(r.controller_model), c.Ts,
+                         WithModelInputMap(ToControllerSpec(r.settings), r.controller_model));
+      const CodegenResult code = GenerateC(*built.controller, CodegenOptions{});
+      WriteCodegenFiles(code, (dir / "c").string());
+      c_module = (dir / "c").string();
+    } catch (const std::exception& e) {
+      c_module = std::string("not written: ") + e.what();
+    }
+  }
   if (c.json) {
     nlohmann::ordered_json j = r.ToJson();
     j["directory"] = c.directory;
+    j["c_module"] = c_module;
     std::cout << j.dump(2) << "\n";
   } else {
     PrintSummary(r, c.directory);
+    if (!c_module.empty()) std::cout << "C module: " << c_module << "\n";
   }
   if (r.termination == Termination::kStopped) throw ExitCode{130};
   if (r.termination == Termination::kFailure) {

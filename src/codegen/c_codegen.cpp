@@ -852,6 +852,12 @@ void GenerateModulator(const ModulatedController& c, Module& m, const std::strin
   const DutyModulator& mod = c.modulator();
   m.Member({Field::kReal, stem + "err", 0, "carried modulation error (input units)"});
   m.Member({Field::kReal, stem + "v", 0, "inner controller's request v"});
+  // w clipped to the input range (what lies beyond it is not carried).
+  std::string clip;
+  if (std::isfinite(mod.u_min()))
+    clip += fmt::format("  if (w < {0}) w = {0};\n", m.Literal(mod.u_min()));
+  if (std::isfinite(mod.u_max()))
+    clip += fmt::format("  if (w > {0}) w = {0};\n", m.Literal(mod.u_max()));
   std::string chain;
   for (const InputGap& g : mod.gaps()) {
     chain += fmt::format("{0}if (w > {1} && w < {2}) a = (w - {1} < {2} - w) ? {1} : {2};\n",
@@ -868,7 +874,7 @@ PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
   s->{0}v = PFX_{0}step(s, setpoint, measurement);
   if (!PFX_ISFINITE(s->{0}v)) return s->{0}v;
   w = s->{0}v + s->{0}err;
-  a = w;
+{3}  a = w;
 {1}  e = w - a;
   s->{0}err = e < -{2} ? -{2} : ({2} < e ? {2} : e);
   return a;
@@ -878,7 +884,7 @@ void PFX_applied(PFX_state* s, PFX_real u) {{
   if (PFX_ISFINITE(u) && PFX_FABS(u - s->{0}v) > {2}) PFX_{0}applied(s, u);
 }}
 )C",
-                         stem, chain, m.Literal(mod.max_error()));
+                         stem, chain, m.Literal(mod.max_error()), clip);
 }
 
 // OutputMapController: the inner controller on g^-1(r), g^-1(y).
@@ -1222,7 +1228,8 @@ void GenerateLayers(const Controller& controller, Module& m, int depth, CodegenR
   } else {
     PNEUMID_CHECK(false,
                   "code generation supports the dmc, gpc, pid and mpc controllers, alone or "
-                  "behind an input map, an output map, a NARX linearization or a sigma-delta modulator, not '{}'",
+                  "behind an input map, an output map, a NARX linearization or a sigma-delta "
+                  "modulator, not '{}'",
                   controller.Describe());
   }
 }

@@ -338,7 +338,8 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
                                const ControllerSpec& spec) {
   BuiltController b = BuildController(model, Ts, spec);
   if (!spec.input_gaps.empty())
-    b.controller = std::make_unique<ModulatedController>(std::move(b.controller), spec.input_gaps);
+    b.controller = std::make_unique<ModulatedController>(std::move(b.controller), spec.input_gaps,
+                                                         spec.limits);
   b.controller->SetMeasurementGuard(spec.guard);
   return b;
 }
@@ -346,7 +347,8 @@ BuiltController MakeController(const TransferFunction& model, double Ts,
 BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec) {
   BuiltController b = BuildController(model, spec);
   if (!spec.input_gaps.empty())
-    b.controller = std::make_unique<ModulatedController>(std::move(b.controller), spec.input_gaps);
+    b.controller = std::make_unique<ModulatedController>(std::move(b.controller), spec.input_gaps,
+                                                         spec.limits);
   b.controller->SetMeasurementGuard(spec.guard);
   return b;
 }

@@ -44,7 +44,10 @@ std::vector<InputGap> ParseInputGaps(const std::string& text) {
   return gaps;
 }
 
-DutyModulator::DutyModulator(std::vector<InputGap> gaps) : gaps_(std::move(gaps)) {
+DutyModulator::DutyModulator(std::vector<InputGap> gaps, double u_min, double u_max)
+    : gaps_(std::move(gaps)), u_min_(u_min), u_max_(u_max) {
+  PNEUMID_CHECK(!(u_min > u_max) && !std::isnan(u_min) && !std::isnan(u_max),
+                "DutyModulator: needs u_min <= u_max, got {} and {}", u_min, u_max);
   std::sort(gaps_.begin(), gaps_.end(),
             [](const InputGap& a, const InputGap& b) { return a.lo < b.lo; });
   for (std::size_t i = 0; i < gaps_.size(); ++i) {
@@ -58,7 +61,7 @@ DutyModulator::DutyModulator(std::vector<InputGap> gaps) : gaps_(std::move(gaps)
 }
 
 double DutyModulator::Next(double v) {
-  const double w = v + error_;
+  const double w = std::clamp(v + error_, u_min_, u_max_);
   double a = w;
   for (const InputGap& g : gaps_) {
     if (w > g.lo && w < g.hi) {
@@ -66,15 +69,15 @@ double DutyModulator::Next(double v) {
       break;
     }
   }
-  // A request held outside the gaps empties the error; one held beyond the
-  // actuator's range cannot be met on average and must not wind it up.
+  // A request held outside the gaps empties the error; what lies beyond the
+  // actuator's range was clipped off w above and is not carried.
   error_ = std::clamp(w - a, -max_error_, max_error_);
   return a;
 }
 
 ModulatedController::ModulatedController(std::unique_ptr<Controller> inner,
-                                         std::vector<InputGap> gaps)
-    : inner_(std::move(inner)), modulator_(std::move(gaps)) {
+                                         std::vector<InputGap> gaps, const InputLimits& limits)
+    : inner_(std::move(inner)), modulator_(std::move(gaps), limits.u_min, limits.u_max) {
   PNEUMID_CHECK(inner_ != nullptr, "ModulatedController: the inner controller is null");
 }
 

@@ -31,8 +31,13 @@ struct ExperimentEnded {
 // is applied, as RunExperiment does); counts plant time.
 class Recorder {
  public:
-  Recorder(Plant& plant, const CommissionOptions& o, double u_safe, std::vector<InputGap> gaps)
-      : plant_(plant), o_(o), u_safe_(u_safe), Ts_(plant.Ts()), modulator_(std::move(gaps)) {}
+  Recorder(Plant& plant, const CommissionOptions& o, double u_safe, double u_max,
+           std::vector<InputGap> gaps)
+      : plant_(plant),
+        o_(o),
+        u_safe_(u_safe),
+        Ts_(plant.Ts()),
+        modulator_(std::move(gaps), u_safe, u_max) {}
 
   double Ts() const { return Ts_; }
   double time() const { return static_cast<double>(u_.size()) * Ts_; }
@@ -436,7 +441,7 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   CommissionExperiment& ex = r.experiment;
   plant.Reset();
   const std::vector<InputGap> gaps = o.modulate ? act.input_gaps : std::vector<InputGap>{};
-  Recorder rec(plant, o, u_lo, gaps);
+  Recorder rec(plant, o, u_lo, u_hi, gaps);
   const double Ts = rec.Ts();
   auto finish_data = [&] {
     ex.data = rec.size() > 0 ? rec.Slice(0, rec.size(), act.input, act.output) : Dataset();

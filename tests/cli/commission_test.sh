@@ -11,7 +11,8 @@ source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 rc=$?
 # 0: the specification is met; 4: a controller that misses it (stated).
 [ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission exited $rc"
-for f in data.csv models.json controller.toml verification.csv experiment.png verification.png; do
+for f in data.csv models.json controller.toml verification.csv experiment.png verification.png \
+  c/pneumid_ctrl.c c/pneumid_ctrl.h; do
   [ -s "$TMP/c/$f" ] || fail "commission did not write $f"
 done
 $PY - "$TMP/c.json" <<'PYEOF' || fail "commission JSON"

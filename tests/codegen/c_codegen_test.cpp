@@ -112,6 +112,11 @@ std::vector<Case> Cases() {
     s.y_max = 82.0;
   });
   cases.back().model = "hammerstein";
+  // Sigma-delta modulation across the valves' input gaps (duty_modulator.hpp).
+  add("mpc_sigma_delta", "mpc", true, [](ControllerSettings& s) { s.input_gaps = "0:15,85:100"; });
+  add("hammerstein_mpc_sigma_delta", "mpc", true,
+      [](ControllerSettings& s) { s.input_gaps = "0:15,85:100"; });
+  cases.back().model = "hammerstein";
   return cases;
 }
 
@@ -593,10 +598,11 @@ class OtherController : public Controller {
 
 TEST(CodegenTest, RejectsOtherControllers) {
   OtherController other;
-  EXPECT_THAT([&] { GenerateC(other, CodegenOptions{}); },
-              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr(
-                  "supports the dmc, gpc, pid and mpc controllers, alone or behind an input "
-                  "map, an output map or a NARX linearization, not 'other'")));
+  EXPECT_THAT(
+      [&] { GenerateC(other, CodegenOptions{}); },
+      ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr(
+          "supports the dmc, gpc, pid and mpc controllers, alone or behind an input "
+          "map, an output map, a NARX linearization or a sigma-delta modulator, not 'other'")));
 }
 
 // The plant module (plant_codegen.hpp) of the paper's FOPDT: its unit step

@@ -47,6 +47,21 @@ TEST(DutyModulator, ARequestBeyondTheRangeDoesNotWindUpTheError) {
   EXPECT_NEAR(m.Next(50.0), 50.0, 15.0);
 }
 
+TEST(DutyModulator, TheAppliedInputStaysWithinTheLimits) {
+  DutyModulator m(kIpaGaps, 0.0, 100.0);
+  // A request that alternates near the top: w = v + e would pass 100 %.
+  for (int k = 0; k < 200; ++k) {
+    const double a = m.Next(k % 2 == 0 ? 99.0 : 100.0);
+    EXPECT_GE(a, 0.0);
+    EXPECT_LE(a, 100.0);
+  }
+  // Beyond the range nothing is carried: back inside, the request passes.
+  for (int k = 0; k < 50; ++k) EXPECT_DOUBLE_EQ(m.Next(120.0), 100.0);
+  EXPECT_DOUBLE_EQ(m.error(), 0.0);
+  EXPECT_DOUBLE_EQ(m.Next(50.0), 50.0);
+  EXPECT_THROW(DutyModulator(kIpaGaps, 10.0, 0.0), InvalidArgument);
+}
+
 TEST(DutyModulator, ParsesAndPrintsGaps) {
   EXPECT_EQ(ParseInputGaps("0:15,85:100"), kIpaGaps);
   EXPECT_EQ(InputGapsToString(kIpaGaps), "0:15,85:100");

@@ -20,6 +20,7 @@
 // controller is designed and updated as if its request v were applied.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -41,14 +42,20 @@ class DutyModulator {
  public:
   /// @throws InvalidArgument for a gap with lo >= hi, a non-finite end, or
   /// overlapping gaps.
-  explicit DutyModulator(std::vector<InputGap> gaps);
-  /// The input to apply for the request v (finite); v outside every gap and
-  /// with no carried error passes unchanged.
+  explicit DutyModulator(std::vector<InputGap> gaps,
+                         double u_min = -std::numeric_limits<double>::infinity(),
+                         double u_max = std::numeric_limits<double>::infinity());
+  /// The input to apply for the request v (finite): w = v + e clipped to
+  /// [u_min, u_max] (what lies beyond the range is not carried), then the
+  /// nearer end of a gap that holds it; v outside every gap and with no
+  /// carried error passes unchanged.
   double Next(double v);
   /// Clears the carried error.
   void Reset() { error_ = 0.0; }
   /// The gaps, sorted by lo.
   const std::vector<InputGap>& gaps() const { return gaps_; }
+  double u_min() const { return u_min_; }  ///< lowest input applied
+  double u_max() const { return u_max_; }  ///< highest input applied
   /// The carried error e (input units).
   double error() const { return error_; }
   /// The widest gap: the bound on |e| and on the applied input's distance from the request.
@@ -58,13 +65,16 @@ class DutyModulator {
   std::vector<InputGap> gaps_;
   double error_ = 0.0;
   double max_error_ = 0.0;  ///< the widest gap: bounds e
+  double u_min_, u_max_;
 };
 
 /// A controller whose input goes through a DutyModulator (file comment).
 class ModulatedController : public Controller {
  public:
   /// @throws InvalidArgument for a null controller or invalid gaps.
-  ModulatedController(std::unique_ptr<Controller> inner, std::vector<InputGap> gaps);
+  /// `limits`: the actuator's input range, which the modulated input keeps.
+  ModulatedController(std::unique_ptr<Controller> inner, std::vector<InputGap> gaps,
+                      const InputLimits& limits = {});
 
   double Ts() const override { return inner_->Ts(); }
   /// The inner controller's description + " with sigma-delta modulation over
