@@ -10,6 +10,7 @@
 // that control, run and codegen take with --config), verification.csv, the
 // plots experiment.png, validation.png and verification.png, and c/ (the
 // controller as C99, as `pneumid codegen --config DIR/controller.toml`).
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <filesystem>
@@ -33,6 +34,7 @@
 #include "pneumid/realtime/realtime_config.hpp"
 #include "pneumid/report/figures.hpp"
 #include "pneumid/workflow/commission.hpp"
+#include "pneumid/workflow/commission_report.hpp"
 #include "progress.hpp"
 #include "validators.hpp"
 
@@ -58,6 +60,7 @@ struct CommissionCli {
   CommissionOptions options;
   std::string directory;
   bool json = false;
+  bool report = false;
   bool progress = false;
 };
 
@@ -217,6 +220,12 @@ void Run(CommissionCli& c) {
                   "a comedi card runs in real time");
     RealtimeConfig config = c.config.empty() ? RealtimeConfig{} : LoadRealtimeConfig(c.config);
     config.loop.period = c.Ts;
+    if (c.fast) {
+      // Not bound to the clock: wait for late replies (a loaded machine) rather
+      // than count them as missed; a server silent for 100 periods is a fault.
+      config.udp.reply_wait = 0.9;
+      config.udp.max_missed = std::max(config.udp.max_missed, 100);
+    }
     auto io_plant = std::make_unique<IoPlant>(MakeIoBackend(io, config, po), c.Ts, !c.fast);
     o.actuator = io_plant->actuator();
     plant = std::move(io_plant);
@@ -272,6 +281,9 @@ void Run(CommissionCli& c) {
     ClosedLoopFigure(cl.t, cl.r, {{r.settings.controller, cl.y, cl.u}}, options)
         .Save((dir / "verification.png").string());
   }
+  if (c.report)
+    WriteCommissionReport(r, plant->Describe(), act.input, act.output,
+                          (dir / "report.html").string());
   // The C module of the final design (pneumid codegen): DIR/c.
   std::string c_module;
   if (!r.attempts.empty()) {
@@ -319,7 +331,9 @@ const Registrar reg(
       app.add_option("--config", c->config,
                      "Real-time configuration (TOML) of the udp or comedi backend");
       app.add_flag("--fast", c->fast,
-                   "udp: step the plant server as fast as it answers instead of in real time");
+                   "udp: step the plant server as fast as it answers instead of in real time "
+                   "(late replies are waited for, up to 0.9 period, and 100 missed in a row "
+                   "are a fault)");
       app.add_option("--input-gaps", c->input_gaps,
                      "Inputs the actuator cannot hold, modulated across: plant (the plant's own, "
                      "IPA 0:15,85:100 from its valves), none, or LO:HI[,LO:HI]")
@@ -361,6 +375,9 @@ const Registrar reg(
                      "and the plots")
           ->required();
       app.add_flag("--json", c->json, "Print the result as JSON");
+      app.add_flag("--report", c->report,
+                   "Also write DIR/report.html: the experiment, the models, every verification "
+                   "with its figure and per-step table, what limits the loop");
       app.add_flag("--progress", c->progress,
                    "Draw the progress bar even when stderr is not a terminal");
       app.callback([c] {

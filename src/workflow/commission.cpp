@@ -320,6 +320,204 @@ nlohmann::ordered_json NullIfNaN(double v) {
   return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
 }
 
+// Stage 3's preconditions: the range served (the one asked for, which must
+// be reachable, or the reachable one less 5 % at each end), the dwell per
+// level, and a budget that leaves room for 11 levels. "" or the reason.
+std::string PlanExcitation(const CommissionOptions& o, const Recorder& rec, double u_lo,
+                           double u_hi, CommissionExperiment& ex) {
+  const double Ts = rec.Ts();
+  std::string error;
+  if (std::isfinite(o.range_min)) {
+    const double tol = 0.01 * (ex.reachable_max - ex.reachable_min);
+    if (o.range_min < ex.reachable_min - tol || o.range_max > ex.reachable_max + tol) {
+      error = fmt::format(
+          "the range {:g}..{:g} cannot be reached: the output reaches {:.4g}..{:.4g} between "
+          "the inputs {:g} and {:g}",
+          o.range_min, o.range_max, ex.reachable_min, ex.reachable_max, u_lo, u_hi);
+    }
+    ex.range_min = o.range_min;
+    ex.range_max = o.range_max;
+  } else {
+    const double span = ex.reachable_max - ex.reachable_min;
+    ex.range_min = ex.reachable_min + 0.05 * span;
+    ex.range_max = ex.reachable_max - 0.05 * span;
+  }
+  ex.dwell = std::max(ex.dead_time + 4 * ex.time_constant, 10 * Ts);
+  ex.dwell = std::ceil(ex.dwell / Ts - 1e-9) * Ts;
+  const double left = o.budget - rec.time();
+  if (error.empty() && left < 11 * ex.dwell) {
+    error = fmt::format(
+        "the budget of {:g} s is too short for the time scale found (tau = {:.3g} s, theta = "
+        "{:.3g} s: {:.3g} s per level): the probe and sweep took {:.1f} s and the excitation "
+        "needs at least {:.1f} s more (a budget of {:.0f} s or more)",
+        o.budget, ex.time_constant, ex.dead_time, ex.dwell, rec.time(), 11 * ex.dwell,
+        std::ceil(rec.time() + 11 * ex.dwell));
+  }
+  return error;
+}
+
+// Sample ranges of the excitation in the record.
+struct ExcitationSamples {
+  std::size_t est_from = 0, est_to = 0, val_to = 0;
+};
+
+// Stage 3: the shuffled levels over the inputs that cover the range
+// (monotone interpolation through the three measured points; the whole input
+// range when they are not monotone), estimation then held-out.
+ExcitationSamples RunExcitation(Recorder& rec, const CommissionOptions& o, const Probe& p,
+                                double u_lo, double u_hi, CommissionExperiment& ex) {
+  const double Ts = rec.Ts();
+  const double left = o.budget - rec.time();
+  std::vector<std::pair<double, double>> map = {
+      {p.y_rest, u_lo}, {p.y_mid, p.u_mid}, {p.y_high, u_hi}};
+  std::sort(map.begin(), map.end());
+  const bool monotone = (p.y_mid - p.y_rest) * (p.y_high - p.y_mid) > 0;
+  const double span = ex.range_max - ex.range_min;
+  double ua = u_lo, ub = u_hi;
+  if (monotone) {
+    ua = Interpolate(map, ex.range_min - 0.05 * span);
+    ub = Interpolate(map, ex.range_max + 0.05 * span);
+    if (ua > ub) std::swap(ua, ub);
+  }
+  const int n_est = std::max(8, static_cast<int>(0.7 * left / ex.dwell));
+  const int n_val = std::max(3, static_cast<int>((left - n_est * ex.dwell) / ex.dwell));
+  std::mt19937_64 engine(o.seed);
+  for (int i = 0; i < n_est; ++i) ex.estimation_levels.push_back(ua + (ub - ua) * i / (n_est - 1));
+  for (int i = 0; i < n_val; ++i)
+    ex.validation_levels.push_back(ua + (ub - ua) * (i + 0.5) / n_val);
+  Shuffle(ex.estimation_levels, engine);
+  Shuffle(ex.validation_levels, engine);
+  Report(o, "excitation", 0.0);
+  const double total = (n_est + n_val) * ex.dwell;
+  ExcitationSamples x;
+  x.est_from = rec.size();
+  for (double u : ex.estimation_levels) {
+    rec.Hold(u, ex.dwell);
+    Report(o, "excitation", (rec.size() - x.est_from) * Ts / total);
+  }
+  x.est_to = rec.size();
+  for (double u : ex.validation_levels) {
+    rec.Hold(u, ex.dwell);
+    Report(o, "excitation", (rec.size() - x.est_from) * Ts / total);
+  }
+  x.val_to = rec.size();
+  rec.Safe();
+  return x;
+}
+
+// Stage 4: the models, ranked on the held-out sequence, written to
+// DIR/models.json. False (with r.message) when none could be identified.
+bool IdentifyAndSave(CommissionResult& r, const CommissionOptions& o, double Ts) {
+  const CommissionExperiment& ex = r.experiment;
+  Report(o, "identify", 0.0);
+  IdentifyOptions io;
+  io.nonlinear.choose_structure = true;
+  // The input delay of the polynomial models from the probe's dead time.
+  IdentifyRequest request;
+  request.nk = std::max(1, static_cast<int>(std::floor(ex.dead_time / Ts + 1e-9)));
+  r.identification = IdentifyModels(
+      o.methods, ex.estimation, request, io, &ex.validation,
+      [&](std::size_t done, std::size_t total, const std::string&) {
+        Report(o, "identify", static_cast<double>(done) / static_cast<double>(total));
+      });
+  if (r.identification.models.empty()) {
+    r.message = "no model could be identified: " + r.identification.message;
+    return false;
+  }
+  r.model_file = (std::filesystem::path(o.directory) / "models.json").string();
+  nlohmann::json file;
+  file["models"] = nlohmann::json::array();
+  for (const IdentifiedModel& m : r.identification.models) file["models"].push_back(ToJson(m));
+  file["best"] = r.identification.models.front().method;
+  file["ranked_by"] = "validation_fit_percent";
+  std::ofstream out(r.model_file);
+  out << file.dump(2) << "\n";
+  if (!out) throw DataError(fmt::format("{}: cannot write", r.model_file));
+  return true;
+}
+
+// Stage 5: the best-ranked model a controller can be built from with
+// `settings`. False (with r.message) when there is none.
+bool ChooseModel(CommissionResult& r, const CommissionOptions& o,
+                 const ControllerSettings& settings, double Ts, TransferFunction* model) {
+  std::vector<std::string> skipped;
+  for (const IdentifiedModel& m : r.identification.models) {
+    const std::string spec = r.model_file + "#" + m.method;
+    try {
+      *model = ParseControllerModel(spec);
+      (void)MakeController(*model, Ts, WithModelInputMap(ToControllerSpec(settings), spec));
+      r.chosen_model = m.method;
+      r.controller_model = spec;
+      r.chosen_reason = fmt::format(
+          "best held-out fit ({:.1f} %, estimation {:.1f} %) among the models a {} can use",
+          m.validation_fit_percent, m.fit_percent, o.controller);
+      if (!skipped.empty()) {
+        std::string list;
+        for (const std::string& s : skipped) list += (list.empty() ? "" : "; ") + s;
+        r.chosen_reason += " (ranked above it but not usable: " + list + ")";
+      }
+      return true;
+    } catch (const std::exception& e) {
+      skipped.push_back(m.method + ": " + e.what());
+    }
+  }
+  r.message = "no identified model can be used by a controller";
+  for (const std::string& s : skipped) r.message += "; " + s;
+  return false;
+}
+
+// Stage 6: the verification staircase and load step on the plant, the
+// design repeated at half the aggressiveness after an overshoot failure.
+// False when stopped on request (r.termination and r.message set).
+bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
+            ControllerSettings settings, const TransferFunction& model, double Ts) {
+  const CommissionExperiment& ex = r.experiment;
+  const double range = ex.range_max - ex.range_min;
+  std::vector<double> levels;
+  for (double f : {0.0, 0.25, 0.6, 0.85, 1.0, 0.7, 0.35, 0.1, 0.0})
+    levels.push_back(ex.range_min + f * range);
+  const double dwell =
+      std::isnan(o.verification_dwell) ? std::max(2.0, 4 * o.settling) : o.verification_dwell;
+  const double load = std::isnan(o.load_step) ? -0.08 * range : o.load_step;
+  const auto setpoint =
+      ParseSignal(fmt::format("staircase:levels={},dwell={:g}", LevelList(levels), dwell));
+  ClosedLoopOptions cl;
+  cl.duration = static_cast<double>(levels.size()) * dwell;
+  cl.load_steps.push_back({(static_cast<double>(levels.size()) - 0.5) * dwell, load});
+  cl.actuator.u_min = settings.limits.u_min;
+  cl.actuator.u_max = settings.limits.u_max;
+  double aggressiveness = o.aggressiveness;
+  for (int attempt = 0; attempt <= o.retunes; ++attempt) {
+    Report(o, "verify", static_cast<double>(attempt) / (o.retunes + 1));
+    if (o.stop != nullptr && o.stop->load()) {
+      r.termination = Termination::kStopped;
+      r.message = "stopped on request before the verification";
+      return false;
+    }
+    settings.aggressiveness = aggressiveness;
+    CommissionAttempt a;
+    a.aggressiveness = aggressiveness;
+    BuiltController built = MakeController(
+        model, Ts, WithModelInputMap(ToControllerSpec(settings), r.controller_model));
+    a.design = built.Summary();
+    a.settings = built.SettingsToJson();
+    a.result = SimulateClosedLoop(*built.controller, plant, *setpoint, cl);
+    plant.Advance(settings.limits.u_min);  // the safe state after the run
+    r.plant_time += cl.duration;
+    a.failures = Judge(a.result.metrics, o, range, ex.noise_peak_to_peak);
+    a.passed = a.failures.empty();
+    r.attempts.push_back(std::move(a));
+    r.settings = settings;
+    const bool overshoot_failed =
+        std::any_of(r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
+                    [](const std::string& f) { return f.rfind("overshoot", 0) == 0; });
+    if (r.attempts.back().passed || !overshoot_failed) break;
+    aggressiveness *= 0.5;
+  }
+  Report(o, "verify", 1.0);
+  return true;
+}
+
 }  // namespace
 
 bool CommissionOptions::IsValid(std::string* error) const {
@@ -449,81 +647,19 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     r.plant_time = ex.duration;
   };
 
-  // ---- stages 1-3: the experiment
-  Probe p;
-  std::size_t est_from = 0, est_to = 0, val_to = 0;
+  // Stages 1-3: the experiment.
+  ExcitationSamples x;
   try {
+    Probe p;
     error = ProbeAndSweep(rec, o, u_lo, u_hi, ex, p);
-    if (error.empty()) {
-      if (std::isfinite(o.range_min)) {
-        const double tol = 0.01 * (ex.reachable_max - ex.reachable_min);
-        if (o.range_min < ex.reachable_min - tol || o.range_max > ex.reachable_max + tol) {
-          error = fmt::format(
-              "the range {:g}..{:g} cannot be reached: the output reaches {:.4g}..{:.4g} between "
-              "the inputs {:g} and {:g}",
-              o.range_min, o.range_max, ex.reachable_min, ex.reachable_max, u_lo, u_hi);
-        }
-        ex.range_min = o.range_min;
-        ex.range_max = o.range_max;
-      } else {
-        const double span = ex.reachable_max - ex.reachable_min;
-        ex.range_min = ex.reachable_min + 0.05 * span;
-        ex.range_max = ex.reachable_max - 0.05 * span;
-      }
-    }
-    ex.dwell = std::max(ex.dead_time + 4 * ex.time_constant, 10 * Ts);
-    ex.dwell = std::ceil(ex.dwell / Ts - 1e-9) * Ts;
-    const double left = o.budget - rec.time();
-    if (error.empty() && left < 11 * ex.dwell) {
-      error = fmt::format(
-          "the budget of {:g} s is too short for the time scale found (tau = {:.3g} s, theta = "
-          "{:.3g} s: {:.3g} s per level): the probe and sweep took {:.1f} s and the excitation "
-          "needs at least {:.1f} s more (a budget of {:.0f} s or more)",
-          o.budget, ex.time_constant, ex.dead_time, ex.dwell, rec.time(), 11 * ex.dwell,
-          std::ceil(rec.time() + 11 * ex.dwell));
-    }
+    if (error.empty()) error = PlanExcitation(o, rec, u_lo, u_hi, ex);
     if (!error.empty()) {
       rec.Hold(u_lo, Ts);
       finish_data();
       r.message = error;
       return r;
     }
-    // The inputs that cover the range (monotone interpolation through the
-    // three measured points; the whole input range when they are not monotone).
-    std::vector<std::pair<double, double>> map = {
-        {p.y_rest, u_lo}, {p.y_mid, p.u_mid}, {p.y_high, u_hi}};
-    std::sort(map.begin(), map.end());
-    const bool monotone = (p.y_mid - p.y_rest) * (p.y_high - p.y_mid) > 0;
-    const double span = ex.range_max - ex.range_min;
-    double ua = u_lo, ub = u_hi;
-    if (monotone) {
-      ua = Interpolate(map, ex.range_min - 0.05 * span);
-      ub = Interpolate(map, ex.range_max + 0.05 * span);
-      if (ua > ub) std::swap(ua, ub);
-    }
-    const int n_est = std::max(8, static_cast<int>(0.7 * left / ex.dwell));
-    const int n_val = std::max(3, static_cast<int>((left - n_est * ex.dwell) / ex.dwell));
-    std::mt19937_64 engine(o.seed);
-    for (int i = 0; i < n_est; ++i)
-      ex.estimation_levels.push_back(ua + (ub - ua) * i / (n_est - 1));
-    for (int i = 0; i < n_val; ++i)
-      ex.validation_levels.push_back(ua + (ub - ua) * (i + 0.5) / n_val);
-    Shuffle(ex.estimation_levels, engine);
-    Shuffle(ex.validation_levels, engine);
-    Report(o, "excitation", 0.0);
-    const double total = (n_est + n_val) * ex.dwell;
-    est_from = rec.size();
-    for (double u : ex.estimation_levels) {
-      rec.Hold(u, ex.dwell);
-      Report(o, "excitation", (rec.size() - est_from) * Ts / total);
-    }
-    est_to = rec.size();
-    for (double u : ex.validation_levels) {
-      rec.Hold(u, ex.dwell);
-      Report(o, "excitation", (rec.size() - est_from) * Ts / total);
-    }
-    val_to = rec.size();
-    rec.Safe();
+    x = RunExcitation(rec, o, p, u_lo, u_hi, ex);
   } catch (const ExperimentEnded& e) {
     finish_data();
     r.termination = e.termination;
@@ -531,120 +667,23 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     return r;
   }
   finish_data();
-  ex.estimation = rec.Slice(est_from, est_to, act.input, act.output);
-  ex.validation = rec.Slice(est_to, val_to, act.input, act.output);
+  ex.estimation = rec.Slice(x.est_from, x.est_to, act.input, act.output);
+  ex.validation = rec.Slice(x.est_to, x.val_to, act.input, act.output);
 
-  // ---- stage 4: identification, ranked on the held-out sequence
-  Report(o, "identify", 0.0);
-  IdentifyOptions io;
-  io.nonlinear.choose_structure = true;
-  // The input delay of the polynomial models from the probe's dead time.
-  IdentifyRequest request;
-  request.nk = std::max(1, static_cast<int>(std::floor(ex.dead_time / Ts + 1e-9)));
-  r.identification = IdentifyModels(
-      o.methods, ex.estimation, request, io, &ex.validation,
-      [&](std::size_t done, std::size_t total, const std::string&) {
-        Report(o, "identify", static_cast<double>(done) / static_cast<double>(total));
-      });
-  if (r.identification.models.empty()) {
-    r.message = "no model could be identified: " + r.identification.message;
-    return r;
-  }
-  r.model_file = (std::filesystem::path(o.directory) / "models.json").string();
-  {
-    nlohmann::json file;
-    file["models"] = nlohmann::json::array();
-    for (const IdentifiedModel& m : r.identification.models) file["models"].push_back(ToJson(m));
-    file["best"] = r.identification.models.front().method;
-    file["ranked_by"] = "validation_fit_percent";
-    std::ofstream out(r.model_file);
-    out << file.dump(2) << "\n";
-    if (!out) throw DataError(fmt::format("{}: cannot write", r.model_file));
-  }
-
-  // ---- stage 5: the design on the best-ranked model a controller can use
+  // Stages 4-6: models, design, verification.
+  if (!IdentifyAndSave(r, o, Ts)) return r;
   Report(o, "design", 0.0);
   ControllerSettings settings;
   settings.controller = o.controller;
   settings.rule = "auto";
   settings.overshoot = o.overshoot;
+  settings.aggressiveness = o.aggressiveness;
   settings.limits.u_min = u_lo;
   settings.limits.u_max = u_hi;
   settings.input_gaps = InputGapsToString(gaps);
-  std::vector<std::string> skipped;
   TransferFunction model;
-  for (const IdentifiedModel& m : r.identification.models) {
-    const std::string spec = r.model_file + "#" + m.method;
-    try {
-      model = ParseControllerModel(spec);
-      ControllerSettings s = settings;
-      s.aggressiveness = o.aggressiveness;
-      (void)MakeController(model, Ts, WithModelInputMap(ToControllerSpec(s), spec));
-      r.chosen_model = m.method;
-      r.controller_model = spec;
-      r.chosen_reason = fmt::format(
-          "best held-out fit ({:.1f} %, estimation {:.1f} %) among the models a {} can use",
-          m.validation_fit_percent, m.fit_percent, o.controller);
-      if (!skipped.empty()) {
-        std::string list;
-        for (const std::string& s2 : skipped) list += (list.empty() ? "" : "; ") + s2;
-        r.chosen_reason += " (ranked above it but not usable: " + list + ")";
-      }
-      break;
-    } catch (const std::exception& e) {
-      skipped.push_back(m.method + ": " + e.what());
-    }
-  }
-  if (r.chosen_model.empty()) {
-    r.message = "no identified model can be used by a controller";
-    for (const std::string& s : skipped) r.message += "; " + s;
-    return r;
-  }
-
-  // ---- stage 6: verification on the plant, redesigned on overshoot
-  const double range = ex.range_max - ex.range_min;
-  std::vector<double> levels;
-  for (double f : {0.0, 0.25, 0.6, 0.85, 1.0, 0.7, 0.35, 0.1, 0.0})
-    levels.push_back(ex.range_min + f * range);
-  const double dwell =
-      std::isnan(o.verification_dwell) ? std::max(2.0, 4 * o.settling) : o.verification_dwell;
-  const double load = std::isnan(o.load_step) ? -0.08 * range : o.load_step;
-  const auto setpoint =
-      ParseSignal(fmt::format("staircase:levels={},dwell={:g}", LevelList(levels), dwell));
-  ClosedLoopOptions cl;
-  cl.duration = static_cast<double>(levels.size()) * dwell;
-  cl.load_steps.push_back({(static_cast<double>(levels.size()) - 0.5) * dwell, load});
-  cl.actuator.u_min = u_lo;
-  cl.actuator.u_max = u_hi;
-  double aggressiveness = o.aggressiveness;
-  for (int attempt = 0; attempt <= o.retunes; ++attempt) {
-    Report(o, "verify", static_cast<double>(attempt) / (o.retunes + 1));
-    if (o.stop != nullptr && o.stop->load()) {
-      r.termination = Termination::kStopped;
-      r.message = "stopped on request before the verification";
-      return r;
-    }
-    settings.aggressiveness = aggressiveness;
-    CommissionAttempt a;
-    a.aggressiveness = aggressiveness;
-    BuiltController built = MakeController(
-        model, Ts, WithModelInputMap(ToControllerSpec(settings), r.controller_model));
-    a.design = built.Summary();
-    a.settings = built.SettingsToJson();
-    a.result = SimulateClosedLoop(*built.controller, plant, *setpoint, cl);
-    plant.Advance(u_lo);  // the safe state after the run
-    r.plant_time += cl.duration;
-    a.failures = Judge(a.result.metrics, o, range, ex.noise_peak_to_peak);
-    a.passed = a.failures.empty();
-    r.attempts.push_back(std::move(a));
-    r.settings = settings;
-    const bool overshoot_failed =
-        std::any_of(r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
-                    [](const std::string& f) { return f.rfind("overshoot", 0) == 0; });
-    if (r.attempts.back().passed || !overshoot_failed) break;
-    aggressiveness *= 0.5;
-  }
-  Report(o, "verify", 1.0);
+  if (!ChooseModel(r, o, settings, Ts, &model)) return r;
+  if (!Verify(r, plant, o, settings, model, Ts)) return r;
   if (r.passed()) {
     r.termination = Termination::kSuccess;
     r.message = fmt::format(

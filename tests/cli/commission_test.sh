@@ -7,14 +7,19 @@ source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 
 "$PNEUMID" commission --help | grep -q -- "--budget" || fail "--help"
 
-"$PNEUMID" commission --plant ipa -o "$TMP/c" --json > "$TMP/c.json"
+"$PNEUMID" commission --plant ipa -o "$TMP/c" --json --report > "$TMP/c.json"
 rc=$?
 # 0: the specification is met; 4: a controller that misses it (stated).
 [ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission exited $rc"
 for f in data.csv models.json controller.toml verification.csv experiment.png verification.png \
-  c/pneumid_ctrl.c c/pneumid_ctrl.h; do
+  c/pneumid_ctrl.c c/pneumid_ctrl.h report.html; do
   [ -s "$TMP/c/$f" ] || fail "commission did not write $f"
 done
+# The report: every section and one figure per verification plus the two model figures.
+for s in "Experiment" "Models" "Verification on the plant" "held-out"; do
+  grep -q "$s" "$TMP/c/report.html" || fail "report.html: no '$s'"
+done
+[ "$(grep -c "<svg" "$TMP/c/report.html")" -ge 3 ] || fail "report.html: fewer than 3 figures"
 $PY - "$TMP/c.json" <<'PYEOF' || fail "commission JSON"
 import json, sys
 j = json.load(open(sys.argv[1]))
