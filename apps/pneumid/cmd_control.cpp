@@ -179,9 +179,11 @@ std::vector<ControlRun> SimulateControl(const ControlCli& c) {
   const std::string plant_spec = c.plant.empty() ? c.model : c.plant;
   // The plant's physical input range (IPA: duty 0..100 %) unless --u-min/--u-max say otherwise.
   ControllerSettings settings = c.controller;
-  ApplyPlantInputRange(*MakePlant(plant_spec, c.Ts, po), settings.limits.u_min,
-                       settings.limits.u_max);
-  ApplyPlantInputGaps(*MakePlant(plant_spec, c.Ts, po), settings.input_gaps);
+  {
+    const auto plant = MakePlant(plant_spec, c.Ts, po);
+    ApplyPlantInputRange(*plant, settings.limits.u_min, settings.limits.u_max);
+    ApplyPlantInputGaps(*plant, settings.input_gaps);
+  }
   cl.actuator.u_min = settings.limits.u_min;
   cl.actuator.u_max = settings.limits.u_max;
   const ControllerSpec base = WithModelInputMap(ToControllerSpec(settings), c.model);

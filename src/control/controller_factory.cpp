@@ -334,23 +334,23 @@ BuiltController BuildController(const PredictionModel& model, const ControllerSp
 // inner controller sees g^-1(y), and behind an input map its input is v.
 // So does the modulator over the input gaps: it acts on the input that
 // reaches the actuator.
-BuiltController MakeController(const TransferFunction& model, double Ts,
-                               const ControllerSpec& spec) {
-  BuiltController b = BuildController(model, Ts, spec);
+namespace {
+BuiltController WithOuterLayers(BuiltController b, const ControllerSpec& spec) {
   if (!spec.input_gaps.empty())
     b.controller = std::make_unique<ModulatedController>(std::move(b.controller), spec.input_gaps,
                                                          spec.limits);
   b.controller->SetMeasurementGuard(spec.guard);
   return b;
 }
+}  // namespace
+
+BuiltController MakeController(const TransferFunction& model, double Ts,
+                               const ControllerSpec& spec) {
+  return WithOuterLayers(BuildController(model, Ts, spec), spec);
+}
 
 BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec) {
-  BuiltController b = BuildController(model, spec);
-  if (!spec.input_gaps.empty())
-    b.controller = std::make_unique<ModulatedController>(std::move(b.controller), spec.input_gaps,
-                                                         spec.limits);
-  b.controller->SetMeasurementGuard(spec.guard);
-  return b;
+  return WithOuterLayers(BuildController(model, spec), spec);
 }
 
 }  // namespace pneumid
