@@ -59,10 +59,12 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
   app.add_option("--safe-input", s.safe_input,
                  "Input applied on a faulty sample instead of holding the last one (e.g. the "
                  "valves' vented duty)");
-  app.add_option("--input-gaps", s.input_gaps,
-                 "Inputs the actuator cannot hold, LO:HI[,LO:HI] (IPA: 0:15,85:100), or 'plant' "
-                 "for the simulated plant's own: the input is sigma-delta modulated across them, "
-                 "so that their outputs are reached on average instead of by a limit cycle");
+  app.add_option(
+      "--input-gaps", s.input_gaps,
+      "Inputs the actuator cannot hold, LO:HI[,LO:HI] (IPA: 0:15,85:100), or 'plant' "
+      "for the simulated plant's own, or 'none' (a [controller] input_gaps off): the input "
+      "is sigma-delta modulated across them, so that their outputs are reached on "
+      "average instead of by a limit cycle");
 }
 
 void ApplyPlantInputGaps(const Plant& plant, std::string& input_gaps) {

@@ -852,12 +852,24 @@ void GenerateModulator(const ModulatedController& c, Module& m, const std::strin
   const DutyModulator& mod = c.modulator();
   m.Member({Field::kReal, stem + "err", 0, "carried modulation error (input units)"});
   m.Member({Field::kReal, stem + "v", 0, "inner controller's request v"});
-  // w clipped to the input range (what lies beyond it is not carried).
+  // A request at or beyond an end of the input range: that end, nothing
+  // carried; else a = w clipped to the range unless a gap holds w.
   std::string clip;
+  if (std::isfinite(mod.u_min())) {
+    clip +=
+        fmt::format("  if (s->{0}v <= {1}) {{\n    s->{0}err = PFX_ZERO;\n    return {1};\n  }}\n",
+                    stem, m.Literal(mod.u_min()));
+  }
+  if (std::isfinite(mod.u_max())) {
+    clip +=
+        fmt::format("  if (s->{0}v >= {1}) {{\n    s->{0}err = PFX_ZERO;\n    return {1};\n  }}\n",
+                    stem, m.Literal(mod.u_max()));
+  }
+  clip += "  w = s->" + stem + "v + s->" + stem + "err;\n  a = w;\n";
   if (std::isfinite(mod.u_min()))
-    clip += fmt::format("  if (w < {0}) w = {0};\n", m.Literal(mod.u_min()));
+    clip += fmt::format("  if (a < {0}) a = {0};\n", m.Literal(mod.u_min()));
   if (std::isfinite(mod.u_max()))
-    clip += fmt::format("  if (w > {0}) w = {0};\n", m.Literal(mod.u_max()));
+    clip += fmt::format("  if (a > {0}) a = {0};\n", m.Literal(mod.u_max()));
   std::string chain;
   for (const InputGap& g : mod.gaps()) {
     chain += fmt::format("{0}if (w > {1} && w < {2}) a = (w - {1} < {2} - w) ? {1} : {2};\n",
@@ -873,9 +885,7 @@ PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
   PFX_real w, a, e;
   s->{0}v = PFX_{0}step(s, setpoint, measurement);
   if (!PFX_ISFINITE(s->{0}v)) return s->{0}v;
-  w = s->{0}v + s->{0}err;
-{3}  a = w;
-{1}  e = w - a;
+{3}{1}  e = w - a;
   s->{0}err = e < -{2} ? -{2} : ({2} < e ? {2} : e);
   return a;
 }}

@@ -147,7 +147,7 @@ namespace {
 // linear part with the map's image of the limits, behind the map's inverse.
 template <typename Make>
 BuiltController WithInverseMap(const ControllerSpec& spec, Make make) {
-  const StaticMap map = InvertibleInputMap(*spec.input_map);
+  const StaticMap map = InvertibleInputMap(MapThroughGaps(*spec.input_map, spec.input_gaps));
   ControllerSpec inner = spec;
   inner.input_map.reset();
   inner.limits = InnerLimits(map, spec.limits);

@@ -18,6 +18,7 @@ std::string InputGapsToString(const std::vector<InputGap>& gaps) {
 
 std::vector<InputGap> ParseInputGaps(const std::string& text) {
   std::vector<InputGap> gaps;
+  if (text == "none") return gaps;
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
@@ -61,16 +62,23 @@ DutyModulator::DutyModulator(std::vector<InputGap> gaps, double u_min, double u_
 }
 
 double DutyModulator::Next(double v) {
-  const double w = std::clamp(v + error_, u_min_, u_max_);
-  double a = w;
+  // The request is clipped to the actuator's range (what lies beyond it is
+  // not carried); the carried error may take w past an end of the range,
+  // where the end is applied and the rest is carried, so that the mean of
+  // the applied inputs follows a request near an end without bias.
+  if (v <= u_min_ || v >= u_max_) {  // saturated: the end, nothing carried
+    error_ = 0.0;
+    return std::clamp(v, u_min_, u_max_);
+  }
+  const double w = v + error_;
+  double a = std::clamp(w, u_min_, u_max_);
   for (const InputGap& g : gaps_) {
     if (w > g.lo && w < g.hi) {
       a = (w - g.lo < g.hi - w) ? g.lo : g.hi;
       break;
     }
   }
-  // A request held outside the gaps empties the error; what lies beyond the
-  // actuator's range was clipped off w above and is not carried.
+  // A request held outside the gaps empties the error.
   error_ = std::clamp(w - a, -max_error_, max_error_);
   return a;
 }

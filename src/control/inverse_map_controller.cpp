@@ -98,6 +98,29 @@ StaticMap InvertibleInputMap(const StaticMap& f, double tolerance) {
   return MonotoneEnvelope(f, "input map");
 }
 
+StaticMap MapThroughGaps(const StaticMap& f, const std::vector<InputGap>& gaps) {
+  if (gaps.empty()) return f;
+  auto inside = [&](double u) {
+    return std::any_of(gaps.begin(), gaps.end(),
+                       [&](const InputGap& g) { return u > g.lo && u < g.hi; });
+  };
+  std::vector<std::pair<double, double>> knots;
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (!inside(f.u()[i])) knots.emplace_back(f.u()[i], f.y()[i]);
+  for (const InputGap& g : gaps)
+    for (double e : {g.lo, g.hi})
+      if (!inside(e)) knots.emplace_back(e, f.Evaluate(e));
+  std::sort(knots.begin(), knots.end());
+  std::vector<double> u, y;
+  for (const auto& [ku, ky] : knots) {
+    if (!u.empty() && ku <= u.back()) continue;  // a gap end on a knot
+    u.push_back(ku);
+    y.push_back(ky);
+  }
+  if (u.size() < 2) return f;
+  return StaticMap(std::move(u), std::move(y), f.extrapolation());
+}
+
 StaticMap MonotoneEnvelope(const StaticMap& f, const std::string& what) {
   std::vector<double> y = f.y();
   for (std::size_t i = 1; i < y.size(); ++i) y[i] = std::max(y[i], y[i - 1]);

@@ -38,9 +38,12 @@ assert len(v["steps"]) >= 8, len(v["steps"])
 # The chosen model is the best held-out fit among the usable ones, and it holds.
 fits = {m["method"]: m["validation_fit_percent"] for m in j["models"]}
 assert fits[j["chosen_model"]] > 90.0, fits
-# Modulation across the valves' dead bands: worst overshoot within 8 %
-# (the specification is 5 %; JSON says pass or which step fails).
-assert v["overshoot_percent"] < 8.0, v["overshoot_percent"]
+# Modulation across the valves' dead bands, behind the chord of the map
+# inside them: the first design meets the 5 % specification on the plant
+# (before the chord it overshot 5.3 % and commission fell back to half the
+# aggressiveness).
+assert v["overshoot_percent"] <= 5.0, v["overshoot_percent"]
+assert len(j["attempts"]) == 1, [a["aggressiveness"] for a in j["attempts"]]
 PYEOF
 
 # The configuration runs as written: control, codegen and run.
@@ -50,8 +53,25 @@ $PY - "$TMP/ctl.json" <<'PYEOF' || fail "control --config metrics"
 import json, sys
 j = json.load(open(sys.argv[1]))
 assert "sigma-delta" in j["controller"], j["controller"]
-assert j["overshoot_percent"] < 8.0, j["overshoot_percent"]
+assert j["overshoot_percent"] < 6.0, j["overshoot_percent"]
 assert all(s["settled"] for s in j["steps"]), j["steps"]
+PYEOF
+# IAE against the paper's DMC on the same scenario (target 0.7 x; 0.70
+# measured, 0.86 before the chord); without modulation ('none') the loop
+# cycles at 150 N, inside the exhaust's dead band.
+"$PNEUMID" control --controller dmc --model fopdt-paper --rule shridhar-cooper --plant ipa \
+  --setpoint "staircase:levels=10 50 100 150 180 120 60 10,dwell=2" --duration 18 \
+  --load-step at=17,size=-15 --json > "$TMP/dmc.json" || fail "paper DMC"
+"$PNEUMID" control --config "$TMP/c/controller.toml" --input-gaps none \
+  --setpoint "staircase:levels=10 50 100 150 180 120 60 10,dwell=2" --duration 18 \
+  --load-step at=17,size=-15 --json > "$TMP/none.json" || fail "control --input-gaps none"
+$PY - "$TMP/ctl.json" "$TMP/dmc.json" "$TMP/none.json" <<'PYEOF' || fail "IAE and --input-gaps none"
+import json, sys
+ctl, dmc, none = (json.load(open(f)) for f in sys.argv[1:4])
+assert ctl["iae"] <= 0.75 * dmc["iae"], (ctl["iae"], dmc["iae"])
+assert "sigma-delta" not in none["controller"], none["controller"]
+at150 = lambda j: next(s["ripple"] for s in j["steps"] if abs(s["to"] - 150) < 1e-9)
+assert at150(none) > 2 * at150(ctl), (at150(none), at150(ctl))
 PYEOF
 "$PNEUMID" codegen --config "$TMP/c/controller.toml" -o "$TMP/gen" > "$TMP/gen.txt" || fail "codegen --config"
 grep -q "sigma-delta" "$TMP/gen.txt" "$TMP"/gen/*.c 2>/dev/null || fail "codegen: no modulator layer"

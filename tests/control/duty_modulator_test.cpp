@@ -66,6 +66,7 @@ TEST(DutyModulator, ParsesAndPrintsGaps) {
   EXPECT_EQ(ParseInputGaps("0:15,85:100"), kIpaGaps);
   EXPECT_EQ(InputGapsToString(kIpaGaps), "0:15,85:100");
   EXPECT_TRUE(ParseInputGaps("").empty());
+  EXPECT_TRUE(ParseInputGaps("none").empty());
   EXPECT_THROW(ParseInputGaps("15:0"), InvalidArgument);
   EXPECT_THROW(ParseInputGaps("0:15,10:20"), InvalidArgument);
   EXPECT_THROW(ParseInputGaps("0-15"), InvalidArgument);

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/control/duty_modulator.hpp"
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
@@ -222,6 +223,44 @@ TEST(InvertibleInputMapTest, SmallDipsUseTheEnvelopeLargeTurnsAreRefused) {
         InvertibleInputMap(StaticMap({0, 50, 100}, {0, 80, 40}));
       },
       ThrowsMessage<InvalidArgument>(HasSubstr("falls by 40 after rising, more than 2 %")));
+}
+
+}  // namespace
+}  // namespace pneumid
+
+namespace pneumid {
+namespace {
+
+// Inside an input gap the modulator alternates between the gap's ends, so
+// the actuator's mean output is the chord of f between them: MapThroughGaps
+// must equal the mean of f over the modulated inputs, for a map whose knots
+// inside the gaps are anything (here a smooth fit over a jump).
+TEST(MapThroughGapsTest, IsTheMeanOfTheMapOverTheModulatedInputs) {
+  const StaticMap f({0.8, 10.4, 20.0, 50.0, 80.5, 90.1, 99.6},
+                    {0.15, 8.8, 17.8, 57.2, 130.0, 170.0, 193.0});
+  const std::vector<InputGap> gaps = {{0.0, 15.0}, {85.0, 100.0}};
+  const StaticMap g = MapThroughGaps(f, gaps);
+  // Knots: the gap ends replace 0.8, 10.4, 90.1 and 99.6.
+  EXPECT_EQ(g.u(), (std::vector<double>{0.0, 15.0, 20.0, 50.0, 80.5, 85.0, 100.0}));
+  EXPECT_DOUBLE_EQ(g.Evaluate(0.0), 0.15);  // clamped below the first knot
+  EXPECT_DOUBLE_EQ(g.Evaluate(100.0), 193.0);
+  EXPECT_DOUBLE_EQ(g.Evaluate(50.0), 57.2);  // unchanged between the gaps
+  // Requests within half a gap of its middle make the modulator apply only
+  // the gap's ends (or the range's end): the chord is exact. Further out it
+  // also applies inputs beyond the gap, where f bends, and the chord is
+  // close (Jensen's gap of the piecewise-linear f).
+  auto mean_of_f = [&](double request) {
+    DutyModulator m(gaps, 0.0, 100.0);
+    double mean = 0.0;
+    const int n = 6000;
+    for (int k = 0; k < n; ++k) mean += f.Evaluate(m.Next(request));
+    return mean / n;
+  };
+  for (double request : {3.0, 5.0, 7.5, 92.5, 95.0, 99.0})
+    EXPECT_NEAR(g.Evaluate(request), mean_of_f(request), 0.02) << "request " << request;
+  for (double request : {12.0, 86.0})
+    EXPECT_NEAR(g.Evaluate(request), mean_of_f(request), 1.0) << "request " << request;
+  EXPECT_EQ(MapThroughGaps(f, {}).u(), f.u());
 }
 
 }  // namespace

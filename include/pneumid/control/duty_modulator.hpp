@@ -32,7 +32,7 @@ namespace pneumid {
 
 /// "0:15,85:100" for the gaps (0, 15) and (85, 100); "" for none.
 std::string InputGapsToString(const std::vector<InputGap>& gaps);
-/// The gaps of "LO:HI[,LO:HI...]" (empty text: none).
+/// The gaps of "LO:HI[,LO:HI...]" (empty text or "none": none).
 /// @throws InvalidArgument naming the item that is not LO:HI with finite LO < HI,
 /// or gaps that overlap.
 std::vector<InputGap> ParseInputGaps(const std::string& text);
@@ -45,10 +45,11 @@ class DutyModulator {
   explicit DutyModulator(std::vector<InputGap> gaps,
                          double u_min = -std::numeric_limits<double>::infinity(),
                          double u_max = std::numeric_limits<double>::infinity());
-  /// The input to apply for the request v (finite): w = v + e clipped to
-  /// [u_min, u_max] (what lies beyond the range is not carried), then the
-  /// nearer end of a gap that holds it; v outside every gap and with no
-  /// carried error passes unchanged.
+  /// The input to apply for the request v (finite): at or beyond an end of
+  /// [u_min, u_max] that end, with nothing carried; else w = v + e, then the
+  /// nearer end of a gap that holds w, else w clipped to the range, and the
+  /// error w - a is carried. v outside every gap and with no carried error
+  /// passes unchanged.
   double Next(double v);
   /// Clears the carried error.
   void Reset() { error_ = 0.0; }

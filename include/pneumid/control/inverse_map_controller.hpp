@@ -25,9 +25,11 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pneumid/control/controller.hpp"
 #include "pneumid/lti/static_map.hpp"
+#include "pneumid/plant/actuator.hpp"
 
 namespace pneumid {
 
@@ -55,7 +57,7 @@ class InverseMapController : public Controller {
   std::string Describe() const override;
 
   const Controller& inner() const { return *inner_; }  ///< The controller designed on G.
-  const StaticMap& map() const { return map_; }  ///< The actuator's static map f (u -> v).
+  const StaticMap& map() const { return map_; }        ///< The actuator's static map f (u -> v).
   /// The actuator's limits on u.
   const InputLimits& limits() const { return limits_; }
   /// v of the last Update() (the inner controller's request).
@@ -119,6 +121,14 @@ class OutputMapController : public Controller {
 /// @throws InvalidArgument for a map that falls by more (the message gives
 /// the drop).
 StaticMap InvertibleInputMap(const StaticMap& f, double tolerance = 0.02);
+
+/// The map an actuator with input gaps realises on average: inside each gap
+/// (lo, hi) the input is modulated between lo and hi (DutyModulator), so the
+/// mean of f over a modulation cycle is the chord (1 - a) f(lo) + a f(hi)
+/// at the mean input (1 - a) lo + a hi. The knots strictly inside a gap are
+/// replaced by knots at its ends (f there by its extrapolation when an end
+/// lies beyond the knots). `f` itself without gaps.
+StaticMap MapThroughGaps(const StaticMap& f, const std::vector<InputGap>& gaps);
 
 /// The running maximum of a map's knot values (non-decreasing), as the
 /// inverses of fitted maps use it.
