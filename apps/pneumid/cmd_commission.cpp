@@ -14,7 +14,6 @@
 #include <atomic>
 #include <csignal>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 
@@ -22,19 +21,16 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "pneumid/codegen/c_codegen.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/spec.hpp"
-#include "pneumid/data/csv.hpp"
 #include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/realtime/io_factory.hpp"
 #include "pneumid/realtime/io_plant.hpp"
 #include "pneumid/realtime/realtime_config.hpp"
-#include "pneumid/report/figures.hpp"
 #include "pneumid/workflow/commission.hpp"
-#include "pneumid/workflow/commission_report.hpp"
+#include "pneumid/workflow/commission_files.hpp"
 #include "progress.hpp"
 #include "validators.hpp"
 
@@ -106,63 +102,6 @@ void ParseSpecification(const std::string& text, CommissionOptions& o) {
       throw InvalidArgument(
           fmt::format("--spec: unknown key '{}' (expected overshoot, settling)", key));
   }
-}
-
-std::string TomlString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
-// controller.toml: model, controller and its settings, limits, loop, I/O, safety.
-void WriteControllerToml(const std::string& path, const CommissionResult& r,
-                         const CommissionCli& c) {
-  std::ofstream out(path);
-  const ControllerSettings& s = r.settings;
-  const auto& ex = r.experiment;
-  out << "# Controller configuration written by `pneumid commission` (" << r.message << ").\n"
-      << "# Use: pneumid control --config " << path << " --setpoint ... --duration ...\n"
-      << "#      pneumid run --config " << path << "\n"
-      << "#      pneumid codegen --config " << path << " -o DIR\n\n";
-  out << "[controller]\n"
-      << "model = " << TomlString(std::filesystem::absolute(r.controller_model).string()) << "\n"
-      << "type = " << TomlString(s.controller) << "\n"
-      << "rule = \"auto\"\n"
-      << fmt::format("overshoot = {}\n", s.overshoot)
-      << fmt::format("aggressiveness = {}\n", s.aggressiveness)
-      << fmt::format("u_min = {}\nu_max = {}\n", s.limits.u_min, s.limits.u_max);
-  if (!s.input_gaps.empty()) out << "input_gaps = " << TomlString(s.input_gaps) << "\n";
-  out << "\n[loop]\n"
-      << fmt::format("period = {}\n", c.Ts)
-      << fmt::format("duration = {}\n\n", r.attempts.back().result.t.size() * c.Ts);
-  if (c.io == "sim") {
-    out << "[io]\nbackend = \"sim\"\n"
-        << "plant = "
-        << TomlString(c.plant_config.empty()
-                          ? c.plant
-                          : c.plant +
-                                ":config=" + std::filesystem::absolute(c.plant_config).string())
-        << "\n\n";
-  } else {
-    out << "[io]\nbackend = " << TomlString(c.io) << "\n\n";
-  }
-  const double span = ex.reachable_max - ex.reachable_min;
-  out << "[safety]\n"
-      << fmt::format("u_min = {}\nu_max = {}\n", s.limits.u_min, s.limits.u_max)
-      << fmt::format("y_min = {}\ny_max = {}\n", ex.reachable_min - 0.5 * span,
-                     ex.reachable_max + 0.5 * span);
-  if (!out) throw DataError(fmt::format("{}: cannot write", path));
-}
-
-void WriteVerificationCsv(const std::string& path, const ClosedLoopResult& cl) {
-  std::ofstream out(path);
-  out << "t,r,y,u,d\n";
-  for (Eigen::Index k = 0; k < cl.t.size(); ++k)
-    out << fmt::format("{:.6g},{},{},{},{}\n", cl.t(k), cl.r(k), cl.y(k), cl.u(k), cl.d(k));
-  if (!out) throw DataError(fmt::format("{}: cannot write", path));
 }
 
 void PrintSummary(const CommissionResult& r, const std::string& dir) {
@@ -248,56 +187,18 @@ void Run(CommissionCli& c) {
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
 
-  const std::filesystem::path dir(c.directory);
   const Actuator act = o.actuator ? *o.actuator : PlantActuator(*plant);
-  if (r.experiment.data.size() > 0) {
-    WriteCsv(r.experiment.data, (dir / "data.csv").string());
-  }
-  // The experiment with the chosen model simulated on it (held-out part last).
-  for (const IdentifiedModel& m : r.identification.models) {
-    if (m.method != r.chosen_model) continue;
-    NamedModel nm{m.method + " (" + m.structure + ")", m.discrete ? *m.discrete : m.tf, m.u0, m.y0,
-                  std::make_shared<const IdentifiedModel>(m)};
-    ComparisonFigureOptions fo;
-    fo.labels.output = act.output.unit == "N" ? "Force F [N]" : "Output y";
-    fo.labels.input = act.input.unit == "%" ? "Duty cycle u [%]" : "Input u";
-    fo.title = "commission: estimation sequence and the chosen model";
-    ModelComparisonFigure(r.experiment.estimation, {nm}, fo)
-        .Save((dir / "experiment.png").string());
-    fo.title = "commission: held-out sequence and the chosen model";
-    ModelComparisonFigure(r.experiment.validation, {nm}, fo)
-        .Save((dir / "validation.png").string());
-  }
-  if (!r.attempts.empty()) {
-    const ClosedLoopResult& cl = r.attempts.back().result;
-    WriteVerificationCsv((dir / "verification.csv").string(), cl);
-    WriteControllerToml((dir / "controller.toml").string(), r, c);
-    ClosedLoopFigureOptions options;
-    options.labels.time = "Time t [s]";
-    options.labels.output = act.output.unit == "N" ? "Force F [N]" : "Output y";
-    options.labels.input = act.input.unit == "%" ? "Duty cycle u [%]" : "Input u";
-    options.title = fmt::format("verification: {} on {} ({})", r.settings.controller,
-                                PlotLiteral(r.chosen_model), r.passed() ? "pass" : "fail");
-    ClosedLoopFigure(cl.t, cl.r, {{r.settings.controller, cl.y, cl.u}}, options)
-        .Save((dir / "verification.png").string());
-  }
-  if (c.report)
-    WriteCommissionReport(r, plant->Describe(), act.input, act.output,
-                          (dir / "report.html").string());
-  // The C module of the final design (pneumid codegen): DIR/c.
-  std::string c_module;
-  if (!r.attempts.empty()) {
-    try {
-      const BuiltController built =
-          MakeController(ParseControllerModel(r.controller_model), c.Ts,
-                         WithModelInputMap(ToControllerSpec(r.settings), r.controller_model));
-      const CodegenResult code = GenerateC(*built.controller, CodegenOptions{});
-      WriteCodegenFiles(code, (dir / "c").string());
-      c_module = (dir / "c").string();
-    } catch (const std::exception& e) {
-      c_module = std::string("not written: ") + e.what();
-    }
-  }
+  CommissionFilesOptions fo;
+  fo.directory = c.directory;
+  fo.Ts = c.Ts;
+  fo.io = c.io;
+  fo.plant = c.plant_config.empty()
+                 ? c.plant
+                 : c.plant + ":config=" + std::filesystem::absolute(c.plant_config).string();
+  fo.plant_description = plant->Describe();
+  fo.report = c.report;
+  const CommissionFiles files = WriteCommissionFiles(r, act, fo);
+  const std::string& c_module = files.c_module;
   if (c.json) {
     nlohmann::ordered_json j = r.ToJson();
     j["directory"] = c.directory;

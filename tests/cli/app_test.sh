@@ -24,6 +24,9 @@ ln -s /etc "$ROOT/link"
 (cd "$ROOT" && "$PNEUMID" identify demo.csv -m reaction-curve,arx,fit-p1d --detrend none \
   --json > "$TMP/identify_cli.json") || fail "identify --json"
 "$PNEUMID" tune --model fopdt-paper --Ts 0.01 --json > "$TMP/tune_cli.json" || fail "tune --json"
+rc=0
+"$PNEUMID" commission --plant ipa --budget 40 -o "$TMP/comm" --json > "$TMP/commission_cli.json" || rc=$?
+[ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission --json exited $rc"
 "$PNEUMID" tune --rule auto --model fopdt-paper --Ts 0.01 --plant ipa --json > "$TMP/tune_auto_cli.json" ||
   fail "tune --rule auto --plant ipa --json"
 
@@ -325,6 +328,33 @@ if expect(s, a, 400, "control without a set point") and "setpoint" not in a.get(
     fail(f"control without a set point: {a}")
 s, a = call("POST", "/api/control", b"{not json")
 expect(s, a, 400, "a body that is not JSON")
+
+# --- commission: the command's JSON, the files under the root, the limits
+s, a = call("POST", "/api/commission", {"plant": "ipa", "budget": 40, "dir": "comm"})
+if expect(s, a, 200, "commission"):
+    cli = json.load(open(tmp + "/commission_cli.json"))
+    for key in ["termination", "chosen_model", "plant_time", "passed"]:
+        if a.get(key) != cli.get(key):
+            fail(f"commission: {key} {a.get(key)} != the command's {cli.get(key)}")
+    for key in ["overshoot_percent", "settling_time", "iae"]:
+        if a["verification"].get(key) != cli["verification"].get(key):
+            fail(f"commission: verification {key} {a['verification'].get(key)} != "
+                 f"{cli['verification'].get(key)}")
+    if a.get("directory") != "comm" or not os.path.isfile(tmp + "/root/comm/controller.toml"):
+        fail(f"commission: files not in root/comm: {a.get('files')}")
+    if "[controller]" not in a.get("controller_toml", ""):
+        fail("commission: no controller_toml")
+    if len(a["trace"]["t"]) < 100 or len(a["experiment_trace"]["y"]) < 100:
+        fail("commission: traces missing")
+for bad, code in [({"dir": "../out"}, 403), ({"budget": 1e9}, 422), ({"budget": -1}, 422),
+                  ({"controller": "foo"}, 400), ({"range": [10]}, 400),
+                  ({"plant": "ipa:config=/etc/passwd"}, 403)]:
+    s, a = call("POST", "/api/commission", bad)
+    expect(s, a, code, f"commission with {bad}")
+s, a = call("POST", "/api/commission", {"range": [10, 400], "budget": 30})
+if expect(s, a, 200, "commission out of reach") and (
+        a.get("termination") != "failure" or "cannot be reached" not in a.get("message", "")):
+    fail(f"commission out of reach: {a.get('termination')}: {a.get('message')}")
 
 # --- exports
 s, a = call("POST", "/api/export/controller", dict(scenario, model="models.json#arx"), raw=True)

@@ -48,6 +48,7 @@ const state = {
   controlTimings: [] as { server: number; draw: number }[], // ms of the request and of the redraw
   tune: null as any,
   run: { state: 'idle', samples: 0, points: 0, frames: 0, summary: null as any },
+  commission: null as any, // the answer of POST /api/commission
 };
 (window as any).pneumid = state;
 
@@ -873,10 +874,126 @@ function bindExport(): void {
 }
 
 // ---------------------------------------------------------------------------
+// (6) Commission: POST /api/commission, the library's Commission() on the plant
+// ---------------------------------------------------------------------------
+const commissionExpPlot = new TimePlot($('cm-exp-plot'));
+const commissionPlot = new TimePlot($('cm-plot'));
+const commissionUPlot = new TimePlot($('cm-u-plot'));
+
+function commissionBody(): Record<string, unknown> {
+  const num = (id: string) => ($(id) as HTMLInputElement).value.trim();
+  const body: Record<string, unknown> = {
+    plant: num('cm-plant') || 'ipa',
+    budget: Number(num('cm-budget')),
+    controller: ($('cm-ctl') as HTMLSelectElement).value,
+    overshoot: Number(num('cm-overshoot')),
+    settling: Number(num('cm-settling')),
+  };
+  if (num('cm-lo') !== '' || num('cm-hi') !== '') body.range = [Number(num('cm-lo')), Number(num('cm-hi'))];
+  if (num('cm-dir') !== '') body.dir = num('cm-dir');
+  return body;
+}
+
+function cell(text: string, numeric = false): HTMLTableCellElement {
+  const td = document.createElement('td');
+  td.textContent = text;
+  if (numeric) td.className = 'numcol';
+  return td;
+}
+
+function drawCommission(res: any): void {
+  $('cm-result').hidden = false;
+  const msg = $('cm-message');
+  msg.textContent = `${res.termination}: ${res.message}`;
+  msg.dataset.passed = String(!!res.passed);
+  const models = $('cm-models').querySelector('tbody')!;
+  models.innerHTML = '';
+  for (const m of res.models ?? []) {
+    const tr = document.createElement('tr');
+    tr.append(cell(m.method), cell(fmt(m.fit_percent), true), cell(fmt(m.validation_fit_percent), true),
+              cell(m.method === res.chosen_model ? 'chosen' : ''));
+    models.appendChild(tr);
+  }
+  $('cm-chosen').textContent = res.chosen_reason ? 'chosen: ' + res.chosen_reason : '';
+  const attempts = $('cm-attempts').querySelector('tbody')!;
+  attempts.innerHTML = '';
+  for (const a of res.attempts ?? []) {
+    const tr = document.createElement('tr');
+    tr.append(cell(fmt(a.aggressiveness), true), cell(fmt(a.overshoot_percent), true),
+              cell(fmt(a.settling_time), true), cell(fmt(a.iae), true),
+              cell(a.passed ? 'pass' : 'fail: ' + (a.failures ?? []).join('; ')));
+    attempts.appendChild(tr);
+  }
+  const limits = $('cm-limits');
+  limits.innerHTML = '';
+  for (const [prefix, list] of [['limit', res.limits], ['try', res.suggestions]] as [string, string[]][]) {
+    for (const l of list ?? []) {
+      const li = document.createElement('li');
+      li.textContent = `${prefix}: ${l}`;
+      limits.appendChild(li);
+    }
+  }
+  const ex = res.experiment_trace;
+  if (ex && Array.isArray(ex.t)) {
+    commissionExpPlot.draw({
+      title: 'Experiment: input and output',
+      ylabel: 'output y',
+      y2label: 'input u',
+      series: [
+        { label: 'output y', color: COLORS[0] },
+        { label: 'input u', color: COLORS[1], scale: 'y2' },
+      ],
+    }, [ex.t, ex.y, ex.u]);
+  }
+  if (res.trace && Array.isArray(res.trace.t)) {
+    drawLoop(commissionPlot, commissionUPlot, 'Verification on the plant: set point and output', res.trace);
+  }
+  const files = res.files?.written ?? [];
+  $('cm-files').textContent = res.directory
+    ? `${files.length} files in ${res.directory} (under the root)`
+    : `${files.length} files in the app's temporary folder`;
+}
+
+async function startCommission(): Promise<void> {
+  clearError('cm-error');
+  const button = $('cm-start') as HTMLButtonElement;
+  button.disabled = true;
+  const st = $('cm-state');
+  st.textContent = 'commissioning … (experiment, identification, design, verification)';
+  st.dataset.state = 'running';
+  $('cm-result').hidden = true;
+  const t0 = performance.now();
+  try {
+    const res = await call('POST', '/api/commission', { body: commissionBody() });
+    state.commission = res;
+    drawCommission(res);
+    st.textContent = `${res.termination} in ${((performance.now() - t0) / 1000).toFixed(1)} s ` +
+      `(plant time ${fmt(res.plant_time)} s)`;
+    st.dataset.state = res.termination;
+  } catch (e) {
+    st.textContent = 'failed';
+    st.dataset.state = 'failure';
+    showError('cm-error', e);
+  } finally {
+    button.disabled = false;
+  }
+}
+
+function bindCommission(): void {
+  $('cm-start').addEventListener('click', () => void startCommission());
+  $('cm-toml').addEventListener('click', () => {
+    const text = state.commission?.controller_toml;
+    if (!text) return showError('cm-error', new Error('no controller was designed'));
+    download(new Blob([text], { type: 'text/plain' }), 'controller.toml');
+  });
+}
+
+// ---------------------------------------------------------------------------
 async function main(): Promise<void> {
   buildMethods();
   bindController();
   bindExport();
+  bindCommission();
   $('files-up').addEventListener('click', () => void listFiles(state.dir.split('/').slice(0, -1).join('/')));
   $('files-refresh').addEventListener('click', () => void listFiles(state.dir));
   ($('upload') as HTMLInputElement).addEventListener('change', (ev) => {

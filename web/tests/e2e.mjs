@@ -7,7 +7,7 @@
 // --plant ipa --Ts 0.01 --setpoint step:from=0,to=40,at=0.5 --duration 10 --json`
 // printed for the same data (the root holds demo.csv); UPLOAD.csv, when given,
 // is uploaded through the page first. With PNEUMID_SCREENSHOTS=DIR
-// a screenshot of each stage is written to DIR/app-{data,identification,controller,run}.png.
+// a screenshot of each stage is written to DIR/app-{data,identification,controller,run,commission}.png.
 // Exit status 0 when every check passed.
 import fs from 'node:fs';
 import path from 'node:path';
@@ -261,6 +261,34 @@ try {
     if (r.samples >= 2000) fail(`the stopped run streamed ${r.samples} samples`);
     await page.fill('#run-duration', '3');
   });
+
+  await step('commission the simulated plant (section 6)', async () => {
+    await page.fill('#cm-budget', '60');
+    await page.fill('#cm-dir', 'commissioned');
+    const t0 = Date.now();
+    await page.click('#cm-start');
+    await page.waitForFunction(() => ['success', 'partial', 'failure', 'stopped'].includes(document.getElementById('cm-state').dataset.state) && window.pneumid.commission, null, { timeout: 120000 });
+    const c = await page.evaluate(() => ({
+      state: document.getElementById('cm-state').dataset.state,
+      text: document.getElementById('cm-state').textContent,
+      models: document.querySelectorAll('#cm-models tbody tr').length,
+      chosen: document.querySelector('#cm-models tbody tr td:last-child')?.textContent,
+      attempts: document.querySelectorAll('#cm-attempts tbody tr').length,
+      canvases: document.querySelectorAll('#commission canvas').length,
+      res: window.pneumid.commission,
+    }));
+    log(`commission: ${c.text} after ${Date.now() - t0} ms; ${c.models} models, ${c.attempts} verification(s), ${c.canvases} plots`);
+    if (c.state !== 'success') fail(`commission ended ${c.state}: ${c.res?.message}`);
+    if (c.models < 3) fail(`commission: ${c.models} models in the table`);
+    if (c.chosen !== 'chosen') fail('commission: the first-ranked model is not marked chosen');
+    if (c.attempts < 1) fail('commission: no verification in the table');
+    if (c.canvases < 3) fail(`commission: ${c.canvases} plots drawn, expected the experiment, the loop and its input`);
+    if (c.res?.directory !== 'commissioned') fail(`commission: files in '${c.res?.directory}'`);
+    const [t] = await Promise.all([page.waitForEvent('download', { timeout: 10000 }), page.click('#cm-toml')]);
+    const toml = fs.readFileSync(await t.path(), 'utf8');
+    if (!/\[controller\][^[]*model = "[^"]*models\.json#/.test(toml)) fail('commission controller.toml lacks [controller] model');
+  });
+  await shot('commission', 'commission');
 
   const errs = await visibleErrors();
   if (errs.length) fail('errors shown on the page: ' + errs.join(' | '));

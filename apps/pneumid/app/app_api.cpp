@@ -21,6 +21,8 @@
 #include "pneumid/realtime/io_backend.hpp"
 #include "pneumid/realtime/realtime_config.hpp"
 #include "pneumid/report/identification_report.hpp"
+#include "pneumid/workflow/commission.hpp"
+#include "pneumid/workflow/commission_files.hpp"
 
 namespace pneumid::app {
 namespace fs = std::filesystem;
@@ -247,6 +249,10 @@ Response AppApi::Route(const Request& req) {
   if (p == "/api/control") {
     method_check(post, "POST");
     return JsonResponse(Control(body()));
+  }
+  if (p == "/api/commission") {
+    method_check(post, "POST");
+    return JsonResponse(Commission(body()));
   }
   if (p == "/api/run/start") {
     method_check(post, "POST");
@@ -712,6 +718,96 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b) {
   const std::vector<cli::ControlRun> runs = cli::SimulateControl(c);
   nlohmann::ordered_json j = cli::ControlJson(runs);
   j["trace"] = Trace(runs.front().result);
+  return j;
+}
+
+// ---------------------------------------------------------------- commissioning
+
+namespace {
+constexpr double kMaxCommissionBudget = 600.0;  // s of plant time per request
+}  // namespace
+
+// The library's Commission() on a simulated plant, and the files of
+// `pneumid commission -o DIR` (WriteCommissionFiles): in DIR under the root
+// when the request names one, else in the app's temporary folder.
+nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b) {
+  std::string plant_spec = "ipa";
+  if (Get(b, "plant", plant_spec)) plant_spec = PlantSpec(plant_spec);
+  double Ts = 0.01;
+  Get(b, "Ts", Ts);
+  CommissionOptions o;
+  if (b.contains("range") && !b["range"].is_null()) {
+    const nlohmann::json& r = b["range"];
+    if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number())
+      throw HttpError(400,
+                      fmt::format("field 'range' must be [low, high], got {}", Excerpt(r.dump())));
+    o.range_min = r[0].get<double>();
+    o.range_max = r[1].get<double>();
+  }
+  Get(b, "budget", o.budget);
+  if (!(o.budget > 0.0 && o.budget <= kMaxCommissionBudget))
+    throw HttpError(422, fmt::format("budget must lie in (0, {:g}] s of plant time in the app, "
+                                     "got {:g}",
+                                     kMaxCommissionBudget, o.budget));
+  CheckWork(Ts, o.budget, 0, 0);
+  Get(b, "controller", o.controller);
+  Get(b, "overshoot", o.overshoot);
+  Get(b, "settling", o.settling);
+  Get(b, "aggressiveness", o.aggressiveness);
+  Get(b, "methods", o.methods);
+  double limit = 0.0;
+  if (Get(b, "u_min", limit)) o.u_min = limit;
+  if (Get(b, "u_max", limit)) o.u_max = limit;
+  std::uint64_t seed = 1;
+  if (Get(b, "seed", seed)) o.seed = seed;
+  PlantOptions po;
+  po.seed = o.seed;
+  double noise = 0.0;
+  if (Get(b, "noise", noise)) po.noise_sigma = noise;
+  std::string gaps = "plant";
+  Get(b, "input_gaps", gaps);
+  std::string error;
+  PNEUMID_CHECK(o.IsValid(&error), "{}", error);
+  std::unique_ptr<Plant> plant = MakePlant(plant_spec, Ts, po);
+  if (gaps == "none") {
+    o.modulate = false;
+  } else if (gaps != "plant") {
+    Actuator a = PlantActuator(*plant);
+    a.input_gaps = ParseInputGaps(gaps);
+    o.actuator = a;
+  }
+  std::string dir_field;
+  fs::path dir;
+  if (Get(b, "dir", dir_field) && !dir_field.empty()) {
+    dir = Confine(dir_field);
+  } else {
+    std::lock_guard<std::mutex> lock(mutex_);
+    dir = options_.work / fmt::format("commission{}", next_commission_++);
+  }
+  fs::create_directories(dir);
+  o.directory = dir.string();
+  o.stop = &shutting_down_;
+  const CommissionResult r = pneumid::Commission(*plant, o);
+  const Actuator act = o.actuator ? *o.actuator : PlantActuator(*plant);
+  CommissionFilesOptions fo;
+  fo.directory = dir.string();
+  fo.Ts = Ts;
+  fo.plant = plant_spec;
+  fo.plant_description = plant->Describe();
+  fo.report = true;
+  const CommissionFiles files = WriteCommissionFiles(r, act, fo);
+  nlohmann::ordered_json j = r.ToJson();
+  j["directory"] = Inside(dir, options_.root) ? fs::relative(dir, options_.root).string() : "";
+  j["files"] = files.ToJson();
+  j["c_module"] = files.c_module;
+  const fs::path toml = dir / "controller.toml";
+  std::error_code ec;
+  j["controller_toml"] = fs::is_regular_file(toml, ec) ? ReadFile(toml) : "";
+  const Dataset& data = r.experiment.data;
+  if (data.size() > 0)
+    j["experiment_trace"] = {
+        {"t", Decimate(data.time())}, {"u", Decimate(data.u(0))}, {"y", Decimate(data.y(0))}};
+  if (!r.attempts.empty()) j["trace"] = Trace(r.attempts.back().result);
   return j;
 }
 

@@ -60,6 +60,7 @@ class AppApi {
   nlohmann::json Identify(const nlohmann::json& body);
   nlohmann::ordered_json Tune(const nlohmann::json& body);
   nlohmann::ordered_json Control(const nlohmann::json& body);
+  nlohmann::ordered_json Commission(const nlohmann::json& body);
   Response RunStart(const nlohmann::json& body);
   Response ExportController(const nlohmann::json& body);
   Response ExportReport(const nlohmann::json& body);
@@ -85,6 +86,7 @@ class AppApi {
   std::map<std::string, std::shared_ptr<const DataSet>> data_;
   int next_data_ = 1;
   int next_file_ = 1;
+  int next_commission_ = 1;
   LiveRun run_;
   std::atomic<bool> shutting_down_{false};
 };
