@@ -15,11 +15,13 @@
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/frequency.hpp"
 #include "pneumid/lti/interconnect.hpp"
+#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/experiment.hpp"
 #include "pneumid/plant/plant.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/workflow/commission.hpp"
+#include "pneumid/workflow/commission_files.hpp"
 
 namespace py = pybind11;
 using namespace py::literals;
@@ -239,7 +241,7 @@ void BindExtras(py::module_& m) {
          double budget, const std::string& controller, double overshoot, double settling,
          double aggressiveness, std::optional<std::vector<std::string>> methods,
          std::optional<double> u_min, std::optional<double> u_max, bool modulate,
-         std::uint64_t seed) {
+         std::uint64_t seed, std::optional<std::string> plant_spec) {
         CommissionOptions o;
         if (range) {
           o.range_min = range->first;
@@ -257,11 +259,21 @@ void BindExtras(py::module_& m) {
         o.directory = directory;
         o.seed = seed;
         CommissionResult r;
+        CommissionFiles files;
         {
           py::gil_scoped_release release;
           r = Commission(plant, o);
+          if (plant_spec) {
+            CommissionFilesOptions fo;
+            fo.directory = directory;
+            fo.Ts = plant.Ts();
+            fo.plant = *plant_spec;
+            fo.plant_description = plant.Describe();
+            files = WriteCommissionFiles(r, PlantActuator(plant), fo);
+          }
         }
         py::dict d = JsonToPython(r.ToJson());
+        if (plant_spec) d["files"] = JsonToPython(files.ToJson());
         d["data"] = py::cast(r.experiment.data);
         if (!r.attempts.empty()) {
           const ClosedLoopResult& cl = r.attempts.back().result;
@@ -273,6 +285,7 @@ void BindExtras(py::module_& m) {
       "plant"_a, "directory"_a, "range"_a = py::none(), "budget"_a = 120.0, "controller"_a = "mpc",
       "overshoot"_a = 5.0, "settling"_a = 0.5, "aggressiveness"_a = 0.5, "methods"_a = py::none(),
       "u_min"_a = py::none(), "u_max"_a = py::none(), "modulate"_a = true, "seed"_a = 1,
+      "plant_spec"_a = py::none(),
       "From a plant to a verified controller, as `pneumid commission` (docs/commission.md): a "
       "probe step, a sweep of the reachable range, a shuffled multi-level excitation with a "
       "held-out part, models ranked on it, a design to the specification (overshoot in %, "
@@ -283,7 +296,10 @@ void BindExtras(py::module_& m) {
       "Returns the dict of `commission --json` (termination, message, experiment, models, "
       "chosen_model, controller, verification, passed, limits, suggestions, plant_time) with "
       "'data' (the experiment as a Dataset) and 'trace' (the verification's t, r, y, u, d "
-      "arrays). Raises InvalidArgument for invalid settings.");
+      "arrays). With `plant_spec` (the plant's spec as make_plant takes it, for controller.toml's "
+      "[io] plant) the files of `pneumid commission -o DIR` are written too (data.csv, "
+      "controller.toml, verification.csv, figures, the C module in c/; 'files' lists them). "
+      "Raises InvalidArgument for invalid settings.");
 }
 
 }  // namespace pneumid::python
