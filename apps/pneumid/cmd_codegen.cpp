@@ -163,6 +163,7 @@ const Registrar reg(
       app.add_option("--tau-c", c->controller.tau_c,
                      "PID closed-loop time constant in s (0 = rule default)")
           ->check(NonNegative());
+      AddPidGainOptions(app, c->controller);
       app.add_option("--precision", c->precision,
                      "Arithmetic of the generated code: double or float (Cortex-M4F: float)")
           ->capture_default_str();

@@ -282,6 +282,7 @@ const Registrar reg(
       app.add_option("--tau-c", c->controller.tau_c,
                      "PID closed-loop time constant in s (0 = rule default)")
           ->check(NonNegative());
+      AddPidGainOptions(app, c->controller);
       app.add_flag("--json", c->json, "Print the metrics as JSON");
       AddPlotOption(app, c->plot, "set-point, output and input with units");
       app.add_option("-o,--output", c->output, "Write the trajectories to a CSV file");

@@ -13,6 +13,13 @@
 
 namespace pneumid::cli {
 
+void AddPidGainOptions(CLI::App& app, ControllerSettings& s) {
+  app.add_option("--Kc", s.pid_kc,
+                 "PID proportional gain, input units per output unit (default: the rule's)");
+  app.add_option("--Ti", s.pid_ti, "PID integral time in s, inf for none (default: the rule's)");
+  app.add_option("--Td", s.pid_td, "PID derivative time in s (default: the rule's)");
+}
+
 void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
   // Names are checked by the control area (the message lists the valid ones).
   app.add_option("--controller", s.controller,
@@ -112,6 +119,9 @@ void ApplyControllerConfig(const CLI::App& app, const ControllerConfig& file, st
       {"disturbance", "--disturbance", [&] { s.disturbance = f.disturbance; }},
       {"t_filter", "--t-filter", [&] { s.t_filter = f.t_filter; }},
       {"tau_c", "--tau-c", [&] { s.tau_c = f.tau_c; }},
+      {"Kc", "--Kc", [&] { s.pid_kc = f.pid_kc; }},
+      {"Ti", "--Ti", [&] { s.pid_ti = f.pid_ti; }},
+      {"Td", "--Td", [&] { s.pid_td = f.pid_td; }},
       {"pid_rule", "--pid-rule", [&] { s.pid_rule = f.pid_rule; }},
       {"input_map", "--input-map", [&] { s.input_map = f.input_map; }},
       {"input_gaps", "--input-gaps", [&] { s.input_gaps = f.input_gaps; }},

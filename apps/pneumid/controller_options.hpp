@@ -23,6 +23,10 @@ namespace pneumid::cli {
 /// Adds the options above, writing into `settings`.
 void AddControllerOptions(CLI::App& app, ControllerSettings& settings);
 
+/// Adds --Kc, --Ti, --Td: PID gains given explicitly, each replacing the
+/// rule's value of that gain (ControllerSettings::pid_kc, pid_ti, pid_td).
+void AddPidGainOptions(CLI::App& app, ControllerSettings& settings);
+
 /// Input limits of a design against `plant` (`control`, `tune --plant`,
 /// `codegen --plant`): a limit left open (not finite, no --u-min/--u-max) takes
 /// the plant's physical input range (IPA: duty 0..100 %).

@@ -46,6 +46,9 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   spec.t_filter = settings.t_filter;
   spec.pid_rule = PidTuningRuleFromString(settings.pid_rule);
   spec.tau_c = settings.tau_c;
+  spec.pid_kc = settings.pid_kc;
+  spec.pid_ti = settings.pid_ti;
+  spec.pid_td = settings.pid_td;
   spec.disturbance = DisturbanceModelFromString(settings.disturbance);
   spec.auto_options.disturbance = spec.disturbance;
   if (!settings.input_map.empty()) spec.input_map = ReadStaticMap(settings.input_map);
@@ -97,6 +100,12 @@ std::string BuiltController::Summary() const {
     return fmt::format("pid auto from FOPDT K={:g} tau={:g} theta={:g}: Kc={:g} Ti={:g} Td={:g}{}",
                        fopdt.K, fopdt.tau, fopdt.theta, pid_gains.Kc, pid_gains.Ti, pid_gains.Td,
                        tail);
+  if (type == ControllerType::kPid && pid_explicit)
+    return fmt::format(
+        "pid with gains given (the others by {} from FOPDT K={:g} tau={:g} theta={:g}): Kc={:g} "
+        "Ti={:g} Td={:g}",
+        ToString(pid_rule), fopdt.K, fopdt.tau, fopdt.theta, pid_gains.Kc, pid_gains.Ti,
+        pid_gains.Td);
   if (type == ControllerType::kPid)
     return fmt::format("pid {} from FOPDT K={:g} tau={:g} theta={:g} ({}): Kc={:g} Ti={:g} Td={:g}",
                        ToString(pid_rule), fopdt.K, fopdt.tau, fopdt.theta, fopdt.method,
@@ -111,7 +120,7 @@ nlohmann::ordered_json BuiltController::SettingsToJson() const {
     j["Kc"] = pid_gains.Kc;
     j["Ti"] = std::isfinite(pid_gains.Ti) ? nlohmann::json(pid_gains.Ti) : nlohmann::json();
     j["Td"] = pid_gains.Td;
-    j["rule"] = ToString(pid_rule);
+    j["rule"] = pid_explicit ? std::string("explicit") : ToString(pid_rule);
   } else {
     // Settings tuned to specifications say so (their tuning result is explicit).
     j["rule"] = auto_summary.empty() ? ToString(tuning.rule) : std::string("auto");
@@ -128,6 +137,31 @@ namespace {
 BuiltController BuildController(const TransferFunction& model, double Ts,
                                 const ControllerSpec& spec);
 BuiltController BuildController(const PredictionModel& model, const ControllerSpec& spec);
+
+// The gains of `spec` given explicitly replace the rule's in `gains`; true
+// when any was given.
+bool ApplyExplicitPidGains(const ControllerSpec& spec, PidGains& gains) {
+  bool any = false;
+  if (!std::isnan(spec.pid_kc)) {
+    PNEUMID_CHECK(std::isfinite(spec.pid_kc) && spec.pid_kc != 0.0,
+                  "Kc must be finite and non-zero, got {}", spec.pid_kc);
+    gains.Kc = spec.pid_kc;
+    any = true;
+  }
+  if (!std::isnan(spec.pid_ti)) {
+    PNEUMID_CHECK(spec.pid_ti > 0.0, "Ti must be positive (inf: no integral action), got {}",
+                  spec.pid_ti);
+    gains.Ti = spec.pid_ti;
+    any = true;
+  }
+  if (!std::isnan(spec.pid_td)) {
+    PNEUMID_CHECK(std::isfinite(spec.pid_td) && spec.pid_td >= 0.0,
+                  "Td must be finite and >= 0, got {}", spec.pid_td);
+    gains.Td = spec.pid_td;
+    any = true;
+  }
+  return any;
+}
 
 // The spec's tuning replaced by the auto-tuner's design (rule "auto").
 AutoTuneResult AutoTuned(const TransferFunction& model, double Ts, const ControllerSpec& spec) {
@@ -213,6 +247,9 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
     return WithInverseMap(spec, [&](const ControllerSpec& s) { return BuildController(g, Ts, s); });
   }
   if (spec.auto_tune && spec.type == ControllerType::kPid) {
+    PNEUMID_CHECK(std::isnan(spec.pid_kc) && std::isnan(spec.pid_ti) && std::isnan(spec.pid_td),
+                  "explicit PID gains (Kc, Ti, Td) do not apply to the rule auto, which designs "
+                  "them; give a rule (simc, imc) or leave the gains out");
     const AutoTuneResult a = AutoTuned(model, Ts, spec);
     BuiltController b;
     b.type = spec.type;
@@ -235,6 +272,7 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
     b.pid_rule = spec.pid_rule;
     b.fopdt = FopdtFromModel(model);
     b.pid_gains = TunePid(b.fopdt.K, b.fopdt.tau, b.fopdt.theta, Ts, spec.pid_rule, spec.tau_c);
+    b.pid_explicit = ApplyExplicitPidGains(spec, b.pid_gains);
     PidOptions o;
     o.gains = b.pid_gains;
     o.limits = spec.limits;

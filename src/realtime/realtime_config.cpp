@@ -77,12 +77,33 @@ struct Reader {
 // [controller]: the model and the settings of ControllerSettings under the
 // names of the command-line flags (with '_' for '-').
 void ParseControllerSection(const Reader& r, const toml::table& t, RealtimeConfig& c) {
-  r.CheckKeys(
-      t, "controller",
-      {"model",     "type",           "rule",          "P",           "M",           "lambda",
-       "overshoot", "aggressiveness", "response_time", "u_min",       "u_max",       "du_max",
-       "y_min",     "y_max",          "constrained",   "disturbance", "t_filter",    "tau_c",
-       "pid_rule",  "input_map",      "input_gaps",    "y_valid_min", "y_valid_max", "safe_input"});
+  r.CheckKeys(t, "controller", {"model",
+                                "type",
+                                "rule",
+                                "P",
+                                "M",
+                                "lambda",
+                                "overshoot",
+                                "aggressiveness",
+                                "response_time",
+                                "u_min",
+                                "u_max",
+                                "du_max",
+                                "y_min",
+                                "y_max",
+                                "constrained",
+                                "disturbance",
+                                "t_filter",
+                                "tau_c",
+                                "pid_rule",
+                                "input_map",
+                                "input_gaps",
+                                "y_valid_min",
+                                "y_valid_max",
+                                "safe_input",
+                                "Kc",
+                                "Ti",
+                                "Td"});
   ControllerConfig cc;
   ControllerSettings& s = cc.settings;
   r.Get(t, "controller", "model", &cc.model);
@@ -103,6 +124,9 @@ void ParseControllerSection(const Reader& r, const toml::table& t, RealtimeConfi
   r.Get(t, "controller", "disturbance", &s.disturbance);
   r.Get(t, "controller", "t_filter", &s.t_filter);
   r.Get(t, "controller", "tau_c", &s.tau_c);
+  r.Get(t, "controller", "Kc", &s.pid_kc);
+  r.Get(t, "controller", "Ti", &s.pid_ti);
+  r.Get(t, "controller", "Td", &s.pid_td);
   r.Get(t, "controller", "pid_rule", &s.pid_rule);
   r.Get(t, "controller", "input_map", &s.input_map);
   r.Get(t, "controller", "input_gaps", &s.input_gaps);

@@ -12,7 +12,10 @@
 #include <nlohmann/json.hpp>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/control/closed_loop.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/plant/linear_plant.hpp"
+#include "pneumid/plant/signal.hpp"
 
 namespace pneumid {
 namespace {
@@ -122,7 +125,8 @@ TEST(ControllerFactoryTest, InputMapPutsEachControllerBehindTheInverse) {
     ControllerSpec spec = ToControllerSpec(s);
     spec.input_map = map;
     const BuiltController b = MakeController(unit_gain, kTs, spec);
-    EXPECT_THAT(b.controller->Describe(), ::testing::HasSubstr("with inverse map (5 knots")) << type;
+    EXPECT_THAT(b.controller->Describe(), ::testing::HasSubstr("with inverse map (5 knots"))
+        << type;
     b.controller->Reset(10.0, 0.0);
     // 100 N needs f^-1(100) = 70 % at steady state; the input stays in 0..100 %.
     double y = 0.0, x = 0.0, u = 0.0;
@@ -136,6 +140,50 @@ TEST(ControllerFactoryTest, InputMapPutsEachControllerBehindTheInverse) {
     EXPECT_NEAR(u, 70.0, 0.5) << type;
     EXPECT_NEAR(y, 100.0, 0.5) << type;
   }
+}
+
+}  // namespace
+}  // namespace pneumid
+
+namespace pneumid {
+namespace {
+
+// Explicit PID gains replace the rule's, each alone. A proportional-only PID
+// (Ti = inf) on a FOPDT of gain K leaves the closed-form steady-state error
+// r / (1 + K Kc).
+TEST(ControllerFactoryTest, ExplicitPidGainsReplaceTheRulesAndPOnlyLeavesItsOffset) {
+  ControllerSettings s;
+  s.controller = "pid";
+  const BuiltController rule = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  s.pid_td = 0.02;
+  const BuiltController td = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  EXPECT_DOUBLE_EQ(td.pid_gains.Td, 0.02);
+  EXPECT_DOUBLE_EQ(td.pid_gains.Kc, rule.pid_gains.Kc);
+  EXPECT_DOUBLE_EQ(td.pid_gains.Ti, rule.pid_gains.Ti);
+  EXPECT_TRUE(td.pid_explicit);
+  EXPECT_FALSE(rule.pid_explicit);
+  EXPECT_THAT(td.Summary(), ::testing::HasSubstr("gains given"));
+  EXPECT_EQ(td.SettingsToJson()["rule"], "explicit");
+
+  s.pid_td = kNaN;
+  s.pid_kc = 0.5;
+  s.pid_ti = std::numeric_limits<double>::infinity();
+  const BuiltController p = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  const double K = PaperFopdtModel().DcGain();
+  LinearPlant plant(PaperFopdtModel(), kTs);
+  const auto sp = ParseSignal("step:from=0,to=40,at=0.1");
+  ClosedLoopOptions o;
+  o.duration = 20.0;
+  const auto r = SimulateClosedLoop(*p.controller, plant, *sp, o);
+  const double expected_error = 40.0 / (1.0 + K * 0.5);
+  EXPECT_NEAR(r.r(r.r.size() - 1) - r.y(r.y.size() - 1), expected_error, 1e-3 * expected_error);
+
+  s.pid_ti = -1.0;
+  EXPECT_THROW(MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s)), InvalidArgument);
+  s.pid_ti = kNaN;
+  s.rule = "auto";
+  EXPECT_THAT([&] { MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s)); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("rule auto")));
 }
 
 }  // namespace

@@ -13,6 +13,7 @@ const $ = <T extends HTMLElement = HTMLElement>(id: string): T => {
 const METHODS = [
   'reaction-curve', 'tangent', 'smith', 'sundaresan', 'broida', 'sopdt', 'ptn', 'strejc', 'areas',
   'fit-p1d', 'fit-p2d', 'fit-p2du', 'fit-p3d', 'fit-p1di', 'arx', 'armax', 'oe', 'bj', 'iv4', 'n4sid',
+  'static-map', 'hammerstein', 'wiener', 'hw', 'narx', 'affine-narx',
 ];
 const DEFAULT_METHODS = ['reaction-curve', 'arx', 'fit-p1d'];
 const METRIC_KEYS: [string, string][] = [
@@ -49,6 +50,8 @@ const state = {
   tune: null as any,
   run: { state: 'idle', samples: 0, points: 0, frames: 0, summary: null as any },
   commission: null as any, // the answer of POST /api/commission
+  baseline: null as any, // a design kept for comparison: {label, trace, metrics}
+  excluded: [] as string[], // identified models whose responses diverge (not drawn on the shared axis)
 };
 (window as any).pneumid = state;
 
@@ -67,6 +70,27 @@ function clearError(id: string): void {
   el.hidden = true;
   el.textContent = '';
 }
+
+// Results that no longer describe the page's inputs (another file, a failed
+// request) are greyed (class "stale", with the reason as a tooltip) until redrawn.
+function markStale(ids: string[], reason: string): void {
+  for (const id of ids) {
+    const el = document.getElementById(id);
+    if (!el) continue;
+    el.classList.add('stale');
+    el.title = reason;
+  }
+}
+function clearStale(ids: string[]): void {
+  for (const id of ids) {
+    const el = document.getElementById(id);
+    if (!el) continue;
+    el.classList.remove('stale');
+    el.removeAttribute('title');
+  }
+}
+const IDENTIFY_RESULTS = ['fit-table', 'identify-plot', 'identify-failures'];
+const CONTROL_RESULTS = ['control-plot', 'control-u-plot', 'metrics', 'review'];
 
 function fmt(v: unknown, digits = 4): string {
   if (v === null || v === undefined) return '—';
@@ -194,9 +218,28 @@ async function uploadFile(file: File, columns: { t?: string; u?: string; y?: str
   }
 }
 
+// A new data set: the previous one's identification is cleared (its models
+// describe other data) and the closed loop designed from them is greyed.
+function clearIdentify(): void {
+  state.identify = null;
+  state.identifyMethods = [];
+  $('fit-table').querySelector('tbody')!.innerHTML = '';
+  identifyPlot.destroy();
+  $('identify-failures').innerHTML = '';
+  $('identify-failures').hidden = true;
+  clearStale(IDENTIFY_RESULTS);
+  clearError('identify-error');
+  ($('export-model') as HTMLButtonElement).disabled = true;
+  if (state.model) {
+    state.model = '';
+    $('ctl-model').textContent = 'none';
+    markStale(CONTROL_RESULTS, 'designed from the models of the previous data: identify again');
+  }
+}
+
 function setData(ds: DataSet): void {
   state.data = ds;
-  state.identify = null;
+  clearIdentify();
   for (const [id, key] of [['col-t', 't'], ['col-u', 'u'], ['col-y', 'y']] as const) {
     const sel = $(id) as HTMLSelectElement;
     sel.innerHTML = '';
@@ -319,10 +362,12 @@ async function identify(): Promise<void> {
       warn.appendChild(li);
     }
     warn.hidden = nfail === 0;
+    clearStale(IDENTIFY_RESULTS);
     showIdentify(res);
   } catch (e) {
     $('identify-state').textContent = '';
     showError('identify-error', e);
+    markStale(IDENTIFY_RESULTS, 'the last identification failed: these are the results of an earlier one');
   } finally {
     btn.disabled = false;
   }
@@ -392,10 +437,29 @@ function showIdentify(res: IdentifyResult): void {
     });
     tbody.appendChild(tr);
   }
-  // Model responses over the data
+  drawResponses(res);
+  ($('export-model') as HTMLButtonElement).disabled = !res.model_file;
+  chooseModel(best);
+}
+
+// The models' responses to the data's input over the data.
+function drawResponses(res: IdentifyResult): void {
   const r = res.responses;
   if (r && Array.isArray(r.t) && state.data) {
-    const methods = res.models.map((m) => m.method).filter((m) => Array.isArray(r[m]));
+    const all = res.models.map((m) => m.method).filter((m) => Array.isArray(r[m]));
+    // Responses that diverge (non-finite, or beyond 10 x the data's range
+    // from it) would stretch the shared axis: listed, drawn on demand.
+    const ys = state.data.signals.y.filter((v) => Number.isFinite(v));
+    const lo = Math.min(...ys), hi = Math.max(...ys);
+    const span = Math.max(hi - lo, 1e-12);
+    state.excluded = all.filter((m) => (r[m] as (number | null)[]).some(
+      (v) => v === null || !Number.isFinite(v) || v > hi + 10 * span || v < lo - 10 * span));
+    const showAll = ($('identify-show-all') as HTMLInputElement).checked;
+    const methods = showAll ? all : all.filter((m) => !state.excluded.includes(m));
+    $('identify-excluded').hidden = state.excluded.length === 0;
+    $('identify-excluded-list').textContent = state.excluded.length
+      ? `not drawn (their responses diverge from the data by more than 10 x its range): ${state.excluded.join(', ')}. `
+      : '';
     // the responses are in the coordinates of the identification: the data
     // drawn with them is detrended the same way (over the window's points)
     const detrend = state.identifyDetrend;
@@ -409,8 +473,6 @@ function showIdentify(res: IdentifyResult): void {
       ],
     }, [r.t, ydata, ...methods.map((m) => r[m])]);
   }
-  ($('export-model') as HTMLButtonElement).disabled = !res.model_file;
-  chooseModel(best);
 }
 
 function detrendData(y: (number | null)[], t: number[], how: string): (number | null)[] {
@@ -452,22 +514,75 @@ const controlUPlot = new TimePlot($('control-u-plot'));
 
 /** A closed loop's set point and output over its controller output, as both
  *  the design (section 3) and the live run (section 4) show it. */
-function drawLoop(yPlot: TimePlot, uPlot: TimePlot, title: string,
-                  tr: { t: number[]; r: number[]; y: number[]; u: number[] }): void {
-  yPlot.draw({
-    title,
-    ylabel: 'y',
-    series: [
-      { label: 'set point r', color: '#495057', dash: [5, 4] },
-      { label: 'output y', color: COLORS[0], width: 2 },
-    ],
-  }, [tr.t, tr.r, tr.y]);
-  uPlot.draw({
-    title: 'Controller output',
-    ylabel: 'u',
-    height: 180,
-    series: [{ label: 'input u', color: COLORS[1] }],
-  }, [tr.t, tr.u]);
+type Trace = { t: number[]; r: number[]; y: number[]; u: number[] };
+
+// Axis names with units: the IPA twin's force and duty, else the data's
+// column names (which carry their units, e.g. "y [N]").
+function loopLabels(plant: string): { y: string; u: string } {
+  if (plant.startsWith('ipa-position')) return { y: 'position x [m]', u: 'duty u [%]' };
+  if (plant.startsWith('ipa')) return { y: 'force F [N]', u: 'duty u [%]' };
+  const y = (document.getElementById('col-y') as HTMLSelectElement | null)?.value || state.data?.y || 'y';
+  const u = (document.getElementById('col-u') as HTMLSelectElement | null)?.value || state.data?.u || 'u';
+  return { y: 'output ' + y, u: 'input ' + u };
+}
+
+// The limits drawn as lines: the input range asked for (else the IPA's
+// 0..100 %), and the soft output bounds when set.
+function loopLimits(plant: string): { u: [number, number] | null; y: [number, number] | null } {
+  const num = (id: string) => {
+    const v = (document.getElementById(id) as HTMLInputElement | null)?.value.trim() ?? '';
+    return v === '' ? NaN : Number(v);
+  };
+  let uMin = num('u-min'), uMax = num('u-max');
+  if (plant.startsWith('ipa')) {
+    if (Number.isNaN(uMin)) uMin = 0;
+    if (Number.isNaN(uMax)) uMax = 100;
+  }
+  const yMin = num('y-min'), yMax = num('y-max');
+  return {
+    u: Number.isNaN(uMin) && Number.isNaN(uMax) ? null : [uMin, uMax],
+    y: Number.isNaN(yMin) && Number.isNaN(yMax) ? null : [yMin, yMax],
+  };
+}
+
+/** A closed loop's set point and output over its controller output, as both
+ *  the design (section 3) and the live run (section 4) show it, with units,
+ *  the limits as red dashed lines and, when given, a baseline design dashed. */
+function drawLoop(yPlot: TimePlot, uPlot: TimePlot, title: string, tr: Trace,
+                  plant = 'ipa', baseline: { label: string; trace: Trace } | null = null): void {
+  const labels = loopLabels(plant);
+  const limits = loopLimits(plant);
+  const flat = (v: number) => tr.t.map(() => (Number.isFinite(v) ? v : null));
+  const base = baseline ? interpTrace(baseline.trace, tr.t) : null;
+  const ySeries: any[] = [
+    { label: 'set point r', color: '#495057', dash: [5, 4] },
+    { label: 'output y', color: COLORS[0], width: 2 },
+  ];
+  const yData: (number | null)[][] = [tr.t, tr.r, tr.y];
+  if (base) {
+    ySeries.push({ label: 'baseline y (' + baseline!.label + ')', color: '#868e96', dash: [3, 3] });
+    yData.push(base.y);
+  }
+  if (limits.y) {
+    ySeries.push({ label: 'y min', color: '#e03131', dash: [8, 4], width: 1 }, { label: 'y max', color: '#e03131', dash: [8, 4], width: 1 });
+    yData.push(flat(limits.y[0]), flat(limits.y[1]));
+  }
+  yPlot.draw({ title, ylabel: labels.y, series: ySeries }, yData);
+  const uSeries: any[] = [{ label: 'input u', color: COLORS[1] }];
+  const uData: (number | null)[][] = [tr.t, tr.u];
+  if (base) {
+    uSeries.push({ label: 'baseline u', color: '#868e96', dash: [3, 3] });
+    uData.push(base.u);
+  }
+  if (limits.u) {
+    uSeries.push({ label: 'u min', color: '#e03131', dash: [8, 4], width: 1 }, { label: 'u max', color: '#e03131', dash: [8, 4], width: 1 });
+    uData.push(flat(limits.u[0]), flat(limits.u[1]));
+  }
+  uPlot.draw({ title: 'Controller output', ylabel: labels.u, height: 180, series: uSeries }, uData);
+}
+
+function interpTrace(b: Trace, t: number[]): { y: (number | null)[]; u: (number | null)[] } {
+  return { y: interp(b.t, b.y, t), u: interp(b.t, b.u, t) };
 }
 
 let explicitFromSliders = false; // the sliders hold values the user set
@@ -506,6 +621,20 @@ function controllerBody(): Record<string, unknown> {
     const v = ($(id) as HTMLInputElement).value.trim();
     if (v !== '') body[key] = Number(v);
   }
+  if (ctl === 'pid') {
+    for (const key of ['Kc', 'Ti', 'Td']) {
+      const v = ($(key) as HTMLInputElement).value.trim();
+      if (v !== '') body[key] = key === 'Ti' && /^inf/i.test(v) ? 1e300 : Number(v);
+    }
+  }
+  if (ctl === 'mpc' || ctl === 'dmc') {
+    for (const [id, key] of [['du-max', 'du_max'], ['y-min', 'y_min'], ['y-max', 'y_max']]) {
+      const v = ($(id) as HTMLInputElement).value.trim();
+      if (v !== '') body[key] = Number(v);
+    }
+  }
+  if (ctl === 'mpc') body.disturbance = ($('disturbance') as HTMLSelectElement).value;
+  if (ctl === 'dmc' && ($('constrained') as HTMLInputElement).checked) body.constrained = true;
   return body;
 }
 
@@ -538,6 +667,7 @@ async function runControl(): Promise<void> {
     const t1 = performance.now();
     clearError('control-error');
     state.control = res;
+    clearStale(CONTROL_RESULTS);
     drawControl(res);
     const t2 = performance.now();
     const latency = t2 - (pendingSince || t0);
@@ -556,16 +686,29 @@ async function runControl(): Promise<void> {
     state.controlIdle = !controlTimerPending();
     $('control-state').textContent = '';
     showError('control-error', e);
+    markStale(CONTROL_RESULTS, 'the last change failed: these are the results of the settings before it');
   }
 }
 
 function drawControl(res: any): void {
   const tr = res.trace;
+  const plant = ($('plant') as HTMLSelectElement).value;
   if (tr && Array.isArray(tr.t)) {
-    drawLoop(controlPlot, controlUPlot, 'Closed loop: set point and output', tr);
+    drawLoop(controlPlot, controlUPlot, 'Closed loop: set point and output', tr,
+             plant === 'model' ? '' : plant, state.baseline);
   }
   const tbody = $('metrics').querySelector('tbody')!;
   tbody.innerHTML = '';
+  const base = state.baseline?.metrics;
+  if (base) {
+    const head = document.createElement('tr');
+    for (const text of ['', 'this design', 'baseline']) {
+      const th = document.createElement('th');
+      th.textContent = text;
+      head.appendChild(th);
+    }
+    tbody.appendChild(head);
+  }
   for (const [key, label] of METRIC_KEYS) {
     if (!(key in res)) continue;
     const row = document.createElement('tr');
@@ -577,7 +720,24 @@ function drawControl(res: any): void {
     td.dataset.value = JSON.stringify(res[key]);
     td.textContent = fmt(res[key]);
     row.append(th, td);
+    if (base) {
+      const b = document.createElement('td');
+      b.className = 'numcol baseline';
+      b.textContent = fmt(base[key]);
+      row.appendChild(b);
+    }
     tbody.appendChild(row);
+  }
+  // A PID with a rule is described by its gains (the tune review is the
+  // horizons' and applies to the rule auto only).
+  if (($('ctl') as HTMLSelectElement).value === 'pid' && ($('rule') as HTMLSelectElement).value !== 'auto') {
+    const g = res.settings ?? {};
+    $('review').textContent = [
+      `pid, ${g.rule === 'explicit' ? 'gains given (the others by SIMC)' : 'rule ' + (g.rule ?? 'simc')}`,
+      `Kc = ${fmt(g.Kc)}, Ti = ${g.Ti === null || g.Ti === undefined ? 'inf (no integral action)' : fmt(g.Ti) + ' s'}, Td = ${fmt(g.Td)} s`,
+      res.controller ?? '',
+    ].join('\n');
+    $('review').classList.remove('muted');
   }
   // The rule's choice shown on the sliders (unless the user set them)
   const s = res.settings ?? {};
@@ -597,6 +757,7 @@ function setSlider(id: string, value: number, text: string): void {
 
 async function runTune(): Promise<void> {
   if (!state.model) return;
+  if (($('ctl') as HTMLSelectElement).value === 'pid' && ($('rule') as HTMLSelectElement).value !== 'auto') return;
   const body = controllerBody();
   const seq = ++tuneSeq;
   try {
@@ -647,6 +808,10 @@ function controllerChoices(): void {
   if (ctl === 'gpc' && rule.value === 'auto') rule.value = 'shridhar-cooper';
   for (const id of ['P', 'M', 'lambda']) ($(id) as HTMLInputElement).disabled = ctl === 'pid';
   ($('rt') as HTMLInputElement).disabled = ctl === 'gpc';
+  $('pid-gains').hidden = ctl !== 'pid';
+  $('mpc-limits').hidden = ctl !== 'mpc' && ctl !== 'dmc';
+  ($('disturbance') as HTMLSelectElement).disabled = ctl !== 'mpc';
+  ($('constrained') as HTMLInputElement).disabled = ctl !== 'dmc';
 }
 
 function bindController(): void {
@@ -656,7 +821,29 @@ function bindController(): void {
     if (id === 'rule') explicitFromSliders = ($('rule') as HTMLSelectElement).value === 'explicit' && explicitFromSliders;
     scheduleControl();
   });
-  for (const id of ['setpoint', 'duration', 'Ts', 'load-step', 'u-min', 'u-max']) $(id).addEventListener('input', scheduleControl);
+  for (const id of ['setpoint', 'duration', 'Ts', 'load-step', 'u-min', 'u-max', 'du-max', 'y-min', 'y-max']) $(id).addEventListener('input', scheduleControl);
+  for (const id of ['disturbance', 'constrained']) $(id).addEventListener('change', scheduleControl);
+  for (const id of ['Kc', 'Ti', 'Td']) {
+    $(id).addEventListener('input', () => {
+      // explicit gains replace the rule's; the rule auto designs them itself
+      if (($('rule') as HTMLSelectElement).value === 'auto') ($('rule') as HTMLSelectElement).value = 'shridhar-cooper';
+      scheduleControl();
+    });
+  }
+  $('baseline-keep').addEventListener('click', () => {
+    const res = state.control;
+    if (!res?.trace) return showError('control-error', new Error('no closed loop to keep yet'));
+    state.baseline = { label: res.controller ?? 'baseline', trace: res.trace, metrics: res };
+    $('baseline-info').textContent = 'baseline: ' + state.baseline.label;
+    ($('baseline-clear') as HTMLButtonElement).disabled = false;
+    drawControl(res);
+  });
+  $('baseline-clear').addEventListener('click', () => {
+    state.baseline = null;
+    $('baseline-info').textContent = '';
+    ($('baseline-clear') as HTMLButtonElement).disabled = true;
+    if (state.control) drawControl(state.control);
+  });
   for (const id of ['P', 'M', 'lambda']) {
     $(id).addEventListener('input', () => {
       if (state.model) pendingSince = performance.now();
@@ -731,7 +918,10 @@ function appendLive(m: { t: number[]; r?: number[]; y: number[]; u: number[] }):
 
 function drawLive(): void {
   liveFrame = 0;
-  drawLoop(runPlot, runUPlot, 'Real-time run: set point and output', live);
+  const io = ($('io') as HTMLInputElement).value.trim() || 'sim';
+  const plant = ($('plant') as HTMLSelectElement).value;
+  drawLoop(runPlot, runUPlot, 'Real-time run: set point and output', live,
+           io === 'sim' && plant !== 'model' ? plant : io.startsWith('udp') ? 'ipa' : '');
   if (state.run.state === 'running') $('run-state').textContent = runStatusText();
 }
 
@@ -759,6 +949,13 @@ async function startRun(): Promise<void> {
   }
   runT0 = performance.now();
   setRunState('running', 'running: waiting for the first samples …');
+  attachRun();
+}
+
+// The live stream and the status poll of the run going on (started by this
+// page, or found running when the page loaded: the stream sends it from its
+// first sample).
+function attachRun(): void {
   ws = new WebSocket(streamUrl('/api/run/stream'));
   ws.onmessage = (ev) => {
     let m: any;
@@ -784,6 +981,23 @@ async function startRun(): Promise<void> {
   };
   clearInterval(statusTimer);
   statusTimer = window.setInterval(() => void pollStatus(false), 500);
+}
+
+// A page loaded (or reloaded) while a run goes on takes it over: the live
+// plot from the run's first sample and a Stop that works.
+async function findRunningRun(): Promise<void> {
+  try {
+    const s = await call('GET', '/api/run/status');
+    if (s.state !== 'running') return;
+    live = { t: [], r: [], y: [], u: [], stride: 1, skip: 0 };
+    state.run = { state: 'running', samples: 0, points: 0, frames: 0, summary: null };
+    runT0 = performance.now() - 1000 * (typeof s.elapsed === 'number' ? s.elapsed : 0);
+    setRunState('running', 'running (started before this page was loaded) …');
+    document.body.dataset.attached = '1';
+    attachRun();
+  } catch (e) {
+    showError('run-error', e);
+  }
 }
 
 async function pollStatus(final: boolean): Promise<void> {
@@ -1002,6 +1216,9 @@ async function main(): Promise<void> {
   });
   for (const id of ['col-t', 'col-u', 'col-y']) $(id).addEventListener('change', onColumnsChange);
   $('identify').addEventListener('click', () => void identify());
+  $('identify-show-all').addEventListener('change', () => {
+    if (state.identify) drawResponses(state.identify);
+  });
   ($('identify') as HTMLButtonElement).disabled = true;
   $('run-start').addEventListener('click', () => void startRun());
   $('run-stop').addEventListener('click', () => void stopRun());
@@ -1015,6 +1232,7 @@ async function main(): Promise<void> {
     showError('global-error', e);
   }
   await listFiles('');
+  await findRunningRun();
   document.body.dataset.ready = '1';
 }
 

@@ -605,6 +605,9 @@ void ReadControllerSettings(const nlohmann::json& b, ControllerSettings& s) {
   Get(b, "constrained", s.constrained);
   Get(b, "pid_rule", s.pid_rule);
   Get(b, "tau_c", s.tau_c);
+  Get(b, "Kc", s.pid_kc);
+  Get(b, "Ti", s.pid_ti);
+  Get(b, "Td", s.pid_td);
   Get(b, "t_filter", s.t_filter);
   Get(b, "disturbance", s.disturbance);
   Get(b, "response_time", s.response_time);

@@ -7,7 +7,8 @@
 //        "A" (= the model's denominator, DMC's disturbance model) or
 //        coefficients "1 -0.8" (ascending powers of q^-1)
 //   pid  gains by SIMC or IMC from the model's FOPDT description (tuning.hpp,
-//        FopdtFromModel), tau_c <= 0 = the rule's default
+//        FopdtFromModel), tau_c <= 0 = the rule's default; each of Kc, Ti,
+//        Td given explicitly replaces the rule's value
 //   mpc  state-space MPC (mpc.hpp) from the model with its delay as states:
 //        P, M, lambda from the tuning rule as for dmc, the input limits and
 //        soft output bounds (a QP whenever one is finite), the other options
@@ -39,16 +40,22 @@ namespace pneumid {
 /// ControllerSettings for the user-facing form).
 struct ControllerSpec {
   ControllerType type = ControllerType::kDmc;  ///< which controller (default dmc)
-  TuningOptions tuning;  ///< P, M, lambda (dmc, gpc, mpc)
-  InputLimits limits;    ///< limits on the plant input u (default: none)
-  bool constrained = false;                                 ///< dmc: QDMC with the QP solver
+  TuningOptions tuning;                        ///< P, M, lambda (dmc, gpc, mpc)
+  InputLimits limits;                          ///< limits on the plant input u (default: none)
+  bool constrained = false;                    ///< dmc: QDMC with the QP solver
   double y_min = -std::numeric_limits<double>::infinity();  ///< soft output bounds (QDMC, mpc)
   double y_max = std::numeric_limits<double>::infinity();   ///< upper soft output bound
   /// gpc: T filter: "1" (none), "A" (T = A) or monic coefficients such as "1 -0.8".
   std::string t_filter = "1";
   PidTuningRule pid_rule = PidTuningRule::kSimc;  ///< pid tuning rule (default SIMC)
   double tau_c = 0.0;  ///< pid closed-loop time constant (s); <= 0 = rule default
-  DisturbanceModel disturbance = DisturbanceModel::kInput;  ///< mpc (mpc.hpp)
+  /// pid gains given explicitly (NaN = the rule's value of that gain): the
+  /// proportional gain Kc, the integral time Ti in s (inf = no integral
+  /// action) and the derivative time Td in s. Not with auto_tune.
+  double pid_kc = std::numeric_limits<double>::quiet_NaN();
+  double pid_ti = std::numeric_limits<double>::quiet_NaN();  ///< explicit Ti in s (NaN = rule's)
+  double pid_td = std::numeric_limits<double>::quiet_NaN();  ///< explicit Td in s (NaN = rule's)
+  DisturbanceModel disturbance = DisturbanceModel::kInput;   ///< mpc (mpc.hpp)
   /// Tune from specifications (auto_tuning.hpp) instead of the tuning rule:
   /// mpc and dmc get P, M, lambda, pid its gains; auto_options.controller and
   /// .limits are taken from type and limits.
@@ -87,19 +94,24 @@ struct ControllerSettings {
   int P = 0;  ///< prediction horizon override (0 = the rule's)
   int M = 0;  ///< control horizon override (0 = the rule's)
   double lambda = std::numeric_limits<double>::quiet_NaN();  ///< override (NaN = the rule's)
-  InputLimits limits;  ///< limits on the plant input u (default: none)
+  InputLimits limits;        ///< limits on the plant input u (default: none)
   bool constrained = false;  ///< dmc: QDMC with the QP solver
   /// Soft lower output bound (QDMC, mpc); -inf = none.
   double y_min = -std::numeric_limits<double>::infinity();
   double y_max = std::numeric_limits<double>::infinity();  ///< soft upper output bound
-  std::string t_filter = "1";  ///< gpc T filter: "1", "A" or coefficients ("1 -0.8")
+  std::string t_filter = "1";     ///< gpc T filter: "1", "A" or coefficients ("1 -0.8")
   std::string pid_rule = "simc";  ///< pid tuning rule: "simc" or "imc"
-  double tau_c = 0.0;  ///< pid closed-loop time constant (s); <= 0 = the rule's default
-  std::string disturbance = "input";  ///< mpc: input, output or none
+  double tau_c = 0.0;             ///< pid closed-loop time constant (s); <= 0 = the rule's default
+  /// pid: explicit gains (NaN = the rule's value of that gain; Ti inf = no
+  /// integral action), as --Kc, --Ti, --Td.
+  double pid_kc = std::numeric_limits<double>::quiet_NaN();
+  double pid_ti = std::numeric_limits<double>::quiet_NaN();  ///< pid: explicit Ti in s
+  double pid_td = std::numeric_limits<double>::quiet_NaN();  ///< pid: explicit Td in s
+  std::string disturbance = "input";                         ///< mpc: input, output or none
   /// rule "auto": the specifications (auto_tuning.hpp; NaN = from the model).
   double response_time = std::numeric_limits<double>::quiet_NaN();
-  double overshoot = 5.0;        ///< rule "auto": maximum overshoot, percent (default 5)
-  double aggressiveness = 0.5;   ///< rule "auto": 0 robust .. 1 aggressive (default 0.5)
+  double overshoot = 5.0;       ///< rule "auto": maximum overshoot, percent (default 5)
+  double aggressiveness = 0.5;  ///< rule "auto": 0 robust .. 1 aggressive (default 0.5)
   /// A file with the actuator's static map (lti/model_io.hpp ReadStaticMap:
   /// a static-map or Hammerstein model file, or {"u", "y"}); empty = none,
   /// or the model file's own input map (WithModelInputMap).
@@ -143,11 +155,12 @@ TransferFunction ParseControllerModel(const std::string& model_spec);
 struct BuiltController {
   /// The controller to run, wrapped in the input map, NARX or output map layers, if any.
   std::unique_ptr<Controller> controller;
-  ControllerType type = ControllerType::kDmc;  ///< the type of the core controller
+  ControllerType type = ControllerType::kDmc;     ///< the type of the core controller
   TuningResult tuning;                            ///< horizons and lambda (dmc, gpc, mpc)
   PidTuningRule pid_rule = PidTuningRule::kSimc;  ///< (pid)
   PidGains pid_gains;                             ///< (pid)
-  FopdtEstimate fopdt;                            ///< the FOPDT the PID was tuned from (pid)
+  bool pid_explicit = false;  ///< (pid) some gains given explicitly (ControllerSpec::pid_kc ...)
+  FopdtEstimate fopdt;        ///< the FOPDT the PID was tuned from (pid)
   /// Rule "auto": the auto-tuner's message (what it met or why not).
   std::string auto_summary;
 
