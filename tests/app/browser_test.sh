@@ -39,6 +39,9 @@ ROOT="$TMP/root"
 mkdir -p "$ROOT"
 "$PNEUMID" simulate --plant ipa --input step:from=0.61,to=82,at=1.0 --duration 4 --Ts 0.01 \
   --seed 1 -o "$ROOT/demo.csv" > /dev/null || die "pneumid simulate failed"
+# a second file (another step), whose opening must clear the first one's results
+"$PNEUMID" simulate --plant ipa --input step:from=20,to=60,at=0.5 --duration 3 --Ts 0.01 \
+  --seed 2 -o "$ROOT/step2.csv" > /dev/null || die "pneumid simulate (step2.csv) failed"
 "$PNEUMID" identify "$ROOT/demo.csv" -m reaction-curve,arx,fit-p1d -o "$TMP/MODELS.json" \
   > /dev/null || die "pneumid identify failed"
 "$PNEUMID" control --controller mpc --rule auto --model "$TMP/MODELS.json#fit-p1d" --plant ipa \

@@ -40,14 +40,34 @@ export class TimePlot {
     }
     this.destroy();
     this.key = key;
+    // the axis names (drawn on the canvas) for scripts and tests
+    this.el.dataset.ylabel = spec.ylabel ?? '';
+    this.el.dataset.y2label = spec.y2label ?? '';
     const axes: uPlot.Axis[] = [
       { label: 't [s]' },
       { label: spec.ylabel ?? '', scale: 'y' },
     ];
     const scales: uPlot.Scales = { x: { time: false }, y: {} };
+    const hooks: uPlot.Hooks.Arrays = {};
     if (spec.y2label !== undefined) {
-      axes.push({ label: spec.y2label, scale: 'y2', side: 1, grid: { show: false } });
+      // uPlot turns a right-hand label to read downwards ("[%] u" from below):
+      // the axis keeps the space and the label is drawn reading upwards, as the left one.
+      axes.push({ label: ' ', scale: 'y2', side: 1, grid: { show: false } });
       scales.y2 = {};
+      const text = spec.y2label;
+      hooks.draw = [(u: uPlot) => {
+        const ctx = u.ctx;
+        const dpr = window.devicePixelRatio || 1;
+        ctx.save();
+        ctx.font = `bold ${12 * dpr}px system-ui, sans-serif`;
+        ctx.fillStyle = '#000';
+        ctx.textAlign = 'center';
+        ctx.textBaseline = 'bottom';
+        ctx.translate(u.ctx.canvas.width - 6 * dpr, u.bbox.top + u.bbox.height / 2);
+        ctx.rotate(-Math.PI / 2);
+        ctx.fillText(text, 0, 0);
+        ctx.restore();
+      }];
     }
     const opts: uPlot.Options = {
       title: spec.title,
@@ -56,6 +76,7 @@ export class TimePlot {
       scales,
       axes,
       legend: { live: true },
+      hooks,
       cursor: { drag: { x: true, y: false } },
       series: [
         { label: 't' },

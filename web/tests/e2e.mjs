@@ -168,9 +168,21 @@ try {
     await page.fill('#setpoint', 'nonsense:x=1');
     await page.waitForSelector('#control-error:not([hidden])', { timeout: 30000 });
     log('error shown: ' + (await page.textContent('#control-error')).trim());
+    // the results of the settings before the error are greyed, not left as if current
+    if (!(await page.$eval('#control-plot', (e) => e.classList.contains('stale')))) fail('after an error the closed-loop plot is not marked stale');
+    if (!(await page.$eval('#metrics', (e) => e.classList.contains('stale')))) fail('after an error the metrics are not marked stale');
     await page.fill('#setpoint', 'step:from=0,to=40,at=0.5');
     await page.waitForSelector('#control-error[hidden]', { state: 'attached', timeout: 30000 });
     await page.waitForFunction(() => window.pneumid.controlIdle, null, { timeout: 30000 });
+    if (await page.$eval('#control-plot', (e) => e.classList.contains('stale'))) fail('the redrawn closed loop stays marked stale');
+  });
+
+  await step('units and limit lines on the loop plots', async () => {
+    const labels = await page.$$eval('#control-plot, #control-u-plot', (els) => els.map((e) => e.dataset.ylabel));
+    if (!labels.some((l) => /\[N\]/.test(l))) fail(`the output axis has no unit: ${labels}`);
+    if (!labels.some((l) => /\[%\]/.test(l))) fail(`the input axis has no unit: ${labels}`);
+    const legend = await page.$$eval('#control-u-plot .u-legend .u-label', (els) => els.map((e) => e.textContent));
+    if (!legend.includes('u min') || !legend.includes('u max')) fail(`no input limit lines: ${legend}`);
   });
 
   await step('slider to redraw latency (10 s at 100 Hz)', async () => {
@@ -206,6 +218,34 @@ try {
     await page.waitForFunction(() => window.pneumid.controlIdle && window.pneumid.control?.label === 'auto', null, { timeout: 60000 });
   });
   await shot('controller', 'controller');
+
+  await step('a baseline kept, a PID with gains given, its review', async () => {
+    await page.click('#baseline-keep');
+    const base = await page.evaluate(() => window.pneumid.baseline?.label);
+    if (!base || !base.startsWith('mpc')) fail(`baseline: ${base}`);
+    await page.selectOption('#ctl', 'pid');
+    await page.selectOption('#rule', 'shridhar-cooper');
+    await page.waitForSelector('#pid-gains:not([hidden])');
+    await page.fill('#Kc', '5');
+    await page.waitForFunction(() => window.pneumid.controlIdle && String(window.pneumid.control?.controller).startsWith('pid Kc=5'), null, { timeout: 60000 });
+    const review = await page.textContent('#review');
+    if (!/Kc = 5/.test(review) || /P = /.test(review)) fail(`PID review: ${review}`);
+    const cols = await page.$$eval('#metrics td.baseline', (tds) => tds.length);
+    if (cols < 5) fail(`metrics: ${cols} baseline cells`);
+    const legend = await page.$$eval('#control-plot .u-legend .u-label', (els) => els.map((e) => e.textContent));
+    if (!legend.some((l) => l.startsWith('baseline y'))) fail(`no baseline in the plot: ${legend}`);
+    log(`baseline ${base}; PID review: ${review.split('\n').slice(0, 2).join(' | ')}`);
+  });
+  await shot('controller', 'controller-pid-baseline');
+
+  await step('back to the mpc with the rule auto', async () => {
+    await page.click('#baseline-clear');
+    await page.fill('#Kc', '');
+    await page.selectOption('#ctl', 'mpc');
+    await page.selectOption('#rule', 'auto');
+    await page.waitForFunction(() => window.pneumid.controlIdle && window.pneumid.control?.label === 'auto' &&
+      String(window.pneumid.control?.controller).startsWith('mpc'), null, { timeout: 60000 });
+  });
 
   await step('run 3 s on the simulator', async () => {
     await page.fill('#io', 'sim');
@@ -289,6 +329,44 @@ try {
     if (!/\[controller\][^[]*model = "[^"]*models\.json#/.test(toml)) fail('commission controller.toml lacks [controller] model');
   });
   await shot('commission', 'commission');
+
+  await step('reload the page during a run, then stop it from the new page', async () => {
+    await page.fill('#run-duration', '30');
+    await page.click('#run-start');
+    await page.waitForFunction(() => window.pneumid.run.points > 0, null, { timeout: 10000 });
+    await page.reload();
+    await page.waitForSelector('body[data-ready="1"]', { timeout: 15000 });
+    const attached = await page.evaluate(() => ({ state: document.getElementById('run-state').dataset.state, stop: document.getElementById('run-stop').disabled, attached: document.body.dataset.attached }));
+    if (attached.state !== 'running' || attached.stop || attached.attached !== '1') fail(`after the reload: ${JSON.stringify(attached)}`);
+    await page.waitForFunction(() => window.pneumid.run.points > 0, null, { timeout: 10000 });
+    await page.click('#run-stop');
+    await page.waitForFunction(() => ['finished', 'stopped', 'failed'].includes(document.getElementById('run-state').dataset.state), null, { timeout: 10000 });
+    const r = await page.evaluate(() => ({ samples: window.pneumid.run.samples, state: document.getElementById('run-state').dataset.state, text: document.getElementById('run-state').textContent }));
+    log(`reloaded page took over the run (${r.samples} samples from its first) and stopped it: ${r.text}`);
+    if (r.state !== 'stopped') fail(`the run ended ${r.state} after Stop on the reloaded page`);
+  });
+  await shot('run', 'run-reloaded');
+
+  await step('a second file clears the first one\'s results', async () => {
+    await page.click('#files li[data-name="demo.csv"]');
+    await page.waitForFunction(() => window.pneumid.data?.name.includes('demo.csv'), null, { timeout: 15000 });
+    await page.click('#identify');
+    await page.waitForFunction(() => document.querySelectorAll('#fit-table tbody tr').length >= 3, null, { timeout: 60000 });
+    await page.waitForFunction(() => window.pneumid.control && window.pneumid.controlIdle, null, { timeout: 60000 });
+    await page.click('#files li[data-name="step2.csv"]');
+    await page.waitForFunction(() => window.pneumid.data?.name.includes('step2.csv'), null, { timeout: 15000 });
+    const s = await page.evaluate(() => ({
+      rows: document.querySelectorAll('#fit-table tbody tr').length,
+      plot: document.querySelectorAll('#identify-plot canvas').length,
+      model: document.getElementById('ctl-model').textContent,
+      stale: document.getElementById('control-plot').classList.contains('stale'),
+      identify: window.pneumid.identify,
+    }));
+    if (s.rows !== 0 || s.plot !== 0 || s.identify !== null) fail(`the first file's identification is still shown: ${s.rows} rows, ${s.plot} plots`);
+    if (s.model !== 'none') fail(`the first file's model is still chosen: ${s.model}`);
+    if (!s.stale) fail('the closed loop designed from the first file is not marked stale');
+  });
+  await shot('identification', 'identification-cleared');
 
   const errs = await visibleErrors();
   if (errs.length) fail('errors shown on the page: ' + errs.join(' | '));
