@@ -51,6 +51,9 @@ const state = {
   run: { state: 'idle', samples: 0, points: 0, frames: 0, summary: null as any },
   commission: null as any, // the answer of POST /api/commission
   baseline: null as any, // a design kept for comparison: {label, trace, metrics}
+  validation: null as DataSet | null, // the validation data set (identification and views)
+  views: null as any, // POST /api/model/views of the chosen model
+  view: 'data', // the view shown: data, step, bode, residuals
   excluded: [] as string[], // identified models whose responses diverge (not drawn on the shared axis)
 };
 (window as any).pneumid = state;
@@ -122,6 +125,8 @@ function debounce(fn: () => void, ms: number): (() => void) & { pending: () => b
 }
 
 function download(blob: Blob, name: string): void {
+  const done = document.getElementById('export-state');
+  if (done) done.textContent = `${name} downloaded (${humanSize(blob.size)}, ${new Date().toLocaleTimeString()})`;
   const a = document.createElement('a');
   a.href = URL.createObjectURL(blob);
   a.download = name;
@@ -154,6 +159,7 @@ async function listFiles(dir: string): Promise<void> {
       li.textContent = 'no data files here';
       ul.appendChild(li);
     }
+    fillValidationChoices(entries.filter((e) => e.type === 'file').map((e) => (state.dir ? state.dir + '/' : '') + e.name));
     for (const e of entries) {
       const li = document.createElement('li');
       li.dataset.name = e.name;
@@ -230,6 +236,10 @@ function clearIdentify(): void {
   clearStale(IDENTIFY_RESULTS);
   clearError('identify-error');
   ($('export-model') as HTMLButtonElement).disabled = true;
+  state.views = null;
+  $('views').hidden = true;
+  viewsPlot.destroy();
+  viewsPlot2.destroy();
   if (state.model) {
     state.model = '';
     $('ctl-model').textContent = 'none';
@@ -343,7 +353,7 @@ async function identify(): Promise<void> {
   const t0 = performance.now();
   try {
     const res = await call<IdentifyResult>('POST', '/api/identify', {
-      body: { data: state.data.id, methods, ...preprocessing() },
+      body: { data: state.data.id, methods, ...preprocessing(), ...(state.validation ? { validation: state.validation.id } : {}) },
     });
     state.identify = res;
     state.identifyMethods = methods;
@@ -496,6 +506,7 @@ function detrendData(y: (number | null)[], t: number[], how: string): (number | 
 
 function chooseModel(method: string): void {
   state.model = method;
+  void loadViews(method);
   $('ctl-model').textContent = method || 'none';
   for (const tr of $('fit-table').querySelectorAll<HTMLTableRowElement>('tbody tr')) {
     const on = tr.dataset.method === method;
@@ -504,6 +515,132 @@ function chooseModel(method: string): void {
     if (radio) radio.checked = on;
   }
   scheduleControl();
+}
+
+// ---------------------------------------------------------------------------
+// Validation data and the views of the chosen model (POST /api/model/views)
+// ---------------------------------------------------------------------------
+const viewsPlot = new TimePlot($('views-plot'));
+const viewsPlot2 = new TimePlot($('views-plot2'));
+
+function fillValidationChoices(files: string[]): void {
+  const sel = $('validation-file') as HTMLSelectElement;
+  const keep = sel.value;
+  sel.innerHTML = '';
+  const none = document.createElement('option');
+  none.value = '';
+  none.textContent = 'none';
+  sel.appendChild(none);
+  for (const f of files) {
+    const o = document.createElement('option');
+    o.value = o.textContent = f;
+    sel.appendChild(o);
+  }
+  if (keep && ![...sel.options].some((o) => o.value === keep)) {
+    const o = document.createElement('option');
+    o.value = o.textContent = keep;
+    sel.appendChild(o);
+  }
+  sel.value = keep;
+}
+
+async function chooseValidation(path: string): Promise<void> {
+  clearError('identify-error');
+  if (!path) {
+    state.validation = null;
+    $('validation-info').textContent = '';
+  } else {
+    try {
+      const cols = columnChoice();
+      state.validation = await call<DataSet>('POST', '/api/data/open', { body: { path, ...cols } });
+      $('validation-info').textContent = `${state.validation.samples} samples: the models are ranked on it (held-out fit) at the next Identify`;
+    } catch (e) {
+      state.validation = null;
+      ($('validation-file') as HTMLSelectElement).value = '';
+      showError('identify-error', e);
+    }
+  }
+  if (state.model) void loadViews(state.model);
+}
+
+let viewsSeq = 0;
+async function loadViews(method: string): Promise<void> {
+  const entry = modelEntry(method);
+  if (!entry || !state.data) return;
+  const seq = ++viewsSeq;
+  try {
+    const res = await call('POST', '/api/model/views', {
+      body: { model: entry, data: state.data.id, ...(state.validation ? { validation: state.validation.id } : {}) },
+    });
+    if (seq !== viewsSeq) return;
+    state.views = res;
+    $('views').hidden = false;
+    $('views-model').textContent = method;
+    drawView();
+  } catch (e) {
+    if (seq !== viewsSeq) return;
+    showError('identify-error', e);
+  }
+}
+
+function drawView(): void {
+  const v = state.views;
+  if (!v) return;
+  for (const b of $('views-tabs').querySelectorAll<HTMLButtonElement>('button'))
+    b.classList.toggle('primary', b.dataset.view === state.view);
+  viewsPlot2.destroy();
+  const yName = (($('col-y') as HTMLSelectElement).value || state.data?.y) ?? 'y';
+  const info: string[] = [];
+  if (state.view === 'data') {
+    const e = v.estimation;
+    if (e?.t) {
+      viewsPlot.draw({ title: 'Estimation data and the model (from an estimated initial state)', ylabel: yName,
+        series: [{ label: 'data', color: '#495057', width: 2 }, { label: v.method, color: COLORS[0] }] }, [e.t, e.y, e.y_model]);
+      info.push(`fit on the estimation data ${fmt(e.fit_percent)} %`);
+    }
+    const val = v.validation;
+    if (val?.t) {
+      viewsPlot2.draw({ title: 'Validation data and the model', ylabel: yName,
+        series: [{ label: 'validation data', color: '#495057', width: 2 }, { label: v.method, color: COLORS[2] }] }, [val.t, val.y, val.y_model]);
+      info.push(`on the validation data ${fmt(val.fit_percent)} %`);
+    } else {
+      info.push('choose validation data above to see the model on data it was not fitted to');
+    }
+  } else if (state.view === 'step') {
+    if (v.step?.t) {
+      viewsPlot.draw({ title: 'Unit step response' + (v.linear_part ? ' of the linear part' : ''), ylabel: 'y per unit input',
+        series: [{ label: v.method, color: COLORS[0], width: 2 }] }, [v.step.t, v.step.y]);
+    } else info.push('no step response: ' + (v.step?.error ?? ''));
+  } else if (state.view === 'bode') {
+    if (v.bode?.omega) {
+      viewsPlot.draw({ title: 'Bode: magnitude' + (v.linear_part ? ' of the linear part' : ''), ylabel: '|G| [dB]', xlabel: 'ω [rad/s]', xlog: true,
+        series: [{ label: v.method, color: COLORS[0], width: 2 }] }, [v.bode.omega, v.bode.magnitude_db]);
+      viewsPlot2.draw({ title: 'Bode: phase', ylabel: 'phase [°]', xlabel: 'ω [rad/s]', xlog: true,
+        series: [{ label: v.method, color: COLORS[1], width: 2 }] }, [v.bode.omega, v.bode.phase_deg]);
+    } else info.push('no Bode diagram: ' + (v.bode?.error ?? ''));
+  } else {
+    const src = v.validation ?? v.estimation;
+    const r = src?.residuals;
+    if (r?.auto_lags) {
+      const band = (n: number, s: number) => new Array(n).fill(s * r.bound);
+      viewsPlot.draw({ title: `Residual autocorrelation (${v.validation ? 'validation' : 'estimation'} data)`, ylabel: 'r_ee(k) / r_ee(0)', xlabel: 'lag k [samples]',
+        series: [{ label: 'autocorrelation', color: COLORS[0], width: 2 },
+                 { label: `${Math.round(100 * r.confidence)} % band`, color: '#e03131', dash: [6, 4], width: 1 },
+                 { label: '', color: '#e03131', dash: [6, 4], width: 1 }] },
+        [r.auto_lags, r.autocorr, band(r.auto_lags.length, 1), band(r.auto_lags.length, -1)]);
+      viewsPlot2.draw({ title: 'Cross-correlation of the residuals with the input', ylabel: 'r_ue(k)', xlabel: 'lag k [samples]',
+        series: [{ label: 'cross-correlation', color: COLORS[1], width: 2 },
+                 { label: `${Math.round(100 * r.confidence)} % band`, color: '#e03131', dash: [6, 4], width: 1 },
+                 { label: '', color: '#e03131', dash: [6, 4], width: 1 }] },
+        [r.cross_lags, r.crosscorr, band(r.cross_lags.length, 1), band(r.cross_lags.length, -1)]);
+      info.push(`${fmt(100 * r.auto_outside, 3)} % of the autocorrelation lags and ${fmt(100 * r.cross_outside, 3)} % of the cross-correlation lags lie outside the band` +
+        (r.auto_outside > 0.05 ? ': the residuals are not white (the model leaves dynamics unexplained)' : ''));
+    } else {
+      viewsPlot.destroy();
+      info.push('no residual analysis: ' + (r?.error ?? 'no data'));
+    }
+  }
+  $('views-info').textContent = info.join('; ');
 }
 
 // ---------------------------------------------------------------------------
@@ -1216,6 +1353,14 @@ async function main(): Promise<void> {
   });
   for (const id of ['col-t', 'col-u', 'col-y']) $(id).addEventListener('change', onColumnsChange);
   $('identify').addEventListener('click', () => void identify());
+  ($('validation-file') as HTMLSelectElement).addEventListener('change', (ev) =>
+    void chooseValidation((ev.target as HTMLSelectElement).value));
+  for (const b of $('views-tabs').querySelectorAll<HTMLButtonElement>('button')) {
+    b.addEventListener('click', () => {
+      state.view = b.dataset.view ?? 'data';
+      drawView();
+    });
+  }
   $('identify-show-all').addEventListener('change', () => {
     if (state.identify) drawResponses(state.identify);
   });

@@ -16,6 +16,8 @@ export interface PlotSpec {
   title?: string;
   ylabel?: string;
   y2label?: string; // a second axis on the right for the series whose scale is 'y2'
+  xlabel?: string; // default 't [s]'
+  xlog?: boolean; // logarithmic x axis (Bode plots)
   series: SeriesSpec[];
   width?: number;
   height?: number;
@@ -44,10 +46,10 @@ export class TimePlot {
     this.el.dataset.ylabel = spec.ylabel ?? '';
     this.el.dataset.y2label = spec.y2label ?? '';
     const axes: uPlot.Axis[] = [
-      { label: 't [s]' },
+      { label: spec.xlabel ?? 't [s]' },
       { label: spec.ylabel ?? '', scale: 'y' },
     ];
-    const scales: uPlot.Scales = { x: { time: false }, y: {} };
+    const scales: uPlot.Scales = { x: { time: false, distr: spec.xlog ? 3 : 1 }, y: {} };
     const hooks: uPlot.Hooks.Arrays = {};
     if (spec.y2label !== undefined) {
       // uPlot turns a right-hand label to read downwards ("[%] u" from below):

@@ -147,6 +147,28 @@ try {
   });
   await shot('identification', 'identification');
 
+  await step('views of the chosen model: on validation data, step, Bode, residuals', async () => {
+    await page.selectOption('#validation-file', 'step2.csv');
+    await page.waitForFunction(() => window.pneumid.views?.validation?.fit_percent !== undefined, null, { timeout: 30000 });
+    const seen = {};
+    for (const view of ['data', 'step', 'bode', 'residuals']) {
+      await page.click(`#views-tabs button[data-view="${view}"]`);
+      seen[view] = await page.evaluate(() => ({
+        plots: document.querySelectorAll('#views-plot canvas, #views-plot2 canvas').length,
+        info: document.getElementById('views-info').textContent,
+        xlabel: document.getElementById('views-plot').dataset.ylabel,
+      }));
+    }
+    if (seen.data.plots !== 2 || !/validation data/.test(seen.data.info)) fail(`view on the data: ${JSON.stringify(seen.data)}`);
+    if (seen.step.plots !== 1) fail(`step view: ${JSON.stringify(seen.step)}`);
+    if (seen.bode.plots !== 2) fail(`Bode view: ${JSON.stringify(seen.bode)}`);
+    if (seen.residuals.plots !== 2 || !/outside the band/.test(seen.residuals.info)) fail(`residual view: ${JSON.stringify(seen.residuals)}`);
+    const v = await page.evaluate(() => ({ est: window.pneumid.views.estimation.fit_percent, val: window.pneumid.views.validation.fit_percent }));
+    log(`views of fit-p1d: fit ${v.est.toFixed(2)} % on the estimation data, ${v.val.toFixed(2)} % on step2.csv; ${seen.residuals.info}`);
+    await page.click('#views-tabs button[data-view="data"]');
+  });
+  await shot('identification', 'identification-views');
+
   await step('metrics equal pneumid control --json', async () => {
     const cells = await page.$$eval('#metrics td[data-key]', (tds) => tds.map((td) => [td.dataset.key, JSON.parse(td.dataset.value)]));
     if (cells.length < 8) fail(`metrics table: ${cells.length} cells`);
@@ -282,6 +304,7 @@ try {
     const toml = fs.readFileSync(await c.path(), 'utf8');
     if (!toml.trim()) fail('controller TOML is empty');
     if (!/\[io\][^[]*backend = "sim"/.test(toml)) fail('controller TOML lacks [io] backend = "sim"');
+    if (!/controller\.toml downloaded/.test(await page.textContent('#export-state'))) fail('no confirmation of the export');
     const [h] = await Promise.all([page.waitForEvent('download', { timeout: 60000 }), page.click('#export-report')]);
     const html = fs.readFileSync(await h.path(), 'utf8');
     if (!/^<!DOCTYPE html>/i.test(html.trim())) fail('the HTML report is not HTML: ' + html.slice(0, 80));

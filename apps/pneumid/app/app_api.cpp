@@ -15,11 +15,16 @@
 #include "pneumid/common/strings.hpp"
 #include "pneumid/common/version.hpp"
 #include "pneumid/data/load.hpp"
+#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/lti/frequency.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/lti/response.hpp"
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/realtime/io_backend.hpp"
 #include "pneumid/realtime/realtime_config.hpp"
+#include "pneumid/report/figures.hpp"
 #include "pneumid/report/identification_report.hpp"
 #include "pneumid/workflow/commission.hpp"
 #include "pneumid/workflow/commission_files.hpp"
@@ -249,6 +254,10 @@ Response AppApi::Route(const Request& req) {
   if (p == "/api/control") {
     method_check(post, "POST");
     return JsonResponse(Control(body()));
+  }
+  if (p == "/api/model/views") {
+    method_check(post, "POST");
+    return JsonResponse(ModelViews(body()));
   }
   if (p == "/api/commission") {
     method_check(post, "POST");
@@ -721,6 +730,92 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b) {
   const std::vector<cli::ControlRun> runs = cli::SimulateControl(c);
   nlohmann::ordered_json j = cli::ControlJson(runs);
   j["trace"] = Trace(runs.front().result);
+  return j;
+}
+
+// ---------------------------------------------------------------- model views
+
+namespace {
+
+nlohmann::json Array(const Eigen::VectorXd& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (Eigen::Index k = 0; k < v.size(); ++k)
+    a.push_back(std::isfinite(v[k]) ? nlohmann::json(v[k]) : nlohmann::json());
+  return a;
+}
+
+// The model simulated on a data set from an estimated initial state (as
+// `pneumid validate --initial-state estimate`), its fit and the residual
+// correlations (MATLAB resid: whiteness and independence from the input).
+nlohmann::ordered_json OnData(const IdentifiedModel& m, const Dataset& data) {
+  nlohmann::ordered_json j;
+  const Eigen::VectorXd yhat = SimulateModel(m, data, 0, 0, InitialCondition::kEstimate);
+  const Eigen::VectorXd y = data.y(0);
+  j["fit_percent"] = NrmseFit(y, yhat);
+  j["t"] = Decimate(data.time());
+  j["y"] = Decimate(y);
+  j["y_model"] = Decimate(yhat);
+  const Eigen::VectorXd e = y - yhat;
+  if (e.allFinite()) {
+    const Eigen::VectorXd ec = e.array() - e.mean();
+    const Eigen::VectorXd uc = data.u(0).array() - data.u(0).mean();
+    const int max_lag = static_cast<int>(std::min<Eigen::Index>(25, e.size() - 2));
+    try {
+      const ResidualCorrelation c = ComputeResidualCorrelation(ec, uc, max_lag);
+      j["residuals"] = {{"auto_lags", Array(c.auto_lags)},
+                        {"autocorr", Array(c.autocorr)},
+                        {"cross_lags", Array(c.cross_lags)},
+                        {"crosscorr", Array(c.crosscorr)},
+                        {"bound", c.bound},
+                        {"confidence", c.confidence},
+                        {"auto_outside", c.auto_outside},
+                        {"cross_outside", c.cross_outside}};
+    } catch (const InvalidArgument& ex) {
+      j["residuals"] = {{"error", ex.what()}};
+    }
+  } else {
+    j["residuals"] = {{"error", "the simulated output is not finite (the model diverges)"}};
+  }
+  return j;
+}
+
+}  // namespace
+
+// Step, Bode and, on the estimation and validation data, the simulated
+// output and the residual correlations of one model (an entry of a model
+// file, as /api/identify's model_file holds it).
+nlohmann::ordered_json AppApi::ModelViews(const nlohmann::json& b) {
+  if (!b.contains("model") || !b["model"].is_object())
+    throw HttpError(400, "field 'model' must be a model object (an entry of a model file)");
+  IdentifiedModel m;
+  try {
+    m = IdentifiedModelFromJson(b["model"]);
+  } catch (const std::exception& e) {
+    throw HttpError(400, fmt::format("field 'model': {}", e.what()));
+  }
+  nlohmann::ordered_json j;
+  j["method"] = m.method;
+  // The linear dynamics (of a block-oriented model: its linear part).
+  const TransferFunction& g = m.discrete ? *m.discrete : m.tf;
+  j["linear_part"] = m.input_map.has_value() || m.output_map.has_value();
+  try {
+    const TimeResponse s = Step(g);
+    j["step"] = {{"t", Decimate(s.t)}, {"y", Decimate(s.y)}};
+  } catch (const std::exception& e) {
+    j["step"] = {{"error", e.what()}};
+  }
+  try {
+    const BodeData bd = Bode(g);
+    j["bode"] = {{"omega", Array(bd.omega)},
+                 {"magnitude_db", Array(bd.magnitude_db)},
+                 {"phase_deg", Array(bd.phase_deg)}};
+  } catch (const std::exception& e) {
+    j["bode"] = {{"error", e.what()}};
+  }
+  if (b.contains("data") && !b["data"].is_null())
+    j["estimation"] = OnData(m, FindDataSet(b["data"], "data")->data);
+  if (b.contains("validation") && !b["validation"].is_null())
+    j["validation"] = OnData(m, FindDataSet(b["validation"], "validation")->data);
   return j;
 }
 

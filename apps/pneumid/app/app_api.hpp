@@ -61,6 +61,7 @@ class AppApi {
   nlohmann::ordered_json Tune(const nlohmann::json& body);
   nlohmann::ordered_json Control(const nlohmann::json& body);
   nlohmann::ordered_json Commission(const nlohmann::json& body);
+  nlohmann::ordered_json ModelViews(const nlohmann::json& body);
   Response RunStart(const nlohmann::json& body);
   Response ExportController(const nlohmann::json& body);
   Response ExportReport(const nlohmann::json& body);
