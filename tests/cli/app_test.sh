@@ -280,6 +280,30 @@ if expect(s, a, 200, "identify"):
     arx = next(m for m in model_file["models"] if m["method"] == "arx")
 s, a = call("POST", "/api/identify", {"data": "d99", "methods": methods})
 expect(s, a, 404, "identify an unknown data set")
+# the nonlinear methods through the same call
+s, a = call("POST", "/api/identify", {"data": data_id, "methods": ["hammerstein", "affine-narx"]})
+if expect(s, a, 200, "identify nonlinear"):
+    got = sorted(m["method"] for m in a["models"])
+    if got != ["affine-narx", "hammerstein"] or any(m["fit_percent"] < 90 for m in a["models"]):
+        fail(f"identify nonlinear: {[(m['method'], m['fit_percent']) for m in a['models']]}")
+
+# --- views of a model: step, Bode, the fit and residual correlations on data
+s, a = call("POST", "/api/model/views", {"model": arx, "data": data_id, "validation": data_id})
+if expect(s, a, 200, "model views"):
+    if abs(a["estimation"]["fit_percent"] - a["validation"]["fit_percent"]) > 1e-9:
+        fail("model views: the same data set gives two fits")
+    # ARX fits the demo step test above 95 % (the command line's identify says the same)
+    if not a["estimation"]["fit_percent"] > 95:
+        fail(f"model views: fit {a['estimation']['fit_percent']}")
+    r = a["estimation"]["residuals"]
+    if r["autocorr"][0] != 1.0 or len(r["cross_lags"]) != 2 * len(r["auto_lags"]) - 1:
+        fail(f"model views: residual correlations {str(r)[:200]}")
+    if len(a["step"]["t"]) < 10 or len(a["bode"]["omega"]) < 10:
+        fail("model views: no step or Bode data")
+s, a = call("POST", "/api/model/views", {"model": "models.json#arx", "data": data_id})
+expect(s, a, 400, "model views with a spec instead of a model object")
+s, a = call("POST", "/api/model/views", {"model": arx, "data": "d99"})
+expect(s, a, 404, "model views on an unknown data set")
 
 # --- tune and control: the command line's JSON
 s, a = call("POST", "/api/tune", {"model": "fopdt-paper", "Ts": 0.01})
@@ -319,6 +343,13 @@ for bad, what in [({"P": 1e308}, "P = 1e308"), ({"P": 2.5}, "P = 2.5"), ({"M": -
                   ({"Ts": 1e-6, "controller": "dmc"}, "Ts = 1e-6"), ({"P": 100000}, "P = 1e5")]:
     s, a = call("POST", "/api/control", dict(scenario, model="fopdt-paper", **bad))
     expect(s, a, 422, f"control with {what}")
+# PID gains given explicitly replace the rule's
+s, a = call("POST", "/api/control", dict(scenario, model="fopdt-paper", controller="pid", Kc=5.0))
+if expect(s, a, 200, "control pid with Kc") and (a["settings"]["Kc"] != 5.0 or
+                                                  a["settings"]["rule"] != "explicit"):
+    fail(f"control pid with Kc: {a['settings']}")
+s, a = call("POST", "/api/control", dict(scenario, model="fopdt-paper", controller="pid", Ti=-1))
+expect(s, a, 400, "control pid with Ti = -1")
 for bad in [{"controller": "foo"}, {"controller": ["dmc"]}]:
     s, a = call("POST", "/api/tune", {"model": "fopdt-paper", **bad})
     if s == 200:
