@@ -42,6 +42,7 @@ struct AppCli {
   std::string token;
   std::vector<std::string> allow_devices;
   bool allow_remote = false;
+  double request_deadline = 120.0;
 };
 
 bool IsLoopback(const std::string& host) {
@@ -125,6 +126,7 @@ void Serve(const AppCli& c) {
 
   app::AppApi api(options);
   app::ServerOptions so;
+  so.request_deadline = c.request_deadline;
   so.host = c.host;
   so.port = c.port;
   so.token = options.token;
@@ -189,6 +191,11 @@ const Registrar reg(
       app.add_option("--allow-device", c->allow_devices,
                      "A data-acquisition device the page may drive (comedi:PATH), repeatable; "
                      "by default the page drives the simulator or a plant server only");
+      app.add_option("--request-deadline", c->request_deadline,
+                     "Seconds a request may compute before it is stopped and answered 503 (0: "
+                     "none); a request whose client goes away is stopped at once")
+          ->capture_default_str()
+          ->check(CLI::NonNegativeNumber);
       app.callback([c] { Serve(*c); });
     });
 

@@ -170,6 +170,7 @@ std::vector<ControlRun> SimulateControl(const ControlCli& c) {
   auto setpoint = ParseSignal(c.setpoint);
   ClosedLoopOptions cl;
   cl.duration = c.duration;
+  cl.stop = c.stop;
   cl.noise_std = c.noise;
   cl.seed = c.seed;
   for (const std::string& l : c.load_steps)

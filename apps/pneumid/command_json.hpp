@@ -4,6 +4,7 @@
 // options; each function does the command's work without printing.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -42,6 +43,8 @@ struct ControlCli {
   std::string output;
   bool compare_given = false;
   std::string compare;
+  /// When set and true, the simulations throw Cancelled (the app: the client left).
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// One closed-loop simulation of `control`.

@@ -313,6 +313,9 @@ ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const 
   std::normal_distribution<double> noise(0.0, 1.0);
   double u_prev = options.u0;
   for (Eigen::Index k = 0; k < n; ++k) {
+    if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed))
+      throw Cancelled(
+          fmt::format("the closed-loop simulation was stopped on request at t = {} s", res.t(k)));
     const double d = LoadAt(options.load_steps, res.t(k), Ts);
     if (k == 0 || d != res.d(k - 1)) plant.SetLoadDisturbance(d);
     res.d(k) = d;

@@ -295,3 +295,28 @@ TEST(ClosedLoopMetricsTest, SettlingBandWidensToTheMeasuredRippleOnly) {
 
 }  // namespace
 }  // namespace pneumid
+
+namespace pneumid {
+namespace {
+
+// A stop flag ends the simulation at the next sample with Cancelled (a
+// server whose client left); unset or false, it changes nothing.
+TEST(ClosedLoopTest, AStopFlagCancelsAtTheNextSample) {
+  LinearPlant plant(PaperFopdtModel(), 0.01);
+  PidOptions po;
+  po.gains = {1.0, 0.5, 0.0};
+  PidController pid(0.01, po);
+  const auto sp = ParseSignal("step:to=1");
+  ClosedLoopOptions o;
+  o.duration = 1.0;
+  std::atomic<bool> stop{false};
+  o.stop = &stop;
+  const auto running = SimulateClosedLoop(pid, plant, *sp, o);
+  EXPECT_EQ(running.t.size(), 100);
+  stop = true;
+  EXPECT_THAT([&] { SimulateClosedLoop(pid, plant, *sp, o); },
+              ::testing::ThrowsMessage<Cancelled>(::testing::HasSubstr("stopped on request")));
+}
+
+}  // namespace
+}  // namespace pneumid

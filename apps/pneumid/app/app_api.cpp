@@ -192,6 +192,10 @@ Response AppApi::Handle(const Request& request) {
     return ErrorResponse(e.status, e.what());
   } catch (const nlohmann::json::exception& e) {
     return ErrorResponse(400, fmt::format("invalid JSON: {}", e.what()));
+  } catch (const Cancelled& e) {
+    // the client has gone (nobody reads this) or the deadline passed (the
+    // server answers 503 with the deadline)
+    return ErrorResponse(503, e.what());
   } catch (const InvalidArgument& e) {
     return ErrorResponse(400, e.what());
   } catch (const DataError& e) {
@@ -245,7 +249,7 @@ Response AppApi::Route(const Request& req) {
   }
   if (p == "/api/identify") {
     method_check(post, "POST");
-    return JsonResponse(Identify(body()));
+    return JsonResponse(Identify(body(), req.cancel.get()));
   }
   if (p == "/api/tune") {
     method_check(post, "POST");
@@ -253,7 +257,7 @@ Response AppApi::Route(const Request& req) {
   }
   if (p == "/api/control") {
     method_check(post, "POST");
-    return JsonResponse(Control(body()));
+    return JsonResponse(Control(body(), req.cancel.get()));
   }
   if (p == "/api/model/views") {
     method_check(post, "POST");
@@ -261,7 +265,7 @@ Response AppApi::Route(const Request& req) {
   }
   if (p == "/api/commission") {
     method_check(post, "POST");
-    return JsonResponse(Commission(body()));
+    return JsonResponse(Commission(body(), req.cancel.get()));
   }
   if (p == "/api/run/start") {
     method_check(post, "POST");
@@ -525,7 +529,7 @@ std::shared_ptr<const AppApi::DataSet> AppApi::FindDataSet(const nlohmann::json&
 
 // ---------------------------------------------------------------- identify
 
-nlohmann::json AppApi::Identify(const nlohmann::json& body) {
+nlohmann::json AppApi::Identify(const nlohmann::json& body, const std::atomic<bool>* cancel) {
   if (!body.contains("data")) throw HttpError(400, "field 'data' is missing");
   const auto set = FindDataSet(body["data"], "data");
   std::shared_ptr<const DataSet> validation;
@@ -554,7 +558,11 @@ nlohmann::json AppApi::Identify(const nlohmann::json& body) {
   Get(body, "nb", args.request.nb);
   Get(body, "nk", args.request.nk);
   cli::IdentifyOutcome out =
-      cli::IdentifyData(args, set->data, validation ? &validation->data : nullptr);
+      cli::IdentifyData(args, set->data, validation ? &validation->data : nullptr,
+                        [cancel](std::size_t, std::size_t, const std::string& method) {
+                          if (cancel != nullptr && cancel->load())
+                            throw Cancelled("identification stopped on request before " + method);
+                        });
   if (out.summary.models.empty()) throw HttpError(422, out.summary.message);
   nlohmann::json j = out.json;
   nlohmann::json responses;
@@ -709,8 +717,9 @@ nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
   return cli::TuneJson(c);
 }
 
-nlohmann::ordered_json AppApi::Control(const nlohmann::json& b) {
+nlohmann::ordered_json AppApi::Control(const nlohmann::json& b, const std::atomic<bool>* cancel) {
   cli::ControlCli c;
+  c.stop = cancel;
   if (!b.contains("model")) throw HttpError(400, "field 'model' is missing");
   c.model = ModelSpec(b["model"]);
   const RemoveWhenDone stored{b["model"].is_object() ? c.model : std::string()};
@@ -828,7 +837,8 @@ constexpr double kMaxCommissionBudget = 600.0;  // s of plant time per request
 // The library's Commission() on a simulated plant, and the files of
 // `pneumid commission -o DIR` (WriteCommissionFiles): in DIR under the root
 // when the request names one, else in the app's temporary folder.
-nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b) {
+nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
+                                          const std::atomic<bool>* cancel) {
   std::string plant_spec = "ipa";
   if (Get(b, "plant", plant_spec)) plant_spec = PlantSpec(plant_spec);
   double Ts = 0.01;
@@ -884,7 +894,9 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b) {
   }
   fs::create_directories(dir);
   o.directory = dir.string();
-  o.stop = &shutting_down_;
+  // The client leaving, the deadline and the server stopping set `cancel`
+  // (without a server, the app's shutdown flag).
+  o.stop = cancel != nullptr ? cancel : &shutting_down_;
   const CommissionResult r = pneumid::Commission(*plant, o);
   const Actuator act = o.actuator ? *o.actuator : PlantActuator(*plant);
   CommissionFilesOptions fo;

@@ -57,10 +57,12 @@ class AppApi {
   nlohmann::json Files(const Request& request);
   nlohmann::json OpenData(const nlohmann::json& body);
   nlohmann::json Upload(const Request& request);
-  nlohmann::json Identify(const nlohmann::json& body);
+  nlohmann::json Identify(const nlohmann::json& body, const std::atomic<bool>* cancel = nullptr);
   nlohmann::ordered_json Tune(const nlohmann::json& body);
-  nlohmann::ordered_json Control(const nlohmann::json& body);
-  nlohmann::ordered_json Commission(const nlohmann::json& body);
+  nlohmann::ordered_json Control(const nlohmann::json& body,
+                                 const std::atomic<bool>* cancel = nullptr);
+  nlohmann::ordered_json Commission(const nlohmann::json& body,
+                                    const std::atomic<bool>* cancel = nullptr);
   nlohmann::ordered_json ModelViews(const nlohmann::json& body);
   Response RunStart(const nlohmann::json& body);
   Response ExportController(const nlohmann::json& body);

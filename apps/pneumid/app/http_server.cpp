@@ -1,5 +1,6 @@
 #include "http_server.hpp"
 
+#include <poll.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 
@@ -125,6 +126,34 @@ struct HttpServer::Impl {
   int active = 0;
   // Connections waiting for a request header, since when (guarded by mutex).
   std::map<int, std::chrono::steady_clock::time_point> waiting;
+  // Requests being computed: their connection, start and cancel flag (guarded by mutex).
+  struct Running {
+    std::chrono::steady_clock::time_point start;
+    std::shared_ptr<std::atomic<bool>> cancel;
+    bool deadline = false;  // cancelled by the deadline (not by the client)
+  };
+  std::map<int, Running> running;
+
+  // Cancels the requests whose client has gone (the connection reads as
+  // closed) or whose deadline has passed; with `all`, every one (the server
+  // stops). Called with the mutex held.
+  void CancelRunning(bool all) {
+    const auto now = std::chrono::steady_clock::now();
+    for (auto& [fd, r] : running) {
+      if (r.cancel->load()) continue;
+      bool gone = all;
+      if (!gone) {
+        pollfd p{fd, POLLIN | POLLRDHUP, 0};
+        gone = ::poll(&p, 1, 0) > 0 && (p.revents & (POLLRDHUP | POLLHUP | POLLERR)) != 0;
+      }
+      if (!gone && options.request_deadline > 0.0 &&
+          std::chrono::duration<double>(now - r.start).count() > options.request_deadline) {
+        gone = true;
+        r.deadline = true;
+      }
+      if (gone) r.cancel->store(true);
+    }
+  }
 
   void WaitingForHeader(int fd, bool waits) {
     std::lock_guard lock(mutex);
@@ -334,11 +363,26 @@ struct HttpServer::Impl {
       if (auto ct = req.find(http::field::content_type); ct != req.end())
         request.content_type = std::string(ct->value());
       Response response;
+      const int fd = socket.native_handle();
+      {
+        std::lock_guard lock(mutex);
+        running[fd] = {std::chrono::steady_clock::now(), request.cancel, false};
+      }
       try {
         response = handler(request);
       } catch (const std::exception& e) {
         response = ErrorResponse(500, e.what());
       }
+      bool deadline = false;
+      {
+        std::lock_guard lock(mutex);
+        deadline = running[fd].deadline;
+        running.erase(fd);
+      }
+      if (request.cancel->load() && deadline)
+        response = ErrorResponse(503, fmt::format("the request was stopped after its deadline of "
+                                                  "{:g} s",
+                                                  options.request_deadline));
       Write(socket, response, req.version(), req.keep_alive(), ec);
       if (ec || !req.keep_alive() || stopping) break;
     }
@@ -385,6 +429,7 @@ void HttpServer::Run() {
       std::this_thread::sleep_for(std::chrono::milliseconds(250));
       std::lock_guard lock(s.mutex);
       s.EndWaiting(false);
+      s.CancelRunning(false);
     }
   });
   while (!s.stopping) {
@@ -430,6 +475,7 @@ void HttpServer::Stop() {
   if (s.stopping.exchange(true)) return;
   {
     std::lock_guard lock(s.mutex);
+    s.CancelRunning(true);
     for (int fd : s.sockets) ::shutdown(fd, SHUT_RDWR);
   }
   // Unblock accept(): shutdown on the listening socket makes it return.

@@ -32,6 +32,9 @@ struct Request {
   std::map<std::string, std::string> query;  ///< decoded parameters (token removed)
   std::string body;
   std::string content_type;
+  /// Set while the handler runs when the client has gone away, the request's
+  /// deadline has passed or the server stops: work that can stop should.
+  std::shared_ptr<std::atomic<bool>> cancel = std::make_shared<std::atomic<bool>>(false);
 };
 
 struct Response {
@@ -57,6 +60,9 @@ struct ServerOptions {
   /// localhost:PORT, HOST:PORT): a page of another site that a DNS name
   /// resolves to 127.0.0.1 cannot reach the app. Off for a wildcard --host.
   bool check_host = true;
+  /// Seconds a request may compute before Request::cancel is set (its
+  /// answer is then 503); 0: no deadline.
+  double request_deadline = 120.0;
 };
 
 /// The JSON error body {"error": message}.

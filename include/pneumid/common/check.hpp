@@ -29,6 +29,13 @@ class DataError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Work stopped on request (a stop flag an options struct carries, e.g. a
+/// server whose client went away); nothing is wrong with the arguments.
+class Cancelled : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 /// User data quoted in an error message, bounded in length: `text` itself when
 /// it has at most `max_chars` bytes, otherwise its first `max_chars` bytes (cut
 /// at a character boundary) followed by "... (N bytes)". Control characters and
@@ -56,10 +63,10 @@ namespace internal {
 /// Throws pneumid::InvalidArgument unless `condition` holds. The remaining
 /// arguments are an fmt format string and its values, e.g.
 ///   PNEUMID_CHECK(Ts > 0, "sample time must be positive, got Ts = {}", Ts);
-#define PNEUMID_CHECK(condition, ...)                                                  \
-  do {                                                                                 \
-    if (!(condition)) {                                                                \
-      ::pneumid::internal::ThrowInvalidArgument(#condition, __FILE__, __LINE__,        \
-                                                ::fmt::format(__VA_ARGS__));           \
-    }                                                                                  \
+#define PNEUMID_CHECK(condition, ...)                                           \
+  do {                                                                          \
+    if (!(condition)) {                                                         \
+      ::pneumid::internal::ThrowInvalidArgument(#condition, __FILE__, __LINE__, \
+                                                ::fmt::format(__VA_ARGS__));    \
+    }                                                                           \
   } while (0)

@@ -50,6 +50,7 @@
 // Per set-point change the same step metrics are listed in `steps`.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -81,10 +82,10 @@ LoadStep ParseLoadStep(const std::string& what, const std::string& spec);
 
 /// Duration, disturbances, noise and actuator limits of a closed-loop simulation.
 struct ClosedLoopOptions {
-  double duration = 1.0;  ///< s (> 0)
+  double duration = 1.0;             ///< s (> 0)
   std::vector<LoadStep> load_steps;  ///< load disturbance steps (none by default)
-  double noise_std = 0.0;  ///< measurement noise standard deviation (output units)
-  std::uint64_t seed = 1;  ///< noise seed
+  double noise_std = 0.0;            ///< measurement noise standard deviation (output units)
+  std::uint64_t seed = 1;            ///< noise seed
   /// Actuator limits applied after the controller (infinite = none).
   InputLimits actuator;
   /// Also limit the input to the plant's physical range (PlantActuator of
@@ -97,6 +98,9 @@ struct ClosedLoopOptions {
   double settling_threshold = 0.02;
   /// Record the wall-clock time of every Update() call.
   bool time_updates = false;
+  /// When set and true, the simulation throws Cancelled at the next sample
+  /// (a caller that no longer wants the result, e.g. a server whose client left).
+  const std::atomic<bool>* stop = nullptr;
   /// True when duration > 0, the load steps have finite at >= 0 and size, noise_std >= 0,
   /// u0 is finite, settling_threshold is in (0, 1) and actuator is valid; otherwise false
   /// with the reason in *error (when error is not null).
@@ -178,9 +182,9 @@ struct ClosedLoopResult {
   Eigen::VectorXd u_requested;     ///< the controller's input before the actuator limits
   Eigen::VectorXd d;               ///< load disturbance
   Eigen::VectorXd update_seconds;  ///< per Update() (empty unless time_updates)
-  ClosedLoopMetrics metrics;  ///< metrics of the run (see the file comment)
-  std::string controller;  ///< controller.Describe()
-  std::string plant;       ///< plant.Describe()
+  ClosedLoopMetrics metrics;       ///< metrics of the run (see the file comment)
+  std::string controller;          ///< controller.Describe()
+  std::string plant;               ///< plant.Describe()
 };
 
 /// Runs the loop described above; the plant is Reset() first. The plant's
