@@ -552,7 +552,7 @@ async function chooseValidation(path: string): Promise<void> {
   } else {
     try {
       const cols = columnChoice();
-      state.validation = await call<DataSet>('POST', '/api/data/open', { body: { path, ...cols } });
+      state.validation = await call<DataSet>('POST', '/api/data/open', { body: { path, ...cols, validation: true } });
       $('validation-info').textContent = `${state.validation.samples} samples: the models are ranked on it (held-out fit) at the next Identify`;
     } catch (e) {
       state.validation = null;
@@ -1120,6 +1120,33 @@ function attachRun(): void {
   statusTimer = window.setInterval(() => void pollStatus(false), 500);
 }
 
+// A page loaded (or reloaded) takes over the server's session: the last data
+// set opened and its last identification (the chosen model is the best one).
+async function restoreSession(): Promise<void> {
+  try {
+    const s = await call('GET', '/api/session');
+    if (!s.data) return;
+    state.dataSource = { path: s.data.name };
+    setData(s.data);
+    const req = s.identify_request;
+    if (s.identify && req) {
+      const methods: string[] = Array.isArray(req.methods) ? req.methods : String(req.methods ?? '').split(',');
+      for (const cb of document.querySelectorAll<HTMLInputElement>('#methods input[name=method]'))
+        cb.checked = methods.includes(cb.value);
+      if (req.detrend) ($('detrend') as HTMLSelectElement).value = req.detrend;
+      if (req.window) ($('window') as HTMLInputElement).value = req.window;
+      state.identify = s.identify;
+      state.identifyMethods = methods;
+      state.identifyDetrend = req.detrend ?? 'none';
+      $('identify-state').textContent = `${s.identify.models.length} models (restored from the session)`;
+      showIdentify(s.identify);
+    }
+    document.body.dataset.restored = '1';
+  } catch (e) {
+    showError('data-error', e);
+  }
+}
+
 // A page loaded (or reloaded) while a run goes on takes it over: the live
 // plot from the run's first sample and a Stop that works.
 async function findRunningRun(): Promise<void> {
@@ -1377,6 +1404,7 @@ async function main(): Promise<void> {
     showError('global-error', e);
   }
   await listFiles('');
+  await restoreSession();
   await findRunningRun();
   document.body.dataset.ready = '1';
 }

@@ -360,6 +360,9 @@ try {
     await page.reload();
     await page.waitForSelector('body[data-ready="1"]', { timeout: 15000 });
     const attached = await page.evaluate(() => ({ state: document.getElementById('run-state').dataset.state, stop: document.getElementById('run-stop').disabled, attached: document.body.dataset.attached }));
+    // the session's data and models are restored with the run
+    const restored = await page.evaluate(() => ({ data: window.pneumid.data?.name, rows: document.querySelectorAll('#fit-table tbody tr').length, model: window.pneumid.model }));
+    if (restored.data !== 'demo.csv' || restored.rows !== 3 || restored.model !== 'fit-p1d') fail(`after the reload the session is not restored: ${JSON.stringify(restored)}`);
     if (attached.state !== 'running' || attached.stop || attached.attached !== '1') fail(`after the reload: ${JSON.stringify(attached)}`);
     await page.waitForFunction(() => window.pneumid.run.points > 0, null, { timeout: 10000 });
     await page.click('#run-stop');

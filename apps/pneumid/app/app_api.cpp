@@ -235,6 +235,10 @@ Response AppApi::Route(const Request& req) {
     method_check(get, "GET");
     return JsonResponse({{"version", Version()}, {"root", options_.root.string()}});
   }
+  if (p == "/api/session") {
+    method_check(get, "GET");
+    return JsonResponse(Session());
+  }
   if (p == "/api/files") {
     method_check(get, "GET");
     return JsonResponse(Files(req));
@@ -432,7 +436,7 @@ nlohmann::json AppApi::Files(const Request& req) {
   return j;
 }
 
-nlohmann::json AppApi::LoadDataSet(std::string name, const cli::DataOptions& o) {
+nlohmann::json AppApi::LoadDataSet(std::string name, const cli::DataOptions& o, bool session) {
   DataSet set;
   set.name = std::move(name);
   set.path = o.path;
@@ -443,10 +447,10 @@ nlohmann::json AppApi::LoadDataSet(std::string name, const cli::DataOptions& o) 
   set.columns = DataFormatFromPath(o.path) == DataFormat::kMat
                     ? std::vector<std::string>{o.time_col, o.input_col, o.output_col}
                     : CsvColumns(o.path);
-  return AddDataSet(std::move(set));
+  return AddDataSet(std::move(set), session);
 }
 
-nlohmann::json AppApi::AddDataSet(DataSet set) {
+nlohmann::json AppApi::AddDataSet(DataSet set, bool session) {
   const Dataset& d = set.data;
   nlohmann::json j;
   {
@@ -468,6 +472,25 @@ nlohmann::json AppApi::AddDataSet(DataSet set) {
   std::lock_guard lock(mutex_);
   const std::string id = set.id;
   data_[id] = std::make_shared<const DataSet>(std::move(set));
+  if (session) {
+    session_data_ = j;
+    session_identify_ = nullptr;
+    session_identify_request_ = nullptr;
+  }
+  return j;
+}
+
+// What a reloaded or second page restores: the last data set opened, its
+// last identification with the request that made it, and the run's status.
+nlohmann::json AppApi::Session() {
+  nlohmann::json j;
+  {
+    std::lock_guard lock(mutex_);
+    j["data"] = session_data_;
+    j["identify"] = session_identify_;
+    j["identify_request"] = session_identify_request_;
+  }
+  j["run"] = run_.Status();
   return j;
 }
 
@@ -482,7 +505,9 @@ nlohmann::json AppApi::OpenData(const nlohmann::json& body) {
   Get(body, "t", o.time_col);
   Get(body, "u", o.input_col);
   Get(body, "y", o.output_col);
-  return LoadDataSet(path, o);
+  bool validation = false;
+  Get(body, "validation", validation);
+  return LoadDataSet(path, o, !validation);
 }
 
 nlohmann::json AppApi::Upload(const Request& req) {
@@ -577,6 +602,13 @@ nlohmann::json AppApi::Identify(const nlohmann::json& body, const std::atomic<bo
   }
   j["responses"] = std::move(responses);
   j["model_file"] = out.json;
+  {
+    std::lock_guard lock(mutex_);
+    if (session_data_.is_object() && session_data_.value("id", "") == set->id) {
+      session_identify_ = j;
+      session_identify_request_ = body;
+    }
+  }
   return j;
 }
 

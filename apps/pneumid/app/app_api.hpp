@@ -57,6 +57,7 @@ class AppApi {
   nlohmann::json Files(const Request& request);
   nlohmann::json OpenData(const nlohmann::json& body);
   nlohmann::json Upload(const Request& request);
+  nlohmann::json Session();
   nlohmann::json Identify(const nlohmann::json& body, const std::atomic<bool>* cancel = nullptr);
   nlohmann::ordered_json Tune(const nlohmann::json& body);
   nlohmann::ordered_json Control(const nlohmann::json& body,
@@ -69,8 +70,10 @@ class AppApi {
   Response ExportReport(const nlohmann::json& body);
 
   /// Loads the data file of `o` (opened or uploaded) as a data set named `name`.
-  nlohmann::json LoadDataSet(std::string name, const cli::DataOptions& o);
-  nlohmann::json AddDataSet(DataSet set);
+  /// `session`: the set becomes the session's data set (GET /api/session);
+  /// a validation set does not.
+  nlohmann::json LoadDataSet(std::string name, const cli::DataOptions& o, bool session = true);
+  nlohmann::json AddDataSet(DataSet set, bool session = true);
   std::shared_ptr<const DataSet> FindDataSet(const nlohmann::json& id, const char* field) const;
   std::filesystem::path Confine(const std::string& path) const;
   std::string ModelSpec(const nlohmann::json& model);
@@ -90,6 +93,11 @@ class AppApi {
   int next_data_ = 1;
   int next_file_ = 1;
   int next_commission_ = 1;
+  // The session a reloaded or second page takes over (GET /api/session,
+  // guarded by mutex_): the last data set opened and its last identification.
+  nlohmann::json session_data_;
+  nlohmann::json session_identify_;
+  nlohmann::json session_identify_request_;
   LiveRun run_;
   std::atomic<bool> shutting_down_{false};
 };
