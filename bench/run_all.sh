@@ -14,4 +14,6 @@ for b in "$BUILD"/bench/*_benchmark; do
 done
 echo "== ARX against Octave's control package"
 bash bench/arx_vs_octave.sh "$BUILD" || echo "arx_vs_octave: skipped"
+echo "== pneumid app requests"
+/usr/bin/python3 bench/app_requests.py "$BUILD/pneumid" | tee "$OUT/app_requests.txt" || echo "app_requests: skipped"
 echo "results in $OUT/"
