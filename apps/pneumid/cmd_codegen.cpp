@@ -146,9 +146,7 @@ const Registrar reg(
                      "Plant whose input range bounds the input when --u-min/--u-max are not "
                      "given (ipa: 0..100 % duty); default: none")
           ->capture_default_str();
-      app.add_option("--Ts,--sample-time", c->Ts, "Sample time in s")
-          ->capture_default_str()
-          ->check(Positive());
+      AddSampleTimeOption(app, c->Ts, "Sample time in s");
       AddControllerOptions(app, c->controller);
       app.add_option("--u-min", c->controller.limits.u_min,
                      "Lower input limit (default: the plant's input range, or none)");

@@ -241,9 +241,7 @@ const Registrar reg(
           ->capture_default_str();
       app.add_option("--plant-config", c->plant_config,
                      "IPA parameter file (TOML, see config/ipa_default.toml)");
-      app.add_option("--Ts,--sample-time", c->Ts, "Sample period in s")
-          ->capture_default_str()
-          ->check(Positive());
+      AddSampleTimeOption(app, c->Ts, "Sample period in s");
       app.add_option("--range", c->range,
                      "Output range LO:HI the controller must serve (default: the reachable "
                      "range found by the sweep, less 5 % at each end)");

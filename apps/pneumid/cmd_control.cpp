@@ -255,9 +255,7 @@ const Registrar reg(
                      "flags given override it");
       app.add_option("--plant", c->plant,
                      "Plant: ipa, ipa-position, or any model spec (default: the model itself)");
-      app.add_option("--Ts,--sample-time", c->Ts, "Sample time in s")
-          ->capture_default_str()
-          ->check(Positive());
+      AddSampleTimeOption(app, c->Ts, "Sample time in s");
       AddControllerOptions(app, c->controller);
       app.add_option("--setpoint", c->setpoint, SignalSyntaxHelp())->required();
       app.add_option("--duration", c->duration, "Simulated time in s")

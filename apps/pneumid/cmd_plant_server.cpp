@@ -74,10 +74,8 @@ static Registrar reg(
       app.add_option("--port", o->port, "UDP port (0: any free port, printed)")
           ->capture_default_str();
       app.add_option("--bind", o->bind, "numeric address to listen on")->capture_default_str();
-      app.add_option("--Ts,--period,--sample-time", o->Ts,
-                     "sample period of the plant (s); clients must use the same")
-          ->capture_default_str()
-          ->check(Positive());
+      AddSampleTimeOption(app, o->Ts, "sample period of the plant (s); clients must use the same",
+                          true);
       app.add_option("--seed", o->seed, "noise seed")->capture_default_str();
       app.add_option("--noise", o->noise, "measurement noise (output units)")->check(NonNegative());
       app.add_option("--stop-answering-after", o->stop_answering_after,

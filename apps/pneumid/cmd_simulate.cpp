@@ -11,14 +11,14 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "progress.hpp"
-#include "validators.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/csv.hpp"
 #include "pneumid/plant/experiment.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
+#include "progress.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -128,9 +128,7 @@ static Registrar reg(
       app.add_option("--duration", o->duration, "Length of the experiment in s")
           ->capture_default_str()
           ->check(Positive());
-      app.add_option("--Ts,--sample-time", o->Ts, "Sample period in s")
-          ->capture_default_str()
-          ->check(Positive());
+      AddSampleTimeOption(app, o->Ts, "Sample period in s");
       app.add_option("--seed", o->seed, "Seed of the noise generators (runs are reproducible)")
           ->capture_default_str();
       app.add_option("--noise", o->noise,

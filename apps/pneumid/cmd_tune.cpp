@@ -120,9 +120,7 @@ const Registrar reg(
       app.add_option("--model", c->model,
                      "Model spec: fopdt:K=..,tau=..,theta=.., arx-paper, tf:..., FILE.json")
           ->required();
-      app.add_option("--Ts,--sample-time", c->Ts, "Controller sample time in s")
-          ->required()
-          ->check(Positive());
+      AddSampleTimeOption(app, c->Ts, "Controller sample time in s")->required();
       app.add_option("--rule", c->rule,
                      "shridhar-cooper (conventional), paper-modified (P=126, M=10, lambda=1.92), "
                      "explicit (needs --P --M --lambda), auto (to a specification: see "

@@ -23,10 +23,8 @@ void AddRealtimeOptions(CLI::App& app, RealtimeOptions& o, const RealtimeHelp& h
   app.add_option("--duration", o.duration, "length of the run in s")
       ->capture_default_str()
       ->check(Positive());
-  app.add_option("--Ts,--period,--sample-time", o.period,
-                 "loop period (sample time) in s, 0.0001 .. 10 (default 10 ms)")
-      ->capture_default_str()
-      ->check(InRange(1e-4, 10.0));
+  AddSampleTimeOption(app, o.period, "loop period (sample time) in s, 0.0001 .. 10 (default 10 ms)",
+                      true, 1e-4, 10.0);
   app.add_flag("--fast", o.fast, "sim only: as fast as possible instead of real time");
   app.add_flag("--no-realtime", o.no_realtime,
                "do not ask for SCHED_FIFO/mlockall/pinning (normal priority)");

@@ -54,4 +54,12 @@ CLI::Validator AtLeast(long long min) {
       fmt::format(">={}", min));
 }
 
+CLI::Option* AddSampleTimeOption(CLI::App& app, double& Ts, const std::string& help,
+                                 bool period_alias, double lo, double hi) {
+  return app
+      .add_option(period_alias ? "--Ts,--period,--sample-time" : "--Ts,--sample-time", Ts, help)
+      ->capture_default_str()
+      ->check(hi > 0.0 ? InRange(lo, hi) : Positive());
+}
+
 }  // namespace pneumid::cli

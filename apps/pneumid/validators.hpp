@@ -20,4 +20,12 @@ CLI::Validator InRange(double lo, double hi);
 /// An integer >= `min`.
 CLI::Validator AtLeast(long long min);
 
+/// The sample time (loop period) in s of a command that runs or designs a
+/// sampled loop: `--Ts` and `--sample-time` (and `--period` with
+/// `period_alias`), a finite number > 0 (or in [lo, hi] when hi > 0), its
+/// default shown in --help. Every such command declares it here, so the
+/// names and checks agree. Returns the option (e.g. to make it required).
+CLI::Option* AddSampleTimeOption(CLI::App& app, double& Ts, const std::string& help,
+                                 bool period_alias = false, double lo = 0.0, double hi = 0.0);
+
 }  // namespace pneumid::cli
