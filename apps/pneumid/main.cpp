@@ -15,6 +15,7 @@
 #include "command.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/version.hpp"
+#include "pneumid/lti/model_file_scope.hpp"
 
 namespace pneumid::cli {
 
@@ -91,6 +92,8 @@ int main(int argc, char** argv) {
     sub->preparse_callback([name = c.name, &current](std::size_t) { current = name; });
   }
 
+  // A command reads each model file once, however often it consults it.
+  pneumid::ModelFileScope model_files;
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

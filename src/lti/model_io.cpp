@@ -1,10 +1,14 @@
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/lti/model_file_scope.hpp"
+
+#include <sys/stat.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <vector>
 
 #include <fmt/format.h>
@@ -103,6 +107,26 @@ DataError InFile(const std::string& path, const InvalidArgument& e) {
 
 // The JSON of the model file `spec` (FILE.json[#method]), its path and the
 // method selected.
+// The files of the current ModelFileScope (model_io.hpp) on this thread, by
+// path, with what identifies their content on disk.
+struct ScopedModelFile {
+  dev_t device = 0;
+  ino_t inode = 0;
+  off_t size = 0;
+  timespec modified{};
+  timespec changed{};
+  nlohmann::json json;
+};
+thread_local std::map<std::string, ScopedModelFile>* t_model_files = nullptr;
+
+bool Unchanged(const ScopedModelFile& f, const struct stat& st) {
+  return f.device == st.st_dev && f.inode == st.st_ino && f.size == st.st_size &&
+         f.modified.tv_sec == st.st_mtim.tv_sec && f.modified.tv_nsec == st.st_mtim.tv_nsec &&
+         f.changed.tv_sec == st.st_ctim.tv_sec && f.changed.tv_nsec == st.st_ctim.tv_nsec;
+}
+
+nlohmann::json ParseModelFile(const std::string& path);
+
 nlohmann::json ReadModelFile(const std::string& spec, std::string* path_out,
                              std::string* select_out) {
   std::string path = spec, select;
@@ -117,6 +141,19 @@ nlohmann::json ReadModelFile(const std::string& spec, std::string* path_out,
   if (std::filesystem::is_directory(path, ec)) {
     throw DataError(fmt::format("{}: is a directory, not a model file", path));
   }
+  if (t_model_files == nullptr) return ParseModelFile(path);
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return ParseModelFile(path);
+  if (auto it = t_model_files->find(path); it != t_model_files->end() && Unchanged(it->second, st))
+    return it->second.json;
+  nlohmann::json j = ParseModelFile(path);
+  (*t_model_files)[path] = {st.st_dev, st.st_ino, st.st_size, st.st_mtim, st.st_ctim, j};
+  return j;
+}
+
+// The JSON of the model file at `path`. @throws DataError naming the file (and
+// the line and column of a syntax error).
+nlohmann::json ParseModelFile(const std::string& path) {
   std::ifstream in(path);
   if (!in) {
     throw DataError(fmt::format("{}: cannot open model file: {}", path, std::strerror(errno)));
@@ -263,6 +300,16 @@ std::optional<nlohmann::json> ReadModelFileIfAny(const std::string& spec, std::s
 }
 
 }  // namespace
+
+ModelFileScope::ModelFileScope() : outermost_(t_model_files == nullptr) {
+  if (outermost_) t_model_files = new std::map<std::string, ScopedModelFile>();
+}
+
+ModelFileScope::~ModelFileScope() {
+  if (!outermost_) return;
+  delete t_model_files;
+  t_model_files = nullptr;
+}
 
 std::optional<StaticMap> ParseModelInputMap(const std::string& spec) {
   std::string path, select;

@@ -48,7 +48,9 @@ if what == "leave":
     after = busy(1.0)
     print(f"a client that leaves: the app's CPU share {before:.2f} while computing, "
           f"{after:.2f} after it left")
-    if not (before > 0.5 and after < 0.2):
+    # relative to the share while computing: a loaded test machine (ctest -j)
+    # gives the app less than a core
+    if not (before > 0.15 and after < 0.3 * before):
         sys.exit("FAIL: the request went on after its client left")
 elif what == "deadline":
     deadline = float(sys.argv[5])
@@ -69,7 +71,7 @@ elif what == "deadline":
 elif what == "busy":
     share = busy(0.5)
     print(f"the app's CPU share during the long request: {share:.2f}")
-    if share < 0.5:
+    if share < 0.15:
         sys.exit("FAIL: the long request was not running")
 else:
     sys.exit(f"unknown check {what}")

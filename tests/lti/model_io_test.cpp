@@ -1,5 +1,6 @@
 // Model specs and the JSON form of a transfer function.
 #include "pneumid/lti/model_io.hpp"
+#include "pneumid/lti/model_file_scope.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -149,6 +150,64 @@ TEST(ModelIoTest, BadModelFilesNameTheFile) {
               ThrowsMessage<DataError>(HasSubstr("is a directory, not a model file")));
   EXPECT_THAT([] { ParseModelSpec("."); },
               ThrowsMessage<DataError>(HasSubstr(".: is a directory, not a model file")));
+}
+
+}  // namespace
+}  // namespace pneumid
+
+namespace pneumid {
+namespace {
+
+// Read system calls of this process so far (Linux /proc/self/io).
+long ReadCalls() {
+  std::ifstream io("/proc/self/io");
+  std::string key;
+  long value = 0;
+  while (io >> key >> value)
+    if (key == "syscr:") return value;
+  return -1;
+}
+
+void WriteModel(const std::string& path, const std::string& den) {
+  std::ofstream(path) << R"({"num": [2.0], "den": [)" << den << R"(], "Ts": 0.0, "delay": 0.0})";
+}
+
+// The read system calls that `work` makes, less those of measuring them.
+template <typename Work>
+long ReadsOf(Work work) {
+  const auto delta = [](auto f) {
+    const long a = ReadCalls();
+    f();
+    return ReadCalls() - a;
+  };
+  return delta(work) - delta([] {});
+}
+
+// Inside a ModelFileScope a spec consulted again is not read again (no read
+// system call), a file changed on disk is read again, and without a scope
+// every call reads the file.
+TEST(ModelIoTest, AScopeReadsEachModelFileOnce) {
+  if (ReadCalls() < 0) GTEST_SKIP() << "no /proc/self/io";
+  const std::string path = ::testing::TempDir() + "pneumid_model_scope.json";
+  WriteModel(path, "1.0, 1.0");
+  {
+    const ModelFileScope scope;
+    EXPECT_GT(ReadsOf([&] { EXPECT_DOUBLE_EQ(ParseModelSpec(path).DcGain(), 2.0); }), 0);
+    EXPECT_EQ(ReadsOf([&] {
+                EXPECT_DOUBLE_EQ(ParseModelSpec(path).DcGain(), 2.0);
+                EXPECT_FALSE(ParseModelInputMap(path).has_value());
+                EXPECT_FALSE(ParseModelNarx(path).has_value());
+                const ModelFileScope inner;  // nested: the outer scope's files
+                EXPECT_DOUBLE_EQ(ParseModelSpec(path).DcGain(), 2.0);
+              }),
+              0);
+    WriteModel(path, "1.0, 4.0");  // changed on disk: read again
+    EXPECT_GT(ReadsOf([&] { EXPECT_DOUBLE_EQ(ParseModelSpec(path).DcGain(), 0.5); }), 0);
+  }
+  // No scope: every call reads the file.
+  EXPECT_GT(ReadsOf([&] { EXPECT_DOUBLE_EQ(ParseModelSpec(path).DcGain(), 0.5); }), 0);
+  EXPECT_GT(ReadsOf([&] { EXPECT_DOUBLE_EQ(ParseModelSpec(path).DcGain(), 0.5); }), 0);
+  std::remove(path.c_str());
 }
 
 }  // namespace

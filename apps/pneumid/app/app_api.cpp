@@ -19,6 +19,7 @@
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/model_evaluation.hpp"
 #include "pneumid/lti/frequency.hpp"
+#include "pneumid/lti/model_file_scope.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/plant/signal.hpp"
@@ -186,6 +187,8 @@ void AppApi::Shutdown() {
 }
 
 Response AppApi::Handle(const Request& request) {
+  // A request reads each model file once, however often it consults it.
+  const ModelFileScope model_files;
   try {
     return Route(request);
   } catch (const HttpError& e) {
