@@ -15,7 +15,9 @@ namespace pneumid {
 /// `pneumid` opens one per command, the app one per request.
 class ModelFileScope {
  public:
+  /// Opens a scope on this thread (within another one: joins it).
   ModelFileScope();
+  /// Closes the scope; the outermost one forgets the files it kept.
   ~ModelFileScope();
   ModelFileScope(const ModelFileScope&) = delete;             ///< not copyable
   ModelFileScope& operator=(const ModelFileScope&) = delete;  ///< not assignable
