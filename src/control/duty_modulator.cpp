@@ -62,10 +62,10 @@ DutyModulator::DutyModulator(std::vector<InputGap> gaps, double u_min, double u_
 }
 
 double DutyModulator::Next(double v) {
-  // The request is clipped to the actuator's range (what lies beyond it is
-  // not carried); the carried error may take w past an end of the range,
-  // where the end is applied and the rest is carried, so that the mean of
-  // the applied inputs follows a request near an end without bias.
+  // A request at or beyond an end of the range carries nothing; inside it the
+  // carried error may take w past an end, where the end is applied and the
+  // rest is carried, so that the mean of the applied inputs follows a
+  // request near an end without bias.
   if (v <= u_min_ || v >= u_max_) {  // saturated: the end, nothing carried
     error_ = 0.0;
     return std::clamp(v, u_min_, u_max_);

@@ -105,9 +105,7 @@ DataError InFile(const std::string& path, const InvalidArgument& e) {
   return DataError(what.rfind(path + ":", 0) == 0 ? what : fmt::format("{}: {}", path, what));
 }
 
-// The JSON of the model file `spec` (FILE.json[#method]), its path and the
-// method selected.
-// The files of the current ModelFileScope (model_io.hpp) on this thread, by
+// The files of the current ModelFileScope (model_file_scope.hpp) on this thread, by
 // path, with what identifies their content on disk.
 struct ScopedModelFile {
   dev_t device = 0;
@@ -127,6 +125,8 @@ bool Unchanged(const ScopedModelFile& f, const struct stat& st) {
 
 nlohmann::json ParseModelFile(const std::string& path);
 
+// The JSON of the model file `spec` (FILE.json[#method]), its path and the
+// method selected; inside a ModelFileScope read once while unchanged on disk.
 nlohmann::json ReadModelFile(const std::string& spec, std::string* path_out,
                              std::string* select_out) {
   std::string path = spec, select;
