@@ -9,14 +9,18 @@
 
 namespace {
 
-// The paper's step test (0.61 -> 82 % at 1 s) followed by a PRBS, 10 s at Ts = 0.01 s.
+// Force mode: the paper's step test (0.61 -> 82 % at 1 s) followed by a PRBS,
+// 10 s at Ts = 0.01 s. Position mode (the position rig): a signed PRBS of
+// +-30 % that moves the piston back and forth within the stroke.
 void RunIpa(benchmark::State& state, pneumid::IpaMode mode, pneumid::PwmMode pwm) {
-  pneumid::IpaParameters p;
-  p.mode = mode;
+  pneumid::IpaParameters p = pneumid::DefaultIpaParameters(mode);
   p.pwm_mode = pwm;
   pneumid::IpaSimulator sim(p, 0.01, 1);
-  auto step = pneumid::ParseSignal("step:from=0.61,to=82,at=1.0");
-  auto prbs = pneumid::ParseSignal("prbs:low=20,high=90,order=7,clock=0.05");
+  const bool force = mode == pneumid::IpaMode::kForce;
+  auto step = pneumid::ParseSignal(force ? "step:from=0.61,to=82,at=1.0"
+                                         : "prbs:low=-30,high=30,order=7,clock=0.03");
+  auto prbs = pneumid::ParseSignal(force ? "prbs:low=20,high=90,order=7,clock=0.05"
+                                         : "prbs:low=-30,high=30,order=7,clock=0.03");
   const int n = 1000;
   long long steps = 0;
   for (auto _ : state) {
@@ -32,7 +36,8 @@ void RunIpa(benchmark::State& state, pneumid::IpaMode mode, pneumid::PwmMode pwm
   }
   const double simulated = n * 0.01 * static_cast<double>(state.iterations());
   state.counters["x_real_time"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
-  state.counters["ode_steps_per_simulated_s"] = benchmark::Counter(static_cast<double>(steps) / simulated);
+  state.counters["ode_steps_per_simulated_s"] =
+      benchmark::Counter(static_cast<double>(steps) / simulated);
 }
 
 void BM_IpaForceSwitching(benchmark::State& s) {

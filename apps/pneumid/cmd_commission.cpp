@@ -169,14 +169,7 @@ void Run(CommissionCli& c) {
     o.actuator = io_plant->actuator();
     plant = std::move(io_plant);
   }
-  // The input gaps: the plant's own ("plant"), none, or LO:HI,...
-  if (c.input_gaps == "none") {
-    o.modulate = false;
-  } else if (c.input_gaps != "plant") {
-    Actuator a = o.actuator ? *o.actuator : PlantActuator(*plant);
-    a.input_gaps = ParseInputGaps(c.input_gaps);
-    o.actuator = a;
-  }
+  SetInputGaps(o, *plant, c.input_gaps);
   ProgressBar bar("commission", c.progress || StderrIsTerminal());
   o.progress = [&bar](const std::string& stage, double f) { bar(f, stage); };
   g_stop.store(false);

@@ -854,22 +854,22 @@ void GenerateModulator(const ModulatedController& c, Module& m, const std::strin
   m.Member({Field::kReal, stem + "v", 0, "inner controller's request v"});
   // A request at or beyond an end of the input range: that end, nothing
   // carried; else a = w clipped to the range unless a gap holds w.
+  struct End {
+    double value;
+    const char* at_or_beyond;  // comparison of the request with the end
+    const char* beyond;        // comparison of the clipped input with the end
+  };
+  const End ends[] = {{mod.u_min(), "<=", "<"}, {mod.u_max(), ">=", ">"}};
   std::string clip;
-  if (std::isfinite(mod.u_min())) {
-    clip +=
-        fmt::format("  if (s->{0}v <= {1}) {{\n    s->{0}err = PFX_ZERO;\n    return {1};\n  }}\n",
-                    stem, m.Literal(mod.u_min()));
-  }
-  if (std::isfinite(mod.u_max())) {
-    clip +=
-        fmt::format("  if (s->{0}v >= {1}) {{\n    s->{0}err = PFX_ZERO;\n    return {1};\n  }}\n",
-                    stem, m.Literal(mod.u_max()));
-  }
+  for (const End& e : ends)
+    if (std::isfinite(e.value))
+      clip += fmt::format(
+          "  if (s->{0}v {1} {2}) {{\n    s->{0}err = PFX_ZERO;\n    return {2};\n  }}\n", stem,
+          e.at_or_beyond, m.Literal(e.value));
   clip += "  w = s->" + stem + "v + s->" + stem + "err;\n  a = w;\n";
-  if (std::isfinite(mod.u_min()))
-    clip += fmt::format("  if (a < {0}) a = {0};\n", m.Literal(mod.u_min()));
-  if (std::isfinite(mod.u_max()))
-    clip += fmt::format("  if (a > {0}) a = {0};\n", m.Literal(mod.u_max()));
+  for (const End& e : ends)
+    if (std::isfinite(e.value))
+      clip += fmt::format("  if (a {0} {1}) a = {1};\n", e.beyond, m.Literal(e.value));
   std::string chain;
   for (const InputGap& g : mod.gaps()) {
     chain += fmt::format("{0}if (w > {1} && w < {2}) a = (w - {1} < {2} - w) ? {1} : {2};\n",

@@ -306,6 +306,7 @@ ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const 
     PNEUMID_CHECK(actuator.u_min <= actuator.u_max,
                   "the actuator limits {} .. {} do not overlap the plant's input range {} .. {}",
                   options.actuator.u_min, options.actuator.u_max, a.u_min, a.u_max);
+    CheckSetpointsInOutputRange(a, res.r.data(), static_cast<std::size_t>(n), Ts);
   }
   plant.Reset();
   plant.SetLoadDisturbance(0.0);

@@ -3,6 +3,7 @@
 #include <optional>
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -265,13 +266,28 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
     b.controller = std::make_unique<PidController>(Ts, o);
     return b;
   }
-  // A PID is tuned from the continuous FOPDT description; it needs no sampled model.
+  // A PID is tuned from the continuous FOPDT description; it needs no sampled
+  // model. An integrating or unstable model has none: then the gains are given.
   if (spec.type == ControllerType::kPid) {
     BuiltController b;
     b.type = spec.type;
     b.pid_rule = spec.pid_rule;
-    b.fopdt = FopdtFromModel(model);
-    b.pid_gains = TunePid(b.fopdt.K, b.fopdt.tau, b.fopdt.theta, Ts, spec.pid_rule, spec.tau_c);
+    if (model.IsStable()) {
+      b.fopdt = FopdtFromModel(model);
+      b.pid_gains = TunePid(b.fopdt.K, b.fopdt.tau, b.fopdt.theta, Ts, spec.pid_rule, spec.tau_c);
+    } else {
+      PNEUMID_CHECK(!std::isnan(spec.pid_kc),
+                    "the model {} is integrating or unstable: it has no FOPDT description to "
+                    "tune a PID from; give the gains (Kc, and Ti, Td if wanted)",
+                    model.ToString());
+      b.fopdt = FopdtEstimate{};
+      b.fopdt.K = b.fopdt.tau = b.fopdt.theta = std::numeric_limits<double>::quiet_NaN();
+      b.fopdt.method = "none (integrating or unstable model)";
+      b.pid_gains = PidGains{};
+      b.pid_gains.Kc = spec.pid_kc;
+      b.pid_gains.Ti = std::numeric_limits<double>::infinity();
+      b.pid_gains.Td = 0.0;
+    }
     b.pid_explicit = ApplyExplicitPidGains(spec, b.pid_gains);
     PidOptions o;
     o.gains = b.pid_gains;

@@ -63,10 +63,13 @@ const std::vector<DoubleKey>& DoubleKeys() {
       {"mechanics.smoothing_velocity", &IpaParameters::friction_smoothing_velocity},
       {"mechanics.end_stop_stiffness", &IpaParameters::end_stop_stiffness},
       {"mechanics.end_stop_damping", &IpaParameters::end_stop_damping},
+      {"mechanics.lugre_stiffness", &IpaParameters::lugre_stiffness},
+      {"mechanics.lugre_damping", &IpaParameters::lugre_damping},
       {"sensors.pressure_noise", &IpaParameters::pressure_noise},
       {"sensors.pressure_full_scale", &IpaParameters::pressure_full_scale},
       {"sensors.pressure_filter_time_constant", &IpaParameters::pressure_filter_time_constant},
       {"sensors.position_noise", &IpaParameters::position_noise},
+      {"sensors.position_resolution", &IpaParameters::position_resolution},
       {"sensors.adc_range", &IpaParameters::adc_range},
       {"sensors.force_offset", &IpaParameters::force_offset},
       {"simulation.relative_tolerance", &IpaParameters::relative_tolerance},
@@ -127,10 +130,13 @@ constexpr Range kRanges[] = {
     {"mechanics.smoothing_velocity", "m/s", 1e-6, 0.1, false},
     {"mechanics.end_stop_stiffness", "N/m", 1e3, 1e9, false},
     {"mechanics.end_stop_damping", "N s/m", 0.0, 1e6, false},
+    {"mechanics.lugre_stiffness", "N/m", 0.0, 1e8, true},  // 0: Stribeck map, no bristles
+    {"mechanics.lugre_damping", "N s/m", 0.0, 1e5, true},
     {"sensors.pressure_noise", "Pa", 0.0, 1e5, false},
     {"sensors.pressure_full_scale", "Pa", 1e4, 1e8, false},
     {"sensors.pressure_filter_time_constant", "s", 0.0, 0.5, true},
     {"sensors.position_noise", "m", 0.0, 0.01, false},
+    {"sensors.position_resolution", "m", 0.0, 0.01, false},
     {"sensors.adc_range", "V", 0.1, 100.0, false},
     {"sensors.force_offset", "N", -1e4, 1e4, true},
     {"simulation.relative_tolerance", "", 1e-12, 1e-2, false},
@@ -231,7 +237,21 @@ std::string IpaParametersToToml(const IpaParameters& p, const std::string& comme
   return out;
 }
 
-IpaParameters LoadIpaParameters(const std::string& path) {
+IpaParameters DefaultIpaParameters(IpaMode mode) {
+  IpaParameters p;
+  p.mode = mode;
+  if (mode == IpaMode::kPosition) {
+    // The position rig (docs/position.md): four small fast 2/2 valves.
+    p.inlet_conductance = 1.0e-9;
+    p.exhaust_conductance = 1.2e-9;
+    p.open_delay = 0.0003;
+    p.close_delay = 0.0005;
+    p.min_pulse_width = 0.0003;
+  }
+  return p;
+}
+
+IpaParameters LoadIpaParameters(const std::string& path, IpaMode mode) {
   toml::table root;
   try {
     root = toml::parse_file(path);
@@ -241,7 +261,14 @@ IpaParameters LoadIpaParameters(const std::string& path) {
     throw DataError(
         fmt::format("{}:{}:{}: {}", path, src.begin.line, src.begin.column, e.description()));
   }
-  IpaParameters p;
+  // Keys not in the file keep the defaults of the file's mode (checked below).
+  if (auto named = root["simulation"]["mode"].value<std::string>()) {
+    try {
+      mode = IpaModeFromString(*named);
+    } catch (const InvalidArgument&) {
+    }
+  }
+  IpaParameters p = DefaultIpaParameters(mode);
   for (auto&& [table_key, table_node] : root) {
     const std::string table_name(table_key.str());
     const toml::table* table = table_node.as_table();

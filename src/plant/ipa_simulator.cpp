@@ -23,6 +23,7 @@ constexpr double kT0 = 293.15;      // K
 constexpr double kBar = 1e5;        // state scaling: pressures in bar
 constexpr double kMm = 1e-3;        // positions in mm
 constexpr double kGram = 1e-3;      // masses in g
+constexpr double kMicron = 1e-6;    // LuGre bristle deflection in um
 constexpr double kEventTol = 1e-9;  // s, events closer than this are simultaneous
 
 }  // namespace
@@ -106,7 +107,10 @@ bool IpaParameters::IsValid(std::string* error) const {
         Check{end_stop_damping, "mechanics.end_stop_damping", "N s/m"},
         Check{pressure_noise, "sensors.pressure_noise", "Pa"},
         Check{pressure_filter_time_constant, "sensors.pressure_filter_time_constant", "s"},
-        Check{position_noise, "sensors.position_noise", "m"}, Check{rod, "cylinder.rod", "m"}}) {
+        Check{position_noise, "sensors.position_noise", "m"}, Check{rod, "cylinder.rod", "m"},
+        Check{lugre_stiffness, "mechanics.lugre_stiffness", "N/m"},
+        Check{lugre_damping, "mechanics.lugre_damping", "N s/m"},
+        Check{position_resolution, "sensors.position_resolution", "m"}}) {
     if (!(std::isfinite(c.value) && c.value >= 0.0))
       return fail(fmt::format("{} must be >= 0, got {} {}", c.name, c.value, c.unit));
   }
@@ -161,8 +165,10 @@ IpaSimulator::IpaSimulator(IpaParameters parameters, double Ts, std::uint64_t se
   // Fixed storage for the sample loop (see EventQueue and readings_).
   inlet_ = std::make_unique<ipa_detail::Valve>();
   exhaust_ = std::make_unique<ipa_detail::Valve>();
-  inlet_->pending.Reserve(EventCapacity());
-  exhaust_->pending.Reserve(EventCapacity());
+  inlet_b_ = std::make_unique<ipa_detail::Valve>();
+  exhaust_b_ = std::make_unique<ipa_detail::Valve>();
+  for (ipa_detail::Valve* v : {inlet_.get(), exhaust_.get(), inlet_b_.get(), exhaust_b_.get()})
+    v->pending.Reserve(EventCapacity());
   readings_.resize(static_cast<std::size_t>(p_.transport_delay_samples) + 1);
   Reset();
 }
@@ -186,19 +192,21 @@ std::size_t IpaSimulator::EventCapacity() const {
 void IpaSimulator::Reset() {
   rng_.seed(seed_);
   normal_.reset();
-  x_ = {p_.atmospheric_pressure / kBar,
-        (p_.supply_pressure + p_.atmospheric_pressure) / kBar,
-        p_.piston_position / kMm,
-        0.0,
-        0.0,
-        0.0,
-        p_.atmospheric_pressure / kBar,
-        p_.atmospheric_pressure / kBar};
+  double pa0 = p_.atmospheric_pressure;
+  double pb0 = p_.supply_pressure + p_.atmospheric_pressure;
+  if (p_.mode == IpaMode::kPosition) {
+    // At rest in balance: chamber B at half the supply gauge pressure, chamber
+    // A at the pressure whose force balances it.
+    pb0 = p_.atmospheric_pressure + 0.5 * p_.supply_pressure;
+    pa0 = p_.atmospheric_pressure + p_.AreaB() / p_.AreaA() * 0.5 * p_.supply_pressure;
+  }
+  x_ = {pa0 / kBar, pb0 / kBar, p_.piston_position / kMm, 0.0, 0.0, 0.0, pa0 / kBar,
+        pa0 / kBar, 0.0};
   t_ = 0.0;
   dt_ = 1e-4;
   steps_ = 0;
   sample_ = 0;
-  for (ipa_detail::Valve* v : {inlet_.get(), exhaust_.get()}) {
+  for (ipa_detail::Valve* v : {inlet_.get(), exhaust_.get(), inlet_b_.get(), exhaust_b_.get()}) {
     v->open = false;
     v->command = false;
     v->pending.clear();  // keeps its storage
@@ -225,6 +233,7 @@ void IpaSimulator::SetState(double p_a, double p_b, double x) {
   x_[3] = 0.0;
   x_[6] = x_[0];
   x_[7] = x_[0];
+  x_[8] = 0.0;
   for (double& r : readings_) r = SenseOutput();
   reading_head_ = 0;
 }
@@ -238,6 +247,7 @@ double IpaSimulator::pressure_manifold() const {
 }
 double IpaSimulator::position() const { return x_[2] * kMm; }
 double IpaSimulator::velocity() const { return x_[3]; }
+double IpaSimulator::bristle_deflection() const { return x_[8] * kMicron; }
 double IpaSimulator::force() const {
   return p_.AreaA() * (pressure_a() - p_.atmospheric_pressure) + p_.force_offset;
 }
@@ -283,12 +293,14 @@ double IpaSimulator::SenseOutput() {
     return p_.AreaA() * volts / p_.adc_range * p_.pressure_full_scale + p_.force_offset +
            load_disturbance_;
   }
-  const double pos = position() + p_.position_noise * n;
+  double pos = position() + p_.position_noise * n;
+  if (p_.position_resolution > 0.0)
+    pos = std::round(pos / p_.position_resolution) * p_.position_resolution;
   const double volts = Quantize(pos / p_.stroke * p_.adc_range);
   return volts / p_.adc_range * p_.stroke + load_disturbance_;
 }
 
-void IpaSimulator::Rhs(const State& x, State& dxdt, double open_in, double open_out) const {
+void IpaSimulator::Rhs(const State& x, State& dxdt, const Openings& open) const {
   const double pa = x[0] * kBar;
   const double pb = x[1] * kBar;
   const bool moving = p_.mode == IpaMode::kPosition;
@@ -308,27 +320,39 @@ void IpaSimulator::Rhs(const State& x, State& dxdt, double open_in, double open_
   // manifold, which the tube connects to chamber A.
   const bool tube = p_.tube_conductance > 0.0;
   const double pv = tube ? x[7] * kBar : pa;
+  // Mass flows (kg/s) into and out of a volume at pressure pv through an inlet
+  // valve open for the fraction `in` and an exhaust valve open for `out`.
+  auto valve_flows = [&](double pv, double in, double out, double& m_in, double& m_out) {
+    m_in = m_out = 0.0;
+    if (in > 0.0) {
+      const double C = p_.inlet_conductance, b = p_.inlet_critical_ratio;
+      m_in += in * Iso6358MassFlow(C, b, ps, pv, T, rl);
+      m_out += in * Iso6358MassFlow(C, b, pv, ps, T, rl);
+    }
+    if (out > 0.0) {
+      const double C = p_.exhaust_conductance, b = p_.exhaust_critical_ratio;
+      m_out += out * Iso6358MassFlow(C, b, pv, patm, T, rl);
+      m_in += out * Iso6358MassFlow(C, b, patm, pv, T, rl);
+    }
+  };
   double in_v = 0.0, out_v = 0.0;  // mass flows entering / leaving the valve side, kg/s
-  if (open_in > 0.0) {
-    const double C = p_.inlet_conductance, b = p_.inlet_critical_ratio;
-    in_v += open_in * Iso6358MassFlow(C, b, ps, pv, T, rl);
-    out_v += open_in * Iso6358MassFlow(C, b, pv, ps, T, rl);
-  }
-  if (open_out > 0.0) {
-    const double C = p_.exhaust_conductance, b = p_.exhaust_critical_ratio;
-    out_v += open_out * Iso6358MassFlow(C, b, pv, patm, T, rl);
-    in_v += open_out * Iso6358MassFlow(C, b, patm, pv, T, rl);
-  }
+  valve_flows(pv, open.in_a, open.out_a, in_v, out_v);
   double in_a = in_v, out_a = out_v;  // mass flows entering / leaving chamber A, kg/s
   if (tube) {
     const double C = p_.tube_conductance, b = p_.tube_critical_ratio;
     in_a = Iso6358MassFlow(C, b, pv, pa, T, rl);
     out_a = Iso6358MassFlow(C, b, pa, pv, T, rl);
   }
-  // Chamber B: supply line through the (relieving) regulator.
-  const double C = p_.supply_line_conductance, b = p_.supply_line_critical_ratio;
-  const double in_b = Iso6358MassFlow(C, b, ps, pb, T, rl);
-  const double out_b = Iso6358MassFlow(C, b, pb, ps, T, rl);
+  // Chamber B: its own valves (position mode, the same valve type as A's) or
+  // the supply line through the (relieving) regulator (force mode).
+  double in_b = 0.0, out_b = 0.0;
+  if (moving) {
+    valve_flows(pb, open.in_b, open.out_b, in_b, out_b);
+  } else {
+    const double C = p_.supply_line_conductance, b = p_.supply_line_critical_ratio;
+    in_b = Iso6358MassFlow(C, b, ps, pb, T, rl);
+    out_b = Iso6358MassFlow(C, b, pb, ps, T, rl);
+  }
 
   const double RT = p_.gas_constant * T;
   const double dVa = Aa * v;
@@ -352,18 +376,26 @@ void IpaSimulator::Rhs(const State& x, State& dxdt, double open_in, double open_
   dxdt[7] = tube ? RT / p_.manifold_volume *
                        (p_.alpha_in * in_v - p_.alpha_out * out_v + out_a - in_a) / kBar
                  : 0.0;
+  dxdt[8] = 0.0;
   if (!moving) {
     dxdt[2] = 0.0;
     dxdt[3] = 0.0;
     return;
   }
-  // Piston and load: pressure force, Stribeck friction, end stops (penalty).
+  // Piston and load: pressure force, friction [4], end stops (penalty).
   const double Fp = Aa * (pa - patm) - Ab * (pb - patm);
   const double vs = p_.stribeck_velocity;
-  const double Ff = (p_.coulomb_friction +
-                     (p_.static_friction - p_.coulomb_friction) * std::exp(-(v / vs) * (v / vs))) *
-                        std::tanh(v / p_.friction_smoothing_velocity) +
-                    p_.viscous_friction * v;
+  const double g = p_.coulomb_friction +
+                   (p_.static_friction - p_.coulomb_friction) * std::exp(-(v / vs) * (v / vs));
+  double Ff = p_.viscous_friction * v;
+  if (p_.lugre_stiffness > 0.0) {
+    const double z = x[8] * kMicron;
+    const double dz = g > 0.0 ? v - p_.lugre_stiffness * std::abs(v) * z / g : 0.0;
+    Ff += p_.lugre_stiffness * z + p_.lugre_damping * dz;
+    dxdt[8] = dz / kMicron;
+  } else {
+    Ff += g * std::tanh(v / p_.friction_smoothing_velocity);
+  }
   double Fstop = 0.0;
   if (pos < 0.0) Fstop = -p_.end_stop_stiffness * pos - p_.end_stop_damping * std::min(v, 0.0);
   if (pos > p_.stroke)
@@ -372,14 +404,12 @@ void IpaSimulator::Rhs(const State& x, State& dxdt, double open_in, double open_
   dxdt[3] = (Fp - Ff + Fstop) / p_.mass;
 }
 
-void IpaSimulator::Integrate(double t0, double t1, double open_in, double open_out) {
+void IpaSimulator::Integrate(double t0, double t1, const Openings& open) {
   if (!(t1 > t0)) return;
   namespace odeint = boost::numeric::odeint;
   using Stepper = odeint::runge_kutta_dopri5<State>;
   auto stepper = odeint::make_controlled<Stepper>(p_.absolute_tolerance, p_.relative_tolerance);
-  auto system = [this, open_in, open_out](const State& x, State& dxdt, double /*t*/) {
-    Rhs(x, dxdt, open_in, open_out);
-  };
+  auto system = [this, &open](const State& x, State& dxdt, double /*t*/) { Rhs(x, dxdt, open); };
   State dxdt;
   system(x_, dxdt, t0);
   double t = t0;
@@ -413,18 +443,42 @@ void IpaSimulator::Command(ipa_detail::Valve& valve, bool on, double t) {
   valve.pending.push_back(ipa_detail::ValveEvent{t_phys, on});
 }
 
+void IpaSimulator::StartPositionPeriod(double T) {
+  // Signed duty: u > 0 fills A and vents B, u < 0 the reverse, for |u| T; all
+  // valves closed for the rest of the period. Pulses shorter than the minimum
+  // width do not open the valves; off times shorter than it do not close them.
+  const double a = std::min(std::abs(duty_), 1.0);
+  const bool full = a >= 1.0 || (a > 0.0 && (1.0 - a) * T < p_.min_pulse_width);
+  const bool pulse = full || (a > 0.0 && a * T >= p_.min_pulse_width);
+  const bool out = duty_ > 0.0;
+  Command(out ? *inlet_ : *inlet_b_, pulse, t_);
+  Command(out ? *exhaust_b_ : *exhaust_, pulse, t_);
+  Command(out ? *inlet_b_ : *inlet_, false, t_);
+  Command(out ? *exhaust_ : *exhaust_b_, false, t_);
+  falling_edge_ = (pulse && !full) ? t_ + a * T : -1.0;
+  exhaust_pulse_ = false;
+}
+
 void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaust_cmd) {
   const double T = 1.0 / p_.pwm_frequency;
+  const bool position = p_.mode == IpaMode::kPosition;
   if (!pwm) {
     Command(*inlet_, inlet_cmd, t_);
     Command(*exhaust_, exhaust_cmd, t_);
+    if (position) {
+      Command(*inlet_b_, inlet_cmd, t_);
+      Command(*exhaust_b_, exhaust_cmd, t_);
+    }
     falling_edge_ = -1.0;
   } else if (period_start_ < t_ - kEventTol) {
     period_start_ = t_;  // restart the PWM generator after manual valve commands
   }
   while (true) {
     // Events due now.
-    if (pwm && std::abs(t_ - period_start_) <= kEventTol) {
+    if (pwm && position && std::abs(t_ - period_start_) <= kEventTol) {
+      StartPositionPeriod(T);
+      period_start_ += T;
+    } else if (pwm && std::abs(t_ - period_start_) <= kEventTol) {
       // A new PWM period latches the duty held now.
       const double d = duty_;
       const double w_in = d * T, w_out = (1.0 - d) * T;
@@ -438,9 +492,13 @@ void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaus
     if (pwm && falling_edge_ >= 0.0 && std::abs(t_ - falling_edge_) <= kEventTol) {
       Command(*inlet_, false, t_);
       Command(*exhaust_, exhaust_pulse_, t_);
+      if (position) {
+        Command(*inlet_b_, false, t_);
+        Command(*exhaust_b_, false, t_);
+      }
       falling_edge_ = -1.0;
     }
-    for (ipa_detail::Valve* v : {inlet_.get(), exhaust_.get()}) {
+    for (ipa_detail::Valve* v : {inlet_.get(), exhaust_.get(), inlet_b_.get(), exhaust_b_.get()}) {
       while (!v->pending.empty() && v->pending.front().time <= t_ + kEventTol) {
         v->open = v->pending.front().open;
         v->pending.pop_front();
@@ -452,17 +510,22 @@ void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaus
       t_next = std::min(t_next, period_start_);
       if (falling_edge_ > t_) t_next = std::min(t_next, falling_edge_);
     }
-    for (const ipa_detail::Valve* v : {inlet_.get(), exhaust_.get()})
+    for (const ipa_detail::Valve* v :
+         {inlet_.get(), exhaust_.get(), inlet_b_.get(), exhaust_b_.get()})
       if (!v->pending.empty()) t_next = std::min(t_next, v->pending.front().time);
-    Integrate(t_, t_next, inlet_->open ? 1.0 : 0.0, exhaust_->open ? 1.0 : 0.0);
+    Integrate(t_, t_next,
+              Openings{inlet_->open ? 1.0 : 0.0, exhaust_->open ? 1.0 : 0.0,
+                       inlet_b_->open ? 1.0 : 0.0, exhaust_b_->open ? 1.0 : 0.0});
     t_ = t_next;
   }
   t_ = t_end;
 }
 
 void IpaSimulator::Advance(double u) {
-  PNEUMID_CHECK(std::isfinite(u), "IPA input (PWM duty, %) must be finite, got {}", u);
-  duty_ = std::clamp(u, 0.0, 100.0) / 100.0;
+  const bool position = p_.mode == IpaMode::kPosition;
+  PNEUMID_CHECK(std::isfinite(u), "IPA input ({}, %) must be finite, got {}",
+                position ? "signed valve command" : "PWM duty", u);
+  duty_ = std::clamp(u, position ? -100.0 : 0.0, 100.0) / 100.0;
   ++sample_;
   const double t_end = static_cast<double>(sample_) * Ts_;
   if (p_.pwm_mode == PwmMode::kSwitching) {
@@ -475,7 +538,14 @@ void IpaSimulator::Advance(double u) {
       if (w <= 0.0 || w < p_.min_pulse_width) return 0.0;
       return std::clamp((w - p_.open_delay + p_.close_delay) / T, 0.0, 1.0);
     };
-    Integrate(t_, t_end, fraction(duty_ * T), fraction((1.0 - duty_) * T));
+    if (position) {
+      // An off time shorter than the minimum pulse does not close the valves.
+      const double a = std::min(std::abs(duty_), 1.0);
+      const double f = (1.0 - a) * T < p_.min_pulse_width && a > 0.0 ? 1.0 : fraction(a * T);
+      Integrate(t_, t_end, duty_ > 0.0 ? Openings{f, 0.0, 0.0, f} : Openings{0.0, f, f, 0.0});
+    } else {
+      Integrate(t_, t_end, Openings{fraction(duty_ * T), fraction((1.0 - duty_) * T), 0.0, 0.0});
+    }
     t_ = t_end;
   }
   PushReading();

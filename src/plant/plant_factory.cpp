@@ -34,7 +34,9 @@ std::unique_ptr<Plant> MakeIpa(const std::string& spec, const std::string& base,
   if (fields.Has("mode")) mode = IpaModeFromString(fields.Text("mode"));
   if (fields.Has("pwm")) pwm = PwmModeFromString(fields.Text("pwm"));
   fields.Finish();
-  IpaParameters p = config.empty() ? IpaParameters{} : LoadIpaParameters(config);
+  const IpaMode base_mode = mode.value_or(IpaMode::kForce);
+  IpaParameters p =
+      config.empty() ? DefaultIpaParameters(base_mode) : LoadIpaParameters(config, base_mode);
   if (mode) p.mode = *mode;
   if (pwm) p.pwm_mode = *pwm;
   if (options.noise_sigma) {
@@ -76,7 +78,7 @@ std::string PlantSpecHelp() {
   return R"(Plant specs:
   ipa                      IPA physics simulator, force mode (rod fixed): input PWM duty %,
                            output force N (docs/simulator.md)
-  ipa-position             the same with a moving piston: output position m
+  ipa-position             the position rig: moving piston, four valves, command -100..100 %, output m
   ipa:config=FILE.toml[,mode=force|position][,pwm=switching|averaged]
                            IPA with parameters from a TOML file (see config/ipa_default.toml)
   arx-paper                the paper's ARX(3,3,1) force model, Ts = 0.01 s (Eq. 5)

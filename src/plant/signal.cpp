@@ -233,6 +233,34 @@ class ChirpSignal final : public Signal {
   Shaping s_;
 };
 
+class SineSignal final : public Signal {
+ public:
+  SineSignal(double from, double to, double frequency, double at, double duration, Shaping s)
+      : from_(from), to_(to), f_(frequency), at_(at), duration_(duration), s_(s) {}
+  double operator()(double t) const override {
+    const double mid = 0.5 * (from_ + to_);
+    const double tau = t - at_;
+    if (tau < 0.0 || tau > duration_) return s_.Apply(mid);
+    return s_.Apply(mid + 0.5 * (to_ - from_) * std::sin(2.0 * std::numbers::pi * f_ * tau));
+  }
+  void CheckSampleTime(double Ts) const override {
+    PNEUMID_CHECK(f_ <= 0.5 / Ts,
+                  "signal '{}': {} Hz is above the Nyquist frequency {} Hz of the sample time "
+                  "Ts = {} s (it would be aliased): lower the frequency or Ts",
+                  ToString(), f_, 0.5 / Ts, Ts);
+  }
+  std::string ToString() const override {
+    std::string text =
+        "sine:from=" + Num(from_) + ",to=" + Num(to_) + ",frequency=" + Num(f_) + ",at=" + Num(at_);
+    if (std::isfinite(duration_)) text += ",duration=" + Num(duration_);
+    return text + s_.Suffix();
+  }
+
+ private:
+  double from_, to_, f_, at_, duration_;
+  Shaping s_;
+};
+
 class RampSignal final : public Signal {
  public:
   RampSignal(double from, double to, double at, double duration, Shaping s)
@@ -298,11 +326,11 @@ std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
   const std::string_view trimmed = Trim(spec_in);
   PNEUMID_CHECK(!trimmed.empty(), "empty signal spec (expected e.g. 'step:from=0,to=1,at=1')");
   const std::string kind = ToLower(Trim(trimmed.substr(0, trimmed.find(':'))));
-  static const std::set<std::string> kinds = {"step",        "staircase", "multistep", "prbs",
-                                              "prbs-levels", "chirp",     "ramp",      "file"};
+  static const std::set<std::string> kinds = {
+      "step", "staircase", "multistep", "prbs", "prbs-levels", "chirp", "sine", "ramp", "file"};
   PNEUMID_CHECK(kinds.count(kind) != 0,
                 "signal '{}': unknown kind '{}' (expected step, staircase, multistep, prbs, "
-                "prbs-levels, chirp, ramp or file)",
+                "prbs-levels, chirp, sine, ramp or file)",
                 trimmed, kind);
   Spec p("signal", trimmed, {.has_kind = true, .has_head = kind == "file"});
   const std::string& spec = p.text();
@@ -371,6 +399,18 @@ std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
     Shaping s = TakeShaping(p);
     p.Finish();
     out = std::make_unique<ChirpSignal>(from, to, f0, f1, at, duration, s);
+  } else if (kind == "sine") {
+    double from = p.Number("from");
+    double to = p.Number("to");
+    double frequency = p.Number("frequency");
+    PNEUMID_CHECK(frequency > 0.0, "signal '{}': frequency must be positive, got {}", spec,
+                  frequency);
+    double at = p.Number("at", 0.0);
+    double duration = p.Number("duration", std::numeric_limits<double>::infinity());
+    PNEUMID_CHECK(duration > 0.0, "signal '{}': duration must be positive, got {}", spec, duration);
+    Shaping s = TakeShaping(p);
+    p.Finish();
+    out = std::make_unique<SineSignal>(from, to, frequency, at, duration, s);
   } else if (kind == "ramp") {
     double from = p.Number("from", 0.0);
     double to = p.Number("to");
@@ -412,6 +452,10 @@ std::string SignalSyntaxHelp() {
   chirp:from=A,to=B,f0=F0,f1=F1[,at=T][,duration=D]
                                         sine between A and B, frequency swept linearly from
                                         F0 to F1 over D seconds (default 10), (A+B)/2 outside
+  sine:from=A,to=B,frequency=F[,at=T][,duration=D]
+                                        sine between A and B of F Hz from T on, starting at
+                                        (A+B)/2 upwards; (A+B)/2 before T and after D seconds
+                                        (default: no end)
   ramp:from=A,to=B,at=T,duration=D      A until T, linear to B over D seconds, then B
   file:PATH[,col=NAME][,time=NAME]     column (MAT: variable) NAME (default u) of a CSV or
                                         .mat data file against its time column (default t),

@@ -17,8 +17,7 @@ std::string DescribeSafety(const SafetyOptions& s, const Actuator& actuator) {
   return fmt::format(
       "u in [{:g}, {:g}]{}, rate {}, y in [{:g}, {:g}], frozen {}, max overruns {}, safe state {}",
       s.u_min, s.u_max, unit,
-      s.rate_max > 0 ? fmt::format("<= {:g}{}/s", s.rate_max, unit) : "unlimited", s.y_min,
-      s.y_max,
+      s.rate_max > 0 ? fmt::format("<= {:g}{}/s", s.rate_max, unit) : "unlimited", s.y_min, s.y_max,
       s.frozen_samples > 0
           ? fmt::format("after {} samples within {:g}", s.frozen_samples, s.frozen_tolerance)
           : "off",
@@ -30,6 +29,7 @@ SessionResult RunSession(const SessionOptions& options, IoBackend& io, LoopContr
                          const std::vector<double>& setpoint) {
   std::string error;
   PNEUMID_CHECK(options.loop.IsValid(&error), "invalid loop options: {}", error);
+  CheckSetpointsInOutputRange(io.actuator(), setpoint.data(), setpoint.size(), options.loop.period);
   SafetyMonitor safety(options.safety);
   std::unique_ptr<LogWriter> log;
   if (!options.log_path.empty() || options.keep_records) {

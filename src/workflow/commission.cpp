@@ -699,4 +699,15 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   return r;
 }
 
+void SetInputGaps(CommissionOptions& options, const Plant& plant, const std::string& text) {
+  if (text == "plant") return;
+  if (text == "none") {
+    options.modulate = false;
+    return;
+  }
+  Actuator a = options.actuator ? *options.actuator : PlantActuator(plant);
+  a.input_gaps = ParseInputGaps(text);
+  options.actuator = a;
+}
+
 }  // namespace pneumid

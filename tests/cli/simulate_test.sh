@@ -63,7 +63,7 @@ simulate_error() {
 }
 simulate_error "unknown plant 'nope'" --plant nope
 simulate_error "key 'to': not a finite number" --input step:to=x
-simulate_error "unknown kind 'sine'" --input sine:f=1
+simulate_error "unknown kind 'square'" --input square:f=1
 simulate_error "--duration: must be > 0, got 0" --duration 0
 simulate_error "duration must be at least one sample period" --duration 0.001
 simulate_error "--Ts: must be > 0, got 0" --Ts 0

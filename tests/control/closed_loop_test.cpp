@@ -67,6 +67,26 @@ TEST(ClosedLoopMetricsTest, LoadStepPeakAndRecovery) {
   EXPECT_TRUE(std::isnan(m.rise_time));
 }
 
+TEST(ClosedLoopTest, SetpointsOutsideThePlantsOutputRangeAreRefused) {
+  // The position twin's output range is its stroke, 0..0.1 m.
+  IpaParameters p = DefaultIpaParameters(IpaMode::kPosition);
+  IpaSimulator plant(p, 0.01);
+  PidOptions po;
+  po.gains.Kc = 3000.0;
+  PidController pid(0.01, po);
+  ClosedLoopOptions o;
+  o.duration = 0.5;
+  auto outside = ParseSignal("step:from=0.05,to=0.12,at=0.3");
+  EXPECT_THAT([&] { SimulateClosedLoop(pid, plant, *outside, o); },
+              ::testing::ThrowsMessage<InvalidArgument>(
+                  ::testing::AllOf(::testing::HasSubstr("set-point 0.12 m at t = 0.3 s"),
+                                   ::testing::HasSubstr("position range 0 .. 0.1 m"))));
+  auto inside = ParseSignal("step:from=0.05,to=0.06,at=0.3");
+  EXPECT_NO_THROW(SimulateClosedLoop(pid, plant, *inside, o));
+  o.plant_range = false;  // the caller's own limits only
+  EXPECT_NO_THROW(SimulateClosedLoop(pid, plant, *outside, o));
+}
+
 TEST(ClosedLoopTest, ActuatorLimitsAndNoise) {
   DmcOptions d;
   d.P = 126;

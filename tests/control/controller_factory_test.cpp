@@ -186,5 +186,31 @@ TEST(ControllerFactoryTest, ExplicitPidGainsReplaceTheRulesAndPOnlyLeavesItsOffs
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("rule auto")));
 }
 
+TEST(ControllerFactoryTest, IntegratingModelsTakeTheirPidGainsFromTheSettings) {
+  // A positioning cylinder: y' = K u (m/s per %), sampled with a zero-order
+  // hold, y(k+1) = y(k) + K Ts u(k). No FOPDT description: the PID needs Kc.
+  const TransferFunction integrator(Eigen::VectorXd::Constant(1, 0.004),
+                                    (Eigen::VectorXd(2) << 1.0, 0.0).finished());
+  ControllerSettings s;
+  s.controller = "pid";
+  EXPECT_THAT([&] { MakeController(integrator, kTs, ToControllerSpec(s)); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("give the gains")));
+  s.pid_kc = 1000.0;
+  const BuiltController p = MakeController(integrator, kTs, ToControllerSpec(s));
+  EXPECT_DOUBLE_EQ(p.pid_gains.Kc, 1000.0);
+  EXPECT_TRUE(std::isinf(p.pid_gains.Ti));
+  EXPECT_EQ(p.pid_gains.Td, 0.0);
+  // P control of the integrator: e(k+1) = (1 - Kc K Ts) e(k), no offset.
+  LinearPlant plant(integrator, kTs);
+  const auto sp = ParseSignal("step:from=0,to=0.02,at=0.1");
+  ClosedLoopOptions o;
+  o.duration = 1.0;
+  const auto r = SimulateClosedLoop(*p.controller, plant, *sp, o);
+  for (int n : {1, 5, 40, 80}) {
+    const double expected = 0.02 * std::pow(1.0 - 1000.0 * 0.004 * kTs, n);
+    EXPECT_NEAR(r.r(10 + n) - r.y(10 + n), expected, 1e-9 + 1e-6 * expected) << n;
+  }
+}
+
 }  // namespace
 }  // namespace pneumid

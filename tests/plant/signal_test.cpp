@@ -74,6 +74,21 @@ TEST(SignalTest, ChirpFollowsTheLinearSweep) {
   // Instantaneous frequency near the end: zero crossings about 1/(2 f1) apart.
 }
 
+TEST(SignalTest, SineOscillatesBetweenItsEndsFromItsStart) {
+  auto s = ParseSignal("sine:from=0.03,to=0.07,frequency=0.5,at=1");
+  for (double tau : {0.0, 0.25, 0.5, 0.77, 1.5, 9.1})
+    EXPECT_NEAR((*s)(1.0 + tau), 0.05 + 0.02 * std::sin(std::numbers::pi * tau), 1e-15) << tau;
+  EXPECT_DOUBLE_EQ((*s)(0.5), 0.05);
+  auto ended = ParseSignal("sine:from=0,to=2,frequency=1,duration=2");
+  EXPECT_DOUBLE_EQ((*ended)(2.5), 1.0);
+  EXPECT_EQ(ParseSignal(ended->ToString())->ToString(), ended->ToString());
+  EXPECT_EQ(ParseSignal(s->ToString())->ToString(), s->ToString());
+  EXPECT_THAT([] { ParseSignal("sine:from=0,to=1,frequency=0"); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("frequency must be positive")));
+  EXPECT_THAT([&] { s->Sample(1.5, 10); },  // 0.5 Hz at Ts = 1.5 s: Nyquist 0.33 Hz
+              ThrowsMessage<InvalidArgument>(HasSubstr("Nyquist")));
+}
+
 // Reference sequences: tests/plant/gen_prbs.py (scipy.signal.max_len_seq).
 struct PrbsReference {
   int order;
@@ -201,7 +216,8 @@ TEST(SignalTest, BadSpecsGiveClearErrors) {
     }
   };
   expect_error("", "empty signal spec");
-  expect_error("sine:f=1", "unknown kind 'sine'");
+  expect_error("square:f=1", "unknown kind 'square'");
+  expect_error("sine:f=1", "missing key 'from'");
   expect_error("step:from=0,at=1", "needs 'to='");
   expect_error("step:from=0,to=x1,at=1", "key 'to': not a finite number: 'x1'");
   expect_error("step:to=1,speed=3", "unknown key 'speed'");

@@ -11,6 +11,7 @@
 
 #include "../command_json.hpp"
 #include "../data_options.hpp"
+#include "../output_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
 #include "pneumid/common/version.hpp"
@@ -781,12 +782,7 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b, const std::atomi
 
 namespace {
 
-nlohmann::json Array(const Eigen::VectorXd& v) {
-  nlohmann::json a = nlohmann::json::array();
-  for (Eigen::Index k = 0; k < v.size(); ++k)
-    a.push_back(std::isfinite(v[k]) ? nlohmann::json(v[k]) : nlohmann::json());
-  return a;
-}
+using cli::JsonNumbers;
 
 // The model simulated on a data set from an estimated initial state (as
 // `pneumid validate --initial-state estimate`), its fit and the residual
@@ -806,10 +802,10 @@ nlohmann::ordered_json OnData(const IdentifiedModel& m, const Dataset& data) {
     const int max_lag = static_cast<int>(std::min<Eigen::Index>(25, e.size() - 2));
     try {
       const ResidualCorrelation c = ComputeResidualCorrelation(ec, uc, max_lag);
-      j["residuals"] = {{"auto_lags", Array(c.auto_lags)},
-                        {"autocorr", Array(c.autocorr)},
-                        {"cross_lags", Array(c.cross_lags)},
-                        {"crosscorr", Array(c.crosscorr)},
+      j["residuals"] = {{"auto_lags", JsonNumbers(c.auto_lags)},
+                        {"autocorr", JsonNumbers(c.autocorr)},
+                        {"cross_lags", JsonNumbers(c.cross_lags)},
+                        {"crosscorr", JsonNumbers(c.crosscorr)},
                         {"bound", c.bound},
                         {"confidence", c.confidence},
                         {"auto_outside", c.auto_outside},
@@ -850,9 +846,9 @@ nlohmann::ordered_json AppApi::ModelViews(const nlohmann::json& b) {
   }
   try {
     const BodeData bd = Bode(g);
-    j["bode"] = {{"omega", Array(bd.omega)},
-                 {"magnitude_db", Array(bd.magnitude_db)},
-                 {"phase_deg", Array(bd.phase_deg)}};
+    j["bode"] = {{"omega", JsonNumbers(bd.omega)},
+                 {"magnitude_db", JsonNumbers(bd.magnitude_db)},
+                 {"phase_deg", JsonNumbers(bd.phase_deg)}};
   } catch (const std::exception& e) {
     j["bode"] = {{"error", e.what()}};
   }
@@ -912,13 +908,7 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
   std::string error;
   PNEUMID_CHECK(o.IsValid(&error), "{}", error);
   std::unique_ptr<Plant> plant = MakePlant(plant_spec, Ts, po);
-  if (gaps == "none") {
-    o.modulate = false;
-  } else if (gaps != "plant") {
-    Actuator a = PlantActuator(*plant);
-    a.input_gaps = ParseInputGaps(gaps);
-    o.actuator = a;
-  }
+  SetInputGaps(o, *plant, gaps);
   std::string dir_field;
   fs::path dir;
   if (Get(b, "dir", dir_field) && !dir_field.empty()) {

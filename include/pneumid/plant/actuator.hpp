@@ -14,6 +14,7 @@
 // in position mode).
 #pragma once
 
+#include <cstddef>
 #include <limits>
 #include <string>
 #include <vector>
@@ -43,6 +44,10 @@ struct Actuator {
   /// Physical input range (input units; infinite = unbounded).
   double u_min = -std::numeric_limits<double>::infinity();
   double u_max = std::numeric_limits<double>::infinity();  ///< upper end, e.g. 100 % duty
+  /// Physical output range (output units; infinite = unbounded), e.g. the
+  /// stroke of a positioning cylinder: set-points outside it cannot be reached.
+  double y_min = -std::numeric_limits<double>::infinity();
+  double y_max = std::numeric_limits<double>::infinity();  ///< upper end of the output range
   /// Inputs the actuator cannot hold (IPA: a PWM pulse shorter than the valves'
   /// minimum width does not open them, so duties below 100 min_pulse_width
   /// pwm_frequency % act as 0 and those as far below 100 % act as 100 %);
@@ -62,8 +67,15 @@ struct Actuator {
 /// force mode, position (m) in position mode.
 Actuator IpaActuator(IpaMode mode = IpaMode::kForce);
 
-/// The actuator of a plant: IpaActuator for the IPA simulator, the generic
-/// description (u, y without units, unbounded, hold/release) otherwise.
+/// The actuator of a plant: IpaActuator for the IPA simulator (in position
+/// mode with the output range 0..stroke), the generic description (u, y
+/// without units, unbounded, hold/release) otherwise.
 Actuator PlantActuator(const Plant& plant);
+
+/// Checks set-points r (sampled every Ts s from t = 0) against the actuator's
+/// output range.
+/// @throws InvalidArgument naming the first set-point outside it, its time and the range.
+void CheckSetpointsInOutputRange(const Actuator& actuator, const double* r, std::size_t n,
+                                 double Ts);
 
 }  // namespace pneumid

@@ -1,7 +1,10 @@
 // Physics simulator of the Intelligent Pneumatic Actuator (IPA): a
-// double-acting cylinder whose chamber A is filled and vented by two 2/2 on/off
-// solenoid valves driven by one PWM signal, while chamber B is held at the
-// regulated supply pressure.
+// double-acting cylinder driven by 2/2 on/off solenoid valves under PWM.
+//   force mode     the rod is held; chamber A is filled and vented by an inlet
+//                  and an exhaust valve driven by one PWM signal, chamber B is
+//                  held at the regulated supply pressure (the paper's setup)
+//   position mode  the piston moves; each chamber has its own inlet and
+//                  exhaust valve, driven by one signed command (below)
 //
 // Convention (used everywhere in pneumid; the paper's text and its Eq. 1 swap
 // the indices):
@@ -21,9 +24,21 @@
 //              pressure with the supply pressure taken as constant. F = 0 with
 //              chamber A vented (duty in the dead band, e.g. 0.61 %), F ~ 129 N
 //              at 82 % duty with the default parameters.
-//   u          PWM duty cycle in percent (0..100): in each PWM period of length
-//              T_pwm the inlet valve is commanded open for u/100 T_pwm and the
-//              exhaust valve for the rest of the period (complementary drive).
+//   u          force mode: PWM duty cycle in percent (0..100): in each PWM
+//              period of length T_pwm the inlet valve is commanded open for
+//              u/100 T_pwm and the exhaust valve for the rest of the period
+//              (complementary drive).
+//              position mode: signed command in percent (-100..100): for u > 0
+//              chamber A's inlet and chamber B's exhaust are open for u/100 T_pwm
+//              of each period (A fills, B vents, the piston moves out), for
+//              u < 0 chamber B's inlet and chamber A's exhaust for |u|/100
+//              T_pwm; all four valves are closed for the rest of the period
+//              (the chambers hold their gas). The same pulse width limit makes
+//              the dead band around 0, and an off time shorter than it does
+//              not close the valves (|u| near 100 acts as 100).
+//              Position-mode state at rest (Reset): chamber B at half the
+//              supply gauge pressure, chamber A at the pressure that balances
+//              the piston, A_a (p_a - p_atm) = A_b (p_b - p_atm).
 //
 // Physics:
 // [1] E. Richer, Y. Hurmuzlu, A high performance pneumatic force actuator
@@ -44,9 +59,21 @@
 //     min_pulse_width do not open the valve (dead band at small and large duty).
 // [4] Friction: Stribeck curve with a smoothed sign, B. Armstrong-Helouvry,
 //     Control of Machines with Friction, 1991:
-//       F_f = (F_c + (F_s - F_c) exp(-(v/v_s)^2)) tanh(v/v_eps) + b v
-// Sensors: pressure transducer with an optional first-order low-pass (time
-// constant pressure_filter_time_constant: transducer bandwidth, the RC
+//       g(v) = F_c + (F_s - F_c) exp(-(v/v_s)^2)
+//       F_f  = g(v) tanh(v/v_eps) + b v
+//     or (lugre_stiffness sigma0 > 0) the LuGre model, C. Canudas de Wit,
+//     H. Olsson, K. J. Astrom, P. Lischinsky, A new model for control of
+//     systems with friction, IEEE TAC 40(3), 1995, eq. 2-5:
+//       dz/dt = v - sigma0 |v| z / g(v)
+//       F_f   = sigma0 z + sigma1 dz/dt + b v
+//     which sticks (pre-sliding deflection z <= F_s / sigma0) until the net
+//     force exceeds F_s, where the smoothed sign creeps at v ~ v_eps F / F_s.
+//     Piston: m dv/dt = A_a (p_a - p_atm) - A_b (p_b - p_atm) - F_f + F_stop,
+//     F_stop a stiff spring-damper at each end of the stroke.
+// Sensors: position (position mode): potentiometer or encoder reading plus
+// Gaussian noise, rounded to position_resolution (an encoder's count; 0: none),
+// 0..stroke -> 0..10 V through the same ADC. Force mode: pressure transducer with an optional
+// first-order low-pass (time constant pressure_filter_time_constant: transducer bandwidth, the RC
 // anti-aliasing filter before the ADC, digital smoothing of the PWM ripple), Gaussian noise,
 // 0..full scale -> 0..10 V, read by a bipolar 16-bit ADC over +-10 V (NI PCI-6221: 20 V / 2^16 =
 // 0.305 mV per code), output delayed by transport_delay_samples sample periods. Integration:
@@ -149,6 +176,10 @@ struct IpaParameters {
   double friction_smoothing_velocity = 1.0e-3;  ///< m/s, width of the smoothed sign
   double end_stop_stiffness = 1.0e6;            ///< N/m
   double end_stop_damping = 1000.0;             ///< N s/m
+  /// N/m, LuGre bristle stiffness sigma0 [4]; 0: the static Stribeck map with
+  /// a smoothed sign (the piston creeps under forces below breakaway).
+  double lugre_stiffness = 0.0;
+  double lugre_damping = 0.0;  ///< N s/m, LuGre micro-damping sigma1 [4]
 
   // [sensors]
   double pressure_noise = 150.0;       ///< Pa, standard deviation of the transducer noise
@@ -158,7 +189,10 @@ struct IpaParameters {
   /// digital smoothing of the PWM ripple); 0: none. The default is calibrated
   /// to the paper's rig (docs/simulator.md, "The default twin").
   double pressure_filter_time_constant = 0.21564;
-  double position_noise = 1.0e-5;   ///< m, standard deviation (position mode)
+  double position_noise = 1.0e-5;  ///< m, standard deviation (position mode)
+  /// m, position sensor resolution (an encoder's count); 0: continuous (a
+  /// potentiometer, then only the ADC quantizes).
+  double position_resolution = 0.0;
   int adc_bits = 16;                ///< ADC resolution; 0 disables quantization
   double adc_range = 10.0;          ///< V, bipolar input range +-adc_range
   int transport_delay_samples = 0;  ///< sample periods between reading and output
@@ -177,11 +211,21 @@ struct IpaParameters {
   bool IsValid(std::string* error) const;
 };
 
+/// The defaults of a mode: IpaParameters{} for force mode; for position mode
+/// the position rig (docs/position.md): the same cylinder with four small fast
+/// valves, inlet C = 0.1 dm^3/(s bar), exhaust 0.12 dm^3/(s bar), opening
+/// 0.3 ms, closing 0.5 ms, minimum pulse 0.3 ms. The force twin's valves are
+/// sized for the force loop: one minimum pulse of theirs moves the free piston
+/// by about 14 mm (its air springs, p A^2 / V ~ 3 kN/m, take up the pulse's
+/// 40 N), which no position loop can use.
+IpaParameters DefaultIpaParameters(IpaMode mode);
+
 /// Reads parameters from a TOML file (keys as in config/ipa_default.toml, every
-/// key optional, defaults as above). Throws DataError naming the file, the key
-/// and (for syntax errors) line and column, for unknown keys, wrong types and
-/// values that fail IsValid().
-IpaParameters LoadIpaParameters(const std::string& path);
+/// key optional). Keys not in the file take DefaultIpaParameters of the file's
+/// [simulation] mode or, when the file names none, of `mode`. Throws DataError
+/// naming the file, the key and (for syntax errors) line and column, for
+/// unknown keys, wrong types and values that fail IsValid().
+IpaParameters LoadIpaParameters(const std::string& path, IpaMode mode = IpaMode::kForce);
 
 /// One numeric parameter of IpaParameters, named by its TOML key
 /// ("valves.inlet_conductance"), with its unit and the range physics allows
@@ -221,7 +265,8 @@ std::string IpaParametersToToml(const IpaParameters& p, const std::string& comme
 double Iso6358MassFlow(double C, double b, double p_up, double p_down, double T_up,
                        double laminar_ratio = 0.999);
 
-/// The IPA as a Plant. Input: PWM duty in percent (clamped to 0..100).
+/// The IPA as a Plant. Input: PWM duty in percent (clamped to 0..100) in force
+/// mode, signed command in percent (clamped to -100..100) in position mode.
 /// Output: force in N (force mode) or position in m (position mode), through
 /// the sensor model. Measure, Advance and AdvanceValves do not allocate
 /// (storage is sized at construction), so the simulator can run on the
@@ -250,7 +295,9 @@ class IpaSimulator final : public Plant {
   void SetState(double p_a, double p_b, double x);
 
   /// Holds the valve commands (true = energized/open) for one sample period,
-  /// bypassing the PWM generator; valve delays still apply.
+  /// bypassing the PWM generator; valve delays still apply. In position mode
+  /// both chambers' inlets get inlet_open and both exhausts exhaust_open
+  /// (false, false holds both chambers; false, true vents both).
   void AdvanceValves(bool inlet_open, bool exhaust_open);
 
   const IpaParameters& parameters() const { return p_; }  ///< as given at construction
@@ -274,10 +321,18 @@ class IpaSimulator final : public Plant {
   /// Number of odeint steps taken since Reset (for benchmarks).
   long long steps() const { return steps_; }
 
+  /// LuGre bristle deflection z (m; 0 without LuGre).
+  double bristle_deflection() const;
+
   /// Internal state, scaled for the error control: p_a, p_b [bar], x [mm],
   /// v [m/s], m_in_a, m_out_a [g], sensed p_a after the sensor filter [bar],
-  /// valve manifold pressure [bar].
-  using State = std::array<double, 8>;
+  /// valve manifold pressure [bar], LuGre bristle deflection z [um].
+  using State = std::array<double, 9>;
+  /// Fraction of the sample interval each valve is open (averaged mode) or
+  /// 0/1 (switching): chamber A's inlet and exhaust, chamber B's (position mode).
+  struct Openings {
+    double in_a = 0.0, out_a = 0.0, in_b = 0.0, out_b = 0.0;
+  };
 
  private:
   // Advance, AdvanceValves and Measure do not allocate: the valve event queues
@@ -288,8 +343,10 @@ class IpaSimulator final : public Plant {
   /// within the longest valve delay (PWM edges and sample instants).
   std::size_t EventCapacity() const;
   void Command(ipa_detail::Valve& valve, bool on, double t);
-  void Integrate(double t0, double t1, double open_in, double open_out);
-  void Rhs(const State& x, State& dxdt, double open_in, double open_out) const;
+  void Integrate(double t0, double t1, const Openings& open);
+  void Rhs(const State& x, State& dxdt, const Openings& open) const;
+  /// Position mode: the PWM period starting now latches the signed duty.
+  void StartPositionPeriod(double T);
   double SenseOutput();
   /// Appends SenseOutput() to the sensor delay line, dropping the oldest reading.
   void PushReading();
@@ -307,8 +364,9 @@ class IpaSimulator final : public Plant {
   double dt_ = 1e-4;  // last accepted step size
   long long steps_ = 0;
   long long sample_ = 0;
-  std::unique_ptr<ipa_detail::Valve> inlet_, exhaust_;
-  double duty_ = 0.0;             // input held now (fraction 0..1)
+  std::unique_ptr<ipa_detail::Valve> inlet_, exhaust_;      // chamber A's
+  std::unique_ptr<ipa_detail::Valve> inlet_b_, exhaust_b_;  // chamber B's (position mode)
+  double duty_ = 0.0;             // input held now (fraction 0..1; signed -1..1 in position mode)
   double period_start_ = 0.0;     // start of the next PWM period
   double falling_edge_ = -1.0;    // pending inlet->exhaust command switch in this period
   bool exhaust_pulse_ = false;    // the exhaust valve is pulsed in this period

@@ -1,7 +1,8 @@
 // Plants by name, for every command that takes `--plant`:
 //
 //   ipa                         the IPA physics simulator, force mode (rod fixed), output N
-//   ipa-position                the same in position mode, output m
+//   ipa-position                the position rig (moving piston, four valves, signed
+//                               command -100..100 %), output m
 //   ipa:config=FILE.toml[,mode=force|position][,pwm=switching|averaged]
 //                               parameters from a TOML file (config/ipa_default.toml)
 //   anything ParseModelSpec accepts (pneumid/lti/model_io.hpp): arx-paper,

@@ -6,6 +6,7 @@
 //   prbs:low=A,high=B,order=7,clock=0.05[,seed=N][,at=T]
 //   prbs-levels:low=A,high=B,levels=5,clock=0.2[,seed=N][,at=T]  (multi-level PRBS)
 //   chirp:from=A,to=B,f0=0.1,f1=10[,at=T][,duration=D]   (A..B amplitude range)
+//   sine:from=A,to=B,frequency=F[,at=T][,duration=D]     (A..B amplitude range)
 //   ramp:from=A,to=B,at=T,duration=D
 //   file:PATH[,col=u][,time=t]                          (CSV or .mat; held between samples)
 // Every kind also accepts min=, max= (amplitude limits) and offset=. Values of

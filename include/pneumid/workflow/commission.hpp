@@ -192,4 +192,11 @@ struct CommissionResult {
 /// short for its time scale, no settling) end with kFailure and the message.
 CommissionResult Commission(Plant& plant, const CommissionOptions& options);
 
+/// Sets the input gaps of `options` from text, as `--input-gaps` and the
+/// app's `input_gaps` give them: "plant" keeps the actuator's own (options.actuator,
+/// else PlantActuator(plant)), "none" turns the modulation off, "LO:HI[,LO:HI]"
+/// replaces the actuator's gaps (ParseInputGaps).
+/// @throws InvalidArgument naming the item that is not LO:HI (ParseInputGaps).
+void SetInputGaps(CommissionOptions& options, const Plant& plant, const std::string& text);
+
 }  // namespace pneumid
