@@ -69,9 +69,11 @@ void Execute(const CodegenCli& c) {
   // As `pneumid control`: the plant's input range (IPA: duty 0..100 %) unless
   // --u-min/--u-max say otherwise.
   ControllerSettings settings = c.controller;
-  if (!c.plant.empty())
-    ApplyPlantInputRange(*MakePlant(c.plant, c.Ts, PlantOptions{}), settings.limits.u_min,
-                         settings.limits.u_max);
+  if (!c.plant.empty()) {
+    const auto plant = MakePlant(c.plant, c.Ts, PlantOptions{});
+    ApplyPlantInputRange(*plant, settings.limits.u_min, settings.limits.u_max);
+    ApplyPlantInputGaps(*plant, settings.input_gaps);
+  }
   PNEUMID_CHECK(!(settings.limits.u_min > settings.limits.u_max), "--u-min {} is above --u-max {}",
                 settings.limits.u_min, settings.limits.u_max);
   // Options the chosen controller would silently ignore are errors here: the

@@ -34,9 +34,10 @@ namespace {
 
 // The control area's settings and factory (controller_factory.hpp).
 BuiltController BuildController(const RunOptions& o, const TransferFunction& model, double Ts,
-                                const InputLimits& limits) {
+                                const InputLimits& limits, const IoBackend& io) {
   ControllerSettings c = o.controller;
   c.limits = limits;  // the safety layer's clamp
+  ApplyPlantInputGaps(io.actuator(), io.Describe(), c.input_gaps);
   return MakeController(model, Ts, WithModelInputMap(ToControllerSpec(c), o.model));
 }
 
@@ -61,10 +62,22 @@ RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
   const IoSpec spec = ParseIoSpec(config.io);
   const double Ts = config.loop.period;
   const TransferFunction model = ParseControllerModel(o.model);
+  const PlantOptions plant_options = SimulatedPlantOptions(o.rt);
+  auto io = MakeIoBackend(spec, config, plant_options);
+  // Without a clamp from the flags or the file: the plant's input range where
+  // it is finite (the position twin's -100..100 %), else the safety defaults.
+  SafetyOptions safety = s;
+  if (!o.u_min && !o.u_max && !config.safety_range_given) {
+    const Actuator a = io->actuator();
+    if (std::isfinite(a.u_min) && std::isfinite(a.u_max) && a.u_min < a.u_max) {
+      safety.u_min = a.u_min;
+      safety.u_max = a.u_max;
+    }
+  }
   InputLimits limits;
-  limits.u_min = s.u_min;
-  limits.u_max = s.u_max;
-  BuiltController built = BuildController(o, model, Ts, limits);
+  limits.u_min = safety.u_min;
+  limits.u_max = safety.u_max;
+  BuiltController built = BuildController(o, model, Ts, limits, *io);
   const std::string controller_text = built.controller->Describe();
   ControllerAdapter controller(std::move(built.controller));
 
@@ -73,15 +86,13 @@ RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
   const Eigen::VectorXd r = sp->Sample(Ts, n);
   const std::vector<double> setpoint(r.data(), r.data() + r.size());
 
-  const PlantOptions plant_options = SimulatedPlantOptions(o.rt);
-  auto io = MakeIoBackend(spec, config, plant_options);
   std::vector<LoadStep> loads;
   for (const std::string& l : o.load_steps) loads.push_back(ParseLoadStep("--load-step", l));
   if (auto* sim = dynamic_cast<SimBackend*>(io.get())) sim->SetLoadSteps(loads);
 
   SessionOptions so;
   so.loop = config.loop;
-  so.safety = s;
+  so.safety = safety;
   so.log = config.log;
   so.log.live = live;
   so.log_path = o.rt.log;
@@ -116,7 +127,7 @@ RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
   if (o.offline) {
     // The same scenario simulated offline (no real time, no network) for comparison.
     auto plant = MakePlant(config.plant, Ts, plant_options);
-    BuiltController again = BuildController(o, model, Ts, limits);
+    BuiltController again = BuildController(o, model, Ts, limits, *io);
     const ClosedLoopResult ref = SimulateClosedLoop(*again.controller, *plant, *sp, clo);
     offline = ref.metrics.ToJson();
   }
@@ -181,6 +192,7 @@ static Registrar reg(
     [](CLI::App& app) {
       auto o = std::make_shared<RunOptions>();
       AddControllerOptions(app, o->controller);
+      AddPidGainOptions(app, o->controller);
       app.add_option("--model", o->model,
                      "controller model: built-in name, inline spec or model JSON")
           ->capture_default_str();
@@ -190,8 +202,10 @@ static Registrar reg(
       help.plant = "plant of the sim backend and of --offline (default ipa)";
       help.json = "print samples, overruns, jitter_p99_us, jitter_max_us, ... and metrics as JSON";
       AddRealtimeOptions(app, o->rt, help);
-      app.add_option("--u-min", o->u_min, "output clamp, lower (%; default 0)");
-      app.add_option("--u-max", o->u_max, "output clamp, upper (%; default 100)");
+      app.add_option("--u-min", o->u_min,
+                     "output clamp, lower (%; default: the plant's input range, IPA 0, position "
+                     "twin -100)");
+      app.add_option("--u-max", o->u_max, "output clamp, upper (%; default: the plant's, 100)");
       app.add_option("--rate-max", o->rate_max, "output rate limit (%/s; default none)");
       app.add_option("--y-min", o->y_min, "measurement range, lower (N): outside is a fault");
       app.add_option("--y-max", o->y_max, "measurement range, upper (N)");

@@ -75,11 +75,15 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
 }
 
 void ApplyPlantInputGaps(const Plant& plant, std::string& input_gaps) {
+  ApplyPlantInputGaps(PlantActuator(plant), plant.Describe(), input_gaps);
+}
+
+void ApplyPlantInputGaps(const Actuator& actuator, const std::string& plant_name,
+                         std::string& input_gaps) {
   if (input_gaps != "plant") return;
-  const Actuator actuator = PlantActuator(plant);
   PNEUMID_CHECK(!actuator.input_gaps.empty(),
                 "--input-gaps plant: the plant '{}' has no known input gaps (give LO:HI)",
-                plant.Describe());
+                plant_name);
   input_gaps = InputGapsToString(actuator.input_gaps);
 }
 

@@ -15,6 +15,7 @@
 #include <CLI/CLI.hpp>
 
 #include "pneumid/control/controller_factory.hpp"
+#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/plant.hpp"
 #include "pneumid/realtime/realtime_config.hpp"
 
@@ -35,6 +36,10 @@ void ApplyPlantInputRange(const Plant& plant, double& u_min, double& u_max);
 /// Replaces the --input-gaps value "plant" by the plant's known gaps
 /// (PlantActuator(plant).input_gaps). @throws InvalidArgument when it has none.
 void ApplyPlantInputGaps(const Plant& plant, std::string& input_gaps);
+/// The same for the plant behind an I/O backend, described by its actuator
+/// (realtime: IoBackend::actuator()); plant_name names it in the error.
+void ApplyPlantInputGaps(const Actuator& actuator, const std::string& plant_name,
+                         std::string& input_gaps);
 /// The [controller] section of a --config file (realtime_config.hpp) applied
 /// to `model` and `settings`: each key the file gives, unless its flag was
 /// given on the command line (flags override the file).

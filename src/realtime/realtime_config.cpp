@@ -196,6 +196,7 @@ RealtimeConfig ParseRealtimeConfig(const std::string& text, const std::string& s
       auto& s = c.safety;
       r.Get(t, "safety", "u_min", &s.u_min);
       r.Get(t, "safety", "u_max", &s.u_max);
+      c.safety_range_given = t.contains("u_min") || t.contains("u_max");
       r.Get(t, "safety", "rate_max", &s.rate_max);
       r.Get(t, "safety", "y_min", &s.y_min);
       r.Get(t, "safety", "y_max", &s.y_max);

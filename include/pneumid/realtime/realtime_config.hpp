@@ -54,6 +54,9 @@ struct RealtimeConfig {
   ComediConfig comedi;        ///< [comedi]: used by a comedi backend (device from io)
   LogWriterOptions log;       ///< [log]: flushing and buffer capacity
   std::optional<ControllerConfig> controller;  ///< [controller], when the file has it
+  /// [safety] gave u_min or u_max; otherwise `pneumid run` clamps to the
+  /// plant's input range (PlantActuator: IPA force 0..100 %, position -100..100 %).
+  bool safety_range_given = false;
 };
 
 /// Reads a configuration file. @throws DataError naming the file, line and column
