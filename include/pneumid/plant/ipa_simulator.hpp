@@ -328,13 +328,14 @@ class IpaSimulator final : public Plant {
   /// v [m/s], m_in_a, m_out_a [g], sensed p_a after the sensor filter [bar],
   /// valve manifold pressure [bar], LuGre bristle deflection z [um].
   using State = std::array<double, 9>;
-  /// Fraction of the sample interval each valve is open (averaged mode) or
-  /// 0/1 (switching): chamber A's inlet and exhaust, chamber B's (position mode).
+
+ private:
+  // Fraction of the interval each valve is open (averaged mode) or 0/1
+  // (switching): chamber A's inlet and exhaust, chamber B's (position mode).
   struct Openings {
     double in_a = 0.0, out_a = 0.0, in_b = 0.0, out_b = 0.0;
   };
 
- private:
   // Advance, AdvanceValves and Measure do not allocate: the valve event queues
   // (src/plant/ipa_valve.hpp) and the sensor delay line are ring buffers sized
   // at construction.
