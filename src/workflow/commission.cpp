@@ -13,6 +13,7 @@
 #include "pneumid/control/duty_modulator.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/plant/actuator.hpp"
+#include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/signal.hpp"
 
 namespace pneumid {
@@ -189,7 +190,8 @@ std::string ProbeAndSweep(Recorder& rec, const CommissionOptions& o, double u_lo
   if (std::abs(dy) <= std::max(6 * p.noise, 1e-6 * scale)) {
     return fmt::format(
         "the plant does not respond: a step of the input from {:g} to {:g} moved the output by "
-        "{:.3g} (noise {:.3g}) in {:.1f} s; is the sensor connected and the supply on?",
+        "{:.3g} (noise {:.3g}) in {:.1f} s; is the sensor connected and the supply on? (An "
+        "integrating plant, such as a positioning drive resting on an end stop, looks the same.)",
         u_lo, p.u_mid, dy, p.noise, rec.time() - rest_end * Ts);
   }
   // Still moving at the cap: a first-order approach shrinks its change per
@@ -636,6 +638,17 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
                 "commission: the input range must be finite (give u_min and u_max), got [{}, {}]",
                 u_lo, u_hi);
   CommissionResult r;
+  // A positioning drive integrates its input: it has no steady state to probe
+  // and its model no static gain to design on (docs/position.md).
+  if (const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant);
+      ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition) {
+    r.message =
+        "the plant integrates its input (the IPA in position mode: the piston moves as long as "
+        "the valves are open), and commissioning needs a plant that settles at a constant "
+        "input; for a position loop see docs/position.md (a PD on an integrator model, "
+        "--input-gaps plant)";
+    return r;
+  }
   CommissionExperiment& ex = r.experiment;
   plant.Reset();
   const std::vector<InputGap> gaps = o.modulate ? act.input_gaps : std::vector<InputGap>{};

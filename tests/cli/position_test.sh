@@ -76,6 +76,8 @@ expect_error "set-point beyond the stroke" "outside the plant's position range 0
 expect_error "run: set-point beyond the stroke" "set-point -0.01 m at t = 0 s" \
   run --model "$MODEL" --plant ipa-position "${PD[@]}" --fast \
   --setpoint "step:from=-0.01,to=0.05,at=1" --duration 2
+expect_error "commission of an integrating plant" "the plant integrates its input" \
+  commission --plant ipa-position -o "$TMP/commission"
 expect_error "PID without gains on an integrator" "give the gains" \
   control --model "$MODEL" --plant ipa-position --controller pid \
   --setpoint "step:from=0.05,to=0.06,at=1" --duration 2
