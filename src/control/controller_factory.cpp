@@ -283,10 +283,7 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
       b.fopdt = FopdtEstimate{};
       b.fopdt.K = b.fopdt.tau = b.fopdt.theta = std::numeric_limits<double>::quiet_NaN();
       b.fopdt.method = "none (integrating or unstable model)";
-      b.pid_gains = PidGains{};
-      b.pid_gains.Kc = spec.pid_kc;
-      b.pid_gains.Ti = std::numeric_limits<double>::infinity();
-      b.pid_gains.Td = 0.0;
+      b.pid_gains = PidGains{};  // no integral, no derivative; Kc from the spec below
     }
     b.pid_explicit = ApplyExplicitPidGains(spec, b.pid_gains);
     PidOptions o;

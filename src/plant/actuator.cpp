@@ -37,14 +37,16 @@ Actuator PlantActuator(const Plant& plant) {
   if (const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant)) {
     Actuator a = IpaActuator(ipa->parameters().mode);
     const double w = 100.0 * ipa->parameters().min_pulse_width * ipa->parameters().pwm_frequency;
-    if (ipa->parameters().mode == IpaMode::kPosition) {
+    const bool position = ipa->parameters().mode == IpaMode::kPosition;
+    if (position) {
       a.y_min = 0.0;
       a.y_max = ipa->parameters().stroke;
     }
     if (w > 0.0 && w < 50.0) {
-      a.input_gaps = {{0.0, w}, {100.0 - w, 100.0}};
-      if (ipa->parameters().mode == IpaMode::kPosition)
-        a.input_gaps = {{-100.0, -100.0 + w}, {-w, 0.0}, {0.0, w}, {100.0 - w, 100.0}};
+      a.input_gaps =
+          position
+              ? std::vector<InputGap>{{-100.0, -100.0 + w}, {-w, 0.0}, {0.0, w}, {100.0 - w, 100.0}}
+              : std::vector<InputGap>{{0.0, w}, {100.0 - w, 100.0}};
     }
     return a;
   }

@@ -26,6 +26,13 @@ constexpr double kGram = 1e-3;      // masses in g
 constexpr double kMicron = 1e-6;    // LuGre bristle deflection in um
 constexpr double kEventTol = 1e-9;  // s, events closer than this are simultaneous
 
+// Position mode: a signed duty of magnitude a (0..1) keeps its valves open the
+// whole PWM period T when it is full, or when its off time is shorter than the
+// minimum pulse width w_min (the valves cannot close for so short a time).
+bool HeldOpen(double a, double T, double w_min) {
+  return a >= 1.0 || (a > 0.0 && (1.0 - a) * T < w_min);
+}
+
 }  // namespace
 
 namespace {
@@ -448,7 +455,7 @@ void IpaSimulator::StartPositionPeriod(double T) {
   // valves closed for the rest of the period. Pulses shorter than the minimum
   // width do not open the valves; off times shorter than it do not close them.
   const double a = std::min(std::abs(duty_), 1.0);
-  const bool full = a >= 1.0 || (a > 0.0 && (1.0 - a) * T < p_.min_pulse_width);
+  const bool full = HeldOpen(a, T, p_.min_pulse_width);
   const bool pulse = full || (a > 0.0 && a * T >= p_.min_pulse_width);
   const bool out = duty_ > 0.0;
   Command(out ? *inlet_ : *inlet_b_, pulse, t_);
@@ -475,18 +482,19 @@ void IpaSimulator::AdvanceTo(double t_end, bool pwm, bool inlet_cmd, bool exhaus
   }
   while (true) {
     // Events due now.
-    if (pwm && position && std::abs(t_ - period_start_) <= kEventTol) {
-      StartPositionPeriod(T);
-      period_start_ += T;
-    } else if (pwm && std::abs(t_ - period_start_) <= kEventTol) {
+    if (pwm && std::abs(t_ - period_start_) <= kEventTol) {
       // A new PWM period latches the duty held now.
-      const double d = duty_;
-      const double w_in = d * T, w_out = (1.0 - d) * T;
-      const bool in_pulse = d >= 1.0 || (d > 0.0 && w_in >= p_.min_pulse_width);
-      exhaust_pulse_ = d <= 0.0 || (d < 1.0 && w_out >= p_.min_pulse_width);
-      Command(*inlet_, in_pulse, t_);
-      Command(*exhaust_, d <= 0.0 && exhaust_pulse_, t_);
-      falling_edge_ = (d > 0.0 && d < 1.0) ? t_ + w_in : -1.0;
+      if (position) {
+        StartPositionPeriod(T);
+      } else {
+        const double d = duty_;
+        const double w_in = d * T, w_out = (1.0 - d) * T;
+        const bool in_pulse = d >= 1.0 || (d > 0.0 && w_in >= p_.min_pulse_width);
+        exhaust_pulse_ = d <= 0.0 || (d < 1.0 && w_out >= p_.min_pulse_width);
+        Command(*inlet_, in_pulse, t_);
+        Command(*exhaust_, d <= 0.0 && exhaust_pulse_, t_);
+        falling_edge_ = (d > 0.0 && d < 1.0) ? t_ + w_in : -1.0;
+      }
       period_start_ += T;
     }
     if (pwm && falling_edge_ >= 0.0 && std::abs(t_ - falling_edge_) <= kEventTol) {
@@ -541,7 +549,7 @@ void IpaSimulator::Advance(double u) {
     if (position) {
       // An off time shorter than the minimum pulse does not close the valves.
       const double a = std::min(std::abs(duty_), 1.0);
-      const double f = (1.0 - a) * T < p_.min_pulse_width && a > 0.0 ? 1.0 : fraction(a * T);
+      const double f = HeldOpen(a, T, p_.min_pulse_width) ? 1.0 : fraction(a * T);
       Integrate(t_, t_end, duty_ > 0.0 ? Openings{f, 0.0, 0.0, f} : Openings{0.0, f, f, 0.0});
     } else {
       Integrate(t_, t_end, Openings{fraction(duty_ * T), fraction((1.0 - duty_) * T), 0.0, 0.0});

@@ -202,10 +202,12 @@ class PrbsLevelsSignal final : public Signal {
   Shaping s_;
 };
 
+// Also the sine (f0 = f1, named "sine" in ToString, no end by default).
 class ChirpSignal final : public Signal {
  public:
-  ChirpSignal(double from, double to, double f0, double f1, double at, double duration, Shaping s)
-      : from_(from), to_(to), f0_(f0), f1_(f1), at_(at), duration_(duration), s_(s) {}
+  ChirpSignal(double from, double to, double f0, double f1, double at, double duration, Shaping s,
+              bool sine = false)
+      : from_(from), to_(to), f0_(f0), f1_(f1), at_(at), duration_(duration), s_(s), sine_(sine) {}
   double operator()(double t) const override {
     const double mid = 0.5 * (from_ + to_);
     const double amp = 0.5 * (to_ - from_);
@@ -219,11 +221,18 @@ class ChirpSignal final : public Signal {
   void CheckSampleTime(double Ts) const override {
     const double f_max = std::max(f0_, f1_);
     PNEUMID_CHECK(f_max <= 0.5 / Ts,
-                  "signal '{}': the chirp reaches {} Hz, above the Nyquist frequency {} Hz of "
-                  "the sample time Ts = {} s (it would be aliased): lower f0/f1 or Ts",
-                  ToString(), f_max, 0.5 / Ts, Ts);
+                  "signal '{}': the {} reaches {} Hz, above the Nyquist frequency {} Hz of "
+                  "the sample time Ts = {} s (it would be aliased): lower {} or Ts",
+                  ToString(), sine_ ? "sine" : "chirp", f_max, 0.5 / Ts, Ts,
+                  sine_ ? "the frequency" : "f0/f1");
   }
   std::string ToString() const override {
+    if (sine_) {
+      std::string text = "sine:from=" + Num(from_) + ",to=" + Num(to_) + ",frequency=" + Num(f0_) +
+                         ",at=" + Num(at_);
+      if (std::isfinite(duration_)) text += ",duration=" + Num(duration_);
+      return text + s_.Suffix();
+    }
     return "chirp:from=" + Num(from_) + ",to=" + Num(to_) + ",f0=" + Num(f0_) + ",f1=" + Num(f1_) +
            ",at=" + Num(at_) + ",duration=" + Num(duration_) + s_.Suffix();
   }
@@ -231,34 +240,7 @@ class ChirpSignal final : public Signal {
  private:
   double from_, to_, f0_, f1_, at_, duration_;
   Shaping s_;
-};
-
-class SineSignal final : public Signal {
- public:
-  SineSignal(double from, double to, double frequency, double at, double duration, Shaping s)
-      : from_(from), to_(to), f_(frequency), at_(at), duration_(duration), s_(s) {}
-  double operator()(double t) const override {
-    const double mid = 0.5 * (from_ + to_);
-    const double tau = t - at_;
-    if (tau < 0.0 || tau > duration_) return s_.Apply(mid);
-    return s_.Apply(mid + 0.5 * (to_ - from_) * std::sin(2.0 * std::numbers::pi * f_ * tau));
-  }
-  void CheckSampleTime(double Ts) const override {
-    PNEUMID_CHECK(f_ <= 0.5 / Ts,
-                  "signal '{}': {} Hz is above the Nyquist frequency {} Hz of the sample time "
-                  "Ts = {} s (it would be aliased): lower the frequency or Ts",
-                  ToString(), f_, 0.5 / Ts, Ts);
-  }
-  std::string ToString() const override {
-    std::string text =
-        "sine:from=" + Num(from_) + ",to=" + Num(to_) + ",frequency=" + Num(f_) + ",at=" + Num(at_);
-    if (std::isfinite(duration_)) text += ",duration=" + Num(duration_);
-    return text + s_.Suffix();
-  }
-
- private:
-  double from_, to_, f_, at_, duration_;
-  Shaping s_;
+  bool sine_;
 };
 
 class RampSignal final : public Signal {
@@ -410,7 +392,8 @@ std::unique_ptr<Signal> ParseSignal(const std::string& spec_in) {
     PNEUMID_CHECK(duration > 0.0, "signal '{}': duration must be positive, got {}", spec, duration);
     Shaping s = TakeShaping(p);
     p.Finish();
-    out = std::make_unique<SineSignal>(from, to, frequency, at, duration, s);
+    out = std::make_unique<ChirpSignal>(from, to, frequency, frequency, at, duration, s,
+                                        /*sine=*/true);
   } else if (kind == "ramp") {
     double from = p.Number("from", 0.0);
     double to = p.Number("to");
