@@ -27,6 +27,12 @@ VARIANTS = {
     "friction x1.5, mass x2": "[mechanics]\ncoulomb_friction = 9.0\nstatic_friction = 13.5\nmass = 2.0\n",
     "LuGre": "[mechanics]\nlugre_stiffness = 1.0e6\nlugre_damping = 1000.0\n",
     "encoder 0.02 mm": "[sensors]\nposition_resolution = 2.0e-5\nposition_noise = 2.0e-5\n",
+    "friction x2, mass x3": "[mechanics]\ncoulomb_friction = 12.0\nstatic_friction = 18.0\nmass = 3.0\n",
+    "supply 0.4 MPa, dead volumes x3": (
+        "[supply]\npressure = 4.0e5\n[cylinder]\ndead_volume_a = 3.0e-5\ndead_volume_b = 3.0e-5\n"),
+    "valves x1.5, delays x2": (
+        "[valves]\ninlet_conductance = 1.5e-9\nexhaust_conductance = 1.8e-9\n"
+        "open_delay = 6.0e-4\nclose_delay = 1.0e-3\n"),
 }
 EXPERIMENTS = {
     "staircase 20/70/40/85/30 mm, 2.5 s": ("staircase:levels=0.02 0.07 0.04 0.085 0.03,dwell=2.5", 12.5),
@@ -36,13 +42,16 @@ EXPERIMENTS = {
     ),
     "sine 0.5 Hz, 20 mm": ("sine:from=0.03,to=0.07,frequency=0.5", 8.0),
 }
-# The controllers: a PD on an integrating model, its input modulated across the
-# valves' dead band (--input-gaps plant), and the same without the modulation.
+# The controllers: a PD on an integrating model sampled once per PWM period,
+# its input modulated across the valves' dead band (--input-gaps plant), with
+# the velocity feed-forward 1/Ki + Kc Td of the model (the default); and the
+# first PD (100 Hz, no modulation, no feed-forward) as the baseline.
 CONTROLLERS = {
-    "none (PD, dead band not modulated)": [
-        "--controller", "pid", "--Kc", "3000", "--Td", "0.02", "--input-gaps", "none"],
-    "PD + dead-band modulation": [
-        "--controller", "pid", "--Kc", "3000", "--Td", "0.02", "--input-gaps", "plant"],
+    "none (PD at 100 Hz, no modulation, no feed-forward)": [
+        "--controller", "pid", "--Kc", "3000", "--Td", "0.02", "--Kff", "0", "--input-gaps", "none"],
+    "PD at 300 Hz + dead-band modulation + velocity feed-forward": [
+        "--controller", "pid", "--Kc", "6000", "--Td", "0.04", "--input-gaps", "plant",
+        "--Ts", repr(1.0 / 300.0)],
 }
 MODEL = "tf:num=0.004,den=1 0"  # integrator, (m/s) per %: what the PD is designed on
 

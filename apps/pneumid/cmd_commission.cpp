@@ -48,6 +48,7 @@ struct CommissionCli {
   std::string plant = "ipa";
   std::string plant_config;
   double Ts = 0.01;
+  CLI::Option* ts_option = nullptr;  // --Ts, to tell a default from a given period
   std::uint64_t seed = 1;
   std::optional<double> noise;
   std::string range;
@@ -138,6 +139,12 @@ void Run(CommissionCli& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   CommissionOptions& o = c.options;
   if (!c.range.empty()) ParseRange(c.range, o.range_min, o.range_max);
+  const bool position = c.plant.rfind("ipa-position", 0) == 0;
+  if (position && c.spec.empty()) {
+    // Position loops: docs/position.md's targets.
+    o.overshoot = 2.0;
+    o.settling = 1.0;
+  }
   if (!c.spec.empty()) ParseSpecification(c.spec, o);
   if (!c.methods.empty()) o.methods = ParseMethodList(c.methods);
   std::filesystem::create_directories(c.directory);
@@ -153,6 +160,14 @@ void Run(CommissionCli& c) {
     plant = MakePlant(c.plant, c.Ts, po);
     PNEUMID_CHECK(c.plant_config.empty() || dynamic_cast<IpaSimulator*>(plant.get()),
                   "--plant-config applies to the ipa plant only, not to '{}'", c.plant);
+    // A position loop samples once per PWM period: the valves' fastest action
+    // (docs/position.md).
+    const auto* ipa = dynamic_cast<IpaSimulator*>(plant.get());
+    if (ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition &&
+        c.ts_option->count() == 0) {
+      c.Ts = 1.0 / ipa->parameters().pwm_frequency;
+      plant = MakePlant(c.plant, c.Ts, po);
+    }
   } else {
     PNEUMID_CHECK(!c.fast || io.kind == IoKind::kUdp,
                   "--fast needs --io sim or udp://HOST:PORT (a plant server steps on request); "
@@ -234,7 +249,8 @@ const Registrar reg(
           ->capture_default_str();
       app.add_option("--plant-config", c->plant_config,
                      "IPA parameter file (TOML, see config/ipa_default.toml)");
-      AddSampleTimeOption(app, c->Ts, "Sample period in s");
+      c->ts_option = AddSampleTimeOption(
+          app, c->Ts, "Sample period in s (default 0.01; ipa-position: the PWM period)");
       app.add_option("--range", c->range,
                      "Output range LO:HI the controller must serve (default: the reachable "
                      "range found by the sweep, less 5 % at each end)");
@@ -247,7 +263,7 @@ const Registrar reg(
           ->check(CLI::IsMember({"mpc", "dmc", "gpc", "pid"}));
       app.add_option("--spec", c->spec,
                      "Specification: overshoot=PERCENT,settling=SECONDS (default "
-                     "overshoot=5,settling=0.5)");
+                     "overshoot=5,settling=0.5; ipa-position: overshoot=2,settling=1)");
       app.add_option("--aggressiveness", c->options.aggressiveness,
                      "First design's aggressiveness, 0 robust .. 1 aggressive")
           ->capture_default_str();

@@ -18,6 +18,10 @@ void AddPidGainOptions(CLI::App& app, ControllerSettings& s) {
                  "PID proportional gain, input units per output unit (default: the rule's)");
   app.add_option("--Ti", s.pid_ti, "PID integral time in s, inf for none (default: the rule's)");
   app.add_option("--Td", s.pid_td, "PID derivative time in s (default: the rule's)");
+  app.add_option(
+      "--Kff", s.pid_kff,
+      "PID velocity feed-forward: input per unit set-point rate, e.g. %/(m/s), 0 for "
+      "none (default: 1/Ki + Kc Td on an integrating model of velocity gain Ki, else 0)");
 }
 
 void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
@@ -126,6 +130,7 @@ void ApplyControllerConfig(const CLI::App& app, const ControllerConfig& file, st
       {"Kc", "--Kc", [&] { s.pid_kc = f.pid_kc; }},
       {"Ti", "--Ti", [&] { s.pid_ti = f.pid_ti; }},
       {"Td", "--Td", [&] { s.pid_td = f.pid_td; }},
+      {"Kff", "--Kff", [&] { s.pid_kff = f.pid_kff; }},
       {"pid_rule", "--pid-rule", [&] { s.pid_rule = f.pid_rule; }},
       {"input_map", "--input-map", [&] { s.input_map = f.input_map; }},
       {"input_gaps", "--input-gaps", [&] { s.input_gaps = f.input_gaps; }},

@@ -24,7 +24,7 @@ namespace pneumid::cli {
 /// Adds the options above, writing into `settings`.
 void AddControllerOptions(CLI::App& app, ControllerSettings& settings);
 
-/// Adds --Kc, --Ti, --Td: PID gains given explicitly, each replacing the
+/// Adds --Kc, --Ti, --Td, --Kff: PID gains given explicitly, each replacing the
 /// rule's value of that gain (ControllerSettings::pid_kc, pid_ti, pid_td).
 void AddPidGainOptions(CLI::App& app, ControllerSettings& settings);
 

@@ -275,6 +275,8 @@ void GeneratePid(const PidController& c, Module& m) {
   m.Scalar("B", o.setpoint_weight, "set-point weight b");
   m.Scalar("KR", g.Kc * (o.setpoint_weight - 1.0), "Kc (b - 1), for the bumpless reset");
   if (integral) m.Scalar("CI", g.Kc * Ts / g.Ti, "Kc Ts / Ti");
+  const bool feedforward = o.velocity_feedforward != 0.0;
+  if (feedforward) m.Scalar("KV", o.velocity_feedforward / Ts, "Kff / Ts (velocity feed-forward)");
   if (derivative) {
     m.Scalar("AD", g.Td / (g.Td + nts), "Td / (Td + N Ts)");
     m.Scalar("BD", g.Kc * g.Td * o.derivative_filter / (g.Td + nts), "Kc Td N / (Td + N Ts)");
@@ -285,13 +287,16 @@ void GeneratePid(const PidController& c, Module& m) {
   m.Member({Field::kReal, "derivative", 0, "D (filtered, on y)"});
   m.Member({Field::kReal, "y_prev", 0, "last measurement"});
   m.Member({Field::kReal, "u_prev", 0, "last input"});
+  if (feedforward) m.Member({Field::kReal, "r_prev", 0, "last set-point"});
   EmitClip(m, o.limits);
   m.code_ += R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {
   s->integral = u0 - PFX_KR * y0;
   s->derivative = PFX_ZERO;
   s->y_prev = y0;
   s->u_prev = u0;
-}
+)C";
+  if (feedforward) m.code_ += "  s->r_prev = y0;\n";
+  m.code_ += R"C(}
 
 PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {
 )C";
@@ -299,10 +304,13 @@ PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {
   m.code_ += "  const PFX_real p = PFX_KC * (PFX_B * setpoint - measurement);\n  PFX_real v, u;\n";
   if (derivative)
     m.code_ += "  s->derivative = PFX_AD * s->derivative - PFX_BD * (measurement - s->y_prev);\n";
-  m.code_ += "  v = p + s->integral + s->derivative;\n  u = PFX_clip(v, s->u_prev);\n";
+  m.code_ += "  v = p + s->integral + s->derivative;\n";
+  if (feedforward) m.code_ += "  v += PFX_KV * (setpoint - s->r_prev);\n";
+  m.code_ += "  u = PFX_clip(v, s->u_prev);\n";
   if (integral)
     m.code_ += tracking ? "  s->integral += PFX_CI * e + PFX_CT * (u - v);\n"
                         : "  s->integral += PFX_CI * e;\n";
+  if (feedforward) m.code_ += "  s->r_prev = setpoint;\n";
   m.code_ += R"C(  s->y_prev = measurement;
   s->u_prev = u;
   return u;

@@ -50,6 +50,7 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   spec.pid_kc = settings.pid_kc;
   spec.pid_ti = settings.pid_ti;
   spec.pid_td = settings.pid_td;
+  spec.pid_kff = settings.pid_kff;
   spec.disturbance = DisturbanceModelFromString(settings.disturbance);
   spec.auto_options.disturbance = spec.disturbance;
   if (!settings.input_map.empty()) spec.input_map = ReadStaticMap(settings.input_map);
@@ -101,16 +102,21 @@ std::string BuiltController::Summary() const {
     return fmt::format("pid auto from FOPDT K={:g} tau={:g} theta={:g}: Kc={:g} Ti={:g} Td={:g}{}",
                        fopdt.K, fopdt.tau, fopdt.theta, pid_gains.Kc, pid_gains.Ti, pid_gains.Td,
                        tail);
+  const std::string ff = pid_kff != 0.0 ? fmt::format(" Kff={:g}", pid_kff) : "";
+  if (type == ControllerType::kPid && pid_explicit && !std::isfinite(fopdt.K))
+    return fmt::format("pid with gains given on an integrating model: Kc={:g} Ti={:g} Td={:g}{}",
+                       pid_gains.Kc, pid_gains.Ti, pid_gains.Td, ff);
   if (type == ControllerType::kPid && pid_explicit)
     return fmt::format(
         "pid with gains given (the others by {} from FOPDT K={:g} tau={:g} theta={:g}): Kc={:g} "
-        "Ti={:g} Td={:g}",
+        "Ti={:g} Td={:g}{}",
         ToString(pid_rule), fopdt.K, fopdt.tau, fopdt.theta, pid_gains.Kc, pid_gains.Ti,
-        pid_gains.Td);
+        pid_gains.Td, ff);
   if (type == ControllerType::kPid)
-    return fmt::format("pid {} from FOPDT K={:g} tau={:g} theta={:g} ({}): Kc={:g} Ti={:g} Td={:g}",
-                       ToString(pid_rule), fopdt.K, fopdt.tau, fopdt.theta, fopdt.method,
-                       pid_gains.Kc, pid_gains.Ti, pid_gains.Td);
+    return fmt::format(
+        "pid {} from FOPDT K={:g} tau={:g} theta={:g} ({}): Kc={:g} Ti={:g} Td={:g}{}",
+        ToString(pid_rule), fopdt.K, fopdt.tau, fopdt.theta, fopdt.method, pid_gains.Kc,
+        pid_gains.Ti, pid_gains.Td, ff);
   return fmt::format("{}: P={} M={} lambda={:g}; {}{}", ToString(tuning.rule), tuning.P, tuning.M,
                      tuning.lambda, tuning.formula, tail);
 }
@@ -121,6 +127,7 @@ nlohmann::ordered_json BuiltController::SettingsToJson() const {
     j["Kc"] = pid_gains.Kc;
     j["Ti"] = std::isfinite(pid_gains.Ti) ? nlohmann::json(pid_gains.Ti) : nlohmann::json();
     j["Td"] = pid_gains.Td;
+    j["Kff"] = pid_kff;
     j["rule"] = pid_explicit ? std::string("explicit") : ToString(pid_rule);
   } else {
     // Settings tuned to specifications say so (their tuning result is explicit).
@@ -162,6 +169,27 @@ bool ApplyExplicitPidGains(const ControllerSpec& spec, PidGains& gains) {
     any = true;
   }
   return any;
+}
+
+// The velocity gain Ki = lim_{s->0} s G(s) of a model with one pole at s = 0
+// (z = 1), in output units per second per input unit; NaN for other models.
+// Continuous G = B(s)/(s A'(s)): Ki = B(0)/A'(0). Discrete, in q = z^-1:
+// A(q) = (1 - q) A'(q), so A'(1) = -dA/dq(1) and Ki = B(1)/(A'(1) Ts).
+double VelocityGain(const TransferFunction& model) {
+  const Eigen::VectorXd& b = model.num();
+  const Eigen::VectorXd& a = model.den();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (model.IsContinuous()) {
+    const Eigen::Index n = a.size();
+    if (n < 2 || a(n - 1) != 0.0 || a(n - 2) == 0.0) return nan;
+    return b(b.size() - 1) / a(n - 2);
+  }
+  const double scale = a.cwiseAbs().sum();
+  if (std::abs(a.sum()) > 1e-12 * scale) return nan;
+  double da = 0.0;
+  for (Eigen::Index k = 1; k < a.size(); ++k) da -= static_cast<double>(k) * a(k);
+  if (std::abs(da) <= 1e-12 * scale) return nan;
+  return b.sum() / (da * model.Ts());
 }
 
 // The spec's tuning replaced by the auto-tuner's design (rule "auto").
@@ -262,6 +290,10 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
     o.gains = a.pid;
     o.setpoint_weight = a.setpoint_weight;
     o.derivative_filter = a.derivative_filter;
+    if (!std::isnan(spec.pid_kff)) {
+      PNEUMID_CHECK(std::isfinite(spec.pid_kff), "Kff must be finite, got {}", spec.pid_kff);
+      o.velocity_feedforward = b.pid_kff = spec.pid_kff;
+    }
     o.limits = spec.limits;
     b.controller = std::make_unique<PidController>(Ts, o);
     return b;
@@ -286,8 +318,15 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
       b.pid_gains = PidGains{};  // no integral, no derivative; Kc from the spec below
     }
     b.pid_explicit = ApplyExplicitPidGains(spec, b.pid_gains);
+    if (!std::isnan(spec.pid_kff)) {
+      PNEUMID_CHECK(std::isfinite(spec.pid_kff), "Kff must be finite, got {}", spec.pid_kff);
+      b.pid_kff = spec.pid_kff;
+    } else if (const double ki = VelocityGain(model); std::isfinite(ki) && ki != 0.0) {
+      b.pid_kff = 1.0 / ki + b.pid_gains.Kc * b.pid_gains.Td;
+    }
     PidOptions o;
     o.gains = b.pid_gains;
+    o.velocity_feedforward = b.pid_kff;
     o.limits = spec.limits;
     b.controller = std::make_unique<PidController>(Ts, o);
     return b;

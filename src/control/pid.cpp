@@ -67,6 +67,8 @@ bool PidOptions::IsValid(std::string* error) const {
     return fail(fmt::format("derivative_filter must be positive, got {}", derivative_filter));
   if (!(tracking_time >= 0.0))
     return fail(fmt::format("tracking_time must be >= 0, got {}", tracking_time));
+  if (!std::isfinite(velocity_feedforward))
+    return fail(fmt::format("velocity_feedforward must be finite, got {}", velocity_feedforward));
   std::string e;
   if (!limits.IsValid(&e)) return fail(e);
   return true;
@@ -93,6 +95,7 @@ void PidController::DoReset(double u0, double y0) {
   integral_ = u0 - options_.gains.Kc * (options_.setpoint_weight - 1.0) * y0;
   derivative_ = 0.0;
   y_prev_ = y0;
+  r_prev_ = y0;  // at rest on the set-point
   u_prev_ = u0;
 }
 
@@ -105,12 +108,14 @@ double PidController::DoUpdate(double setpoint, double measurement) {
     derivative_ = g.Td / (g.Td + nts) * derivative_ -
                   g.Kc * g.Td * options_.derivative_filter / (g.Td + nts) * (measurement - y_prev_);
   }
-  const double v = p + integral_ + derivative_;
+  const double v =
+      p + integral_ + derivative_ + options_.velocity_feedforward * (setpoint - r_prev_) / Ts_;
   const double u = options_.limits.Clip(v, u_prev_);
   if (std::isfinite(g.Ti)) {
     integral_ += g.Kc * Ts_ / g.Ti * e + (Tt_ > 0.0 ? Ts_ / Tt_ * (u - v) : 0.0);
   }
   y_prev_ = measurement;
+  r_prev_ = setpoint;
   u_prev_ = u;
   return u;
 }
@@ -125,8 +130,11 @@ void PidController::DoApplied(double u) {
 }
 
 std::string PidController::Describe() const {
-  return fmt::format("pid Kc={:.4g} Ti={:.4g} Td={:.4g}", options_.gains.Kc, options_.gains.Ti,
-                     options_.gains.Td);
+  const std::string ff = options_.velocity_feedforward != 0.0
+                             ? fmt::format(" Kff={:.4g}", options_.velocity_feedforward)
+                             : "";
+  return fmt::format("pid Kc={:.4g} Ti={:.4g} Td={:.4g}{}", options_.gains.Kc, options_.gains.Ti,
+                     options_.gains.Td, ff);
 }
 
 }  // namespace pneumid

@@ -103,7 +103,8 @@ void ParseControllerSection(const Reader& r, const toml::table& t, RealtimeConfi
                                 "safe_input",
                                 "Kc",
                                 "Ti",
-                                "Td"});
+                                "Td",
+                                "Kff"});
   ControllerConfig cc;
   ControllerSettings& s = cc.settings;
   r.Get(t, "controller", "model", &cc.model);
@@ -127,6 +128,7 @@ void ParseControllerSection(const Reader& r, const toml::table& t, RealtimeConfi
   r.Get(t, "controller", "Kc", &s.pid_kc);
   r.Get(t, "controller", "Ti", &s.pid_ti);
   r.Get(t, "controller", "Td", &s.pid_td);
+  r.Get(t, "controller", "Kff", &s.pid_kff);
   r.Get(t, "controller", "pid_rule", &s.pid_rule);
   r.Get(t, "controller", "input_map", &s.input_map);
   r.Get(t, "controller", "input_gaps", &s.input_gaps);

@@ -4,14 +4,18 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
+#include <Eigen/QR>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/duty_modulator.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/signal.hpp"
@@ -32,13 +36,13 @@ struct ExperimentEnded {
 // is applied, as RunExperiment does); counts plant time.
 class Recorder {
  public:
-  Recorder(Plant& plant, const CommissionOptions& o, double u_safe, double u_max,
+  Recorder(Plant& plant, const CommissionOptions& o, double u_safe, double u_min, double u_max,
            std::vector<InputGap> gaps)
       : plant_(plant),
         o_(o),
         u_safe_(u_safe),
         Ts_(plant.Ts()),
-        modulator_(std::move(gaps), u_safe, u_max) {}
+        modulator_(std::move(gaps), u_min, u_max) {}
 
   double Ts() const { return Ts_; }
   double time() const { return static_cast<double>(u_.size()) * Ts_; }
@@ -110,6 +114,13 @@ class Recorder {
   DutyModulator modulator_;
   std::vector<double> u_, y_;
 };
+
+// The result of an experiment that ended early (its data already kept).
+CommissionResult EndedEarly(CommissionResult r, const ExperimentEnded& e) {
+  r.termination = e.termination;
+  r.message = e.message;
+  return r;
+}
 
 // Time at which the response (y - y0) / dy first reaches `fraction`, from
 // sample `from` on (NaN when it never does).
@@ -235,7 +246,7 @@ std::string ProbeAndSweep(Recorder& rec, const CommissionOptions& o, double u_lo
 
 // The checks of the verification against the specification.
 std::vector<std::string> Judge(const ClosedLoopMetrics& m, const CommissionOptions& o, double range,
-                               double noise_p2p) {
+                               double noise_p2p, double sse_share) {
   std::vector<std::string> failures;
   for (std::size_t i = 0; i < m.steps.size(); ++i) {
     const StepMetrics& s = m.steps[i];
@@ -258,10 +269,10 @@ std::vector<std::string> Judge(const ClosedLoopMetrics& m, const CommissionOptio
           "ripple {:.3g} peak to peak > {:.3g} (2 % of the set-point {:.4g}, or twice the "
           "sensor's {:.3g} at rest) on {}",
           s.ripple, ripple_limit, s.to, noise_p2p, step));
-    if (std::isfinite(s.steady_state_error) && std::abs(s.steady_state_error) > 0.005 * range)
+    if (std::isfinite(s.steady_state_error) && std::abs(s.steady_state_error) > sse_share * range)
       failures.push_back(
-          fmt::format("steady-state error {:.3g} > {:.3g} (0.5 % of the range) on {}",
-                      s.steady_state_error, 0.005 * range, step));
+          fmt::format("steady-state error {:.3g} > {:.3g} ({:g} % of the range) on {}",
+                      s.steady_state_error, sse_share * range, 100.0 * sse_share, step));
   }
   return failures;
 }
@@ -471,8 +482,12 @@ bool ChooseModel(CommissionResult& r, const CommissionOptions& o,
 // Stage 6: the verification staircase and load step on the plant, the
 // design repeated at half the aggressiveness after an overshoot failure.
 // False when stopped on request (r.termination and r.message set).
+// `soften` makes the next design less aggressive; `sse_share` is the
+// steady-state error allowed, as a share of the range.
 bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
-            ControllerSettings settings, const TransferFunction& model, double Ts) {
+            ControllerSettings settings, const TransferFunction& model, double Ts,
+            const std::function<void(ControllerSettings&)>& soften, double sse_share,
+            double safe_input, bool retune_on_ripple) {
   const CommissionExperiment& ex = r.experiment;
   const double range = ex.range_max - ex.range_min;
   std::vector<double> levels;
@@ -488,7 +503,6 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
   cl.load_steps.push_back({(static_cast<double>(levels.size()) - 0.5) * dwell, load});
   cl.actuator.u_min = settings.limits.u_min;
   cl.actuator.u_max = settings.limits.u_max;
-  double aggressiveness = o.aggressiveness;
   for (int attempt = 0; attempt <= o.retunes; ++attempt) {
     Report(o, "verify", static_cast<double>(attempt) / (o.retunes + 1));
     if (o.stop != nullptr && o.stop->load()) {
@@ -496,28 +510,183 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
       r.message = "stopped on request before the verification";
       return false;
     }
-    settings.aggressiveness = aggressiveness;
     CommissionAttempt a;
-    a.aggressiveness = aggressiveness;
+    a.aggressiveness = settings.aggressiveness;
     BuiltController built = MakeController(
         model, Ts, WithModelInputMap(ToControllerSpec(settings), r.controller_model));
     a.design = built.Summary();
     a.settings = built.SettingsToJson();
     a.result = SimulateClosedLoop(*built.controller, plant, *setpoint, cl);
-    plant.Advance(settings.limits.u_min);  // the safe state after the run
+    plant.Advance(safe_input);  // the safe state after the run
     r.plant_time += cl.duration;
-    a.failures = Judge(a.result.metrics, o, range, ex.noise_peak_to_peak);
+    a.failures = Judge(a.result.metrics, o, range, ex.noise_peak_to_peak, sse_share);
     a.passed = a.failures.empty();
     r.attempts.push_back(std::move(a));
     r.settings = settings;
-    const bool overshoot_failed =
-        std::any_of(r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
-                    [](const std::string& f) { return f.rfind("overshoot", 0) == 0; });
+    const bool overshoot_failed = std::any_of(
+        r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
+        [&](const std::string& f) {
+          return f.rfind("overshoot", 0) == 0 || (retune_on_ripple && f.rfind("ripple", 0) == 0);
+        });
     if (r.attempts.back().passed || !overshoot_failed) break;
-    aggressiveness *= 0.5;
+    soften(settings);
   }
   Report(o, "verify", 1.0);
   return true;
+}
+
+// The PD of an integrating plant of velocity gain Ki for a closed-loop time
+// constant tau (header comment): Kc Ki = 3 / tau, Kc Ki Td = 1.
+void SetIntegratingPd(ControllerSettings& s, double Ki, double tau) {
+  s.pid_kc = 3.0 / (tau * Ki);
+  s.pid_td = tau / 3.0;
+  s.pid_ti = std::numeric_limits<double>::infinity();
+  s.response_time = tau;
+}
+
+// Commissioning of an integrating plant (header comment: integrating plants).
+CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
+                                       const Actuator& act, double u_lo, double u_hi) {
+  CommissionResult r;
+  CommissionExperiment& ex = r.experiment;
+  PNEUMID_CHECK(u_lo < 0.0 && u_hi > 0.0,
+                "commission: an integrating plant needs inputs of both signs (it holds at 0), "
+                "got [{}, {}]",
+                u_lo, u_hi);
+  ex.reachable_min = act.y_min;
+  ex.reachable_max = act.y_max;
+  if (std::isfinite(o.range_min)) {
+    ex.range_min = o.range_min;
+    ex.range_max = o.range_max;
+  } else if (std::isfinite(act.y_min) && std::isfinite(act.y_max)) {
+    const double span = act.y_max - act.y_min;
+    ex.range_min = act.y_min + 0.1 * span;
+    ex.range_max = act.y_max - 0.1 * span;
+  } else {
+    r.message = "the plant integrates its input and its output range is not known: give --range";
+    return r;
+  }
+  plant.Reset();
+  const std::vector<InputGap> gaps = o.modulate ? act.input_gaps : std::vector<InputGap>{};
+  Recorder rec(plant, o, 0.0, u_lo, u_hi, gaps);
+  const double Ts = rec.Ts();
+  const double span = ex.range_max - ex.range_min, mid = 0.5 * (ex.range_min + ex.range_max);
+  auto finish_data = [&] {
+    ex.data = rec.size() > 0 ? rec.Slice(0, rec.size(), act.input, act.output) : Dataset();
+    ex.duration = rec.time();
+    r.plant_time = ex.duration;
+  };
+  // Stage 1: rest (input 0 holds) for the noise; stage 2: pulses toward the
+  // middle of the range at four levels, each followed by a rest, the pulse
+  // length adapted so that each moves about 15 % of the range.
+  std::vector<double> pulse_u, pulse_v;
+  try {
+    Report(o, "probe", 0.0);
+    rec.Hold(0.0, 0.5);
+    ex.noise_peak_to_peak = rec.PeakToPeakY(rec.size() / 5, rec.size());
+    const double noise = rec.StdY(rec.size() / 5, rec.size());
+    double T = std::max(0.05, 5 * Ts);
+    const double rest = std::max(0.3, 30 * Ts);
+    const double fractions[] = {0.2, 0.3, 0.45, 0.6};
+    int done = 0;
+    for (double f : fractions) {
+      for (int rep = 0; rep < 2; ++rep, ++done) {
+        const double y0 = rec.MeanY(rec.size() - 5, rec.size());
+        const double u = y0 < mid ? f * u_hi : f * u_lo;
+        const std::size_t from = rec.size();
+        const auto n = std::max<long>(1, std::lround(T / Ts));
+        for (long k = 0; k < n; ++k) {
+          rec.Step(u);
+          const double y = rec.y(rec.size() - 1);
+          if (y < ex.range_min - 0.05 * span || y > ex.range_max + 0.05 * span) break;
+        }
+        const double t_on = static_cast<double>(rec.size() - from) * Ts;
+        rec.Hold(0.0, rest);
+        const double y1 = rec.MeanY(rec.size() - 5, rec.size());
+        if (std::abs(y1 - y0) > 10 * noise) {
+          pulse_u.push_back(u);
+          pulse_v.push_back((y1 - y0) / t_on);
+          T = std::clamp(0.15 * span / std::abs(pulse_v.back()), 2 * Ts, 1.0);
+        } else {
+          T = std::min(2 * T, 1.0);
+        }
+        ex.estimation_levels.push_back(u);
+        Report(o, "probe", (done + 1) / 8.0);
+      }
+    }
+    rec.Safe();
+  } catch (const ExperimentEnded& e) {
+    finish_data();
+    return EndedEarly(std::move(r), e);
+  }
+  finish_data();
+  ex.estimation = ex.data;
+  // v = Ki u + c sign(u): least squares in Ki and c.
+  if (pulse_u.size() < 3) {
+    r.message = fmt::format(
+        "the plant does not respond: {} of 8 pulses of the input (up to {:g} and {:g}) moved the "
+        "output by more than 10 x its noise; is the sensor connected and the supply on?",
+        pulse_u.size(), 0.6 * u_hi, 0.6 * u_lo);
+    return r;
+  }
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(pulse_u.size()), 2);
+  Eigen::VectorXd v(A.rows());
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    A(i, 0) = pulse_u[static_cast<std::size_t>(i)];
+    A(i, 1) = -(pulse_u[static_cast<std::size_t>(i)] > 0.0 ? 1.0 : -1.0);
+    v(i) = pulse_v[static_cast<std::size_t>(i)];
+  }
+  const Eigen::Vector2d c = A.colPivHouseholderQr().solve(v);
+  const double Ki = c(0), offset = -c(1);
+  if (!(std::isfinite(Ki) && Ki > 0.0)) {
+    r.message = fmt::format(
+        "the pulses give no positive velocity gain (Ki = {:.3g}): the output does not follow "
+        "the sign of the input",
+        Ki);
+    return r;
+  }
+  ex.gain = Ki;
+  ex.dead_time = kNaN;
+  ex.time_constant = kNaN;
+  ex.dwell = 0.0;
+  r.chosen_model = "integrator";
+  r.controller_model = fmt::format("tf:num={:.6g},den=1 0", Ki);
+  r.chosen_reason = fmt::format(
+      "the plant integrates: velocity = Ki u + c sign(u) fitted to {} pulses: Ki = {:.4g} per "
+      "input unit and second, c = {:.3g} (c < 0: a dead band of -c/Ki = {:.3g}; c > 0: the "
+      "piston coasts on after the pulses)",
+      pulse_u.size(), Ki, offset, -offset / Ki);
+
+  // Stages 5 and 6: the PD with velocity feed-forward, verified on the plant.
+  Report(o, "design", 0.0);
+  ControllerSettings settings;
+  settings.controller = "pid";
+  settings.limits.u_min = u_lo;
+  settings.limits.u_max = u_hi;
+  settings.input_gaps = InputGapsToString(gaps);
+  SetIntegratingPd(settings, Ki, o.settling / 8.0);
+  const TransferFunction model = ParseModelSpec(r.controller_model);
+  const auto soften = [Ki](ControllerSettings& s) {
+    SetIntegratingPd(s, Ki, 1.5 * s.response_time);
+  };
+  if (!Verify(r, plant, o, settings, model, Ts, soften, 0.00125, 0.0, true)) return r;
+  const std::string pd = fmt::format("PD (Kc = {:.4g}, Td = {:.3g} s, velocity feed-forward)",
+                                     r.settings.pid_kc, r.settings.pid_td);
+  if (r.passed()) {
+    r.termination = Termination::kSuccess;
+    r.message = fmt::format(
+        "the plant integrates its input; the {} meets the specification (overshoot <= {:g} %, "
+        "settling <= {:g} s, |steady-state error| <= {:.3g}) across {:.4g}..{:.4g}",
+        pd, o.overshoot, o.settling, 0.00125 * span, ex.range_min, ex.range_max);
+  } else {
+    r.termination = Termination::kPartial;
+    Diagnose(r);
+    r.message = fmt::format(
+        "the plant integrates its input; the {} does not meet the "
+        "specification: {}",
+        pd, r.attempts.back().failures.front());
+  }
+  return r;
 }
 
 }  // namespace
@@ -637,22 +806,16 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   PNEUMID_CHECK(std::isfinite(u_lo) && std::isfinite(u_hi) && u_lo < u_hi,
                 "commission: the input range must be finite (give u_min and u_max), got [{}, {}]",
                 u_lo, u_hi);
-  CommissionResult r;
   // A positioning drive integrates its input: it has no steady state to probe
   // and its model no static gain to design on (docs/position.md).
   if (const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant);
-      ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition) {
-    r.message =
-        "the plant integrates its input (the IPA in position mode: the piston moves as long as "
-        "the valves are open), and commissioning needs a plant that settles at a constant "
-        "input; for a position loop see docs/position.md (a PD on an integrator model, "
-        "--input-gaps plant)";
-    return r;
-  }
+      ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition)
+    return CommissionIntegrating(plant, o, act, u_lo, u_hi);
+  CommissionResult r;
   CommissionExperiment& ex = r.experiment;
   plant.Reset();
   const std::vector<InputGap> gaps = o.modulate ? act.input_gaps : std::vector<InputGap>{};
-  Recorder rec(plant, o, u_lo, u_hi, gaps);
+  Recorder rec(plant, o, u_lo, u_lo, u_hi, gaps);
   const double Ts = rec.Ts();
   auto finish_data = [&] {
     ex.data = rec.size() > 0 ? rec.Slice(0, rec.size(), act.input, act.output) : Dataset();
@@ -675,9 +838,7 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     x = RunExcitation(rec, o, p, u_lo, u_hi, ex);
   } catch (const ExperimentEnded& e) {
     finish_data();
-    r.termination = e.termination;
-    r.message = e.message;
-    return r;
+    return EndedEarly(std::move(r), e);
   }
   finish_data();
   ex.estimation = rec.Slice(x.est_from, x.est_to, act.input, act.output);
@@ -696,7 +857,8 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   settings.input_gaps = InputGapsToString(gaps);
   TransferFunction model;
   if (!ChooseModel(r, o, settings, Ts, &model)) return r;
-  if (!Verify(r, plant, o, settings, model, Ts)) return r;
+  const auto soften = [](ControllerSettings& s) { s.aggressiveness *= 0.5; };
+  if (!Verify(r, plant, o, settings, model, Ts, soften, 0.005, u_lo, false)) return r;
   if (r.passed()) {
     r.termination = Termination::kSuccess;
     r.message = fmt::format(

@@ -26,6 +26,14 @@ std::string TomlString(const std::string& s) {
   return out + "\"";
 }
 
+// A model file reference (FILE[#METHOD]) made absolute; an inline spec
+// (tf:num=..,den=..) as it is.
+std::string ModelReference(const std::string& spec) {
+  const std::string file = spec.substr(0, spec.find('#'));
+  if (!std::filesystem::exists(file)) return spec;
+  return std::filesystem::absolute(file).string() + spec.substr(file.size());
+}
+
 // controller.toml: model, controller and its settings, limits, loop, I/O, safety.
 void WriteControllerToml(const std::string& path, const CommissionResult& r,
                          const CommissionFilesOptions& o) {
@@ -37,12 +45,16 @@ void WriteControllerToml(const std::string& path, const CommissionResult& r,
       << "#      pneumid run --config " << path << "\n"
       << "#      pneumid codegen --config " << path << " -o DIR\n\n";
   out << "[controller]\n"
-      << "model = " << TomlString(std::filesystem::absolute(r.controller_model).string()) << "\n"
-      << "type = " << TomlString(s.controller) << "\n"
-      << "rule = \"auto\"\n"
-      << fmt::format("overshoot = {}\n", s.overshoot)
-      << fmt::format("aggressiveness = {}\n", s.aggressiveness)
-      << fmt::format("u_min = {}\nu_max = {}\n", s.limits.u_min, s.limits.u_max);
+      << "model = " << TomlString(ModelReference(r.controller_model)) << "\n"
+      << "type = " << TomlString(s.controller) << "\n";
+  if (std::isnan(s.pid_kc)) {
+    out << "rule = \"auto\"\n"
+        << fmt::format("overshoot = {}\n", s.overshoot)
+        << fmt::format("aggressiveness = {}\n", s.aggressiveness);
+  } else {  // a PD designed on an integrating model: its gains
+    out << fmt::format("Kc = {}\nTd = {}\n", s.pid_kc, s.pid_td);
+  }
+  out << fmt::format("u_min = {}\nu_max = {}\n", s.limits.u_min, s.limits.u_max);
   if (!s.input_gaps.empty()) out << "input_gaps = " << TomlString(s.input_gaps) << "\n";
   out << "\n[loop]\n"
       << fmt::format("period = {}\n", o.Ts)

@@ -83,6 +83,7 @@ std::vector<Case> Cases() {
   auto none = [](ControllerSettings&) {};
   add("pid_simc", "pid", true, none);
   add("pid_imc", "pid", true, [](ControllerSettings& s) { s.pid_rule = "imc"; });
+  add("pid_feedforward", "pid", true, [](ControllerSettings& s) { s.pid_kff = 0.05; });
   add("dmc", "dmc", false, none);
   add("dmc_clipped", "dmc", true, [](ControllerSettings& s) { s.limits.du_max = 4.0; });
   add("qdmc", "dmc", true, [](ControllerSettings& s) {

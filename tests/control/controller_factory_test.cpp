@@ -108,7 +108,8 @@ TEST(BuiltControllerTest, LabelSummaryAndSettingsJson) {
   const nlohmann::ordered_json p = pid.SettingsToJson();
   keys.clear();
   for (const auto& [key, value] : p.items()) keys.push_back(key);
-  EXPECT_THAT(keys, ::testing::ElementsAre("Kc", "Ti", "Td", "rule"));
+  EXPECT_THAT(keys, ::testing::ElementsAre("Kc", "Ti", "Td", "Kff", "rule"));
+  EXPECT_EQ(p["Kff"], 0.0);  // a stable model: no feed-forward unless asked
   EXPECT_EQ(p["rule"], "simc");
 }
 
@@ -196,6 +197,7 @@ TEST(ControllerFactoryTest, IntegratingModelsTakeTheirPidGainsFromTheSettings) {
   EXPECT_THAT([&] { MakeController(integrator, kTs, ToControllerSpec(s)); },
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("give the gains")));
   s.pid_kc = 1000.0;
+  s.pid_kff = 0.0;  // no velocity feed-forward: the closed form below is P control's
   const BuiltController p = MakeController(integrator, kTs, ToControllerSpec(s));
   EXPECT_DOUBLE_EQ(p.pid_gains.Kc, 1000.0);
   EXPECT_TRUE(std::isinf(p.pid_gains.Ti));
@@ -210,6 +212,53 @@ TEST(ControllerFactoryTest, IntegratingModelsTakeTheirPidGainsFromTheSettings) {
     const double expected = 0.02 * std::pow(1.0 - 1000.0 * 0.004 * kTs, n);
     EXPECT_NEAR(r.r(10 + n) - r.y(10 + n), expected, 1e-9 + 1e-6 * expected) << n;
   }
+}
+
+// The velocity feed-forward of an integrating model: by default Kff = 1/Ki +
+// Kc Td (Ki the model's velocity gain, continuous or discrete). On the plant
+// y(k+1) = y(k) + Ki Ts u(k) and a ramp r = a t, the PD's derivative on y
+// settles at -Kc Td a, so without feed-forward the loop lags by
+// a (1/Ki + Kc Td) / Kc; with it, e(k+1) = (1 - Kc Ki Ts) e(k) -> 0.
+TEST(ControllerFactoryTest, IntegratingModelsFeedTheSetpointRateForward) {
+  const double Ki = 0.004, Kc = 1000.0, Td = 0.05, a = 0.02;  // m/s per %, %/m, s, m/s
+  const TransferFunction integrator(Eigen::VectorXd::Constant(1, Ki),
+                                    (Eigen::VectorXd(2) << 1.0, 0.0).finished());
+  // The same integrator sampled with a zero-order hold: (Ki Ts z^-1) / (1 - z^-1).
+  const TransferFunction sampled((Eigen::VectorXd(2) << 0.0, Ki * kTs).finished(),
+                                 (Eigen::VectorXd(2) << 1.0, -1.0).finished(), kTs);
+  ControllerSettings s;
+  s.controller = "pid";
+  s.pid_kc = Kc;
+  s.pid_td = Td;
+  for (const TransferFunction& model : {integrator, sampled}) {
+    const BuiltController b = MakeController(model, kTs, ToControllerSpec(s));
+    EXPECT_NEAR(b.pid_kff, 1.0 / Ki + Kc * Td, 1e-9 * b.pid_kff) << model.ToString();
+    EXPECT_NEAR(b.SettingsToJson()["Kff"].get<double>(), b.pid_kff, 1e-12);
+    EXPECT_THAT(b.Summary(), ::testing::HasSubstr("Kff="));
+  }
+  auto final_error = [&](double kff) {
+    ControllerSettings t = s;
+    t.pid_kff = kff;
+    const BuiltController b = MakeController(integrator, kTs, ToControllerSpec(t));
+    LinearPlant plant(integrator, kTs);
+    const auto sp = ParseSignal(fmt::format("ramp:from=0,to={},at=0.1,duration=10", 10.0 * a));
+    ClosedLoopOptions o;
+    o.duration = 6.0;
+    const auto r = SimulateClosedLoop(*b.controller, plant, *sp, o);
+    const Eigen::Index n = r.r.size() - 1;
+    return r.r(n) - r.y(n);
+  };
+  const double lag = a * (1.0 / Ki + Kc * Td) / Kc;
+  EXPECT_NEAR(final_error(0.0), lag, 1e-3 * lag);
+  EXPECT_NEAR(final_error(1.0 / Ki + Kc * Td), 0.0, 1e-6 * lag);
+  // Half the feed-forward leaves half the lag.
+  EXPECT_NEAR(final_error(0.5 * (1.0 / Ki + Kc * Td)), 0.5 * lag, 1e-3 * lag);
+  // A stable model gets none unless it is asked for.
+  s.pid_kc = kNaN;
+  s.pid_td = kNaN;
+  EXPECT_EQ(MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s)).pid_kff, 0.0);
+  s.pid_kff = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s)), InvalidArgument);
 }
 
 }  // namespace

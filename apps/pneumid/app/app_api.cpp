@@ -661,6 +661,7 @@ void ReadControllerSettings(const nlohmann::json& b, ControllerSettings& s) {
   Get(b, "Kc", s.pid_kc);
   Get(b, "Ti", s.pid_ti);
   Get(b, "Td", s.pid_td);
+  Get(b, "Kff", s.pid_kff);
   Get(b, "t_filter", s.t_filter);
   Get(b, "disturbance", s.disturbance);
   Get(b, "response_time", s.response_time);

@@ -8,7 +8,11 @@
 //        coefficients "1 -0.8" (ascending powers of q^-1)
 //   pid  gains by SIMC or IMC from the model's FOPDT description (tuning.hpp,
 //        FopdtFromModel), tau_c <= 0 = the rule's default; each of Kc, Ti,
-//        Td given explicitly replaces the rule's value
+//        Td given explicitly replaces the rule's value; an integrating model
+//        (a pole at s = 0 / z = 1, no FOPDT) takes Kc (and Ti, Td) as given,
+//        and its velocity feed-forward Kff defaults to 1/Ki + Kc Td (pid.hpp,
+//        Ki the model's velocity gain lim s G(s)): a ramp set-point is then
+//        tracked without lag
 //   mpc  state-space MPC (mpc.hpp) from the model with its delay as states:
 //        P, M, lambda from the tuning rule as for dmc, the input limits and
 //        soft output bounds (a QP whenever one is finite), the other options
@@ -55,7 +59,10 @@ struct ControllerSpec {
   double pid_kc = std::numeric_limits<double>::quiet_NaN();
   double pid_ti = std::numeric_limits<double>::quiet_NaN();  ///< explicit Ti in s (NaN = rule's)
   double pid_td = std::numeric_limits<double>::quiet_NaN();  ///< explicit Td in s (NaN = rule's)
-  DisturbanceModel disturbance = DisturbanceModel::kInput;   ///< mpc (mpc.hpp)
+  /// pid velocity feed-forward Kff (PidOptions::velocity_feedforward); NaN =
+  /// 1/Ki + Kc Td for an integrating model, 0 otherwise (file comment).
+  double pid_kff = std::numeric_limits<double>::quiet_NaN();
+  DisturbanceModel disturbance = DisturbanceModel::kInput;  ///< mpc (mpc.hpp)
   /// Tune from specifications (auto_tuning.hpp) instead of the tuning rule:
   /// mpc and dmc get P, M, lambda, pid its gains; auto_options.controller and
   /// .limits are taken from type and limits.
@@ -107,7 +114,10 @@ struct ControllerSettings {
   double pid_kc = std::numeric_limits<double>::quiet_NaN();
   double pid_ti = std::numeric_limits<double>::quiet_NaN();  ///< pid: explicit Ti in s
   double pid_td = std::numeric_limits<double>::quiet_NaN();  ///< pid: explicit Td in s
-  std::string disturbance = "input";                         ///< mpc: input, output or none
+  /// pid: velocity feed-forward, input per unit set-point rate, as --Kff (NaN
+  /// = 1/Ki + Kc Td for an integrating model, 0 otherwise).
+  double pid_kff = std::numeric_limits<double>::quiet_NaN();
+  std::string disturbance = "input";  ///< mpc: input, output or none
   /// rule "auto": the specifications (auto_tuning.hpp; NaN = from the model).
   double response_time = std::numeric_limits<double>::quiet_NaN();
   double overshoot = 5.0;       ///< rule "auto": maximum overshoot, percent (default 5)
@@ -161,6 +171,7 @@ struct BuiltController {
   PidGains pid_gains;                             ///< (pid)
   bool pid_explicit = false;  ///< (pid) some gains given explicitly (ControllerSpec::pid_kc ...)
   FopdtEstimate fopdt;        ///< the FOPDT the PID was tuned from (pid)
+  double pid_kff = 0.0;       ///< (pid) velocity feed-forward Kff (0: none)
   /// Rule "auto": the auto-tuner's message (what it met or why not).
   std::string auto_summary;
 
@@ -171,7 +182,7 @@ struct BuiltController {
   /// or the PID rule, the FOPDT it used and the gains.
   std::string Summary() const;
   /// `settings` of `pneumid control --json`: {rule, P, M, lambda, formula}
-  /// (dmc, gpc, mpc) or {Kc, Ti, Td, rule} (pid; Ti null when infinite).
+  /// (dmc, gpc, mpc) or {Kc, Ti, Td, Kff, rule} (pid; Ti null when infinite).
   nlohmann::ordered_json SettingsToJson() const;
 };
 

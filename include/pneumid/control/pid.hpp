@@ -19,6 +19,13 @@
 //   v = P + I + D,  u = sat(v),
 //   I += Kc Ts/Ti e + Ts/Tt (u - v)      (back-calculation anti-windup [3]),
 // with tracking time Tt = sqrt(Ti Td) for PID and Ti/2 for PI [3, sec. 3.5].
+// With a velocity feed-forward gain Kv (PidOptions::velocity_feedforward), v
+// also holds Kv (r - r_prev)/Ts: the set-point's rate times the input that
+// holds that rate. On an integrating plant dy/dt = Ki u, with the derivative
+// on y, a ramp r = a t is tracked without lag when Kv = 1/Ki + Kc Td (the
+// derivative term's share of the ramp, -Kc Td a, is fed forward too); a PD
+// alone lags it by a (1/Ki) / Kc [3, ch. 5]. A set-point step gives one
+// sample of Kv (step)/Ts, which the limits clip.
 //
 // [1] S. Skogestad, "Simple analytic rules for model reduction and PID
 //     controller tuning", J. Process Control 13 (2003) 291-309.
@@ -58,14 +65,17 @@ PidGains TunePid(double K, double tau, double theta, double Ts, PidTuningRule ru
 
 /// Gains, set-point weight, derivative filter, anti-windup and limits of the discrete PID.
 struct PidOptions {
-  PidGains gains;  ///< Kc, Ti, Td (default P-only with Kc = 1)
+  PidGains gains;                   ///< Kc, Ti, Td (default P-only with Kc = 1)
   double setpoint_weight = 1.0;     ///< b in P = Kc (b r - y), in [0, 1]
   double derivative_filter = 10.0;  ///< N: derivative filter time Td / N
   double tracking_time = 0.0;       ///< Tt (s) for anti-windup; 0 = automatic (file comment)
+  /// Kv: input per unit rate of the set-point (input units per output unit per second),
+  /// added as Kv (r - r_prev)/Ts (file comment); 0 = none.
+  double velocity_feedforward = 0.0;
   InputLimits limits;  ///< saturation and rate limit of u (sat in the file comment)
   /// True when Kc is finite, Ti > 0 (inf allowed), Td finite and >= 0, setpoint_weight in
-  /// [0, 1], derivative_filter > 0, tracking_time >= 0 and limits are valid; otherwise
-  /// false with the reason in *error (when error is not null).
+  /// [0, 1], derivative_filter > 0, tracking_time >= 0, velocity_feedforward finite and limits are
+  /// valid; otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -94,6 +104,7 @@ class PidController : public Controller {
   double integral_ = 0.0;
   double derivative_ = 0.0;
   double y_prev_ = 0.0;
+  double r_prev_ = 0.0;
   double u_prev_ = 0.0;
 };
 

@@ -46,6 +46,26 @@
 //                 the loop (saturation, dead time, model error, ripple) is
 //                 stated with what to try.
 //
+// Integrating plants (the IPA in position mode: the piston moves while the
+// valves are open and stays where it is when they are closed) have no steady
+// state to probe; their stages are:
+//
+//   1. rest       0.5 s at input 0 (valves closed): the sensor's noise.
+//   2. pulses     eight pulses at 20, 30, 45 and 60 % of the input range, two
+//                 each, each toward the middle of the range and followed by a
+//                 rest; the first lasts 0.05 s, the next are timed to move
+//                 about 15 % of the range. The velocity gain Ki is the least-
+//                 squares slope of v = Ki u + c sign(u) over the pulses (v =
+//                 displacement / pulse time); the model is Ki / s.
+//   3. design     a PD on y with the velocity feed-forward 1/Ki + Kc Td
+//                 (controller_factory.hpp): for a closed-loop time constant
+//                 tau = settling / 8, Kc Ki = 3 / tau and Kc Ki Td = 1
+//                 (docs/position.md); the range served is the output range of
+//                 the actuator less 10 % at each end, or the one asked for.
+//   4. verify     as above, with |steady-state error| at most 0.125 % of the
+//                 range (0.1 mm over 80 mm); a design that overshoots or
+//                 cycles is repeated with tau x 1.5.
+//
 // Plant time is counted and reported for every stage. A stop request (the
 // `stop` flag, set by SIGINT) or an output beyond the safety limits ends the
 // experiment with the plant at its lowest input (the IPA's vented state) and
