@@ -45,15 +45,25 @@ EXPERIMENTS = {
 # The controllers: a PD on an integrating model sampled once per PWM period,
 # its input modulated across the valves' dead band (--input-gaps plant), with
 # the velocity feed-forward 1/Ki + Kc Td of the model (the default); and the
-# first PD (100 Hz, no modulation, no feed-forward) as the baseline.
+# first PD (100 Hz, no modulation, no feed-forward) as the baseline; an MPC
+# without a disturbance model (the plant's integrator removes the offset; the
+# input disturbance model adds integral action, which hunts under stick-slip)
+# and a GPC (integral action through its CARIMA model) on the same model.
 CONTROLLERS = {
     "none (PD at 100 Hz, no modulation, no feed-forward)": [
         "--controller", "pid", "--Kc", "3000", "--Td", "0.02", "--Kff", "0", "--input-gaps", "none"],
     "PD at 300 Hz + dead-band modulation + velocity feed-forward": [
         "--controller", "pid", "--Kc", "6000", "--Td", "0.04", "--input-gaps", "plant",
         "--Ts", repr(1.0 / 300.0)],
+    "MPC (no disturbance model) at 300 Hz + modulation": [
+        "--controller", "mpc", "--rule", "explicit", "--P", "40", "--M", "5", "--lambda", "1e-5",
+        "--disturbance", "none", "--measurement-noise", "1e-10", "--state-noise", "1e-6",
+        "--input-gaps", "plant", "--Ts", repr(1.0 / 300.0)],
+    "GPC at 300 Hz + modulation": [
+        "--controller", "gpc", "--rule", "explicit", "--P", "40", "--M", "5", "--lambda", "1e-5",
+        "--input-gaps", "plant", "--Ts", repr(1.0 / 300.0)],
 }
-MODEL = "tf:num=0.004,den=1 0"  # integrator, (m/s) per %: what the PD is designed on
+MODEL = os.environ.get("POSITION_MODEL", "tf:num=0.004,den=1 0")  # integrator, (m/s) per %: what the PD is designed on
 
 
 def run(variant, setpoint, duration, args):

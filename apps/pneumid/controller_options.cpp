@@ -61,6 +61,14 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
                  "disturbance at the plant input), output (on the output) or none")
       ->capture_default_str()
       ->check(CLI::IsMember({"output", "input", "none"}));
+  app.add_option("--measurement-noise", s.measurement_noise,
+                 "MPC Kalman filter: measurement noise variance, output units squared (default "
+                 "1; a position in m wants about the sensor's, e.g. 1e-10)");
+  app.add_option("--state-noise", s.state_noise,
+                 "MPC Kalman filter: process noise variance on each model state (default 0; > 0 "
+                 "with --disturbance none on an integrating model)");
+  app.add_option("--disturbance-noise", s.disturbance_noise,
+                 "MPC Kalman filter: process noise variance on the disturbance (default 1)");
   app.add_option("--y-valid-min", s.y_valid_min,
                  "Lowest measurement a working sensor gives; a sample below it (or NaN/Inf) is a "
                  "fault: the controller holds its last input and keeps its state (default: any "
@@ -125,6 +133,11 @@ void ApplyControllerConfig(const CLI::App& app, const ControllerConfig& file, st
       {"y_max", "--y-max", [&] { s.y_max = f.y_max; }},
       {"constrained", "--constrained", [&] { s.constrained = f.constrained; }},
       {"disturbance", "--disturbance", [&] { s.disturbance = f.disturbance; }},
+      {"measurement_noise", "--measurement-noise",
+       [&] { s.measurement_noise = f.measurement_noise; }},
+      {"state_noise", "--state-noise", [&] { s.state_noise = f.state_noise; }},
+      {"disturbance_noise", "--disturbance-noise",
+       [&] { s.disturbance_noise = f.disturbance_noise; }},
       {"t_filter", "--t-filter", [&] { s.t_filter = f.t_filter; }},
       {"tau_c", "--tau-c", [&] { s.tau_c = f.tau_c; }},
       {"Kc", "--Kc", [&] { s.pid_kc = f.pid_kc; }},

@@ -479,6 +479,10 @@ void PFX_applied(PFX_state* s, PFX_real u) {{
 }
 
 void GenerateMpc(const MpcController& c, Module& m) {
+  PNEUMID_CHECK(!c.integrating(),
+                "generated C of an MPC on an integrating model is not available (its target "
+                "and reset have no static gain to use); generate the PD (--controller pid) for a "
+                "position loop");
   const MpcOptions& o = c.options();
   const int P = o.P, M = o.M, nx = c.num_model_states();
   const int nz = static_cast<int>(c.Az().rows());

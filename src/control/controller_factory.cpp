@@ -52,6 +52,9 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   spec.pid_td = settings.pid_td;
   spec.pid_kff = settings.pid_kff;
   spec.disturbance = DisturbanceModelFromString(settings.disturbance);
+  spec.measurement_noise = settings.measurement_noise;
+  spec.state_noise = settings.state_noise;
+  spec.disturbance_noise = settings.disturbance_noise;
   spec.auto_options.disturbance = spec.disturbance;
   if (!settings.input_map.empty()) spec.input_map = ReadStaticMap(settings.input_map);
   spec.guard.y_min = settings.y_valid_min;
@@ -408,6 +411,9 @@ BuiltController BuildController(const PredictionModel& model, const ControllerSp
       o.y_min = spec.y_min;
       o.y_max = spec.y_max;
       o.disturbance = spec.disturbance;
+      if (!std::isnan(spec.measurement_noise)) o.measurement_noise = spec.measurement_noise;
+      if (!std::isnan(spec.state_noise)) o.state_noise = spec.state_noise;
+      if (!std::isnan(spec.disturbance_noise)) o.disturbance_noise = spec.disturbance_noise;
       b.controller = std::make_unique<MpcController>(model.model(), model.Ts(), o);
       break;
     }

@@ -127,16 +127,55 @@ void MpcController::Build(const StateSpace& model_in) {
                 "MPC needs a strictly proper model: D = {} makes y_k depend on u_k, which is "
                 "computed from y_k (use an input delay of at least one sample, e.g. nk >= 1)",
                 model.D()(0, 0));
-  PNEUMID_CHECK(model.IsStable(),
-                "MPC needs a stable model; the model has a pole of magnitude {:.6g} (>= 1)",
-                model.Poles().cwiseAbs().maxCoeff());
+  // Stable, or integrating: one pole at z = 1, the others inside the circle.
+  const Eigen::VectorXcd poles = model.Poles();
+  int at_one = 0;
+  double outside = 0.0;
+  for (Eigen::Index i = 0; i < poles.size(); ++i) {
+    if (std::abs(poles(i) - 1.0) <= 1e-9)
+      ++at_one;
+    else
+      outside = std::max(outside, std::abs(poles(i)));
+  }
+  PNEUMID_CHECK(outside < 1.0 && at_one <= 1,
+                "MPC needs a stable or integrating model; the model has {}",
+                at_one > 1 ? fmt::format("{} poles at z = 1", at_one)
+                           : fmt::format("a pole of magnitude {:.6g} (>= 1)", outside));
+  integrating_ = at_one == 1;
   Ts_ = model.Ts();
   const Eigen::MatrixXd& A = model.A();
   nx_ = model.num_states();
-  xs_unit_ = (Eigen::MatrixXd::Identity(nx_, nx_) - A).partialPivLu().solve(model.B().col(0));
-  G_ = model.C().row(0).dot(xs_unit_);
-  PNEUMID_CHECK(std::isfinite(G_) && std::abs(G_) > 1e-12 * std::max(1.0, xs_unit_.norm()),
-                "MPC needs a model with a nonzero static gain, got {}", G_);
+  if (!integrating_) {
+    xs_unit_ = (Eigen::MatrixXd::Identity(nx_, nx_) - A).partialPivLu().solve(model.B().col(0));
+    G_ = model.C().row(0).dot(xs_unit_);
+    PNEUMID_CHECK(std::isfinite(G_) && std::abs(G_) > 1e-12 * std::max(1.0, xs_unit_.norm()),
+                  "MPC needs a model with a nonzero static gain, got {}", G_);
+  } else {
+    // [I - A, -B; C, 0] [x_s; v_s] = [0; r] (file comment): x_s per unit r.
+    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nx_ + 1, nx_ + 1);
+    T.topLeftCorner(nx_, nx_) = Eigen::MatrixXd::Identity(nx_, nx_) - A;
+    T.topRightCorner(nx_, 1) = -model.B();
+    T.bottomLeftCorner(1, nx_) = model.C();
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(T);
+    // A pole at z = 1 cancelled (to rounding) by a zero there, as least
+    // squares can fit on noise-free data, leaves T all but singular.
+    PNEUMID_CHECK(lu.isInvertible() && lu.rcond() > 1e-9,
+                  "MPC needs a stable model, or an integrating one without a zero at z = 1; "
+                  "the model has a pole at z = 1 {}",
+                  lu.isInvertible()
+                      ? fmt::format("all but cancelled by a zero (rcond {:.3g})", lu.rcond())
+                      : std::string("cancelled by a zero"));
+    const Eigen::VectorXd col = lu.solve(Eigen::VectorXd::Unit(nx_ + 1, nx_));
+    xs_unit_ = col.head(nx_);
+    G_ = std::numeric_limits<double>::infinity();
+    PNEUMID_CHECK(options_.disturbance != DisturbanceModel::kOutput,
+                  "MPC on an integrating model needs the input disturbance model (or none): an "
+                  "output disturbance is not detectable behind the model's own integrator");
+    PNEUMID_CHECK(options_.disturbance != DisturbanceModel::kNone || options_.state_noise > 0.0,
+                  "MPC on an integrating model without a disturbance model needs process noise "
+                  "on its states (state_noise > 0, --state-noise): the Kalman filter has nothing "
+                  "else to follow the integrator with");
+  }
 
   // Augmented model.
   const DisturbanceModel dm = options_.disturbance;
@@ -269,13 +308,14 @@ void MpcController::DoReset(double u0, double y0) {
       z_prior_(nx_) = y0 - Cz_.head(nx_).dot(z_prior_.head(nx_));
       break;
     case DisturbanceModel::kInput: {
-      const double d = y0 / G_ - u0;
-      z_prior_.head(nx_) = xs_unit_ * (u0 + d);
+      // Integrating: at rest at y0, the disturbance cancelling u0.
+      const double d = integrating_ ? -u0 : y0 / G_ - u0;
+      z_prior_.head(nx_) = integrating_ ? Eigen::VectorXd(xs_unit_ * y0) : xs_unit_ * (u0 + d);
       z_prior_(nx_) = d;
       break;
     }
     case DisturbanceModel::kNone:
-      z_prior_ = xs_unit_ * u0;
+      z_prior_ = integrating_ ? Eigen::VectorXd(xs_unit_ * y0) : xs_unit_ * u0;
       break;
   }
   z_post_ = z_prior_;
@@ -325,10 +365,10 @@ double MpcController::DoUpdate(double setpoint, double measurement) {
       us = (setpoint - z_post_(nx_)) / G_;
       break;
     case DisturbanceModel::kInput:
-      us = setpoint / G_ - z_post_(nx_);
+      us = (integrating_ ? 0.0 : setpoint / G_) - z_post_(nx_);
       break;
     case DisturbanceModel::kNone:
-      us = setpoint / G_;
+      us = integrating_ ? 0.0 : setpoint / G_;
       break;
   }
   // The unconstrained moves; in constrained mode they are the QP's solution

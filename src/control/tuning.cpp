@@ -113,7 +113,8 @@ TuningResult Tune(const PredictionModel& model, const TuningOptions& options) {
                        : f.tau;
       r.P_unrounded = 5.0 * r.tau_used / Ts + f.theta / Ts + 1.0;
       r.P = options.P > 0 ? options.P : std::max(1, static_cast<int>(std::lround(r.P_unrounded)));
-      r.M = options.M > 0 ? options.M : 5;
+      // Five moves, or P when the horizon is shorter (a plant fast for Ts).
+      r.M = options.M > 0 ? options.M : std::min(5, r.P);
       PNEUMID_CHECK(r.M <= r.P, "need M <= P, got M = {}, P = {}", r.M, r.P);
       const Eigen::MatrixXd A = model.DynamicMatrix(r.P, r.M);
       const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A.transpose() * A,

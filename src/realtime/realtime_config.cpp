@@ -77,34 +77,38 @@ struct Reader {
 // [controller]: the model and the settings of ControllerSettings under the
 // names of the command-line flags (with '_' for '-').
 void ParseControllerSection(const Reader& r, const toml::table& t, RealtimeConfig& c) {
-  r.CheckKeys(t, "controller", {"model",
-                                "type",
-                                "rule",
-                                "P",
-                                "M",
-                                "lambda",
-                                "overshoot",
-                                "aggressiveness",
-                                "response_time",
-                                "u_min",
-                                "u_max",
-                                "du_max",
-                                "y_min",
-                                "y_max",
-                                "constrained",
-                                "disturbance",
-                                "t_filter",
-                                "tau_c",
-                                "pid_rule",
-                                "input_map",
-                                "input_gaps",
-                                "y_valid_min",
-                                "y_valid_max",
-                                "safe_input",
-                                "Kc",
-                                "Ti",
-                                "Td",
-                                "Kff"});
+  r.CheckKeys(t, "controller",
+              {"model",
+               "type",
+               "rule",
+               "P",
+               "M",
+               "lambda",
+               "overshoot",
+               "aggressiveness",
+               "response_time",
+               "u_min",
+               "u_max",
+               "du_max",
+               "y_min",
+               "y_max",
+               "constrained",
+               "disturbance",
+               "measurement_noise",
+               "state_noise",
+               "disturbance_noise",
+               "t_filter",
+               "tau_c",
+               "pid_rule",
+               "input_map",
+               "input_gaps",
+               "y_valid_min",
+               "y_valid_max",
+               "safe_input",
+               "Kc",
+               "Ti",
+               "Td",
+               "Kff"});
   ControllerConfig cc;
   ControllerSettings& s = cc.settings;
   r.Get(t, "controller", "model", &cc.model);
@@ -123,6 +127,9 @@ void ParseControllerSection(const Reader& r, const toml::table& t, RealtimeConfi
   r.Get(t, "controller", "y_max", &s.y_max);
   r.Get(t, "controller", "constrained", &s.constrained);
   r.Get(t, "controller", "disturbance", &s.disturbance);
+  r.Get(t, "controller", "measurement_noise", &s.measurement_noise);
+  r.Get(t, "controller", "state_noise", &s.state_noise);
+  r.Get(t, "controller", "disturbance_noise", &s.disturbance_noise);
   r.Get(t, "controller", "t_filter", &s.t_filter);
   r.Get(t, "controller", "tau_c", &s.tau_c);
   r.Get(t, "controller", "Kc", &s.pid_kc);

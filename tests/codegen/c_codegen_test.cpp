@@ -547,6 +547,16 @@ TEST(CodegenTest, RejectsBadPrefixesAndPrecisions) {
   EXPECT_EQ(CodegenPrecisionFromString("float"), CodegenPrecision::kFloat);
 }
 
+// An MPC on an integrating model has no static gain for the generated
+// target and reset: refused with the reason, not written wrong.
+TEST(CodegenTest, RefusesAnMpcOnAnIntegratingModel) {
+  MpcOptions o;
+  o.measurement_noise = 1e-10;
+  const MpcController mpc(TransferFunction::Continuous({0.004}, {1.0, 0.0}), kTs, o);
+  EXPECT_THAT([&] { GenerateC(mpc, CodegenOptions{}); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("integrating")));
+}
+
 // The QP's failure paths mirror the library's: a QDMC whose QP is capped at
 // 2 iterations (max_iterations) and which is told of an applied input far
 // outside its limits (u = 150 with u <= 100 and |du| <= 4: the QP is

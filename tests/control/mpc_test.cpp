@@ -231,6 +231,47 @@ TEST(MpcTest, OffsetWithoutDisturbanceModel) {
   EXPECT_GT(OffsetWithModelError(DisturbanceModel::kNone, false), 1e-3);
 }
 
+// An integrating plant y(k+1) = y(k) + K Ts (u(k) + d) with a constant input
+// disturbance d (a friction force, in input units): its only steady state on
+// the set-point has u = -d. The input disturbance model gets there (u_s =
+// -d^, d^ -> d); without a disturbance model (u_s = 0) an offset remains.
+struct IntegratorRun {
+  double error = 0.0, u = 0.0, d_hat = 0.0;
+};
+IntegratorRun RunIntegrator(DisturbanceModel dm, double d) {
+  const double K = 0.004;  // m/s per %
+  MpcOptions o;
+  o.P = 40;
+  o.M = 5;
+  o.lambda = 1e-5;
+  o.disturbance = dm;
+  o.measurement_noise = 1e-10;
+  o.state_noise = dm == DisturbanceModel::kNone ? 1e-6 : 0.0;
+  MpcController c(TransferFunction::Continuous({K}, {1.0, 0.0}), kTs, o);
+  EXPECT_TRUE(c.integrating());
+  EXPECT_TRUE(std::isinf(c.static_gain()));
+  double y = 0.05, u = 0.0;
+  c.Reset(0.0, y);
+  for (int k = 0; k < 3000; ++k) {
+    u = c.Update(0.07, y);
+    y += K * kTs * (u + d);
+  }
+  return {0.07 - y, u, c.disturbance_estimate()};
+}
+
+TEST(MpcTest, IntegratingModelIsOffsetFreeWithTheInputDisturbanceModel) {
+  const IntegratorRun with = RunIntegrator(DisturbanceModel::kInput, 2.0);
+  EXPECT_NEAR(with.error, 0.0, 1e-9);
+  EXPECT_NEAR(with.u, -2.0, 1e-6);
+  EXPECT_NEAR(with.d_hat, 2.0, 1e-6);
+  // No disturbance: the plant's integrator alone removes the offset.
+  const IntegratorRun none_clean = RunIntegrator(DisturbanceModel::kNone, 0.0);
+  EXPECT_NEAR(none_clean.error, 0.0, 1e-9);
+  EXPECT_NEAR(none_clean.u, 0.0, 1e-6);
+  // With the disturbance and no model of it, the state feedback holds an offset.
+  EXPECT_GT(std::abs(RunIntegrator(DisturbanceModel::kNone, 2.0).error), 1e-5);
+}
+
 TEST(MpcTest, TransferFunctionPathEqualsExplicitStateSpace) {
   // With no state noise the filter, and hence the loop, does not depend on
   // the realization: zoh with the fractional delay (C2D) equals the closed form.
@@ -356,12 +397,30 @@ TEST(MpcTest, BadInputThrows) {
         MpcController(TransferFunction::Continuous({1.0}, {1.0, -1.0}), kTs, ok);
       },
       ThrowsMessage<InvalidArgument>(HasSubstr("stable")));
-  // Integrator (pole at z = 1) is not stable either.
+  // A double integrator (two poles at z = 1) is refused; one integrator is
+  // accepted, but not with the output disturbance model (not detectable), nor
+  // without a disturbance model and without state noise.
   EXPECT_THAT(
       [&] {
-        MpcController(TransferFunction::Continuous({1.0}, {1.0, 0.0}), kTs, ok);
+        MpcController(TransferFunction::Continuous({1.0}, {1.0, 0.0, 0.0}), kTs, ok);
       },
-      ThrowsMessage<InvalidArgument>(HasSubstr("stable")));
+      ThrowsMessage<InvalidArgument>(HasSubstr("2 poles at z = 1")));
+  const TransferFunction integrator = TransferFunction::Continuous({1.0}, {1.0, 0.0});
+  EXPECT_TRUE(MpcController(integrator, kTs, ok).integrating());
+  MpcOptions output_model;
+  output_model.disturbance = DisturbanceModel::kOutput;
+  EXPECT_THAT([&] { MpcController(integrator, kTs, output_model); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("not detectable")));
+  // A pole at z = 1 cancelled by a zero (least squares on noise-free data):
+  // 0.04 z^-2 (1 - z^-1) / ((1 - z^-1)(1 - 0.98 z^-1)) is no integrator.
+  const TransferFunction cancelled((Eigen::VectorXd(4) << 0.0, 0.0, 0.04, -0.04).finished(),
+                                   (Eigen::VectorXd(4) << 1.0, -1.98, 0.98, 0.0).finished(), kTs);
+  EXPECT_THAT([&] { MpcController(cancelled, kTs, ok); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("cancelled by a zero")));
+  MpcOptions none;
+  none.disturbance = DisturbanceModel::kNone;
+  EXPECT_THAT([&] { MpcController(integrator, kTs, none); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("state_noise > 0")));
   // Not SISO.
   const StateSpace two_out(Eigen::MatrixXd::Constant(1, 1, 0.5), Eigen::MatrixXd::Ones(1, 1),
                            Eigen::MatrixXd::Ones(2, 1), Eigen::MatrixXd::Zero(2, 1), kTs);

@@ -664,6 +664,9 @@ void ReadControllerSettings(const nlohmann::json& b, ControllerSettings& s) {
   Get(b, "Kff", s.pid_kff);
   Get(b, "t_filter", s.t_filter);
   Get(b, "disturbance", s.disturbance);
+  Get(b, "measurement_noise", s.measurement_noise);
+  Get(b, "state_noise", s.state_noise);
+  Get(b, "disturbance_noise", s.disturbance_noise);
   Get(b, "response_time", s.response_time);
   Get(b, "overshoot", s.overshoot);
   Get(b, "aggressiveness", s.aggressiveness);

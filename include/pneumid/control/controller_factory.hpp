@@ -63,6 +63,11 @@ struct ControllerSpec {
   /// 1/Ki + Kc Td for an integrating model, 0 otherwise (file comment).
   double pid_kff = std::numeric_limits<double>::quiet_NaN();
   DisturbanceModel disturbance = DisturbanceModel::kInput;  ///< mpc (mpc.hpp)
+  /// mpc: the Kalman filter's noise variances (MpcOptions::measurement_noise,
+  /// state_noise, disturbance_noise); NaN = MpcOptions' defaults.
+  double measurement_noise = std::numeric_limits<double>::quiet_NaN();
+  double state_noise = std::numeric_limits<double>::quiet_NaN();        ///< (NaN = default 0)
+  double disturbance_noise = std::numeric_limits<double>::quiet_NaN();  ///< (NaN = default 1)
   /// Tune from specifications (auto_tuning.hpp) instead of the tuning rule:
   /// mpc and dmc get P, M, lambda, pid its gains; auto_options.controller and
   /// .limits are taken from type and limits.
@@ -118,6 +123,12 @@ struct ControllerSettings {
   /// = 1/Ki + Kc Td for an integrating model, 0 otherwise).
   double pid_kff = std::numeric_limits<double>::quiet_NaN();
   std::string disturbance = "input";  ///< mpc: input, output or none
+  /// mpc: Kalman filter noise variances, as --measurement-noise (output
+  /// units squared), --state-noise, --disturbance-noise; NaN = the defaults
+  /// (1, 0, 1: mpc.hpp).
+  double measurement_noise = std::numeric_limits<double>::quiet_NaN();
+  double state_noise = std::numeric_limits<double>::quiet_NaN();  ///< mpc: see measurement_noise
+  double disturbance_noise = std::numeric_limits<double>::quiet_NaN();  ///< mpc: ditto
   /// rule "auto": the specifications (auto_tuning.hpp; NaN = from the model).
   double response_time = std::numeric_limits<double>::quiet_NaN();
   double overshoot = 5.0;       ///< rule "auto": maximum overshoot, percent (default 5)

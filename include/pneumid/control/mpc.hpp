@@ -1,7 +1,8 @@
 // State-space model predictive control with a steady-state Kalman filter and
 // an integrating disturbance model for offset-free tracking [1, 2, 3].
 //
-// Model: a stable SISO discrete state space without direct feedthrough; an
+// Model: a SISO discrete state space without direct feedthrough, stable or
+// integrating (poles inside the unit circle and at z = 1); an
 // input delay of d samples becomes d states of a shift register
 // (DelayAsStates), a continuous transfer function with input delay is sampled
 // with an exact zero-order hold first (SampledStateSpace, lti/conversion.hpp):
@@ -29,6 +30,14 @@
 //   output: u_s = (r - d^) / G,  x_s = (I - A)^-1 B u_s
 //   input:  u_s = r / G - d^,    x_s = (I - A)^-1 B (u_s + d^)
 //   none:   u_s = r / G,         x_s = (I - A)^-1 B u_s
+// An integrating model has no G; its steady state for the output r and the
+// input v = u + d (input model; v = u otherwise) solves
+//   [I - A, -B; C, 0] [x_s; v_s] = [0; r]
+// [2, eq. 20], which gives v_s = 0 for a model with a pole at z = 1 and no
+// zero there: u_s = -d^ (input model: the input that cancels the estimated
+// friction or load), u_s = 0 (none). The output model is not detectable on an
+// integrating plant (the plant's mode and d both sit at z = 1 behind one
+// output) and is refused.
 //
 // Prediction over i = 1..P with M moves du_j = u_{k+j} - u_{k+j-1}, j < M,
 // and u held from k + M - 1 on [1, sec. 2.6]:
@@ -144,9 +153,11 @@ StateSpace DelayAsStates(const StateSpace& model);
 class MpcController : public Controller {
  public:
   /// Design from a discrete SISO state space (input delay as extra states).
-  /// @throws InvalidArgument for invalid options, a continuous, unstable,
-  /// non-SISO or not strictly proper model, a zero static gain, or an
-  /// estimator whose DARE has no stabilizing solution.
+  /// @throws InvalidArgument for invalid options, a continuous, unstable
+  /// (a pole outside the unit circle or repeated at z = 1), non-SISO or not
+  /// strictly proper model, a zero static gain (or a zero at z = 1 of an
+  /// integrating model), the output disturbance model on an integrating
+  /// model, or an estimator whose DARE has no stabilizing solution.
   MpcController(const StateSpace& model, const MpcOptions& options);
   /// Design from a transfer function at sample time Ts (SampledStateSpace).
   /// @throws InvalidArgument as above, and for Ts <= 0 or a discrete model
@@ -163,8 +174,10 @@ class MpcController : public Controller {
   const Eigen::MatrixXd& Az() const { return Az_; }
   const Eigen::VectorXd& Bz() const { return Bz_; }     ///< Input vector Bz (nz).
   const Eigen::RowVectorXd& Cz() const { return Cz_; }  ///< Output row Cz (1 x nz).
-  /// Static gain G of the plant model.
+  /// Static gain G of the plant model (infinite for an integrating model).
   double static_gain() const { return G_; }
+  /// True for a model with a pole at z = 1 (file comment).
+  bool integrating() const { return integrating_; }
   /// Kalman gain L (nz) and the DARE behind it (X the a priori covariance).
   const Eigen::VectorXd& kalman_gain() const { return L_; }
   /// X (nz x nz), the a priori error covariance of the estimator's DARE.
@@ -175,11 +188,12 @@ class MpcController : public Controller {
   const MpcGain& gain() const { return gain_; }
   /// H (M x M), Theta (P x M), Psi (P x nz).
   const Eigen::MatrixXd& hessian() const { return H_; }
-  const Eigen::MatrixXd& dynamic_matrix() const { return Theta_; }  ///< Theta (P x M).
+  const Eigen::MatrixXd& dynamic_matrix() const { return Theta_; }      ///< Theta (P x M).
   const Eigen::MatrixXd& free_response_matrix() const { return Psi_; }  ///< Psi (P x nz).
   /// Ups_1..Ups_P, the response of y^ to u_{k-1} (P).
   const Eigen::VectorXd& input_response() const { return Ups_; }
-  /// (I - A)^-1 B of the model with its delay states (nx): the steady state per unit input.
+  /// (I - A)^-1 B of the model with its delay states (nx): the steady state per unit input
+  /// (an integrating model: the state at rest per unit output, v_s = 0; file comment).
   const Eigen::VectorXd& unit_steady_state() const { return xs_unit_; }
   /// Model states nx (delay states included; nz = nx + 1 with a disturbance model).
   int num_model_states() const { return nx_; }
@@ -240,7 +254,8 @@ class MpcController : public Controller {
   Eigen::VectorXd Bz_;
   Eigen::RowVectorXd Cz_;
   double G_ = 0.0;
-  Eigen::VectorXd xs_unit_;  // (I - A)^-1 B
+  bool integrating_ = false;
+  Eigen::VectorXd xs_unit_;  // (I - A)^-1 B; integrating: x_s per unit r
   Eigen::VectorXd L_;
   Eigen::MatrixXd X_;
   DareSummary dare_summary_;

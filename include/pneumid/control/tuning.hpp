@@ -70,7 +70,7 @@ FopdtEstimate FopdtFromModel(const TransferFunction& model);
 /// The tuning rule and the settings that override it.
 struct TuningOptions {
   TuningRule rule = TuningRule::kShridharCooper;  ///< default shridhar-cooper
-  /// Control horizon; 0 = the rule's default (5 for shridhar-cooper, 10 for
+  /// Control horizon; 0 = the rule's default (5 for shridhar-cooper, or P when P < 5; 10 for
   /// paper-modified; required for explicit).
   int M = 0;
   /// Explicit settings (rule explicit only; also override P or lambda of the
@@ -91,16 +91,16 @@ struct TuningOptions {
 /// Settings of a predictive controller from a tuning rule, with the values behind them.
 struct TuningResult {
   TuningRule rule = TuningRule::kShridharCooper;  ///< the rule applied
-  int P = 0;  ///< prediction horizon, samples
-  int M = 0;  ///< control horizon, samples
-  double lambda = 0.0;  ///< the value used
+  int P = 0;                                      ///< prediction horizon, samples
+  int M = 0;                                      ///< control horizon, samples
+  double lambda = 0.0;                            ///< the value used
   /// Both Shridhar-Cooper move suppressions (NaN for other rules).
   double lambda_condition = std::numeric_limits<double>::quiet_NaN();
   /// Closed-form (M/500) K^2 (3.5 tau/Ts + 2 - (M-1)/2) (NaN for other rules).
   double lambda_formula = std::numeric_limits<double>::quiet_NaN();
   double P_unrounded = 0.0;  ///< 5 tau'/Ts + theta/Ts + 1 before rounding
   double tau_used = 0.0;     ///< tau after rounding, as used for P
-  FopdtEstimate fopdt;  ///< K, tau, theta the rule started from, and how they were found
+  FopdtEstimate fopdt;       ///< K, tau, theta the rule started from, and how they were found
   /// Human-readable statement of the formulas used, with their values.
   std::string formula;
   double Ts = 0.0;  ///< controller sample time the settings are for (s)
