@@ -503,6 +503,7 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
   cl.load_steps.push_back({(static_cast<double>(levels.size()) - 0.5) * dwell, load});
   cl.actuator.u_min = settings.limits.u_min;
   cl.actuator.u_max = settings.limits.u_max;
+  std::vector<ControllerSettings> tried;
   for (int attempt = 0; attempt <= o.retunes; ++attempt) {
     Report(o, "verify", static_cast<double>(attempt) / (o.retunes + 1));
     if (o.stop != nullptr && o.stop->load()) {
@@ -522,6 +523,7 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     a.failures = Judge(a.result.metrics, o, range, ex.noise_peak_to_peak, sse_share);
     a.passed = a.failures.empty();
     r.attempts.push_back(std::move(a));
+    tried.push_back(settings);
     r.settings = settings;
     const bool overshoot_failed = std::any_of(
         r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
@@ -530,6 +532,23 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
         });
     if (r.attempts.back().passed || !overshoot_failed) break;
     soften(settings);
+  }
+  // None passed: the final design is the one with the fewest failures (then
+  // the smallest worst overshoot), moved last.
+  if (!r.attempts.back().passed) {
+    const auto worse = [&](std::size_t i, std::size_t j) {
+      const CommissionAttempt &a = r.attempts[i], &b = r.attempts[j];
+      if (a.failures.size() != b.failures.size()) return a.failures.size() > b.failures.size();
+      return a.result.metrics.overshoot_percent > b.result.metrics.overshoot_percent;
+    };
+    std::size_t best = r.attempts.size() - 1;
+    for (std::size_t i = 0; i + 1 < r.attempts.size(); ++i)
+      if (worse(best, i)) best = i;
+    if (best + 1 != r.attempts.size()) {
+      std::rotate(r.attempts.begin() + static_cast<std::ptrdiff_t>(best),
+                  r.attempts.begin() + static_cast<std::ptrdiff_t>(best) + 1, r.attempts.end());
+      r.settings = tried[best];
+    }
   }
   Report(o, "verify", 1.0);
   return true;
@@ -606,7 +625,10 @@ CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
         if (std::abs(y1 - y0) > 10 * noise) {
           pulse_u.push_back(u);
           pulse_v.push_back((y1 - y0) / t_on);
-          T = std::clamp(0.15 * span / std::abs(pulse_v.back()), 2 * Ts, 1.0);
+          // Toward a move of 15 % of the range, at most doubling or halving
+          // (the first pulses also spend time breaking away).
+          T = std::clamp(0.15 * span / std::abs(pulse_v.back()), 0.5 * T, 2.0 * T);
+          T = std::clamp(T, 2 * Ts, 1.0);
         } else {
           T = std::min(2 * T, 1.0);
         }

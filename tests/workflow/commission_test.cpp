@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -99,6 +100,30 @@ TEST(Commission, AnIntegratingPlantDoesNotSettle) {
   EXPECT_EQ(r.termination, Termination::kFailure);
   EXPECT_THAT(r.message, HasSubstr("did not settle"));
   EXPECT_LE(r.plant_time, 0.25 * 60.0 + 2.0);
+}
+
+// The IPA's position twin integrates its input: the pulses measure its
+// velocity gain (the rig's nominal 0.004 m/s per %, within the coasting
+// after each pulse), the PD follows the design rule Kc Ki = 3 / tau, Kc Ki Td
+// = 1 with tau = settling / 8, and the verification passes at 0.1 mm.
+TEST(Commission, APositioningDriveGetsAPdFromItsVelocityGain) {
+  auto plant = MakePlant("ipa-position", 1.0 / 300.0);
+  CommissionOptions o;
+  o.directory = TempDir("position");
+  o.overshoot = 2.0;
+  o.settling = 1.0;
+  const CommissionResult r = Commission(*plant, o);
+  ASSERT_EQ(r.termination, Termination::kSuccess) << r.message;
+  const double Ki = r.experiment.gain;
+  EXPECT_NEAR(Ki, 0.004, 0.0006);
+  EXPECT_LE(r.experiment.duration, 10.0);
+  EXPECT_EQ(r.settings.controller, "pid");
+  const double tau = 1.0 / 8.0;
+  EXPECT_NEAR(r.settings.pid_kc * Ki * tau, 3.0, 1e-9);
+  EXPECT_NEAR(r.settings.pid_td, tau / 3.0, 1e-12);
+  EXPECT_EQ(r.controller_model, fmt::format("tf:num={:.6g},den=1 0", Ki));
+  for (const StepMetrics& s : r.attempts.back().result.metrics.steps)
+    if (s.time > 0.0) EXPECT_LE(std::abs(s.steady_state_error), 1e-4) << s.time;
 }
 
 TEST(Commission, ARangeOutOfReachNamesTheReachableRange) {

@@ -42,7 +42,8 @@
 //                 noise, when that is larger) and
 //                 |steady-state error| at most 0.5 % of the range at every
 //                 level. On an overshoot failure the design is repeated with a
-//                 less aggressive setting (up to `retunes` times); what limits
+//                 less aggressive setting (up to `retunes` times; when none
+//                 passes, the one with the fewest failures is kept); what limits
 //                 the loop (saturation, dead time, model error, ripple) is
 //                 stated with what to try.
 //
@@ -54,7 +55,10 @@
 //   2. pulses     eight pulses at 20, 30, 45 and 60 % of the input range, two
 //                 each, each toward the middle of the range and followed by a
 //                 rest; the first lasts 0.05 s, the next are timed to move
-//                 about 15 % of the range. The velocity gain Ki is the least-
+//                 about 15 % of the range (at most twice or half the last
+//                 length: the first pulses also spend time breaking away;
+//                 a pulse ends early when the output leaves the range by
+//                 5 %). The velocity gain Ki is the least-
 //                 squares slope of v = Ki u + c sign(u) over the pulses (v =
 //                 displacement / pulse time); the model is Ki / s.
 //   3. design     a PD on y with the velocity feed-forward 1/Ki + Kc Td
@@ -194,10 +198,12 @@ struct CommissionResult {
   std::string chosen_reason;     ///< why that model (its fits, the better-ranked ones skipped)
   std::string controller_model;  ///< DIR/models.json\#METHOD
   ControllerSettings settings;   ///< the final design's settings (rule auto resolved)
-  std::vector<CommissionAttempt> attempts;  ///< every verification, the final last
-  std::vector<std::string> limits;          ///< what limits the final loop
-  std::vector<std::string> suggestions;     ///< what to try when it fails
-  double plant_time = 0.0;                  ///< s of plant time in all stages
+  /// Every verification, the final design last: the one that passed, or when
+  /// none did, the one with the fewest failures (then the smallest overshoot).
+  std::vector<CommissionAttempt> attempts;
+  std::vector<std::string> limits;       ///< what limits the final loop
+  std::vector<std::string> suggestions;  ///< what to try when it fails
+  double plant_time = 0.0;               ///< s of plant time in all stages
   /// True when the final verification met the specification.
   bool passed() const { return !attempts.empty() && attempts.back().passed; }
   /// {termination, message, experiment, models, chosen_model, controller,
