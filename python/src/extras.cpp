@@ -188,7 +188,9 @@ void BindExtras(py::module_& m) {
   m.def(
       "make_controller",
       [](const TransferFunction& model, double Ts, const std::string& type, const std::string& rule,
-         int M, int P, double lambda, double u_min, double u_max, bool constrained) {
+         int M, int P, double lambda, double u_min, double u_max, bool constrained, double Kc,
+         double Ti, double Td, double Kff, const std::string& disturbance,
+         const std::string& input_gaps) {
         ControllerSettings s;  // as `pneumid control` and `pneumid run` read them
         s.controller = type;
         s.rule = rule;
@@ -198,6 +200,12 @@ void BindExtras(py::module_& m) {
         s.limits.u_min = u_min;
         s.limits.u_max = u_max;
         s.constrained = constrained;
+        s.pid_kc = Kc;
+        s.pid_ti = Ti;
+        s.pid_td = Td;
+        s.pid_kff = Kff;
+        s.disturbance = disturbance;
+        s.input_gaps = input_gaps;
         BuiltController b = MakeController(model, Ts, ToControllerSpec(s));
         return std::move(b.controller);
       },
@@ -205,7 +213,15 @@ void BindExtras(py::module_& m) {
       "lambda_"_a = std::numeric_limits<double>::quiet_NaN(),
       "u_min"_a = -std::numeric_limits<double>::infinity(),
       "u_max"_a = std::numeric_limits<double>::infinity(), "constrained"_a = false,
-      "Controller of type 'dmc', 'gpc', 'pid' or 'mpc' designed from `model` at Ts.");
+      "Kc"_a = std::numeric_limits<double>::quiet_NaN(),
+      "Ti"_a = std::numeric_limits<double>::quiet_NaN(),
+      "Td"_a = std::numeric_limits<double>::quiet_NaN(),
+      "Kff"_a = std::numeric_limits<double>::quiet_NaN(), "disturbance"_a = "input",
+      "input_gaps"_a = "",
+      "Controller of type 'dmc', 'gpc', 'pid' or 'mpc' designed from `model` at Ts, with the "
+      "settings of `pneumid control`: PID gains Kc, Ti, Td and velocity feed-forward Kff (NaN: "
+      "the rule's; an integrating model needs Kc and gets Kff = 1/Ki + Kc Td), the MPC "
+      "disturbance model, and input gaps 'LO:HI[,LO:HI]' to modulate across.");
   m.def(
       "simulate_closed_loop",
       [](Controller& controller, Plant& plant, const std::string& setpoint, double duration,

@@ -122,3 +122,20 @@ def test_nan_measurement_holds_the_input_and_control_resumes(kind):
     assert np.max(np.abs(np.array(ys[215:]) - 60.0)) < 0.5
     with pytest.raises(ValueError):
         c.set_measurement_guard(y_min=10.0, y_max=0.0)
+
+
+def test_position_pd_with_velocity_feed_forward_on_the_position_twin():
+    # An integrating model (m/s per %) needs Kc; Kff defaults to 1/Ki + Kc Td.
+    model = pneumid.TransferFunction(np.array([0.004]), np.array([1.0, 0.0]))
+    Ts = 1.0 / 300.0
+    with pytest.raises(pneumid.InvalidArgument, match="give the gains"):
+        pneumid.make_controller(model, Ts, "pid")
+    c = pneumid.make_controller(model, Ts, "pid", Kc=6000.0, Td=0.04, u_min=-100.0, u_max=100.0,
+                                input_gaps="-100:-91,-9:0,0:9,91:100")
+    assert "Kff=490" in c.describe()
+    p = pneumid.make_plant("ipa-position", Ts)
+    r = pneumid.simulate_closed_loop(c, p, "step:from=0.05,to=0.07,at=0.1", 1.5, u_min=-100.0,
+                                     u_max=100.0)
+    steps = [s for s in r["metrics"]["steps"] if s["time"] > 0]
+    assert steps[0]["overshoot_percent"] <= 2.0
+    assert abs(steps[0]["steady_state_error"]) <= 1e-4
