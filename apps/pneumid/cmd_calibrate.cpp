@@ -12,12 +12,12 @@
 #include "command.hpp"
 #include "data_options.hpp"
 #include "output_options.hpp"
-#include "progress.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
 #include "pneumid/identify/fit_metrics.hpp"
 #include "pneumid/identify/ipa_calibration.hpp"
 #include "pneumid/report/plot.hpp"
+#include "progress.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -53,15 +53,18 @@ std::pair<std::string, std::pair<double, double>> ParseBound(const std::string& 
 }
 
 std::string FormatValue(double v, double sd, const std::string& unit) {
-  if (std::isfinite(sd))
-    return fmt::format("{:.6g} +- {:.2g} {}", v, sd, unit);
+  if (std::isfinite(sd)) return fmt::format("{:.6g} +- {:.2g} {}", v, sd, unit);
   return fmt::format("{:.6g} {} (std n/a)", v, unit);
 }
 
 void Run(const CalibrateArgs& a) {
   IpaCalibrationOptions options;
-  if (!a.plant_config.empty()) options.start = LoadIpaParameters(a.plant_config);
-  if (!a.mode.empty()) options.start.mode = IpaModeFromString(a.mode);
+  // --mode position starts from the position rig's defaults (a file's keys
+  // replace them), as `--plant ipa-position` does.
+  const IpaMode mode = a.mode.empty() ? IpaMode::kForce : IpaModeFromString(a.mode);
+  options.start =
+      a.plant_config.empty() ? DefaultIpaParameters(mode) : LoadIpaParameters(a.plant_config, mode);
+  if (!a.mode.empty()) options.start.mode = mode;
   if (!a.pwm_mode.empty()) options.start.pwm_mode = PwmModeFromString(a.pwm_mode);
   if (!a.free.empty())
     for (const auto& name : Split(a.free, ','))
@@ -104,9 +107,9 @@ void Run(const CalibrateArgs& a) {
     }
 
   if (s.termination != Termination::kFailure && !a.output.empty()) {
-    std::string comment = fmt::format(
-        "IPA parameters calibrated by `pneumid calibrate` ({}, {} iterations) from:", 
-        ToString(s.termination), s.iterations);
+    std::string comment =
+        fmt::format("IPA parameters calibrated by `pneumid calibrate` ({}, {} iterations) from:",
+                    ToString(s.termination), s.iterations);
     for (const auto& e : s.experiments)
       comment += fmt::format("\n  {} (fit {:.2f} %)", e.name, e.fit_percent);
     std::string free;
@@ -120,8 +123,7 @@ void Run(const CalibrateArgs& a) {
   if (!a.plot.empty() && !s.experiments.empty()) {
     // One panel per experiment, then the held-out ones: at most four panels.
     const std::size_t fitted = std::min<std::size_t>(s.experiments.size(), 3);
-    const std::size_t shown_held_out =
-        std::min<std::size_t>(validation_sim.size(), 4 - fitted);
+    const std::size_t shown_held_out = std::min<std::size_t>(validation_sim.size(), 4 - fitted);
     Figure fig(static_cast<int>(fitted + shown_held_out));
     fig.title = "IPA twin calibration: measured and simulated output";
     const std::string ylabel =
@@ -153,14 +155,10 @@ void Run(const CalibrateArgs& a) {
     nlohmann::ordered_json j;
     nlohmann::ordered_json params = nlohmann::ordered_json::object();
     for (const auto& e : s.estimates)
-      params[e.name] = {{"value", e.value},
-                        {"std", JsonNumber(e.std)},
-                        {"unit", e.unit},
-                        {"start", e.start},
-                        {"lower", e.lower},
-                        {"upper", e.upper},
-                        {"determined", e.determined},
-                        {"at_bound", e.at_bound}};
+      params[e.name] = {
+          {"value", e.value},           {"std", JsonNumber(e.std)}, {"unit", e.unit},
+          {"start", e.start},           {"lower", e.lower},         {"upper", e.upper},
+          {"determined", e.determined}, {"at_bound", e.at_bound}};
     j["parameters"] = params;
     nlohmann::ordered_json ex = nlohmann::ordered_json::array();
     for (const auto& e : s.experiments)
@@ -192,10 +190,11 @@ void Run(const CalibrateArgs& a) {
     if (!a.plot.empty()) j["plot"] = a.plot;
     std::cout << j.dump(2) << "\n";
   } else {
-    std::cout << fmt::format("IPA calibration ({} mode, {} PWM): {} after {} iterations, "
-                             "{} simulations, {:.2f} s\n",
-                             ToString(options.start.mode), ToString(options.start.pwm_mode),
-                             ToString(s.termination), s.iterations, s.simulations, s.seconds);
+    std::cout << fmt::format(
+        "IPA calibration ({} mode, {} PWM): {} after {} iterations, "
+        "{} simulations, {:.2f} s\n",
+        ToString(options.start.mode), ToString(options.start.pwm_mode), ToString(s.termination),
+        s.iterations, s.simulations, s.seconds);
     if (!s.message.empty()) std::cout << "  " << s.message << "\n";
     if (!s.experiments.empty()) std::cout << "experiments (NRMSE fit, start -> calibrated):\n";
     for (const auto& e : s.experiments)
@@ -243,7 +242,9 @@ static Registrar reg(
                      "Starting parameters and fixed values (TOML as config/ipa_default.toml); "
                      "default: the built-in twin")
           ->check(CLI::ExistingFile);
-      app.add_option("--mode", args->mode, "force or position (default: the config's)")
+      app.add_option("--mode", args->mode,
+                     "force or position (default: the config's; position starts from the position "
+                     "rig's defaults)")
           ->check(CLI::IsMember({"force", "position"}));
       app.add_option("--pwm", args->pwm_mode,
                      "PWM simulation: switching or averaged (default: the config's)")

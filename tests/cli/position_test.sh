@@ -99,6 +99,35 @@ rms = float(np.sqrt(np.mean((d["y"][keep] - d["r"][keep]) ** 2)))
 assert rms <= 1e-3, rms
 PYEND
 
+# Calibration of the position twin: the mass, Coulomb and static friction of
+# a heavier, stickier twin recovered from one experiment and checked on
+# another of other levels.
+cat > "$TMP/heavy.toml" <<'TOML'
+[simulation]
+mode = "position"
+[mechanics]
+coulomb_friction = 9.0
+static_friction = 13.5
+mass = 2.0
+TOML
+TS=0.0033333333333333335
+expect_ok "simulate heavy" simulate --plant "ipa-position:config=$TMP/heavy.toml" --Ts $TS \
+  --duration 4 --input "staircase:levels=0 25 0 -25 0 15 0 -35 0 20 0 -20,dwell=0.3" -o "$TMP/est.csv"
+expect_ok "simulate heavy (other levels)" simulate --plant "ipa-position:config=$TMP/heavy.toml" \
+  --Ts $TS --duration 3 --seed 7 -o "$TMP/val.csv" \
+  --input "staircase:levels=0 -30 0 40 0 -12 0 18 0 -22,dwell=0.3"
+expect_ok "calibrate position" calibrate "$TMP/est.csv" --validation "$TMP/val.csv" --mode position \
+  --free mass,coulomb_friction,static_friction --output-col y --json
+$PY - "$TMP/out" <<'PYEND' || fail "calibrate position: $(head -c 1500 "$TMP/out")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+p = {k: v["value"] for k, v in d["parameters"].items()}
+assert abs(p["mechanics.mass"] - 2.0) < 0.02, p
+assert abs(p["mechanics.coulomb_friction"] - 9.0) < 0.1, p
+assert abs(p["mechanics.static_friction"] - 13.5) < 0.3, p
+assert d["validation"][0]["fit_percent"] > 99.0, d["validation"]
+PYEND
+
 # Generated C of the same loop (with its sigma-delta layer).
 expect_ok "codegen" codegen --model "$MODEL" --plant ipa-position "${PD[@]}" -o "$TMP/c"
 grep -q "sigma-delta" "$TMP/out" || fail "codegen: no sigma-delta layer: $(cat "$TMP/out")"
