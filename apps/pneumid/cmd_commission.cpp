@@ -139,13 +139,6 @@ void Run(CommissionCli& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   CommissionOptions& o = c.options;
   if (!c.range.empty()) ParseRange(c.range, o.range_min, o.range_max);
-  const bool position = c.plant.rfind("ipa-position", 0) == 0;
-  if (position && c.spec.empty()) {
-    // Position loops: docs/position.md's targets.
-    o.overshoot = 2.0;
-    o.settling = 1.0;
-  }
-  if (!c.spec.empty()) ParseSpecification(c.spec, o);
   if (!c.methods.empty()) o.methods = ParseMethodList(c.methods);
   std::filesystem::create_directories(c.directory);
   o.directory = c.directory;
@@ -163,10 +156,13 @@ void Run(CommissionCli& c) {
     // A position loop samples once per PWM period: the valves' fastest action
     // (docs/position.md).
     const auto* ipa = dynamic_cast<IpaSimulator*>(plant.get());
-    if (ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition &&
-        c.ts_option->count() == 0) {
-      c.Ts = 1.0 / ipa->parameters().pwm_frequency;
-      plant = MakePlant(c.plant, c.Ts, po);
+    if (ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition) {
+      o.overshoot = 2.0;  // docs/position.md's targets, unless --spec says otherwise
+      o.settling = 1.0;
+      if (c.ts_option->count() == 0) {
+        c.Ts = 1.0 / ipa->parameters().pwm_frequency;
+        plant = MakePlant(c.plant, c.Ts, po);
+      }
     }
   } else {
     PNEUMID_CHECK(!c.fast || io.kind == IoKind::kUdp,
@@ -184,6 +180,7 @@ void Run(CommissionCli& c) {
     o.actuator = io_plant->actuator();
     plant = std::move(io_plant);
   }
+  if (!c.spec.empty()) ParseSpecification(c.spec, o);
   SetInputGaps(o, *plant, c.input_gaps);
   ProgressBar bar("commission", c.progress || StderrIsTerminal());
   o.progress = [&bar](const std::string& stage, double f) { bar(f, stage); };
@@ -250,7 +247,7 @@ const Registrar reg(
       app.add_option("--plant-config", c->plant_config,
                      "IPA parameter file (TOML, see config/ipa_default.toml)");
       c->ts_option = AddSampleTimeOption(
-          app, c->Ts, "Sample period in s (default 0.01; ipa-position: the PWM period)");
+          app, c->Ts, "Sample period in s (default 0.01; an IPA in position mode: the PWM period)");
       app.add_option("--range", c->range,
                      "Output range LO:HI the controller must serve (default: the reachable "
                      "range found by the sweep, less 5 % at each end)");
@@ -263,7 +260,7 @@ const Registrar reg(
           ->check(CLI::IsMember({"mpc", "dmc", "gpc", "pid"}));
       app.add_option("--spec", c->spec,
                      "Specification: overshoot=PERCENT,settling=SECONDS (default "
-                     "overshoot=5,settling=0.5; ipa-position: overshoot=2,settling=1)");
+                     "overshoot=5,settling=0.5; an IPA in position mode: overshoot=2,settling=1)");
       app.add_option("--aggressiveness", c->options.aggressiveness,
                      "First design's aggressiveness, 0 robust .. 1 aggressive")
           ->capture_default_str();

@@ -174,6 +174,12 @@ bool ApplyExplicitPidGains(const ControllerSpec& spec, PidGains& gains) {
   return any;
 }
 
+// The velocity feed-forward given in `spec` (not NaN), checked finite.
+double ExplicitKff(const ControllerSpec& spec) {
+  PNEUMID_CHECK(std::isfinite(spec.pid_kff), "Kff must be finite, got {}", spec.pid_kff);
+  return spec.pid_kff;
+}
+
 // The velocity gain Ki = lim_{s->0} s G(s) of a model with one pole at s = 0
 // (z = 1), in output units per second per input unit; NaN for other models.
 // Continuous G = B(s)/(s A'(s)): Ki = B(0)/A'(0). Discrete, in q = z^-1:
@@ -293,10 +299,7 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
     o.gains = a.pid;
     o.setpoint_weight = a.setpoint_weight;
     o.derivative_filter = a.derivative_filter;
-    if (!std::isnan(spec.pid_kff)) {
-      PNEUMID_CHECK(std::isfinite(spec.pid_kff), "Kff must be finite, got {}", spec.pid_kff);
-      o.velocity_feedforward = b.pid_kff = spec.pid_kff;
-    }
+    if (!std::isnan(spec.pid_kff)) o.velocity_feedforward = b.pid_kff = ExplicitKff(spec);
     o.limits = spec.limits;
     b.controller = std::make_unique<PidController>(Ts, o);
     return b;
@@ -322,8 +325,7 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
     }
     b.pid_explicit = ApplyExplicitPidGains(spec, b.pid_gains);
     if (!std::isnan(spec.pid_kff)) {
-      PNEUMID_CHECK(std::isfinite(spec.pid_kff), "Kff must be finite, got {}", spec.pid_kff);
-      b.pid_kff = spec.pid_kff;
+      b.pid_kff = ExplicitKff(spec);
     } else if (const double ki = VelocityGain(model); std::isfinite(ki) && ki != 0.0) {
       b.pid_kff = 1.0 / ki + b.pid_gains.Kc * b.pid_gains.Td;
     }

@@ -115,6 +115,14 @@ class Recorder {
   std::vector<double> u_, y_;
 };
 
+// The record so far as the result's data, with its plant time.
+void FinishData(const Recorder& rec, const Actuator& act, CommissionResult& r) {
+  CommissionExperiment& ex = r.experiment;
+  ex.data = rec.size() > 0 ? rec.Slice(0, rec.size(), act.input, act.output) : Dataset();
+  ex.duration = rec.time();
+  r.plant_time = ex.duration;
+}
+
 // The result of an experiment that ended early (its data already kept).
 CommissionResult EndedEarly(CommissionResult r, const ExperimentEnded& e) {
   r.termination = e.termination;
@@ -590,11 +598,6 @@ CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
   Recorder rec(plant, o, 0.0, u_lo, u_hi, gaps);
   const double Ts = rec.Ts();
   const double span = ex.range_max - ex.range_min, mid = 0.5 * (ex.range_min + ex.range_max);
-  auto finish_data = [&] {
-    ex.data = rec.size() > 0 ? rec.Slice(0, rec.size(), act.input, act.output) : Dataset();
-    ex.duration = rec.time();
-    r.plant_time = ex.duration;
-  };
   // Stage 1: rest (input 0 holds) for the noise; stage 2: pulses toward the
   // middle of the range at four levels, each followed by a rest, the pulse
   // length adapted so that each moves about 15 % of the range.
@@ -638,10 +641,10 @@ CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
     }
     rec.Safe();
   } catch (const ExperimentEnded& e) {
-    finish_data();
+    FinishData(rec, act, r);
     return EndedEarly(std::move(r), e);
   }
-  finish_data();
+  FinishData(rec, act, r);
   ex.estimation = ex.data;
   // v = Ki u + c sign(u): least squares in Ki and c.
   if (pulse_u.size() < 3) {
@@ -667,10 +670,7 @@ CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
         Ki);
     return r;
   }
-  ex.gain = Ki;
-  ex.dead_time = kNaN;
-  ex.time_constant = kNaN;
-  ex.dwell = 0.0;
+  ex.gain = Ki;  // no time constant, dead time or dwell: they stay NaN and 0
   r.chosen_model = "integrator";
   r.controller_model = fmt::format("tf:num={:.6g},den=1 0", Ki);
   r.chosen_reason = fmt::format(
@@ -839,11 +839,6 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   const std::vector<InputGap> gaps = o.modulate ? act.input_gaps : std::vector<InputGap>{};
   Recorder rec(plant, o, u_lo, u_lo, u_hi, gaps);
   const double Ts = rec.Ts();
-  auto finish_data = [&] {
-    ex.data = rec.size() > 0 ? rec.Slice(0, rec.size(), act.input, act.output) : Dataset();
-    ex.duration = rec.time();
-    r.plant_time = ex.duration;
-  };
 
   // Stages 1-3: the experiment.
   ExcitationSamples x;
@@ -853,16 +848,16 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     if (error.empty()) error = PlanExcitation(o, rec, u_lo, u_hi, ex);
     if (!error.empty()) {
       rec.Hold(u_lo, Ts);
-      finish_data();
+      FinishData(rec, act, r);
       r.message = error;
       return r;
     }
     x = RunExcitation(rec, o, p, u_lo, u_hi, ex);
   } catch (const ExperimentEnded& e) {
-    finish_data();
+    FinishData(rec, act, r);
     return EndedEarly(std::move(r), e);
   }
-  finish_data();
+  FinishData(rec, act, r);
   ex.estimation = rec.Slice(x.est_from, x.est_to, act.input, act.output);
   ex.validation = rec.Slice(x.est_to, x.val_to, act.input, act.output);
 
