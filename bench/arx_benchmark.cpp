@@ -15,9 +15,9 @@
 #include <fmt/format.h>
 
 #include "pneumid/data/load.hpp"
-#include "pneumid/identify/arx.hpp"
-#include "pneumid/identify/arx_streaming.hpp"
-#include "pneumid/identify/subspace.hpp"
+#include "pneumid/identify/parametric/arx.hpp"
+#include "pneumid/identify/parametric/arx_streaming.hpp"
+#include "pneumid/identify/parametric/subspace.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Speed of the IPA calibration (include/pneumid/identify/ipa_calibration.hpp):
+// Speed of the IPA calibration (include/pneumid/identify/nonlinear/ipa_calibration.hpp):
 // six free parameters (the force-mode valve and cylinder defaults, without the
 // sensor filter the default twin adds to them) from one 3 s step test at
 // Ts = 0.01 s, started from the default twin, the data made by a twin with
@@ -7,7 +7,7 @@
 //   build/bench/calibration_benchmark
 #include <benchmark/benchmark.h>
 
-#include "pneumid/identify/ipa_calibration.hpp"
+#include "pneumid/identify/nonlinear/ipa_calibration.hpp"
 #include "pneumid/plant/experiment.hpp"
 #include "pneumid/plant/signal.hpp"
 

@@ -9,9 +9,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "pneumid/identify/hammerstein.hpp"
-#include "pneumid/identify/narx.hpp"
-#include "pneumid/identify/static_map_fit.hpp"
+#include "pneumid/identify/nonlinear/hammerstein.hpp"
+#include "pneumid/identify/nonlinear/narx.hpp"
+#include "pneumid/identify/nonlinear/static_map_fit.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/signal.hpp"
 

@@ -7,9 +7,9 @@
 #include <benchmark/benchmark.h>
 
 #include "pneumid/data/load.hpp"
-#include "pneumid/identify/process_model.hpp"
-#include "pneumid/identify/reaction_curve.hpp"
-#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/identify/parametric/process_model.hpp"
+#include "pneumid/identify/step/reaction_curve.hpp"
+#include "pneumid/identify/step/step_methods.hpp"
 
 namespace {
 

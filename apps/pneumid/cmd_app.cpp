@@ -33,7 +33,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct AppCli {
+struct AppArgs {
   int port = 8050;
   std::string host = "127.0.0.1";
   std::string root = ".";
@@ -75,7 +75,7 @@ void OpenBrowser(const std::string& url) {
     std::cerr << "pneumid app: xdg-open is not available; open the address by hand\n";
 }
 
-void Serve(const AppCli& c) {
+void Serve(const AppArgs& c) {
   PNEUMID_CHECK(c.port >= 0 && c.port <= 65535, "--port must be 0 .. 65535, got {}", c.port);
   PNEUMID_CHECK(c.token.find_first_of(" \t\r\n&;=%#?") == std::string::npos,
                 "--token must not contain spaces or any of &;=%#?");
@@ -170,7 +170,7 @@ void Serve(const AppCli& c) {
 
 const Registrar reg(
     "app", "Serve the browser app and its HTTP JSON API (docs/app.md)", [](CLI::App& app) {
-      auto c = std::make_shared<AppCli>();
+      auto c = std::make_shared<AppArgs>();
       app.add_option("--port", c->port, "TCP port (0: a free one)")->capture_default_str();
       app.add_option("--host", c->host,
                      "Address to listen on (other than 127.0.0.1 exposes the "

@@ -13,7 +13,7 @@
 #include "identified_spec.hpp"
 #include "output_options.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/model_uncertainty.hpp"
+#include "pneumid/identify/evaluation/model_uncertainty.hpp"
 #include "pneumid/lti/frequency.hpp"
 #include "pneumid/report/figures.hpp"
 #include "validators.hpp"
@@ -21,7 +21,7 @@
 namespace pneumid::cli {
 namespace {
 
-struct BodeOptions {
+struct BodeArgs {
   ModelOptions model;
   double w_min = 0.0;
   double w_max = 0.0;
@@ -31,7 +31,7 @@ struct BodeOptions {
   std::string plot;
 };
 
-void Run(const BodeOptions& o) {
+void Run(const BodeArgs& o) {
   const TransferFunction g = ResolveModel(o.model);
   Eigen::VectorXd omega;
   const bool has_range = o.w_min > 0.0 || o.w_max > 0.0;
@@ -108,7 +108,7 @@ void Run(const BodeOptions& o) {
 const Registrar reg("bode",
                     "Frequency response (magnitude, unwrapped phase) and margins of a model",
                     [](CLI::App& app) {
-                      auto o = std::make_shared<BodeOptions>();
+                      auto o = std::make_shared<BodeArgs>();
                       AddModelOptions(app, o->model);
                       app.add_option("--w-min", o->w_min,
                                      "Lowest frequency in rad/s (default: from the poles/zeros)")

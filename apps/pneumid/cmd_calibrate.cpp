@@ -14,8 +14,8 @@
 #include "output_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
-#include "pneumid/identify/ipa_calibration.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/nonlinear/ipa_calibration.hpp"
 #include "pneumid/report/plot.hpp"
 #include "progress.hpp"
 

@@ -30,7 +30,7 @@
 namespace pneumid::cli {
 namespace {
 
-struct CodegenCli {
+struct CodegenArgs {
   ControllerSettings controller;
   std::string model;
   std::string config;
@@ -49,7 +49,7 @@ struct CodegenCli {
   bool json = false;
 };
 
-void Execute(const CodegenCli& c) {
+void Execute(const CodegenArgs& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   CodegenOptions options;
   options.precision = CodegenPrecisionFromString(c.precision);
@@ -136,7 +136,7 @@ const Registrar reg(
     "codegen",
     "Write a designed controller (dmc, gpc, pid, mpc) as embedded C99 code for a microcontroller",
     [](CLI::App& app) {
-      auto c = std::make_shared<CodegenCli>();
+      auto c = std::make_shared<CodegenArgs>();
       app.add_option("--model", c->model,
                      "Controller's model: fopdt-paper, arx-paper, fopdt:K=..,tau=..,theta=.., "
                      "tf:..., FILE.json (required unless --config has [controller] model)");

@@ -40,7 +40,7 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void OnStopSignal(int) { g_stop.store(true); }
 
-struct CommissionCli {
+struct CommissionArgs {
   std::string io = "sim";
   std::string config;
   bool fast = false;
@@ -135,7 +135,7 @@ void PrintSummary(const CommissionResult& r, const std::string& dir) {
   std::cout << fmt::format("plant time {:.1f} s; files in {}\n", r.plant_time, dir);
 }
 
-void Run(CommissionCli& c) {
+void Run(CommissionArgs& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   CommissionOptions& o = c.options;
   if (!c.range.empty()) ParseRange(c.range, o.range_min, o.range_max);
@@ -225,7 +225,7 @@ const Registrar reg(
     "commission",
     "From a plant to a verified controller: experiment, identification, design, verification",
     [](CLI::App& app) {
-      auto c = std::make_shared<CommissionCli>();
+      auto c = std::make_shared<CommissionArgs>();
       app.add_option("--plant", c->plant,
                      "Plant of the simulator (--io sim): ipa, ipa:config=FILE.toml or a model "
                      "spec")

@@ -38,17 +38,6 @@ namespace {
 
 using Run = ControlRun;
 
-nlohmann::ordered_json RunJson(const Run& run) {
-  nlohmann::ordered_json j;
-  j["label"] = run.built.Label();
-  j["controller"] = run.result.controller;
-  j["plant"] = run.result.plant;
-  j["settings"] = run.built.SettingsToJson();
-  const nlohmann::ordered_json metrics = run.result.metrics.ToJson();  // outlives the loop
-  for (const auto& [key, value] : metrics.items()) j[key] = value;
-  return j;
-}
-
 std::string Fmt(double v, const char* unit = "") {
   if (!std::isfinite(v)) return "-";
   return fmt::format("{:.4g}{}", v, unit);
@@ -142,10 +131,9 @@ std::string ControllerLabel(const BuiltController& b) {
 // Output and input (units of the plant: force N or position m and duty % for
 // the IPA, none for a linear model), the set-point, one legend entry per
 // controller, and a title naming controller, plant, model and sample time.
-void WritePlot(const std::string& path, const std::vector<Run>& runs, const ControlCli& c,
-               const std::string& plant_spec) {
-  const auto plant = MakePlant(plant_spec, c.Ts, PlantOptions{});
-  const Channel in = PlantInputChannel(*plant), out = PlantOutputChannel(*plant);
+void WritePlot(const std::string& path, const std::vector<Run>& runs, const ControlArgs& c,
+               const std::string& plant_spec, const Actuator& actuator) {
+  const Channel in = actuator.input, out = actuator.output;
   ClosedLoopFigureOptions options;
   options.labels.time = "Time t [s]";
   options.labels.output = out.unit == "N"   ? "Force F [N]"
@@ -163,73 +151,42 @@ void WritePlot(const std::string& path, const std::vector<Run>& runs, const Cont
 
 }  // namespace
 
-std::vector<ControlRun> SimulateControl(const ControlCli& c) {
-  PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
-  PNEUMID_CHECK(c.duration > 0.0, "--duration must be positive, got {}", c.duration);
-  const TransferFunction model = ParseControllerModel(c.model);
-  auto setpoint = ParseSignal(c.setpoint);
-  ClosedLoopOptions cl;
-  cl.duration = c.duration;
-  cl.stop = c.stop;
-  cl.noise_std = c.noise;
-  cl.seed = c.seed;
-  for (const std::string& l : c.load_steps)
-    cl.load_steps.push_back(ParseLoadStep("--load-step", l));
-  PlantOptions po;
-  po.seed = c.seed;
-  const std::string plant_spec = c.plant.empty() ? c.model : c.plant;
-  // The plant's physical input range (IPA: duty 0..100 %) unless --u-min/--u-max say otherwise.
-  ControllerSettings settings = c.controller;
-  {
-    const auto plant = MakePlant(plant_spec, c.Ts, po);
-    ApplyPlantInputRange(*plant, settings.limits.u_min, settings.limits.u_max);
-    ApplyPlantInputGaps(*plant, settings.input_gaps);
-  }
-  cl.actuator.u_min = settings.limits.u_min;
-  cl.actuator.u_max = settings.limits.u_max;
-  const ControllerSpec base = WithModelInputMap(ToControllerSpec(settings), c.model);
-
+ControlScenarioOptions ToScenarioOptions(const ControlArgs& c) {
+  ControlScenarioOptions o;
+  o.model = c.model;
+  o.controller = c.controller;
+  o.plant = c.plant;
+  o.Ts = c.Ts;
+  o.setpoint = c.setpoint;
+  o.duration = c.duration;
+  o.noise = c.noise;
+  o.seed = c.seed;
+  o.stop = c.stop;
+  for (const std::string& l : c.load_steps) o.load_steps.push_back(ParseLoadStep("--load-step", l));
   // --compare: the same controller with each rule's own settings.
-  std::vector<ControllerSpec> specs;
   if (c.compare_given) {
-    std::string list = c.compare.empty() ? "shridhar-cooper,paper-modified" : c.compare;
-    std::stringstream in(list);
+    std::stringstream in(c.compare.empty() ? "shridhar-cooper,paper-modified" : c.compare);
     std::string item;
-    while (std::getline(in, item, ',')) {
-      ControllerSpec s = base;
-      s.tuning = TuningOptions{};
-      s.tuning.rule = TuningRuleFromString(item);
-      specs.push_back(s);
-    }
-    PNEUMID_CHECK(!specs.empty(), "--compare: no settings given");
-  } else {
-    specs.push_back(base);
+    while (std::getline(in, item, ',')) o.compare_rules.push_back(item);
+    PNEUMID_CHECK(!o.compare_rules.empty(), "--compare: no settings given");
   }
+  return o;
+}
 
-  std::vector<Run> runs;
-  for (const ControllerSpec& spec : specs) {
-    Run run;
-    run.built = MakeController(model, c.Ts, spec);
-    auto plant = MakePlant(plant_spec, c.Ts, po);
-    run.result = SimulateClosedLoop(*run.built.controller, *plant, *setpoint, cl);
-    runs.push_back(std::move(run));
-  }
-  if (!c.output.empty()) WriteCsv(c.output, runs);
-  if (!c.plot.empty()) WritePlot(c.plot, runs, c, plant_spec);
-  return runs;
+std::vector<ControlRun> SimulateControl(const ControlArgs& c) {
+  ControlScenarioResult scenario = RunControlScenario(ToScenarioOptions(c));
+  if (!c.output.empty()) WriteCsv(c.output, scenario.runs);
+  if (!c.plot.empty()) WritePlot(c.plot, scenario.runs, c, scenario.plant_spec, scenario.actuator);
+  return std::move(scenario.runs);
 }
 
 nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs) {
-  if (runs.size() == 1) return RunJson(runs[0]);
-  nlohmann::ordered_json j;
-  j["compare"] = nlohmann::json::array();
-  for (const Run& r : runs) j["compare"].push_back(RunJson(r));
-  return j;
+  return ControlScenarioJson(runs);
 }
 
 namespace {
 
-void Execute(const ControlCli& c) {
+void Execute(const ControlArgs& c) {
   const std::vector<Run> runs = SimulateControl(c);
   if (c.json) {
     std::cout << ControlJson(runs).dump(2) << "\n";
@@ -245,7 +202,7 @@ void Execute(const ControlCli& c) {
 const Registrar reg(
     "control", "Closed-loop simulation of DMC, GPC, PID or MPC against a plant, with metrics",
     [](CLI::App& app) {
-      auto c = std::make_shared<ControlCli>();
+      auto c = std::make_shared<ControlArgs>();
       app.add_option("--model", c->model,
                      "Controller's model: fopdt-paper, arx-paper, fopdt:K=..,tau=..,theta=.., "
                      "tf:..., FILE.json (required unless --config has [controller] model)");

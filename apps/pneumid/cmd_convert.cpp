@@ -23,7 +23,7 @@
 namespace pneumid::cli {
 namespace {
 
-struct ConvertOptions {
+struct ConvertArgs {
   ModelOptions model;
   std::string to;
   std::string method = "zoh";
@@ -32,7 +32,7 @@ struct ConvertOptions {
   bool json = false;
 };
 
-void Run(ConvertOptions o) {
+void Run(ConvertArgs o) {
   PNEUMID_CHECK(o.to == "continuous" || o.to == "discrete",
                 "--to must be 'continuous' or 'discrete', got '{}'", o.to);
   PNEUMID_CHECK(std::isfinite(o.Ts) && o.Ts >= 0.0, "--Ts must be >= 0 s, got {}", o.Ts);
@@ -81,7 +81,7 @@ void Run(ConvertOptions o) {
 
 const Registrar reg(
     "convert", "Convert a linear model between continuous and discrete time", [](CLI::App& app) {
-      auto o = std::make_shared<ConvertOptions>();
+      auto o = std::make_shared<ConvertArgs>();
       AddModelOptions(app, o->model, /*with_ts=*/false);
       app.add_option("--to", o->to, "Target domain: continuous or discrete")
           ->required()

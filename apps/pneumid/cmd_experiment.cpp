@@ -25,7 +25,7 @@
 namespace pneumid::cli {
 namespace {
 
-struct ExperimentOptions {
+struct ExperimentArgs {
   std::string kind;
   std::string input;  // --input SPEC overrides the kind's parameters
   // step
@@ -41,7 +41,7 @@ struct ExperimentOptions {
   std::string output;
 };
 
-std::string InputSpec(const ExperimentOptions& o) {
+std::string InputSpec(const ExperimentArgs& o) {
   if (!o.input.empty()) return o.input;
   if (o.kind == "step") return fmt::format("step:from={:g},to={:g},at={:g}", o.from, o.to, o.at);
   if (o.kind == "prbs")
@@ -53,7 +53,7 @@ std::string InputSpec(const ExperimentOptions& o) {
       "experiment kind must be step, prbs or staircase (or give --input), got '{}'", o.kind));
 }
 
-void Run(const ExperimentOptions& o, CLI::App& app) {
+void Run(const ExperimentArgs& o, CLI::App& app) {
   const RealtimeConfig config = ResolveRealtimeConfig(o.rt, app);
   PNEUMID_CHECK(!o.output.empty(), "-o/--output is required");
   const IoSpec spec = ParseIoSpec(config.io);
@@ -123,7 +123,7 @@ static Registrar reg(
     "Run an open-loop identification experiment (step, prbs, staircase) in real time on the "
     "simulator, a comedi card or a plant server, and write t,u,y for `pneumid identify`",
     [](CLI::App& app) {
-      auto o = std::make_shared<ExperimentOptions>();
+      auto o = std::make_shared<ExperimentArgs>();
       app.add_option("kind", o->kind, "step, prbs or staircase (optional with --input)")
           ->check(CLI::IsMember({"step", "prbs", "staircase"}));
       app.add_option("--input", o->input,

@@ -20,7 +20,7 @@
 namespace pneumid::cli {
 namespace {
 
-struct ImpulseOptions {
+struct ImpulseArgs {
   ModelOptions model;
   double t_final = 0.0;
   double dt = 0.0;
@@ -59,7 +59,7 @@ ImpulseInfo ComputeImpulseInfo(const TimeResponse& r, bool discrete, double thre
   return info;
 }
 
-void Run(const ImpulseOptions& o) {
+void Run(const ImpulseArgs& o) {
   const TransferFunction g = ResolveModel(o.model);
   const TimeResponse r = Impulse(g, o.t_final, o.dt);
   const ImpulseInfo info = ComputeImpulseInfo(r, g.IsDiscrete(), o.settling_threshold);
@@ -102,7 +102,7 @@ void Run(const ImpulseOptions& o) {
 const Registrar reg(
     "impulse", "Impulse response of a model (peak, settling time, area; --plot, --json)",
     [](CLI::App& app) {
-      auto o = std::make_shared<ImpulseOptions>();
+      auto o = std::make_shared<ImpulseArgs>();
       AddModelOptions(app, o->model);
       AddTimeGridOptions(app, o->t_final, o->dt);
       app.add_option("--settling-threshold", o->settling_threshold,

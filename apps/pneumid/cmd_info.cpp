@@ -18,7 +18,7 @@
 namespace pneumid::cli {
 namespace {
 
-struct InfoOptions {
+struct InfoArgs {
   DataOptions data;
   bool json = false;
   bool strict = false;
@@ -45,7 +45,7 @@ std::string Label(const Channel& c) {
   return c.unit.empty() ? c.name : fmt::format("{} [{}]", c.name, c.unit);
 }
 
-void Run(const InfoOptions& o) {
+void Run(const InfoArgs& o) {
   PNEUMID_CHECK(o.tolerance >= 0, "--tolerance must be >= 0, got {}", o.tolerance);
   PNEUMID_CHECK(o.decimate >= 1, "--decimate must be >= 1, got {}", o.decimate);
   std::optional<TimeWindow> window;
@@ -256,7 +256,7 @@ void Run(const InfoOptions& o) {
 static Registrar reg(
     "info", "Validate a data file and print its summary (samples, sample time, ranges, step)",
     [](CLI::App& app) {
-      auto o = std::make_shared<InfoOptions>();
+      auto o = std::make_shared<InfoArgs>();
       AddDataOptions(app, o->data);
       app.add_flag("--json", o->json, "Print the summary as JSON");
       app.add_option("--tolerance", o->tolerance,

@@ -9,8 +9,8 @@
 #include "validators.hpp"
 #include "data_options.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/order_selection.hpp"
-#include "pneumid/identify/validation.hpp"
+#include "pneumid/identify/parametric/order_selection.hpp"
+#include "pneumid/identify/evaluation/validation.hpp"
 
 namespace pneumid::cli {
 namespace {

@@ -115,7 +115,7 @@ void Run(const ReportArgs& a) {
     for (const auto& [m, e] : s.failures) std::cout << fmt::format("{:<16} failed: {}\n", m, e);
     std::cout << s.BriefReport() << "\n";
   }
-  if (s.termination == ReportTermination::kFailure) {
+  if (s.termination == Termination::kFailure) {
     std::cerr << "pneumid report: error: " << s.message << " (see " << s.html_path << ")\n";
     throw cli::ExitCode{1};
   }

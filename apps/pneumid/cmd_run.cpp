@@ -33,7 +33,7 @@ namespace pneumid::cli {
 namespace {
 
 // The control area's settings and factory (controller_factory.hpp).
-BuiltController BuildController(const RunOptions& o, const TransferFunction& model, double Ts,
+BuiltController BuildController(const RunArgs& o, const TransferFunction& model, double Ts,
                                 const InputLimits& limits, const IoBackend& io) {
   ControllerSettings c = o.controller;
   c.limits = limits;  // the safety layer's clamp
@@ -43,7 +43,7 @@ BuiltController BuildController(const RunOptions& o, const TransferFunction& mod
 
 }  // namespace
 
-void ApplySafetyFlags(const RunOptions& o, RealtimeConfig& config) {
+void ApplySafetyFlags(const RunArgs& o, RealtimeConfig& config) {
   auto& s = config.safety;
   if (o.u_min) s.u_min = *o.u_min;
   if (o.u_max) s.u_max = *o.u_max;
@@ -55,7 +55,7 @@ void ApplySafetyFlags(const RunOptions& o, RealtimeConfig& config) {
   PNEUMID_CHECK(s.IsValid(&error), "invalid safety settings: {}", error);
 }
 
-RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
+RunOutcome RunRealtime(const RunArgs& o, const RealtimeConfig& config,
                        SpscRingBuffer<LogRecord>* live) {
   const auto& s = config.safety;
 
@@ -120,7 +120,7 @@ RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
       y[i] = res.records[i].y;
       u[i] = res.records[i].u;
     }
-    if (sum.termination == LoopTermination::kSuccess)
+    if (sum.termination == Termination::kSuccess)
       metrics = ComputeClosedLoopMetrics(t, rr, y, u, (*sp)(-Ts), 0.0, clo).ToJson();
   }
   nlohmann::json offline = nullptr;
@@ -152,9 +152,9 @@ RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
 
 namespace {
 
-void Run(const RunOptions& options, CLI::App& app) {
+void Run(const RunArgs& options, CLI::App& app) {
   RealtimeConfig config = ResolveRealtimeConfig(options.rt, app);
-  RunOptions o = options;
+  RunArgs o = options;
   if (config.controller) ApplyControllerConfig(app, *config.controller, o.model, o.controller);
   ApplySafetyFlags(o, config);
   const RunOutcome out = RunRealtime(o, config);
@@ -190,7 +190,7 @@ static Registrar reg(
     "Run a DMC, GPC, PID or MPC loop in real time on the simulator, a plant server (udp) or a "
     "comedi card, with safety limits, a log and timing statistics",
     [](CLI::App& app) {
-      auto o = std::make_shared<RunOptions>();
+      auto o = std::make_shared<RunArgs>();
       AddControllerOptions(app, o->controller);
       AddPidGainOptions(app, o->controller);
       app.add_option("--model", o->model,

@@ -23,7 +23,7 @@
 namespace pneumid::cli {
 namespace {
 
-struct SimulateOptions {
+struct SimulateArgs {
   std::string plant = "ipa";
   std::string input = "step:from=0.61,to=82,at=1.0";
   double duration = 4.0;
@@ -37,7 +37,7 @@ struct SimulateOptions {
   bool progress = false;
 };
 
-void Run(const SimulateOptions& o) {
+void Run(const SimulateArgs& o) {
   PNEUMID_CHECK(o.Ts > 0.0 && std::isfinite(o.Ts), "--Ts must be positive, got {}", o.Ts);
   PNEUMID_CHECK(std::isfinite(o.duration) && o.duration >= o.Ts,
                 "--duration must be at least one sample period (--Ts {}), got {}", o.Ts,
@@ -119,7 +119,7 @@ void Run(const SimulateOptions& o) {
 static Registrar reg(
     "simulate", "Run an open-loop experiment on a simulated plant (IPA physics or a linear model)",
     [](CLI::App& app) {
-      auto o = std::make_shared<SimulateOptions>();
+      auto o = std::make_shared<SimulateArgs>();
       app.add_option("--plant", o->plant,
                      "Plant: ipa, ipa-position, ipa:config=FILE.toml, arx-paper, MODEL.json, "
                      "fopdt:K=..,tau=..,theta=.. (see below)")

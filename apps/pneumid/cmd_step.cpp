@@ -16,14 +16,14 @@
 #include "identified_spec.hpp"
 #include "output_options.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/model_uncertainty.hpp"
+#include "pneumid/identify/evaluation/model_uncertainty.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/report/figures.hpp"
 
 namespace pneumid::cli {
 namespace {
 
-struct StepOptions {
+struct StepArgs {
   ModelOptions model;
   double t_final = 0.0;
   double dt = 0.0;
@@ -36,7 +36,7 @@ struct StepOptions {
 
 // "Step response of MODEL" on a generic output axis.
 // With `identified`, a band of o.confidence standard deviations around it.
-void WritePlot(const StepOptions& o, const TransferFunction& g,
+void WritePlot(const StepArgs& o, const TransferFunction& g,
                const std::optional<IdentifiedModel>& identified) {
   StepFigureOptions fo;
   fo.t_final = o.t_final;
@@ -74,7 +74,7 @@ std::string UnstablePole(const TransferFunction& g) {
          hint;
 }
 
-void Run(const StepOptions& o) {
+void Run(const StepArgs& o) {
   const TransferFunction g = ResolveModel(o.model);
   const std::optional<IdentifiedModel> identified = ModelForConfidence(o.model.model, o.confidence);
   PNEUMID_CHECK(o.rise_limits.size() == 2, "--rise-limits takes two fractions LOW,HIGH, got {}",
@@ -166,7 +166,7 @@ void Run(const StepOptions& o) {
 const Registrar reg(
     "step", "Step-response metrics of a model (rise/settling time, overshoot, peak)",
     [](CLI::App& app) {
-      auto o = std::make_shared<StepOptions>();
+      auto o = std::make_shared<StepArgs>();
       AddModelOptions(app, o->model);
       AddTimeGridOptions(app, o->t_final, o->dt);
       app.add_option("--settling-threshold", o->settling_threshold,

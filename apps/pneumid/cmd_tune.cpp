@@ -32,7 +32,7 @@
 namespace pneumid::cli {
 namespace {
 
-AutoTuneResult Auto(const TuneCli& c, const TransferFunction& model) {
+AutoTuneResult Auto(const TuneArgs& c, const TransferFunction& model) {
   PNEUMID_CHECK(c.P == 0 && std::isnan(c.lambda),
                 "--rule auto chooses P and lambda itself; drop --P/--lambda");
   AutoTuneOptions o;
@@ -51,7 +51,7 @@ AutoTuneResult Auto(const TuneCli& c, const TransferFunction& model) {
   return AutoTune(model, c.Ts, o);
 }
 
-void RunAuto(const TuneCli& c, const TransferFunction& model) {
+void RunAuto(const TuneArgs& c, const TransferFunction& model) {
   const AutoTuneResult r = Auto(c, model);
   if (c.json) {
     std::cout << r.ToJson().dump(2) << "\n";
@@ -61,7 +61,7 @@ void RunAuto(const TuneCli& c, const TransferFunction& model) {
 }
 
 // The settings of a rule other than auto.
-TuningResult Conventional(const TuneCli& c, const TransferFunction& model) {
+TuningResult Conventional(const TuneArgs& c, const TransferFunction& model) {
   PNEUMID_CHECK(c.controller.empty() && std::isnan(c.response_time) && c.measure.empty() &&
                     std::isnan(c.overshoot) && std::isnan(c.aggressiveness) &&
                     std::isinf(c.u_min) && std::isinf(c.u_max) && std::isinf(c.du_max) &&
@@ -77,7 +77,7 @@ TuningResult Conventional(const TuneCli& c, const TransferFunction& model) {
   return Tune(model, c.Ts, o);
 }
 
-void Run(const TuneCli& c) {
+void Run(const TuneArgs& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   const TransferFunction model = ParseModelSpec(c.model);
   if (c.rule == "auto") {
@@ -104,7 +104,7 @@ void Run(const TuneCli& c) {
 
 }  // namespace
 
-nlohmann::ordered_json TuneJson(const TuneCli& c) {
+nlohmann::ordered_json TuneJson(const TuneArgs& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   const TransferFunction model = ParseModelSpec(c.model);
   if (c.rule == "auto") return Auto(c, model).ToJson();
@@ -116,7 +116,7 @@ namespace {
 const Registrar reg(
     "tune", "Horizons and move suppression (P, M, lambda) of DMC/GPC from a model",
     [](CLI::App& app) {
-      auto c = std::make_shared<TuneCli>();
+      auto c = std::make_shared<TuneArgs>();
       app.add_option("--model", c->model,
                      "Model spec: fopdt:K=..,tau=..,theta=.., arx-paper, tf:..., FILE.json")
           ->required();

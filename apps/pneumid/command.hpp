@@ -9,6 +9,11 @@
 // pneumid::DataError, CLI::Error, std::exception) and main() prints them on stderr
 // as "pneumid <command>: error: <message>" with exit code 1 (2 for usage errors).
 // A callback may throw pneumid::cli::ExitCode to end with another status.
+//
+// Naming: a command's parsed flags are a struct `<Command>Args` (IdentifyArgs,
+// ControlArgs, ...); option groups shared by several commands are
+// `<Group>Options` with their Add function (DataOptions, ModelOptions,
+// RealtimeOptions in *_options.hpp).
 #pragma once
 
 #include <functional>

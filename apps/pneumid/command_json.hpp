@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "data_options.hpp"
+#include "pneumid/workflow/control_scenario.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/identify/identify.hpp"
@@ -27,7 +28,7 @@ namespace pneumid::cli {
 
 // ---------------------------------------------------------------- control
 
-struct ControlCli {
+struct ControlArgs {
   ControllerSettings controller;  // --controller, --rule, --P, ..., --u-min, --t-filter, --tau-c
   std::string model;
   std::string config;  // --config FILE.toml ([controller], [loop] period, [io] plant)
@@ -47,23 +48,24 @@ struct ControlCli {
   const std::atomic<bool>* stop = nullptr;
 };
 
-/// One closed-loop simulation of `control`.
-struct ControlRun {
-  BuiltController built;
-  ClosedLoopResult result;
-};
+/// One closed-loop simulation of `control` (the library's scenario run).
+using ControlRun = ControlScenarioRun;
 
-/// The simulations of `control` (one, or one per rule with --compare), after
-/// writing -o and --plot when given.
+/// The scenario of `control`'s flags (workflow/control_scenario.hpp).
+/// @throws InvalidArgument for a bad --load-step or an empty --compare list.
+ControlScenarioOptions ToScenarioOptions(const ControlArgs& c);
+
+/// The simulations of `control` (one, or one per rule with --compare:
+/// RunControlScenario), after writing -o and --plot when given.
 /// @throws InvalidArgument / DataError for invalid settings or an unreadable model.
-std::vector<ControlRun> SimulateControl(const ControlCli& c);
+std::vector<ControlRun> SimulateControl(const ControlArgs& c);
 
 /// What `control --json` prints for these runs.
 nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs);
 
 // ---------------------------------------------------------------- tune
 
-struct TuneCli {
+struct TuneArgs {
   std::string model;
   double Ts = 0.0;
   std::string rule = "shridhar-cooper";
@@ -87,7 +89,7 @@ struct TuneCli {
 };
 
 /// What `tune --json` prints. @throws InvalidArgument as `tune` does.
-nlohmann::ordered_json TuneJson(const TuneCli& c);
+nlohmann::ordered_json TuneJson(const TuneArgs& c);
 
 // ---------------------------------------------------------------- identify
 
@@ -126,7 +128,7 @@ IdentifyOutcome IdentifyData(const IdentifyArgs& args, const Dataset& raw,
 
 // ---------------------------------------------------------------- run
 
-struct RunOptions {
+struct RunArgs {
   ControllerSettings controller;  // --controller, --rule, --P, --M, --lambda, ...
   std::string model = "fopdt-paper";
   std::string setpoint = "step:from=0,to=100,at=0.5";
@@ -150,13 +152,13 @@ struct RunOutcome {
 
 /// `run`'s safety settings: the configuration's with the flags applied.
 /// @throws InvalidArgument for invalid settings.
-void ApplySafetyFlags(const RunOptions& o, RealtimeConfig& config);
+void ApplySafetyFlags(const RunArgs& o, RealtimeConfig& config);
 
 /// Runs the loop of `run` with `config` (ResolveRealtimeConfig and
 /// ApplySafetyFlags applied). `live` (may be null) receives a copy of every
 /// logged record from the loop thread (LogWriterOptions::live).
 /// @throws InvalidArgument / DataError as RunSession does (before the run).
-RunOutcome RunRealtime(const RunOptions& o, const RealtimeConfig& config,
+RunOutcome RunRealtime(const RunArgs& o, const RealtimeConfig& config,
                        SpscRingBuffer<LogRecord>* live = nullptr);
 
 }  // namespace pneumid::cli

@@ -8,6 +8,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/plant/actuator.hpp"
+#include "pneumid/workflow/control_scenario.hpp"
 
 #include "validators.hpp"
 
@@ -92,20 +93,11 @@ void ApplyPlantInputGaps(const Plant& plant, std::string& input_gaps) {
 
 void ApplyPlantInputGaps(const Actuator& actuator, const std::string& plant_name,
                          std::string& input_gaps) {
-  if (input_gaps != "plant") return;
-  PNEUMID_CHECK(!actuator.input_gaps.empty(),
-                "--input-gaps plant: the plant '{}' has no known input gaps (give LO:HI)",
-                plant_name);
-  input_gaps = InputGapsToString(actuator.input_gaps);
+  ResolvePlantInputGaps(actuator, plant_name, input_gaps);
 }
 
 void ApplyPlantInputRange(const Plant& plant, double& u_min, double& u_max) {
-  const Actuator actuator = PlantActuator(plant);
-  if (!std::isfinite(u_min)) u_min = actuator.u_min;
-  if (!std::isfinite(u_max)) u_max = actuator.u_max;
-  PNEUMID_CHECK(u_min <= u_max,
-                "--u-min {} is above --u-max {} (the plant's input range is {} .. {})", u_min,
-                u_max, actuator.u_min, actuator.u_max);
+  ResolvePlantInputRange(plant.actuator(), u_min, u_max);
 }
 
 }  // namespace pneumid::cli

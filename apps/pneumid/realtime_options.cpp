@@ -72,7 +72,7 @@ bool IsMatPath(const std::string& path) {
 }
 
 void FinishSession(const std::string& command, const LoopSummary& summary) {
-  if (summary.termination == LoopTermination::kSuccess) return;
+  if (summary.termination == Termination::kSuccess) return;
   std::cerr << "pneumid " << command << ": " << ToString(summary.termination) << ": "
             << summary.message << "\n";
   throw ExitCode{summary.ExitStatus()};

@@ -17,8 +17,8 @@
 
 #include "bindings.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
-#include "pneumid/identify/ipa_calibration.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/nonlinear/ipa_calibration.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 
 namespace py = pybind11;

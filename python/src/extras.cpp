@@ -22,6 +22,7 @@
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/workflow/commission.hpp"
 #include "pneumid/workflow/commission_files.hpp"
+#include "pneumid/workflow/control_scenario.hpp"
 
 namespace py = pybind11;
 using namespace py::literals;
@@ -29,6 +30,30 @@ using namespace py::literals;
 namespace pneumid::python {
 
 namespace {
+
+// Controller settings from make_controller's and simulate_control's keyword
+// arguments, as `pneumid control` and `pneumid run` read them.
+ControllerSettings Settings(const std::string& type, const std::string& rule, int M, int P,
+                            double lambda, double u_min, double u_max, bool constrained, double Kc,
+                            double Ti, double Td, double Kff, const std::string& disturbance,
+                            const std::string& input_gaps) {
+  ControllerSettings s;
+  s.controller = type;
+  s.rule = rule;
+  s.M = M;
+  s.P = P;
+  s.lambda = lambda;
+  s.limits.u_min = u_min;
+  s.limits.u_max = u_max;
+  s.constrained = constrained;
+  s.pid_kc = Kc;
+  s.pid_ti = Ti;
+  s.pid_td = Td;
+  s.pid_kff = Kff;
+  s.disturbance = disturbance;
+  s.input_gaps = input_gaps;
+  return s;
+}
 
 // TuningResult::ToJson (as `pneumid tune --json`), plus the keys earlier
 // versions had for every rule: K, tau, theta (= fopdt), lambda_condition,
@@ -191,21 +216,8 @@ void BindExtras(py::module_& m) {
          int M, int P, double lambda, double u_min, double u_max, bool constrained, double Kc,
          double Ti, double Td, double Kff, const std::string& disturbance,
          const std::string& input_gaps) {
-        ControllerSettings s;  // as `pneumid control` and `pneumid run` read them
-        s.controller = type;
-        s.rule = rule;
-        s.M = M;
-        s.P = P;
-        s.lambda = lambda;
-        s.limits.u_min = u_min;
-        s.limits.u_max = u_max;
-        s.constrained = constrained;
-        s.pid_kc = Kc;
-        s.pid_ti = Ti;
-        s.pid_td = Td;
-        s.pid_kff = Kff;
-        s.disturbance = disturbance;
-        s.input_gaps = input_gaps;
+        const ControllerSettings s = Settings(type, rule, M, P, lambda, u_min, u_max, constrained,
+                                              Kc, Ti, Td, Kff, disturbance, input_gaps);
         BuiltController b = MakeController(model, Ts, ToControllerSpec(s));
         return std::move(b.controller);
       },
@@ -222,6 +234,49 @@ void BindExtras(py::module_& m) {
       "settings of `pneumid control`: PID gains Kc, Ti, Td and velocity feed-forward Kff (NaN: "
       "the rule's; an integrating model needs Kc and gets Kff = 1/Ki + Kc Td), the MPC "
       "disturbance model, and input gaps 'LO:HI[,LO:HI]' to modulate across.");
+  m.def(
+      "simulate_control",
+      [](const std::string& model, const std::string& plant, double Ts, const std::string& setpoint,
+         double duration, const std::vector<std::pair<double, double>>& load_steps, double noise,
+         std::uint64_t seed, const std::vector<std::string>& compare, const std::string& type,
+         const std::string& rule, int M, int P, double lambda, double u_min, double u_max,
+         bool constrained, double Kc, double Ti, double Td, double Kff,
+         const std::string& disturbance, const std::string& input_gaps) {
+        ControlScenarioOptions o;
+        o.model = model;
+        o.plant = plant;
+        o.Ts = Ts;
+        o.setpoint = setpoint;
+        o.duration = duration;
+        for (const auto& [at, size] : load_steps) o.load_steps.push_back({at, size});
+        o.noise = noise;
+        o.seed = seed;
+        o.compare_rules = compare;
+        o.controller = Settings(type, rule, M, P, lambda, u_min, u_max, constrained, Kc, Ti, Td,
+                                Kff, disturbance, input_gaps);
+        std::string text;
+        {
+          py::gil_scoped_release release;
+          text = RunControlScenario(o).ToJson().dump();
+        }
+        return py::module_::import("json").attr("loads")(text);
+      },
+      "model"_a, "plant"_a = "", "Ts"_a = 0.01, "setpoint"_a, "duration"_a,
+      "load_steps"_a = std::vector<std::pair<double, double>>{}, "noise"_a = 0.0, "seed"_a = 1,
+      "compare"_a = std::vector<std::string>{}, "type"_a = "dmc", "rule"_a = "shridhar-cooper",
+      "M"_a = 0, "P"_a = 0, "lambda_"_a = std::numeric_limits<double>::quiet_NaN(),
+      "u_min"_a = -std::numeric_limits<double>::infinity(),
+      "u_max"_a = std::numeric_limits<double>::infinity(), "constrained"_a = false,
+      "Kc"_a = std::numeric_limits<double>::quiet_NaN(),
+      "Ti"_a = std::numeric_limits<double>::quiet_NaN(),
+      "Td"_a = std::numeric_limits<double>::quiet_NaN(),
+      "Kff"_a = std::numeric_limits<double>::quiet_NaN(), "disturbance"_a = "input",
+      "input_gaps"_a = "",
+      "The closed-loop scenario of `pneumid control` (workflow/control_scenario.hpp): a "
+      "controller designed from the model spec, run against the plant spec (empty: the model) "
+      "through the set-point spec with load_steps = [(at_s, size), ...]; compare = rule names "
+      "runs one per rule. Returns the dict `pneumid control --json` prints (the same numbers). "
+      "Input limits left open take the plant's range; controller settings as make_controller.");
   m.def(
       "simulate_closed_loop",
       [](Controller& controller, Plant& plant, const std::string& setpoint, double duration,

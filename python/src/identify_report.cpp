@@ -9,14 +9,14 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/preprocess.hpp"
 #include "pneumid/data/preprocess_io.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/identify/initial_state.hpp"
-#include "pneumid/identify/model_evaluation.hpp"
-#include "pneumid/identify/step_analysis.hpp"
-#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/identify/evaluation/initial_state.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
+#include "pneumid/identify/step/step_analysis.hpp"
+#include "pneumid/identify/step/step_methods.hpp"
 #include "pneumid/report/figures.hpp"
 #include "pneumid/report/identification_report.hpp"
 #include "pneumid/report/paper.hpp"
@@ -100,6 +100,15 @@ void BindIdentify(py::module_& m) {
       .def_readonly("tf", &IdentifiedModel::tf, "Model (continuous when it exists).")
       .def_readonly("discrete", &IdentifiedModel::discrete,
                     "Discrete form of polynomial models, else None.")
+      .def_property_readonly(
+          "continuous_form",
+          [](const IdentifiedModel& m) -> std::optional<std::string> {
+            if (!m.continuous_form) return std::nullopt;
+            return ToString(*m.continuous_form);
+          },
+          "How tf derives from discrete: 'zoh' (exact), 'tustin' (no zoh equivalent; the "
+          "model is used in discrete form), 'none' (tf is the discrete model); None for "
+          "models estimated in continuous time.")
       .def_readonly("fit_percent", &IdentifiedModel::fit_percent, "NRMSE fit [%].")
       .def_readonly("iae", &IdentifiedModel::iae, "Integrated absolute error [units s].")
       .def_readonly("notes", &IdentifiedModel::notes,

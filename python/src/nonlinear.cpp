@@ -7,8 +7,8 @@
 
 #include "bindings.hpp"
 #include "pneumid/identify/identified_model.hpp"
-#include "pneumid/identify/nonlinear.hpp"
-#include "pneumid/identify/static_map_fit.hpp"
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
+#include "pneumid/identify/nonlinear/static_map_fit.hpp"
 #include "pneumid/lti/static_map.hpp"
 
 namespace py = pybind11;

@@ -8,7 +8,7 @@
 
 #include "bindings.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/model_uncertainty.hpp"
+#include "pneumid/identify/evaluation/model_uncertainty.hpp"
 #include "pneumid/report/figures.hpp"
 
 namespace py = pybind11;

@@ -24,6 +24,19 @@ ModelFlag ModelFlagFromString(const std::string& name) {
 }
 
 namespace {
+inline constexpr EnumName<ContinuousForm> kContinuousFormNames[] = {
+    {ContinuousForm::kZoh, "zoh"}, {ContinuousForm::kTustin, "tustin"}, {ContinuousForm::kNone, "none"}};
+}  // namespace
+
+std::string ToString(ContinuousForm form) {
+  return std::string(EnumToString(kContinuousFormNames, form));
+}
+
+ContinuousForm ContinuousFormFromString(const std::string& name) {
+  return EnumFromString(kContinuousFormNames, name, "continuous form");
+}
+
+namespace {
 inline constexpr EnumName<OperatingPointKind> kOperatingPointKindNames[] = {
     {OperatingPointKind::kAuto, "auto"},
     {OperatingPointKind::kZero, "zero"},

@@ -1,7 +1,12 @@
 #include "pneumid/identify/identified_model_io.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <limits>
+
+#include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/preprocess_io.hpp"
@@ -98,6 +103,7 @@ nlohmann::json ToJson(const IdentifiedModel& model) {
   if (!model.param_std.empty()) j["param_std"] = ToJson(model.param_std);
   j["tf"] = ToJson(model.tf);
   if (model.discrete) j["discrete"] = ToJson(*model.discrete);
+  if (model.continuous_form) j["continuous_form"] = ToString(*model.continuous_form);
   j["fit_percent"] = model.fit_percent;
   j["iae"] = model.iae;
   if (!model.notes.empty()) j["notes"] = model.notes;
@@ -125,6 +131,18 @@ nlohmann::json ToJson(const IdentifiedModel& model) {
   return j;
 }
 
+// The continuous form of a model file written before the key
+// "continuous_form" existed, from the note the estimator wrote then.
+static ContinuousForm LegacyContinuousForm(const std::vector<std::string>& notes) {
+  for (const std::string& note : notes) {
+    if (note.find("continuous form by tustin d2c") != std::string::npos)
+      return ContinuousForm::kTustin;
+    if (note.find("no continuous (zoh d2c) equivalent") != std::string::npos)
+      return ContinuousForm::kNone;
+  }
+  return ContinuousForm::kZoh;
+}
+
 IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
   PNEUMID_CHECK(j.is_object(), "an identified model must be a JSON object, got a JSON {}",
                 j.type_name());
@@ -146,6 +164,11 @@ IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
   m.fit_percent = number("fit_percent", -std::numeric_limits<double>::infinity());
   m.iae = number("iae", std::numeric_limits<double>::infinity());
   if (j.contains("notes")) m.notes = j.at("notes").get<std::vector<std::string>>();
+  if (j.contains("continuous_form")) {
+    m.continuous_form = ContinuousFormFromString(j.at("continuous_form").get<std::string>());
+  } else if (m.discrete) {
+    m.continuous_form = LegacyContinuousForm(m.notes);
+  }
   if (j.contains("operating_point")) {
     const nlohmann::json& op = j.at("operating_point");
     PNEUMID_CHECK(op.is_object(), "'operating_point' must be an object with u0 and y0, got {}",
@@ -184,6 +207,23 @@ IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
   if (j.contains("output_map")) m.output_map = StaticMapFromJson(j.at("output_map"));
   if (j.contains("narx")) m.narx = NarxModelFromJson(j.at("narx"));
   return m;
+}
+
+std::optional<IdentifiedModel> LoadIdentifiedModel(const std::string& spec) {
+  std::string path;
+  const std::optional<nlohmann::json> entry = ReadModelEntry(spec, &path);
+  const bool json_name = path.size() > 5 && path.compare(path.size() - 5, 5, ".json") == 0;
+  if (!json_name) return std::nullopt;
+  std::error_code ec;
+  if (!entry && !std::filesystem::exists(path, ec))
+    throw DataError(fmt::format("{}: cannot open model file: {}", path, std::strerror(ENOENT)));
+  if (!entry || !entry->is_object() || !entry->contains("params") || !entry->contains("tf"))
+    return std::nullopt;
+  try {
+    return IdentifiedModelFromJson(*entry);
+  } catch (const InvalidArgument& e) {
+    throw DataError(fmt::format("{}: {}", path, e.what()));
+  }
 }
 
 }  // namespace pneumid

@@ -12,9 +12,9 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
-#include "pneumid/identify/nonlinear.hpp"
-#include "pneumid/identify/parametric.hpp"
-#include "pneumid/identify/validation.hpp"
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
+#include "pneumid/identify/parametric/parametric.hpp"
+#include "pneumid/identify/evaluation/validation.hpp"
 
 namespace pneumid {
 

@@ -89,10 +89,17 @@ TransferFunction FromModelJson(const nlohmann::json& j_in, const std::string& wh
   // (tustin) approximation (no zoh equivalent: a pole on the negative real
   // axis) is used as identified: the tustin form is biproper and its step
   // response differs from the data's model between and at the samples.
-  if (j.contains("discrete") && j.contains("notes") && j.at("notes").is_array()) {
-    for (const auto& note : j.at("notes"))
-      if (note.is_string() && note.get<std::string>().find("tustin d2c") != std::string::npos)
-        return TransferFunctionFromJson(j.at("discrete"));
+  // Files written before the key "continuous_form" said so in a note.
+  if (j.contains("discrete")) {
+    bool tustin = false;
+    if (j.contains("continuous_form")) {
+      tustin = j.at("continuous_form") == "tustin";
+    } else if (j.contains("notes") && j.at("notes").is_array()) {
+      for (const auto& note : j.at("notes"))
+        tustin |= note.is_string() &&
+                  note.get<std::string>().find("tustin d2c") != std::string::npos;
+    }
+    if (tustin) return TransferFunctionFromJson(j.at("discrete"));
   }
   if (j.contains("tf")) return TransferFunctionFromJson(j.at("tf"));
   return TransferFunctionFromJson(j);
@@ -300,6 +307,18 @@ std::optional<nlohmann::json> ReadModelFileIfAny(const std::string& spec, std::s
 }
 
 }  // namespace
+
+std::optional<nlohmann::json> ReadModelEntry(const std::string& spec, std::string* path_out) {
+  std::string path, select;
+  const std::optional<nlohmann::json> j = ReadModelFileIfAny(spec, &path, &select);
+  if (path_out != nullptr) *path_out = path.empty() ? SpecPath(spec) : path;
+  if (!j) return std::nullopt;
+  try {
+    return SelectModelJson(*j, path, select);
+  } catch (const InvalidArgument& e) {
+    throw InFile(path, e);
+  }
+}
 
 ModelFileScope::ModelFileScope() : outermost_(t_model_files == nullptr) {
   if (outermost_) t_model_files = new std::map<std::string, ScopedModelFile>();

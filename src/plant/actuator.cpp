@@ -15,6 +15,7 @@ Actuator IpaActuator(IpaMode mode) {
   a.hold_name = "valves-closed";
   a.release_name = "exhaust-open";
   if (mode == IpaMode::kPosition) {
+    a.integrating = true;
     a.input_label = "command";
     a.output_label = "position";
     a.u_min = -100.0;
@@ -33,25 +34,9 @@ Actuator IpaActuator(IpaMode mode) {
   return a;
 }
 
-Actuator PlantActuator(const Plant& plant) {
-  if (const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant)) {
-    Actuator a = IpaActuator(ipa->parameters().mode);
-    const double w = 100.0 * ipa->parameters().min_pulse_width * ipa->parameters().pwm_frequency;
-    const bool position = ipa->parameters().mode == IpaMode::kPosition;
-    if (position) {
-      a.y_min = 0.0;
-      a.y_max = ipa->parameters().stroke;
-    }
-    if (w > 0.0 && w < 50.0) {
-      a.input_gaps =
-          position
-              ? std::vector<InputGap>{{-100.0, -100.0 + w}, {-w, 0.0}, {0.0, w}, {100.0 - w, 100.0}}
-              : std::vector<InputGap>{{0.0, w}, {100.0 - w, 100.0}};
-    }
-    return a;
-  }
-  return Actuator{};
-}
+Actuator Plant::actuator() const { return Actuator{}; }
+
+Actuator PlantActuator(const Plant& plant) { return plant.actuator(); }
 
 void CheckSetpointsInOutputRange(const Actuator& actuator, const double* r, std::size_t n,
                                  double Ts) {

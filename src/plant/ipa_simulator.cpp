@@ -1,6 +1,8 @@
 // IPA physics simulator (see include/pneumid/plant/ipa_simulator.hpp).
 #include "pneumid/plant/ipa_simulator.hpp"
 
+#include "pneumid/plant/actuator.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -570,6 +572,23 @@ void IpaSimulator::AdvanceValves(bool inlet_open, bool exhaust_open) {
   ++sample_;
   AdvanceTo(static_cast<double>(sample_) * Ts_, false, inlet_open, exhaust_open);
   PushReading();
+}
+
+Actuator IpaSimulator::actuator() const {
+  Actuator a = IpaActuator(p_.mode);
+  const double w = 100.0 * p_.min_pulse_width * p_.pwm_frequency;
+  const bool position = p_.mode == IpaMode::kPosition;
+  if (position) {
+    a.y_min = 0.0;
+    a.y_max = p_.stroke;
+  }
+  if (w > 0.0 && w < 50.0) {
+    a.input_gaps =
+        position
+            ? std::vector<InputGap>{{-100.0, -100.0 + w}, {-w, 0.0}, {0.0, w}, {100.0 - w, 100.0}}
+            : std::vector<InputGap>{{0.0, w}, {100.0 - w, 100.0}};
+  }
+  return a;
 }
 
 }  // namespace pneumid

@@ -147,11 +147,11 @@ std::int64_t LoopOptions::Samples() const {
 
 int LoopSummary::ExitStatus() const {
   switch (termination) {
-    case LoopTermination::kSuccess:
+    case Termination::kSuccess:
       return 0;
-    case LoopTermination::kStopped:
+    case Termination::kStopped:
       return signal > 0 ? 128 + signal : 130;
-    case LoopTermination::kFailure:
+    case Termination::kFailure:
       return 3;
     default:
       return 1;
@@ -312,7 +312,7 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
   summary.log_dropped = log ? log->dropped() : 0;
   summary.fault = fault;
   if (fault != Fault::kNone) {
-    summary.termination = LoopTermination::kFailure;
+    summary.termination = Termination::kFailure;
     summary.message = fmt::format(
         "{} at t = {:.4f} s (sample {}): y = {}, u = {}, I/O status {}; outputs set to {}{}",
         ToString(fault), static_cast<double>(fault_k) * options.period, fault_k, fault_y, fault_u,
@@ -322,7 +322,7 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
       summary.message += fmt::format(" ({} overruns > max {})", summary.timing.overruns,
                                      safety.options().max_overruns);
   } else if (stop_signal >= 0) {
-    summary.termination = LoopTermination::kStopped;
+    summary.termination = Termination::kStopped;
     summary.signal = stop_signal;
     summary.message = fmt::format(
         "stopped by {} after {} samples; outputs set to {}",
@@ -330,7 +330,7 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
                         : std::string("request"),
         done, summary.safe_state_name);
   } else {
-    summary.termination = LoopTermination::kSuccess;
+    summary.termination = Termination::kSuccess;
     summary.message =
         fmt::format("{} samples completed; outputs set to {}", done, summary.safe_state_name);
   }

@@ -7,10 +7,10 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
-#include "pneumid/identify/model_evaluation.hpp"
-#include "pneumid/identify/model_uncertainty.hpp"
-#include "pneumid/identify/nonlinear.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
+#include "pneumid/identify/evaluation/model_uncertainty.hpp"
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {

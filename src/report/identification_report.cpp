@@ -8,11 +8,11 @@
 #include <fmt/format.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/identify/nonlinear.hpp"
-#include "pneumid/identify/step_analysis.hpp"
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
+#include "pneumid/identify/step/step_analysis.hpp"
 #include "pneumid/report/figures.hpp"
 #include "pneumid/report/html.hpp"
 
@@ -307,14 +307,14 @@ ReportSummary WriteIdentificationReport(const Dataset& data, const ReportOptions
   summary.num_figures = doc.num_figures();
   summary.num_tables = doc.num_tables();
   if (summary.models.empty()) {
-    summary.termination = ReportTermination::kFailure;
+    summary.termination = Termination::kFailure;
     summary.message = "no method gave a model";
   } else if (!summary.failures.empty()) {
-    summary.termination = ReportTermination::kPartial;
+    summary.termination = Termination::kPartial;
     summary.message =
         fmt::format("{} of {} methods failed", summary.failures.size(), options.methods.size());
   } else {
-    summary.termination = ReportTermination::kSuccess;
+    summary.termination = Termination::kSuccess;
     summary.message = "all methods gave a model";
   }
   return summary;

@@ -181,7 +181,7 @@ PaperResult RunPaper(const PaperOptions& o) {
   };
   auto problem = [&](const std::string& what, const std::exception& e) {
     res.problems.push_back(what + ": " + e.what());
-    res.termination = PaperTermination::kPartial;
+    res.termination = Termination::kPartial;
   };
 
   // --- 1. Step test on the IPA simulator ----------------------------------

@@ -830,9 +830,7 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
                 u_lo, u_hi);
   // A positioning drive integrates its input: it has no steady state to probe
   // and its model no static gain to design on (docs/position.md).
-  if (const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant);
-      ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition)
-    return CommissionIntegrating(plant, o, act, u_lo, u_hi);
+  if (act.integrating) return CommissionIntegrating(plant, o, act, u_lo, u_hi);
   CommissionResult r;
   CommissionExperiment& ex = r.experiment;
   plant.Reset();

@@ -21,6 +21,27 @@ ln -s /etc "$ROOT/link"
 (cd "$ROOT" && "$PNEUMID" control --controller dmc --model 'models.json#arx' --plant ipa \
   --Ts 0.01 --setpoint step:from=0,to=80,at=0.5 --duration 3 --load-step at=2,size=-10 \
   --json > "$TMP/control_cli.json") || fail "control --json"
+# Python's simulate_control runs the same library scenario as `control`: the
+# same JSON, number for number (the app's is compared below).
+PY_MODULE_DIR="$(dirname "$PNEUMID")/python"
+if compgen -G "$PY_MODULE_DIR/pneumid*.so" > /dev/null; then
+  (cd "$ROOT" && PYTHONPATH="$PY_MODULE_DIR" "$PY" - "$TMP/control_cli.json" <<'EOF'
+import json, sys
+import pneumid
+cli = json.load(open(sys.argv[1]))
+py = pneumid.simulate_control("models.json#arx", plant="ipa", Ts=0.01,
+                              setpoint="step:from=0,to=80,at=0.5", duration=3,
+                              load_steps=[(2.0, -10.0)], type="dmc")
+if py != cli:
+    diff = {k: (py.get(k), cli.get(k)) for k in set(py) | set(cli) if py.get(k) != cli.get(k)}
+    sys.exit(f"simulate_control differs from control --json: {diff}")
+if not (cli["iae"] > 0 and len(cli["steps"]) >= 1):
+    sys.exit(f"control --json without metrics: {cli}")
+EOF
+  ) || fail "python simulate_control = control --json"
+else
+  echo "note: no Python module in $PY_MODULE_DIR; the Python leg is skipped"
+fi
 (cd "$ROOT" && "$PNEUMID" identify demo.csv -m reaction-curve,arx,fit-p1d --detrend none \
   --json > "$TMP/identify_cli.json") || fail "identify --json"
 "$PNEUMID" tune --model fopdt-paper --Ts 0.01 --json > "$TMP/tune_cli.json" || fail "tune --json"

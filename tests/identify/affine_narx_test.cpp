@@ -3,7 +3,7 @@
 // noise-free data give back the map and coefficients, the written NARX
 // simulates the system, the method runs through IdentifyNonlinear and the
 // model file; bad input gives clear errors.
-#include "pneumid/identify/affine_narx.hpp"
+#include "pneumid/identify/nonlinear/affine_narx.hpp"
 
 #include <cmath>
 #include <random>
@@ -13,9 +13,9 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
-#include "pneumid/identify/nonlinear.hpp"
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
 
 namespace pneumid {
 namespace {

@@ -1,4 +1,4 @@
-#include "pneumid/identify/arx_streaming.hpp"
+#include "pneumid/identify/parametric/arx_streaming.hpp"
 
 #include <cstdio>
 #include <fstream>

@@ -1,4 +1,4 @@
-#include "pneumid/identify/arx.hpp"
+#include "pneumid/identify/parametric/arx.hpp"
 
 #include <cmath>
 #include <string>
@@ -49,7 +49,7 @@ TEST(Arx, EqualsNumpyLstsqOnRecordedCases) {
     o.nb = c.nb;
     o.nk = c.nk;
     const ArxResult r = EstimateArx(y, u, 0.01, o);
-    ASSERT_EQ(r.summary.termination, EstimationTermination::kConvergence) << r.summary.message;
+    ASSERT_EQ(r.summary.termination, Termination::kConvergence) << r.summary.message;
     const Eigen::VectorXd theta = r.model.Parameters();
     ASSERT_EQ(theta.size(), ref.size());
     EXPECT_LT((theta - ref).norm() / ref.norm(), 1e-10) << theta.transpose() << "\n"
@@ -214,7 +214,7 @@ TEST(Arx, ConstantInputIsRankDeficient) {
   Eigen::MatrixXd u = Eigen::MatrixXd::Constant(n, 1, 3.0);
   const Eigen::VectorXd y = testing::WhiteNoise(n, 1.0, 3);
   const ArxResult r = EstimateArx(y, u, 0.01, ArxOptions{});
-  EXPECT_EQ(r.summary.termination, EstimationTermination::kRankDeficient);
+  EXPECT_EQ(r.summary.termination, Termination::kRankDeficient);
   EXPECT_TRUE(r.model.Parameters().allFinite());
 }
 
@@ -243,7 +243,7 @@ TEST(Arx, InvalidArgumentsThrowWithValues) {
   EXPECT_THROW(EstimateArx(ynan, u2.leftCols(1), 0.01, ArxOptions{}), InvalidArgument);
   // Too short: a failure in the summary, not a throw.
   const ArxResult r = EstimateArx(y.head(6), u2.topLeftCorner(6, 1), 0.01, ArxOptions{});
-  EXPECT_EQ(r.summary.termination, EstimationTermination::kFailure);
+  EXPECT_EQ(r.summary.termination, Termination::kFailure);
 }
 
 }  // namespace

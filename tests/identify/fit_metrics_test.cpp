@@ -1,4 +1,4 @@
-#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 
 #include <cmath>
 

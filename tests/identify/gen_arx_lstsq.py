@@ -4,7 +4,7 @@
 Writes arx_lstsq_cases.inc: for each case the data (y, u), the orders and the
 parameter vector theta = lstsq(Phi, Y) with the regressors
   phi(t) = [-y(t-1) .. -y(t-na), u_i(t-nk_i) .. u_i(t-nk_i-nb_i+1) ...]
-for t = max(na, max(nk_i + nb_i - 1)) .. N-1 (pneumid/identify/arx.hpp).
+for t = max(na, max(nk_i + nb_i - 1)) .. N-1 (pneumid/identify/parametric/arx.hpp).
 Run: /usr/bin/python3 tests/identify/gen_arx_lstsq.py > tests/identify/arx_lstsq_cases.inc
 """
 import numpy as np

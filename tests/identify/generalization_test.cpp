@@ -15,10 +15,10 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/identify/model_evaluation.hpp"
-#include "pneumid/identify/nonlinear.hpp"
-#include "pneumid/identify/static_map_fit.hpp"
-#include "pneumid/identify/validation.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
+#include "pneumid/identify/nonlinear/static_map_fit.hpp"
+#include "pneumid/identify/evaluation/validation.hpp"
 
 namespace pneumid {
 namespace {

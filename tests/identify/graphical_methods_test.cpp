@@ -7,11 +7,11 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/areas.hpp"
-#include "pneumid/identify/sopdt.hpp"
-#include "pneumid/identify/strejc.hpp"
-#include "pneumid/identify/tangent.hpp"
-#include "pneumid/identify/two_point.hpp"
+#include "pneumid/identify/step/areas.hpp"
+#include "pneumid/identify/step/sopdt.hpp"
+#include "pneumid/identify/step/strejc.hpp"
+#include "pneumid/identify/step/tangent.hpp"
+#include "pneumid/identify/step/two_point.hpp"
 #include "pneumid/lti/conversion.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "step_test_util.hpp"

@@ -1,6 +1,6 @@
 // Skogestad's half rule, closed forms from the rule itself [Skogestad 2003,
 // J. Process Control 13, sec. 2.2] and the paper's continuous ARX model.
-#include "pneumid/identify/half_rule.hpp"
+#include "pneumid/identify/step/half_rule.hpp"
 
 #include <cmath>
 

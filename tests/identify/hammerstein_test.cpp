@@ -2,7 +2,7 @@
 // (gen_nonlinear_systems.py beside this file, simulated with scipy): the
 // parameters are recovered within 2 %, the simulations match scipy's, and bad
 // input is rejected with the offending values.
-#include "pneumid/identify/hammerstein.hpp"
+#include "pneumid/identify/nonlinear/hammerstein.hpp"
 
 #include <cmath>
 #include <string>

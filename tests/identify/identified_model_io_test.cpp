@@ -51,8 +51,32 @@ TEST(IdentifiedModelIoTest, ReadsAndWritesTheModelFileForm) {
   expected["operating_point"] = {{"u0", 0.0}, {"y0", 0.0}};
   expected["termination"] = "convergence";
   expected["flags"] = nlohmann::json::array();
+  expected["continuous_form"] = "zoh";  // a discrete model without a tustin note
   EXPECT_EQ(ToJson(m), expected);
   EXPECT_EQ(ToJson(m)["params"]["nk"].dump(), "1");
+}
+
+// How the continuous form derives from the discrete one is a typed field
+// ("continuous_form"); files written before it existed said so in a note.
+TEST(IdentifiedModelIoTest, TheContinuousFormIsATypedFieldAndOlderNotesStillSayIt) {
+  nlohmann::json j = nlohmann::json::parse(kWritten);
+  j["notes"] = {"continuous form by tustin d2c: no zoh equivalent (pole at z = -0.3)"};
+  EXPECT_EQ(IdentifiedModelFromJson(j).continuous_form, ContinuousForm::kTustin);
+  j["notes"] = {"no continuous (zoh d2c) equivalent: pole at z = -1; tustin: pole at z = -1"};
+  EXPECT_EQ(IdentifiedModelFromJson(j).continuous_form, ContinuousForm::kNone);
+  // The key wins over any note, and it round-trips.
+  j["continuous_form"] = "tustin";
+  j["notes"] = {"a note"};
+  const IdentifiedModel m = IdentifiedModelFromJson(j);
+  EXPECT_EQ(m.continuous_form, ContinuousForm::kTustin);
+  EXPECT_EQ(ToJson(m)["continuous_form"], "tustin");
+  // Models without a discrete form have none.
+  j.erase("discrete");
+  j.erase("continuous_form");
+  EXPECT_FALSE(IdentifiedModelFromJson(j).continuous_form.has_value());
+  j["continuous_form"] = "bilinear";
+  EXPECT_THAT([&] { IdentifiedModelFromJson(j); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("zoh, tustin, none")));
 }
 
 TEST(IdentifiedModelIoTest, RoundTripsOperatingPointFlagsAndValidationFit) {
@@ -128,6 +152,35 @@ TEST(IdentifiedModelIoTest, ErrorsNameTheKey) {
   no_tf.erase("tf");
   EXPECT_THAT([&] { IdentifiedModelFromJson(no_tf); },
               ThrowsMessage<InvalidArgument>(HasSubstr("'tf'")));
+}
+
+// Identified models are read through lti's one model-file reader: the same
+// #method selection, plain transfer functions and inline specs left to
+// ParseModelSpec, errors that name the file.
+TEST(IdentifiedModelIoTest, LoadIdentifiedModelSelectsAsEveryReaderDoes) {
+  const auto dir = std::filesystem::temp_directory_path() / "pneumid_load_identified";
+  std::filesystem::create_directories(dir);
+  nlohmann::json second = nlohmann::json::parse(kWritten);
+  second["method"] = "arx";
+  second["params"] = {{"K", 2.5}};
+  const std::string file = (dir / "models.json").string();
+  std::ofstream(file) << nlohmann::json{{"models", {nlohmann::json::parse(kWritten), second}}};
+  ASSERT_TRUE(LoadIdentifiedModel(file).has_value());
+  EXPECT_EQ(LoadIdentifiedModel(file)->method, "n4sid");  // the first without #method
+  EXPECT_DOUBLE_EQ(LoadIdentifiedModel(file + "#arx")->params.Scalar("K"), 2.5);
+  EXPECT_THAT([&] { LoadIdentifiedModel(file + "#oe"); },
+              ThrowsMessage<DataError>(HasSubstr("no model with method 'oe' (available: n4sid, arx)")));
+  const std::string plain = (dir / "tf.json").string();
+  std::ofstream(plain) << R"({"num": [1], "den": [1, 1], "Ts": 0, "delay": 0})";
+  EXPECT_FALSE(LoadIdentifiedModel(plain).has_value());
+  EXPECT_FALSE(LoadIdentifiedModel("fopdt:K=1,tau=1,theta=0").has_value());
+  EXPECT_THAT([&] { LoadIdentifiedModel((dir / "missing.json").string()); },
+              ThrowsMessage<DataError>(HasSubstr("missing.json: cannot open model file")));
+  const std::string broken = (dir / "broken.json").string();
+  std::ofstream(broken) << "{\"models\": [";
+  EXPECT_THAT([&] { LoadIdentifiedModel(broken); },
+              ThrowsMessage<DataError>(HasSubstr("broken.json:1:")));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ModelParamsTest, TypedAccessors) {

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/parametric.hpp"
+#include "pneumid/identify/parametric/parametric.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {

@@ -1,7 +1,7 @@
-// Grey-box calibration of the IPA simulator (include/pneumid/identify/ipa_calibration.hpp):
+// Grey-box calibration of the IPA simulator (include/pneumid/identify/nonlinear/ipa_calibration.hpp):
 // recovery of hidden parameters from simulated experiments with sensor noise,
 // identifiability warnings, and the errors of bad input.
-#include "pneumid/identify/ipa_calibration.hpp"
+#include "pneumid/identify/nonlinear/ipa_calibration.hpp"
 
 #include <cmath>
 #include <random>
@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/plant/experiment.hpp"
 #include "pneumid/plant/signal.hpp"
 

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
 

@@ -11,9 +11,9 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/identify/nonparametric_freq.hpp"
-#include "pneumid/identify/pem.hpp"
-#include "pneumid/identify/process_model.hpp"
+#include "pneumid/identify/nonparametric/nonparametric_freq.hpp"
+#include "pneumid/identify/parametric/pem.hpp"
+#include "pneumid/identify/parametric/process_model.hpp"
 #include "pneumid/lti/conversion.hpp"
 #include "pneumid/lti/response.hpp"
 
@@ -101,7 +101,7 @@ TEST(LongData, ProcessModelFitRecoversTheSopdtOnTheLongRecord) {
   ProcessFitOptions o;
   o.structure = ProcessStructure::kP2D;
   const ProcessFitResult r = FitProcessModel(Record(), 0, 0, o);
-  EXPECT_EQ(r.summary.termination, FitTermination::kConvergence) << r.summary.BriefReport();
+  EXPECT_EQ(r.summary.termination, Termination::kConvergence) << r.summary.BriefReport();
   EXPECT_NEAR(r.params.K, 1.6, 1e-3);
   EXPECT_NEAR(r.params.T1, 0.12, 3e-3);
   EXPECT_NEAR(r.params.T2, 0.10, 3e-3);

@@ -1,6 +1,6 @@
 // Simulation around the operating point, the fit on held-out samples, the
 // quality flags and the ranking (model_evaluation.hpp).
-#include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
 
 #include <cmath>
 #include <random>
@@ -9,10 +9,10 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/identify/residual_analysis.hpp"
-#include "pneumid/identify/validation.hpp"
+#include "pneumid/identify/evaluation/residual_analysis.hpp"
+#include "pneumid/identify/evaluation/validation.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {

@@ -1,4 +1,4 @@
-#include "pneumid/identify/model_uncertainty.hpp"
+#include "pneumid/identify/evaluation/model_uncertainty.hpp"
 
 #include <cmath>
 #include <random>
@@ -9,8 +9,8 @@
 #include "parametric_test_util.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
-#include "pneumid/identify/parametric.hpp"
-#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/identify/parametric/parametric.hpp"
+#include "pneumid/identify/step/step_methods.hpp"
 #include "pneumid/lti/frequency.hpp"
 #include "pneumid/lti/response.hpp"
 

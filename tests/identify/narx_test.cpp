@@ -1,7 +1,7 @@
 // NARX term selection by FROLS on recorded data of a known polynomial system
 // (gen_nonlinear_systems.py beside this file): exactly the true terms are
 // selected, their coefficients recovered, the free run matches; bad input.
-#include "pneumid/identify/narx.hpp"
+#include "pneumid/identify/nonlinear/narx.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 // The nonlinear methods through the identification entry point: dispatch by
 // name, not in `all`, the model file round trip (maps and NARX terms), the
 // simulation used by validate, and the errors for unsuitable data.
-#include "pneumid/identify/nonlinear.hpp"
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
 
 #include <algorithm>
 #include <string>
@@ -13,7 +13,7 @@
 #include "pneumid/data/load.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {

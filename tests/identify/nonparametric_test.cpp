@@ -7,8 +7,8 @@
 
 #include "parametric_test_util.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/cra.hpp"
-#include "pneumid/identify/nonparametric_freq.hpp"
+#include "pneumid/identify/nonparametric/cra.hpp"
+#include "pneumid/identify/nonparametric/nonparametric_freq.hpp"
 
 namespace pneumid {
 namespace {

@@ -1,4 +1,4 @@
-#include "pneumid/identify/order_selection.hpp"
+#include "pneumid/identify/parametric/order_selection.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -2,8 +2,8 @@
 // the way the paper obtains its Eq. 5-6 from the measured actuator.
 #include <gtest/gtest.h>
 
-#include "pneumid/identify/parametric.hpp"
-#include "pneumid/identify/residual_analysis.hpp"
+#include "pneumid/identify/parametric/parametric.hpp"
+#include "pneumid/identify/evaluation/residual_analysis.hpp"
 #include "pneumid/plant/experiment.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"

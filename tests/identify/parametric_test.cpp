@@ -1,4 +1,4 @@
-#include "pneumid/identify/parametric.hpp"
+#include "pneumid/identify/parametric/parametric.hpp"
 
 #include <cmath>
 
@@ -7,14 +7,16 @@
 
 #include "parametric_test_util.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
-#include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/lti/model_io.hpp"
 
 namespace pneumid {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 Dataset PaperArxData(Eigen::Index n, double noise, unsigned seed = 1) {
   const PolynomialModel truth = testing::PaperArx();
@@ -156,6 +158,42 @@ TEST(Parametric, PolynomialParamsJsonRoundTrip) {
   } catch (const InvalidArgument& e) {
     EXPECT_THAT(e.what(), HasSubstr("nk"));
   }
+}
+
+// The direct conversion between a polynomial model and an identified
+// model's parameters gives what the model file's JSON gives, both ways, for
+// one input and several.
+TEST(Parametric, PolynomialModelParamsConvertDirectlyAsTheirJsonDoes) {
+  PolynomialModel siso = testing::PaperArx();
+  siso.structure = "BJ";
+  siso.c = Eigen::Vector2d(1, 0.3);
+  siso.d = Eigen::Vector2d(1, -0.5);
+  siso.f = {Eigen::Vector2d(1, -0.2)};
+  PolynomialModel miso = testing::PaperArx();
+  miso.structure = "OE";
+  miso.b = {Eigen::Vector3d(0, 0.5, 0.1), Eigen::Vector2d(0, 0.25)};
+  miso.nk = {1, 1};
+  miso.f = {Eigen::Vector2d(1, -0.2), Eigen::Vector3d(1, -0.4, 0.04)};
+  miso.a = Eigen::VectorXd::Ones(1);
+  for (const PolynomialModel& m : {siso, miso}) {
+    SCOPED_TRACE(m.structure);
+    const ModelParams direct = ToModelParams(m);
+    EXPECT_EQ(direct, ModelParamsFromJson(m.ParamsJson()));
+    const PolynomialModel back = PolynomialModelFromParams(direct, m.structure);
+    EXPECT_EQ(back.Parameters(), m.Parameters());
+    EXPECT_EQ(back.ParameterNames(), m.ParameterNames());
+    EXPECT_EQ(back.nk, m.nk);
+  }
+  // Coefficients written as integers are coefficients; errors name the key.
+  ModelParams p = ToModelParams(siso);
+  p["a"] = std::vector<int>{1, 0};
+  EXPECT_EQ(PolynomialModelFromParams(p, "BJ").a, Eigen::Vector2d(1, 0));
+  p["nk"] = 1.5;
+  EXPECT_THAT([&] { PolynomialModelFromParams(p); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("params.nk must be an integer")));
+  const ModelParams no_b{{"nk", 1}, {"Ts", 0.01}};
+  EXPECT_THAT([&] { PolynomialModelFromParams(no_b); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("params lacks the key 'b'")));
 }
 
 TEST(Parametric, KStepPredictionBetweenOneStepAndSimulation) {

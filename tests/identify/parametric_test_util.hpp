@@ -7,7 +7,7 @@
 
 #include <Eigen/Core>
 
-#include "pneumid/identify/parametric_model.hpp"
+#include "pneumid/identify/parametric/parametric_model.hpp"
 #include "pneumid/lti/model_io.hpp"
 
 namespace pneumid::testing {

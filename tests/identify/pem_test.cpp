@@ -1,4 +1,4 @@
-#include "pneumid/identify/pem.hpp"
+#include "pneumid/identify/parametric/pem.hpp"
 
 #include <cmath>
 
@@ -7,8 +7,8 @@
 
 #include "parametric_test_util.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/arx.hpp"
-#include "pneumid/identify/iv.hpp"
+#include "pneumid/identify/parametric/arx.hpp"
+#include "pneumid/identify/parametric/iv.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
@@ -56,7 +56,7 @@ TEST(Pem, OutputErrorRemovesTheBiasOfArx) {
   o.nf = 2;
   o.nk = 1;
   const PemResult oe = EstimatePolynomial(PolynomialStructure::kOe, o, d.y, d.u, 1.0);
-  ASSERT_EQ(oe.summary.termination, EstimationTermination::kConvergence) << oe.summary.message;
+  ASSERT_EQ(oe.summary.termination, Termination::kConvergence) << oe.summary.message;
   ASSERT_EQ(oe.model.f.size(), 1u);
   const double oe_err = (oe.model.f[0].tail(2) - f_true).norm();
   EXPECT_GT(arx_err, 0.1) << arx.model.a.transpose();    // the bias
@@ -78,7 +78,7 @@ TEST(Pem, Iv4IsConsistentWhereLeastSquaresIsBiased) {
   io.nb = 2;
   io.nk = 1;
   const IvResult iv = EstimateIv4(d.y, d.u, 1.0, io);
-  ASSERT_EQ(iv.summary.termination, EstimationTermination::kConvergence) << iv.summary.message;
+  ASSERT_EQ(iv.summary.termination, Termination::kConvergence) << iv.summary.message;
   EXPECT_LT((iv.model.a.tail(2) - Eigen::Vector2d(-1.5, 0.7)).norm(), 0.05)
       << iv.model.a.transpose();
   EXPECT_LT((iv.model.b[0].tail(2) - Eigen::Vector2d(1.0, 0.5)).norm(), 0.1);
@@ -97,7 +97,7 @@ TEST(Pem, Iv4WithOrdersAboveTheDataStaysStable) {
   io.nb = 3;
   io.nk = 1;
   const IvResult iv = EstimateIv4(d.y, d.u, 1.0, io);
-  ASSERT_EQ(iv.summary.termination, EstimationTermination::kConvergence) << iv.summary.message;
+  ASSERT_EQ(iv.summary.termination, Termination::kConvergence) << iv.summary.message;
   const Eigen::VectorXcd poles = poly::Roots(iv.model.a);
   for (Eigen::Index i = 0; i < poles.size(); ++i) EXPECT_LT(std::abs(poles[i]), 1.0) << poles[i];
   const double gain = iv.model.b[0].sum() / iv.model.a.sum();

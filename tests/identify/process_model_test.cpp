@@ -1,5 +1,5 @@
 // Output-error process-model fitting (MATLAB procest structures) with Ceres.
-#include "pneumid/identify/process_model.hpp"
+#include "pneumid/identify/parametric/process_model.hpp"
 
 #include <cmath>
 
@@ -37,7 +37,7 @@ TEST(ProcessModelTest, P2dRecoversSopdtFromTenSteps) {
   ProcessFitOptions o;
   o.structure = ProcessStructure::kP2D;
   const ProcessFitResult r = FitProcessModel(d, 0, 0, o);
-  EXPECT_EQ(r.summary.termination, FitTermination::kConvergence) << r.summary.BriefReport();
+  EXPECT_EQ(r.summary.termination, Termination::kConvergence) << r.summary.BriefReport();
   EXPECT_NEAR(r.params.K, 1.2, 0.02 * 1.2);
   EXPECT_NEAR(r.params.T1, 2.0, 0.02 * 2.0);
   EXPECT_NEAR(r.params.T2, 0.7, 0.02 * 0.7);
@@ -105,7 +105,7 @@ TEST(ProcessModelTest, AnyInputEveryStructure) {
     o.zero = c.zero;
     const ProcessFitResult r = FitProcessModel(d, 0, 0, o);
     const std::string what = ToString(c.s) + (c.zero ? "Z" : "") + ": " + r.summary.BriefReport();
-    EXPECT_NE(r.summary.termination, FitTermination::kFailure) << what;
+    EXPECT_NE(r.summary.termination, Termination::kFailure) << what;
     for (const auto& [name, value] : NamedParams(c.s, c.zero, c.p)) {
       const auto fitted = NamedParams(c.s, c.zero, r.params);
       for (const auto& [n2, v2] : fitted) {

@@ -1,6 +1,6 @@
 // Equivalent PTn by the tangent-line method, paper Eq. 3 and
 // docs/paper.md, reference value 5.
-#include "pneumid/identify/ptn.hpp"
+#include "pneumid/identify/step/ptn.hpp"
 
 #include <cmath>
 

@@ -2,7 +2,7 @@
 // Golden values: docs/paper.md, reference values 2 and 4: static
 // gain 1.59796, 63.2 % time of the ARX unit step t63 = 0.2306 s; K = 1.6 within
 // 1 % and tau within one sample (Ts = 0.01 s) of t63.
-#include "pneumid/identify/reaction_curve.hpp"
+#include "pneumid/identify/step/reaction_curve.hpp"
 
 #include <gtest/gtest.h>
 

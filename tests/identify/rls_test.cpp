@@ -1,4 +1,4 @@
-#include "pneumid/identify/rls.hpp"
+#include "pneumid/identify/parametric/rls.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // Static map from staircase and ramp experiments: PAVA against closed forms,
 // recovery of a known S-shaped map through first-order dynamics with noise,
 // and the errors for data from which no map follows.
-#include "pneumid/identify/static_map_fit.hpp"
+#include "pneumid/identify/nonlinear/static_map_fit.hpp"
 
 #include <cmath>
 #include <random>

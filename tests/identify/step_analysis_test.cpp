@@ -1,7 +1,7 @@
 // Preparation shared by the graphical methods: step, baseline, final value,
 // noise, and the refusals of bad data (no step, step too small, not settled,
 // NaN, several steps).
-#include "pneumid/identify/step_analysis.hpp"
+#include "pneumid/identify/step/step_analysis.hpp"
 
 #include <cmath>
 

@@ -3,7 +3,7 @@
 // scipy.signal.step), the accuracy of each against the true plant, and the
 // table of errors in docs/identification.md, printed by
 //   build/pneumid_identify_tests --gtest_filter='StepMethodComparison.*'
-#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/identify/step/step_methods.hpp"
 
 #include <cmath>
 #include <iostream>
@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "step_test_util.hpp"

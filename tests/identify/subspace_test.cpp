@@ -1,4 +1,4 @@
-#include "pneumid/identify/subspace.hpp"
+#include "pneumid/identify/parametric/subspace.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -7,8 +7,8 @@
 
 #include "parametric_test_util.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
-#include "pneumid/identify/initial_state.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/initial_state.hpp"
 #include "pneumid/lti/conversion.hpp"
 
 namespace pneumid {
@@ -28,7 +28,7 @@ TEST_P(SubspaceNoise, RecoversThePaperModelPolesAndGain) {
   SubspaceOptions o;
   o.order = 3;
   const SubspaceResult r = EstimateSubspace(y, u, 0.01, o);
-  ASSERT_EQ(r.summary.termination, EstimationTermination::kConvergence);
+  ASSERT_EQ(r.summary.termination, Termination::kConvergence);
   EXPECT_EQ(r.order, 3);
   EXPECT_EQ(r.model.Ts(), 0.01);
   // Poles 0.95685, -0.17407 +- 0.18062j (docs/paper.md, reference value 2; more digits
@@ -105,7 +105,7 @@ TEST_P(SubspaceWeightings, ExactOnNoiseFreeDataWithFeedthroughAndInitialState) {
   o.feedthrough = true;
   o.weighting = GetParam();
   const SubspaceResult r = EstimateSubspace(y, u, 1.0, o);
-  ASSERT_EQ(r.summary.termination, EstimationTermination::kConvergence) << r.summary.message;
+  ASSERT_EQ(r.summary.termination, Termination::kConvergence) << r.summary.message;
   EXPECT_THAT(r.summary.message, ::testing::HasSubstr(GetParam() == SubspaceWeighting::kMoesp
                                                           ? "PO-MOESP"
                                                           : GetParam() == SubspaceWeighting::kN4sid
@@ -144,7 +144,7 @@ TEST(Subspace, LongStepRecordWithConstantStart) {
     o.weighting = w;
     const SubspaceResult r = EstimateSubspace(y, u, 0.01, o);
     SCOPED_TRACE(ToString(w));
-    ASSERT_EQ(r.summary.termination, EstimationTermination::kConvergence) << r.summary.message;
+    ASSERT_EQ(r.summary.termination, Termination::kConvergence) << r.summary.message;
     ASSERT_TRUE(r.singular_values.allFinite());
     EXPECT_EQ(r.order, 2);
     ASSERT_TRUE(r.model.IsStable());
@@ -187,7 +187,7 @@ TEST_P(SubspaceVsOctave, FitWithinTwoPointsOfOctave) {
     o.feedthrough = true;
     o.weighting = w;
     const SubspaceResult r = EstimateSubspace(y, u, 1.0, o);
-    ASSERT_EQ(r.summary.termination, EstimationTermination::kConvergence);
+    ASSERT_EQ(r.summary.termination, Termination::kConvergence);
     const double fit = NrmseFit(y, SimulateFromState(r.model, u, r.x0).col(0));
     // CVA has no Octave counterpart; it is held to N4SID's value.
     const double octave =

@@ -1,13 +1,13 @@
 // Tests of validation.hpp and residual_analysis.hpp.
-#include "pneumid/identify/validation.hpp"
+#include "pneumid/identify/evaluation/validation.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "parametric_test_util.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/arx.hpp"
-#include "pneumid/identify/residual_analysis.hpp"
+#include "pneumid/identify/parametric/arx.hpp"
+#include "pneumid/identify/evaluation/residual_analysis.hpp"
 
 namespace pneumid {
 namespace {

@@ -110,6 +110,17 @@ TEST(ModelIoTest, TustinOnlyModelsAreReadInDiscreteForm) {
     "discrete": {"num": [0, 0.5], "den": [1, -0.5], "Ts": 0.01, "delay": 0},
     "notes": ["fit by least squares"]})");
   EXPECT_TRUE(ParseModelSpec(exact).IsContinuous());
+  // The typed key says it without a note, and wins over one.
+  const std::string keyed = WriteTemp("keyed.json", R"json({"method": "arx",
+    "tf": {"num": [0.1, 1, 100], "den": [1, 50, 100], "Ts": 0, "delay": 0},
+    "discrete": {"num": [0, 0.5, 0.2], "den": [1, -0.5, 0.2], "Ts": 0.01, "delay": 0},
+    "continuous_form": "tustin", "notes": ["fit by least squares"]})json");
+  EXPECT_TRUE(ParseModelSpec(keyed).IsDiscrete());
+  const std::string zoh = WriteTemp("zoh.json", R"json({"method": "arx",
+    "tf": {"num": [1], "den": [1, 1], "Ts": 0, "delay": 0},
+    "discrete": {"num": [0, 0.5], "den": [1, -0.5], "Ts": 0.01, "delay": 0},
+    "continuous_form": "zoh", "notes": ["continuous form by tustin d2c: an old note"]})json");
+  EXPECT_TRUE(ParseModelSpec(zoh).IsContinuous());
 }
 
 TEST(ModelIoTest, BadSpecsNameTheField) {

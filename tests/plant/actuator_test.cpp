@@ -30,6 +30,11 @@ TEST(ActuatorTest, TheIpaNamesItsSafeStatesAndUnits) {
   const auto position = MakePlant("ipa-position", 0.01);
   EXPECT_EQ(PlantActuator(*position).output.unit, "m");
   EXPECT_EQ(PlantActuator(*position).output_label, "position");
+  // Position integrates the command; force settles at each duty.
+  EXPECT_TRUE(position->actuator().integrating);
+  EXPECT_FALSE(a.integrating);
+  // PlantActuator is the plant's own description.
+  EXPECT_EQ(PlantActuator(*position).input_gaps, position->actuator().input_gaps);
   // The channels of the plant factory are the actuator's.
   EXPECT_EQ(PlantInputChannel(*force).unit, a.input.unit);
   EXPECT_EQ(PlantOutputChannel(*position).unit, "m");
@@ -43,6 +48,8 @@ TEST(ActuatorTest, OtherPlantsAreDescribedGenerically) {
   EXPECT_EQ(a.release_name, "release");
   EXPECT_TRUE(std::isinf(a.u_min) && a.u_min < 0.0);
   EXPECT_TRUE(std::isinf(a.u_max) && a.u_max > 0.0);
+  EXPECT_FALSE(a.integrating);
+  EXPECT_TRUE(linear->actuator().input_gaps.empty());
 }
 
 }  // namespace

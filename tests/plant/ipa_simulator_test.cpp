@@ -14,7 +14,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/csv.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/plant/signal.hpp"
 

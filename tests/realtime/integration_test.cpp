@@ -32,7 +32,7 @@ TEST(Integration, DmcOnTheIpaSimulatorTracks) {
   o.fast = true;
   const LoopSummary s = RunLoop(o, io, dmc, std::vector<double>(200, 80.0), safety, &log);
   log.Close();
-  EXPECT_EQ(s.termination, LoopTermination::kSuccess) << s.message;
+  EXPECT_EQ(s.termination, Termination::kSuccess) << s.message;
   EXPECT_EQ(s.samples, 200);
   ASSERT_EQ(log.records().size(), 200u);
   // 80 N reached by the end (DMC's bias correction removes the offset): the mean over the
@@ -70,7 +70,7 @@ TEST(Integration, SafetyClippedControllerFollowsTheAppliedInput) {
     for (int k = 50; k < 200; ++k) r[k] = 150.0;  // beyond what 100 % duty can hold quickly
     const LoopSummary s = RunLoop(o, io, dmc, r, safety, &log);
     log.Close();
-    ASSERT_EQ(s.termination, LoopTermination::kSuccess) << s.message;
+    ASSERT_EQ(s.termination, Termination::kSuccess) << s.message;
     for (const auto& rec : log.records()) {
       u[limited].push_back(rec.u);
       y[limited].push_back(rec.y);

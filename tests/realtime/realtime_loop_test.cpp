@@ -126,7 +126,7 @@ TEST(RealtimeLoop, FastSimMatchesOfflineSimulationAndLogsEveryRow) {
   const std::vector<double> r(200, 10.0);
   const LoopSummary s = RunLoop(FastOptions(2.0), io, pi, r, safety, &log);
   log.Close(s.timing.BriefReport(), s.message);
-  EXPECT_EQ(s.termination, LoopTermination::kSuccess) << s.message;
+  EXPECT_EQ(s.termination, Termination::kSuccess) << s.message;
   EXPECT_EQ(s.ExitStatus(), 0);
   EXPECT_EQ(s.samples, 200);
   const CsvLog csv = ReadCsvLog(path);
@@ -159,7 +159,7 @@ TEST(RealtimeLoop, RealTimePacingRunsOnePeriodPerSample) {
   so.max_overruns = -1;  // a loaded CI machine must not fail this test
   SafetyMonitor lenient(so);
   const LoopSummary s = RunLoop(o, io, pi, {5.0}, lenient);
-  EXPECT_EQ(s.termination, LoopTermination::kSuccess);
+  EXPECT_EQ(s.termination, Termination::kSuccess);
   EXPECT_EQ(s.samples, 100);
   EXPECT_EQ(s.timing.samples, 100);
   // Absolute sleeps: the last wake-up is at t_0 + 99 Ts or later, the first at t_0 plus its
@@ -220,7 +220,7 @@ TEST_P(FaultInjection, EndsInSafeStateWithCompleteLog) {
   const LoopSummary s = RunLoop(FastOptions(5.0), io, pi, {10.0}, safety, &log);
   log.Close(s.timing.BriefReport(), s.message);
 
-  EXPECT_EQ(s.termination, LoopTermination::kFailure);
+  EXPECT_EQ(s.termination, Termination::kFailure);
   EXPECT_EQ(s.fault, c.expected);
   EXPECT_EQ(s.ExitStatus(), 3);
   EXPECT_EQ(io.safe_calls_, 1);
@@ -286,7 +286,7 @@ TEST(RealtimeLoop, DeadlineOverrunsBeyondTheLimitFault) {
   o.realtime = false;
   const LoopSummary s = RunLoop(o, io, slow, {}, safety, &log);
   log.Close(s.timing.BriefReport(), s.message);
-  EXPECT_EQ(s.termination, LoopTermination::kFailure);
+  EXPECT_EQ(s.termination, Termination::kFailure);
   EXPECT_EQ(s.fault, Fault::kDeadlineOverruns);
   EXPECT_EQ(s.timing.overruns, 6);  // every 3 ms step overruns a 1 ms period
   EXPECT_EQ(s.samples, 6);
@@ -331,7 +331,7 @@ TEST(RealtimeLoop, StopRequestEndsWithSafeStateAndSignalStatus) {
   const LoopSummary s = RunLoop(o, io, pi, {1.0}, safety, nullptr, &status);
   stopper.join();
   ClearStopRequest();
-  EXPECT_EQ(s.termination, LoopTermination::kStopped);
+  EXPECT_EQ(s.termination, Termination::kStopped);
   EXPECT_EQ(s.signal, SIGTERM);
   EXPECT_EQ(s.ExitStatus(), 128 + SIGTERM);
   EXPECT_GE(s.samples, 50);

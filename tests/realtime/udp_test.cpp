@@ -272,7 +272,7 @@ TEST(UdpBackend, ClosedLoopThroughThePlantServerMatchesTheOfflineSimulation) {
   log.Close(s.timing.BriefReport(), s.message);
   srv.reset();
 
-  EXPECT_EQ(s.termination, LoopTermination::kSuccess) << s.message;
+  EXPECT_EQ(s.termination, Termination::kSuccess) << s.message;
   EXPECT_EQ(s.samples, 300);
   EXPECT_EQ(pi.allocations_during_run(), 0);
   const LoggedRun run = ReadLog(path);
@@ -310,7 +310,7 @@ TEST(UdpBackend, LateRepliesAreStaleSamplesThatTheLoopActsOn) {
   log.Close(s.timing.BriefReport(), s.message);
   srv.reset();
 
-  EXPECT_EQ(s.termination, LoopTermination::kSuccess) << s.message;
+  EXPECT_EQ(s.termination, Termination::kSuccess) << s.message;
   const LoggedRun run = ReadLog(path);
   ASSERT_EQ(run.y.size(), 300u);
   const auto stale = std::count(run.stale.begin(), run.stale.end(), true);
@@ -344,7 +344,7 @@ TEST(UdpBackend, SilentServerIsATimeoutWithinMaxMissedPeriods) {
   const LoopSummary s = RunLoop(o, io, pi, {10.0}, safety, &log);
   log.Close(s.timing.BriefReport(), s.message);
   srv.reset();
-  EXPECT_EQ(s.termination, LoopTermination::kFailure);
+  EXPECT_EQ(s.termination, Termination::kFailure);
   EXPECT_EQ(s.fault, Fault::kTimeout);
   // 50 steps answered (samples 0..50 fresh), then 3 missing replies: fault at sample 53.
   EXPECT_EQ(s.samples, 54);

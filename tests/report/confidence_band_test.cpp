@@ -5,8 +5,8 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
-#include "pneumid/identify/model_uncertainty.hpp"
-#include "pneumid/identify/parametric_model.hpp"
+#include "pneumid/identify/evaluation/model_uncertainty.hpp"
+#include "pneumid/identify/parametric/parametric_model.hpp"
 #include "pneumid/report/figures.hpp"
 
 namespace pneumid {

@@ -126,7 +126,7 @@ TEST(HtmlReportTest, SectionsTablesFiguresAndOneRowPerModel) {
   o.commands = {"pneumid report step.csv -m reaction-curve,arx,fit-p1d --output-dir out"};
   const ReportSummary s = WriteIdentificationReport(data, o, OutDir("content").string());
   ASSERT_EQ(s.models.size(), 3u) << s.BriefReport();
-  EXPECT_EQ(s.termination, ReportTermination::kSuccess);
+  EXPECT_EQ(s.termination, Termination::kSuccess);
   EXPECT_TRUE(s.failures.empty());
   const std::string html = ReadFile(s.html_path);
 

@@ -38,7 +38,7 @@ const PaperRow& Row(const std::string& quantity) {
 
 TEST(PaperTest, RunsCompletelyWithThreeFigures) {
   const PaperResult& r = Result();
-  EXPECT_EQ(r.termination, PaperTermination::kSuccess) << ::testing::PrintToString(r.problems);
+  EXPECT_EQ(r.termination, Termination::kSuccess) << ::testing::PrintToString(r.problems);
   ASSERT_EQ(r.figure_names, (std::vector<std::string>{"fig4", "fig5", "fig6"}));
   ASSERT_EQ(r.models.size(), 3u);
   EXPECT_GT(r.rows.size(), 40u);

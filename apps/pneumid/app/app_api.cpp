@@ -16,9 +16,9 @@
 #include "pneumid/common/strings.hpp"
 #include "pneumid/common/version.hpp"
 #include "pneumid/data/load.hpp"
-#include "pneumid/identify/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
-#include "pneumid/identify/model_evaluation.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/lti/frequency.hpp"
 #include "pneumid/lti/model_file_scope.hpp"
 #include "pneumid/lti/model_io.hpp"
@@ -727,7 +727,7 @@ void CheckWork(double Ts, double duration, int P, int M) {
 }  // namespace
 
 nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
-  cli::TuneCli c;
+  cli::TuneArgs c;
   if (!b.contains("model")) throw HttpError(400, "field 'model' is missing");
   c.model = ModelSpec(b["model"]);
   const RemoveWhenDone stored{b["model"].is_object() ? c.model : std::string()};
@@ -758,7 +758,7 @@ nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
 }
 
 nlohmann::ordered_json AppApi::Control(const nlohmann::json& b, const std::atomic<bool>* cancel) {
-  cli::ControlCli c;
+  cli::ControlArgs c;
   c.stop = cancel;
   if (!b.contains("model")) throw HttpError(400, "field 'model' is missing");
   c.model = ModelSpec(b["model"]);
@@ -955,7 +955,7 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
 Response AppApi::RunStart(const nlohmann::json& b) {
   if (run_.Running())
     return ErrorResponse(409, "a real-time run is going on (POST /api/run/stop ends it)");
-  cli::RunOptions o;
+  cli::RunArgs o;
   if (b.contains("model")) o.model = ModelSpec(b["model"]);
   ReadControllerSettings(b, o.controller);
   if (Get(b, "setpoint", o.setpoint)) o.setpoint = SignalSpec(o.setpoint);

@@ -22,7 +22,7 @@ bool LiveRun::Running() const {
   return state_ == "running";
 }
 
-bool LiveRun::Start(cli::RunOptions options, RealtimeConfig config) {
+bool LiveRun::Start(cli::RunArgs options, RealtimeConfig config) {
   {
     std::lock_guard lock(mutex_);
     if (state_ == "running") return false;
@@ -55,8 +55,8 @@ bool LiveRun::Start(cli::RunOptions options, RealtimeConfig config) {
     try {
       const cli::RunOutcome out = cli::RunRealtime(options, config, ring_.get());
       summary = out.json;
-      state = out.summary.termination == LoopTermination::kSuccess   ? "finished"
-              : out.summary.termination == LoopTermination::kStopped ? "stopped"
+      state = out.summary.termination == Termination::kSuccess   ? "finished"
+              : out.summary.termination == Termination::kStopped ? "stopped"
                                                                      : "failed";
     } catch (const std::exception& e) {
       state = "failed";

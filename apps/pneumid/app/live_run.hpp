@@ -35,7 +35,7 @@ class LiveRun {
 
   /// Starts a run of `options` (its log path is set here) with `config`.
   /// @returns false when a run is going on (nothing started).
-  bool Start(cli::RunOptions options, RealtimeConfig config);
+  bool Start(cli::RunArgs options, RealtimeConfig config);
 
   /// True while a run is going on.
   bool Running() const;

@@ -21,8 +21,8 @@
 #include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/data/preprocess.hpp"
-#include "pneumid/identify/narx.hpp"
-#include "pneumid/identify/subspace.hpp"
+#include "pneumid/identify/nonlinear/narx.hpp"
+#include "pneumid/identify/parametric/subspace.hpp"
 #include "pneumid/lti/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
@@ -102,6 +102,19 @@ struct ParameterCovariance {
   Eigen::MatrixXd matrix;          ///< covariance, in squared units of the parameters
 };
 
+/// How an identified discrete model's continuous form `tf` was obtained:
+///  - kZoh: the exact zero-order-hold equivalent (matrix logarithm, D2C);
+///  - kTustin: no zoh equivalent exists (a pole on the negative real axis),
+///    `tf` is the bilinear approximation and the model is used in its
+///    discrete form (model_io.hpp);
+///  - kNone: neither exists, `tf` is the discrete model itself.
+/// Written "zoh", "tustin", "none" (model file key "continuous_form").
+enum class ContinuousForm { kZoh, kTustin, kNone };
+/// "zoh", "tustin", "none".
+std::string ToString(ContinuousForm form);
+/// Parses the names of ToString; @throws InvalidArgument naming the valid ones.
+ContinuousForm ContinuousFormFromString(const std::string& name);
+
 /// A model from one identification method: its parameters, transfer function,
 /// operating point, fit on the data and the reasons not to trust it.
 struct IdentifiedModel {
@@ -111,6 +124,8 @@ struct IdentifiedModel {
   ModelParams param_std;  ///< standard deviations when known (same names as params)
   TransferFunction tf;    ///< model usable by the rest of the toolkit (continuous if possible)
   std::optional<TransferFunction> discrete;  ///< discrete form of polynomial models
+  /// How `tf` derives from `discrete` (models estimated in discrete time only).
+  std::optional<ContinuousForm> continuous_form;
   double fit_percent = 0.0;  ///< NRMSE fit, MATLAB compare: 100 (1 - |y - yhat| / |y - mean y|)
   double iae = 0.0;          ///< integral of |y - yhat| dt over the data (output units * s)
   std::vector<std::string> notes;  ///< warnings (poor excitation, not converged, ...)

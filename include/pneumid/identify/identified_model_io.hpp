@@ -22,6 +22,9 @@
 // integers), arrays and arrays of arrays, in the order of their names.
 #pragma once
 
+#include <optional>
+#include <string>
+
 #include <nlohmann/json.hpp>
 
 #include "pneumid/identify/identified_model.hpp"
@@ -43,5 +46,14 @@ nlohmann::json ToJson(const IdentifiedModel& model);
 /// Inverse of ToJson(const IdentifiedModel&).
 /// @throws InvalidArgument naming the key that is missing or malformed.
 IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j);
+
+/// The identified model a file spec FILE.json[#method] names (written by
+/// `pneumid identify -o` or `--json`; the first model without #method), read
+/// through lti's model file reader (ReadModelEntry: once per ModelFileScope).
+/// std::nullopt when the spec is no JSON file name (built-in and inline
+/// specs) or the entry is a plain transfer function {"num", "den", ...}.
+/// @throws DataError naming the file for a missing or unreadable file,
+///         invalid JSON, a selection that names no model or an invalid model.
+std::optional<IdentifiedModel> LoadIdentifiedModel(const std::string& spec);
 
 }  // namespace pneumid

@@ -25,9 +25,9 @@
 #include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/identified_model.hpp"
-#include "pneumid/identify/model_evaluation.hpp"
-#include "pneumid/identify/nonlinear.hpp"
-#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
+#include "pneumid/identify/step/step_methods.hpp"
 
 namespace pneumid {
 

@@ -61,6 +61,17 @@ struct NarxWithMap {
 /// @throws DataError naming the file for an unreadable file or an invalid model.
 std::optional<NarxWithMap> ParseModelNarx(const std::string& spec);
 
+/// The JSON object of the model a file spec FILE[#method] names: the file's
+/// model, or the entry of its "models" list that #method selects (the first
+/// without one), as every reader of this header selects it; `path` (may be
+/// null) receives FILE. Read through the current ModelFileScope (once per
+/// scope). std::nullopt when the spec names no regular file (built-in and
+/// inline specs). The one reader of model files: the identify area reads its
+/// models through it (identified_model_io.hpp, LoadIdentifiedModel).
+/// @throws DataError naming the file for an unreadable file, invalid JSON or
+///         a selection that names no model.
+std::optional<nlohmann::json> ReadModelEntry(const std::string& spec, std::string* path = nullptr);
+
 /// {"num", "den", "Ts", "delay"} with a monic denominator.
 nlohmann::json ToJson(const TransferFunction& g);
 /// Inverse of ToJson; throws InvalidArgument naming the missing/invalid key.

@@ -53,6 +53,10 @@ struct Actuator {
   /// pwm_frequency % act as 0 and those as far below 100 % act as 100 %);
   /// empty = none known. control/duty_modulator.hpp modulates across them.
   std::vector<InputGap> input_gaps;
+  /// The output integrates the input (a positioning drive): no steady state at
+  /// a constant non-zero input and no static gain, so experiments and designs
+  /// that need one (commissioning's step probe) take another route.
+  bool integrating = false;
   /// The plant's names and meanings of the hold and release safe states.
   std::string hold_name = "hold";
   /// What the hold state does, for logs and messages.
@@ -67,9 +71,10 @@ struct Actuator {
 /// force mode, position (m) in position mode.
 Actuator IpaActuator(IpaMode mode = IpaMode::kForce);
 
-/// The actuator of a plant: IpaActuator for the IPA simulator (in position
-/// mode with the output range 0..stroke), the generic description (u, y
-/// without units, unbounded, hold/release) otherwise.
+/// The actuator of a plant, plant.actuator(): IpaActuator for the IPA
+/// simulator (in position mode with the output range 0..stroke, integrating),
+/// the generic description (u, y without units, unbounded, hold/release)
+/// for a plant that gives none.
 Actuator PlantActuator(const Plant& plant);
 
 /// Checks set-points r (sampled every Ts s from t = 0) against the actuator's

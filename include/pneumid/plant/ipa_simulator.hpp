@@ -286,6 +286,9 @@ class IpaSimulator final : public Plant {
   /// "x [m]" and "v [m/s]".
   std::map<std::string, double> Extras() const override;
   std::string Describe() const override;
+  /// IpaActuator(mode) with the valves' input gaps (and, in position mode,
+  /// the output range 0..stroke); plant/actuator.hpp.
+  Actuator actuator() const override;
 
   /// Sets the true state now: chamber pressures p_a, p_b (Pa absolute) and,
   /// in position mode, piston position x (m, within the stroke) at rest. The

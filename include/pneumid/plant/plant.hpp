@@ -15,6 +15,8 @@
 
 namespace pneumid {
 
+struct Actuator;  // plant/actuator.hpp
+
 /// A sampled plant: Measure() the output, then Advance(u) one period (protocol above).
 class Plant {
  public:
@@ -38,6 +40,11 @@ class Plant {
   virtual std::map<std::string, double> Extras() const { return {}; }
   /// Short description for logs, e.g. "ipa (force mode, pwm 50 Hz)".
   virtual std::string Describe() const = 0;
+  /// What drives the plant: its input and output signals and ranges, the
+  /// inputs it cannot hold, whether its output integrates its input, and its
+  /// safe states (plant/actuator.hpp). The generic description (u, y without
+  /// units, unbounded, hold/release) unless the plant knows better.
+  virtual Actuator actuator() const;
 
  protected:
   double load_disturbance_ = 0.0;

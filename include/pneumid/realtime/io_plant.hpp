@@ -47,7 +47,7 @@ class IoPlant : public Plant {
   /// "io: " + the backend's description.
   std::string Describe() const override;
   /// The backend's actuator (channels, input range, safe states).
-  Actuator actuator() const { return backend_->actuator(); }
+  Actuator actuator() const override { return backend_->actuator(); }
   /// Status of the last Read or Write.
   IoStatus last_status() const { return status_; }
   /// Drives the actuator to `state` (best effort, as the backend's EnterSafeState).

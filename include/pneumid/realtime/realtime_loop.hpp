@@ -81,15 +81,14 @@ struct LoopOptions {
   std::int64_t Samples() const;
 };
 
-/// kSuccess (all samples run), kStopped (SIGINT/SIGTERM or RequestStop()) or
-/// kFailure (a safety fault, named in LoopSummary::fault; outputs in the safe
-/// state). Written "success", "stopped", "failure" (common/termination.hpp;
-/// earlier versions wrote "completed" and "fault").
-using LoopTermination = Termination;
+// Termination here: kSuccess (all samples run), kStopped (SIGINT/SIGTERM or RequestStop()) or
+// kFailure (a safety fault, named in LoopSummary::fault; outputs in the safe
+// state). Written "success", "stopped", "failure" (common/termination.hpp;
+// earlier versions wrote "completed" and "fault").
 
 /// How a run of RunLoop ended, with its timing statistics.
 struct LoopSummary {
-  LoopTermination termination = LoopTermination::kSuccess;  ///< success, stopped or failure
+  Termination termination = Termination::kSuccess;  ///< success, stopped or failure
   Fault fault = Fault::kNone;  ///< the safety fault that ended the run (kNone: none)
   int signal = 0;              ///< signal number when stopped by a signal
   std::string message;         ///< what happened, e.g. "sensor-nan at t = 1.230 s (sample 123) ..."

@@ -10,7 +10,7 @@
 //   ClosedLoopFigure         set-point, outputs and inputs of closed-loop runs (Fig. 6)
 //
 // Model simulations against data use deviation variables (SimulateOnData of
-// pneumid/identify/step_methods.hpp): the model is driven by u(t) - u(0) and
+// pneumid/identify/step/step_methods.hpp): the model is driven by u(t) - u(0) and
 // its output is added to the pre-step output level, which is how a model
 // identified from a step test is compared with the test it came from.
 //
@@ -32,7 +32,7 @@
 #include <Eigen/Core>
 
 #include "pneumid/data/dataset.hpp"
-#include "pneumid/identify/step_methods.hpp"
+#include "pneumid/identify/step/step_methods.hpp"
 #include "pneumid/lti/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 #include "pneumid/report/plot.hpp"

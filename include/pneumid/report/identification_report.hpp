@@ -58,15 +58,14 @@ struct ReportOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// kSuccess, kPartial or kFailure ("success", "partial", "failure";
-/// common/termination.hpp).
-using ReportTermination = Termination;
+// Termination here: kSuccess, kPartial or kFailure ("success", "partial", "failure";
+// common/termination.hpp).
 
 /// What WriteIdentificationReport produced.
 struct ReportSummary {
   /// kSuccess: every method gave a model; kPartial: some failed;
   /// kFailure: none did (the report is still written, listing the errors).
-  ReportTermination termination = ReportTermination::kSuccess;
+  Termination termination = Termination::kSuccess;
   std::string message;                  ///< e.g. "2 of 3 methods failed"
   std::vector<IdentifiedModel> models;  ///< the models identified, ranked best first
   std::vector<std::pair<std::string, std::string>> failures;  ///< method, error

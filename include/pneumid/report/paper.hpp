@@ -80,14 +80,13 @@ struct PaperRow {
   std::string note;      ///< empty when they agree; otherwise why they differ
 };
 
-/// kSuccess or kPartial ("success", "partial"; common/termination.hpp).
-using PaperTermination = Termination;
+// Termination here: kSuccess or kPartial ("success", "partial"; common/termination.hpp).
 
 /// Everything RunPaper obtained: the comparison rows, data, models and figures.
 struct PaperResult {
   /// kPartial when a step failed numerically (listed in `problems`); the
   /// rows that could be computed are still filled.
-  PaperTermination termination = PaperTermination::kSuccess;
+  Termination termination = Termination::kSuccess;
   std::vector<std::string> problems;      ///< steps that failed, with their error
   std::vector<PaperRow> rows;             ///< the side-by-side table, in workflow order
   Dataset step_test;                      ///< the simulated step test (duty %, force N)

@@ -1,0 +1,536 @@
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include <fmt/format.h>
+#include <Eigen/Dense>
+
+#include "pneumid/common/check.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
+#include "pneumid/identify/evaluation/validation.hpp"
+#include "pneumid/lti/conversion.hpp"
+#include "pneumid/lti/response.hpp"
+
+namespace pneumid {
+
+namespace {
+
+std::string Values(const std::vector<double>& v) {
+  std::vector<std::string> s;
+  for (double x : v) s.push_back(fmt::format("{:.4g}", x));
+  return fmt::format("[{}]", fmt::join(s, " "));
+}
+
+// "input map: monotone increasing, ...; u = [...]; y = [...]".
+std::string MapNote(const char* which, const StaticMap& f) {
+  const auto [lo, hi] = std::minmax_element(f.y().begin(), f.y().end());
+  // Flat within 0.5 % of the output range counts as dead zone / saturation.
+  return fmt::format("{}: {}; u = {}; y = {}", which, f.Describe(0.005 * (*hi - *lo)),
+                     Values(f.u()), Values(f.y()));
+}
+
+void SetLinearPart(const PolynomialModel& g, IdentifiedModel* m) {
+  m->discrete = g.ToTransferFunction(0);
+  try {
+    m->tf = D2C(*m->discrete, DiscretizationMethod::kZoh);
+  } catch (const InvalidArgument& e) {
+    m->tf = *m->discrete;
+    m->notes.push_back(std::string("no continuous (zoh d2c) form of the linear part: ") + e.what());
+  }
+  const auto a = g.a, b = g.b[0];
+  m->params = {{"A", std::vector<double>(a.data(), a.data() + a.size())},
+               {"B", std::vector<double>(b.data(), b.data() + b.size())},
+               {"nk", g.nk[0]},
+               {"Ts", g.Ts}};
+}
+
+BlockModelOptions BlockOptions(const IdentifyRequest& request, const NonlinearOptions& options) {
+  BlockModelOptions o = options.block;
+  o.na = request.na;
+  o.nb = std::max(1, request.nb);
+  o.nk = request.nk;
+  return o;
+}
+
+void AddSummary(const EstimationSummary& s, IdentifiedModel* m) {
+  m->termination = s.termination;
+  m->notes.push_back(
+      fmt::format("{} ({} iterations, mean squared simulation error {:.4g}, "
+                  "from {:.4g})",
+                  s.message, s.iterations, s.loss, s.initial_loss));
+  for (const std::string& w : s.warnings) m->notes.push_back(w);
+}
+
+}  // namespace
+
+bool NonlinearOptions::IsValid(std::string* error) const {
+  BlockModelOptions b = block;
+  b.na = 0;  // orders come from the request
+  b.nb = 1;
+  b.nk = 0;
+  NarxOptions n = narx;
+  n.ny = 0;
+  n.nu = 1;
+  n.nk = 0;
+  if (!(structure_split > 0.0 && structure_split < 1.0)) {
+    if (error)
+      *error = fmt::format("NonlinearOptions::structure_split must be in (0, 1), got {}",
+                           structure_split);
+    return false;
+  }
+  if (max_narx_lag < 1 || max_narx_terms < 1) {
+    if (error)
+      *error = fmt::format(
+          "NonlinearOptions: max_narx_lag and max_narx_terms must be >= 1, got {} and {}",
+          max_narx_lag, max_narx_terms);
+    return false;
+  }
+  if (max_delay < 0 || max_delay > 1000) {
+    if (error)
+      *error = fmt::format("NonlinearOptions::max_delay must be in 0..1000, got {}", max_delay);
+    return false;
+  }
+  return static_map.IsValid(error) && b.IsValid(error) && n.IsValid(error);
+}
+
+const std::vector<std::string>& NonlinearMethodNames() {
+  static const std::vector<std::string> names = {"static-map", "hammerstein", "wiener",
+                                                 "hw",         "narx",        "affine-narx"};
+  return names;
+}
+
+bool IsNonlinearMethod(const std::string& name) {
+  const auto& n = NonlinearMethodNames();
+  return std::find(n.begin(), n.end(), name) != n.end();
+}
+
+bool IsNonlinearModel(const IdentifiedModel& model) {
+  return model.input_map.has_value() || model.output_map.has_value() || model.narx.has_value();
+}
+
+namespace {
+
+bool IsBlockMethod(const std::string& method) {
+  return method == "hammerstein" || method == "wiener" || method == "hw";
+}
+
+// The NARX part of ChooseBlockStructure (see nonlinear.hpp): `tail` is the
+// held-out record, simulated from its own first outputs.
+StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& tail,
+                                    const IdentifyRequest& request, const NonlinearOptions& options,
+                                    StructureChoice out) {
+  const Eigen::VectorXd ue = estimation.u(request.input), ye = estimation.y(request.output);
+  const Eigen::VectorXd uv = tail.u(request.input), yv = tail.y(request.output);
+  const double Ts = estimation.SampleTime();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int nk = 0; nk <= std::min(1, options.max_delay); ++nk) {
+    for (int lag = 1; lag <= options.max_narx_lag; ++lag) {
+      NarxOptions no = options.narx;
+      no.ny = lag;
+      no.nu = lag;
+      no.nk = nk;
+      no.max_terms = options.max_narx_terms;
+      try {
+        const NarxModel full = EstimateNarx(ue, ye, Ts, no).model;
+        const Eigen::Index n0 = full.FirstSample(), rows = ye.size() - n0;
+        const auto K = static_cast<Eigen::Index>(full.terms.size());
+        PNEUMID_CHECK(yv.size() > n0 + 2, "the held-out part has {} samples, {} start a simulation",
+                      yv.size(), n0);
+        Eigen::MatrixXd S(rows, K);
+        for (Eigen::Index i = 0; i < K; ++i)
+          for (Eigen::Index r = 0; r < rows; ++r)
+            S(r, i) = full.TermValue(full.terms[static_cast<std::size_t>(i)], r + n0, ye, ue);
+        const Eigen::VectorXd target = ye.tail(rows) / full.y_scale;
+        // Prefixes of 1, 2, .., 10 terms, then every 5th.
+        for (Eigen::Index k = std::min<Eigen::Index>(1, K);;
+             k = std::min(K, k + (k < 10 ? 1 : 5))) {
+          NarxModel pm = full;
+          pm.terms.resize(static_cast<std::size_t>(k));
+          pm.err.resize(static_cast<std::size_t>(k));
+          const Eigen::VectorXd theta = S.leftCols(k).colPivHouseholderQr().solve(target);
+          pm.theta.assign(theta.data(), theta.data() + k);
+          const Eigen::VectorXd sim = pm.Simulate(uv, yv);
+          const Eigen::Index nv = yv.size() - n0;
+          double fit = -inf;
+          if (sim.allFinite()) fit = NrmseFit(yv.tail(nv).eval(), sim.tail(nv).eval());
+          if (!std::isfinite(fit)) fit = -inf;
+          out.candidates.push_back({lag, lag, nk, static_cast<int>(k), fit, -inf, ""});
+          if (k == K) break;
+        }
+      } catch (const std::exception& e) {
+        out.candidates.push_back({lag, lag, nk, 0, -inf, -inf, e.what()});
+      }
+    }
+  }
+  double best = -inf;
+  for (const StructureCandidate& c : out.candidates) best = std::max(best, c.fit_percent);
+  PNEUMID_CHECK(std::isfinite(best), "narx: no structure could be estimated ({})",
+                out.candidates.front().error);
+  const StructureCandidate* pick = nullptr;
+  for (const StructureCandidate& c : out.candidates) {
+    if (!(c.fit_percent >= best - 0.1)) continue;
+    if (pick == nullptr || c.terms < pick->terms || (c.terms == pick->terms && c.na < pick->na))
+      pick = &c;
+  }
+  out.na = pick->na;
+  out.nb = pick->nb;
+  out.nk = pick->nk;
+  out.terms = pick->terms;
+  out.fit_percent = pick->fit_percent;
+  return out;
+}
+
+}  // namespace
+
+std::string StructureChoice::Describe() const {
+  if (terms > 0) {
+    std::vector<std::string> tried;
+    for (const StructureCandidate& c : candidates)
+      if (std::isfinite(c.fit_percent))
+        tried.push_back(fmt::format("{} {} {}: {:.2f}", c.na, c.nk, c.terms, c.fit_percent));
+    return fmt::format(
+        "ny = nu = {}, nk = {}, {} terms (held-out simulation fit {:.2f} % on {}); tried (lags nk "
+        "terms: held-out fit %): {}",
+        na, nk, terms, fit_percent, held_out, fmt::join(tried, ", "));
+  }
+  std::vector<std::string> tried;
+  for (const StructureCandidate& c : candidates)
+    tried.push_back(std::isfinite(c.fit_percent)
+                        ? fmt::format("{} {} {}: {:.2f} / {:.2f}", c.na, c.nb, c.nk,
+                                      c.record_fit_percent, c.fit_percent)
+                        : fmt::format("{} {} {}: failed", c.na, c.nb, c.nk));
+  return fmt::format(
+      "na = {}, nb = {}, nk = {} (held-out simulation fit {:.2f} % on {}); tried (na nb nk: "
+      "estimation / held-out fit %): {}",
+      na, nb, nk, fit_percent, held_out, fmt::join(tried, ", "));
+}
+
+StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& data,
+                                     const IdentifyRequest& request,
+                                     const NonlinearOptions& options, const Dataset* held_out) {
+  PNEUMID_CHECK(IsBlockMethod(method) || method == "narx",
+                "the structure search is for hammerstein, wiener, hw and narx, got '{}'", method);
+  std::string why;
+  PNEUMID_CHECK(options.IsValid(&why), "{}", why);
+  data.RequireUniform();
+  StructureChoice out;
+  std::optional<Dataset> head;
+  const Dataset* scored = held_out;
+  Eigen::Index score_from = 0;
+  if (held_out == nullptr) {
+    auto parts = SplitDataset(data, options.structure_split);
+    PNEUMID_CHECK(parts.first.size() >= 20 && parts.second.size() >= 10,
+                  "{}: {} samples are too few to choose the structure on held-out data (a split "
+                  "at {:g} leaves {} to estimate and {} to validate); give the orders "
+                  "(--na, --nb, --nk) or more data",
+                  method, data.size(), options.structure_split, parts.first.size(),
+                  parts.second.size());
+    const auto range = [](const Eigen::VectorXd& v) { return v.maxCoeff() - v.minCoeff(); };
+    PNEUMID_CHECK(range(parts.second.u(request.input)) > 0.0,
+                  "{}: the held-out last {:.0f} % of the data hold a constant input (no "
+                  "excitation to choose the structure on); give the orders (--na, --nb, --nk), "
+                  "another --split or --validation data",
+                  method, 100.0 * (1.0 - options.structure_split));
+    head.emplace(std::move(parts.first));
+    scored = &data;
+    score_from = head->size();
+    out.held_out =
+        fmt::format("the last {:.0f} % of the data", 100.0 * (1.0 - options.structure_split));
+  } else {
+    out.held_out = held_out->source().empty() ? "the validation data" : held_out->source();
+  }
+  const Dataset& estimation = head ? *head : data;
+  if (method == "narx")
+    return ChooseNarxStructure(estimation,
+                               held_out ? *held_out : SliceDataset(data, score_from, data.size()),
+                               request, options, std::move(out));
+  NonlinearOptions fixed = options;
+  fixed.choose_structure = false;
+  auto try_one = [&](int na, int nb, int nk) {
+    StructureCandidate c{na,
+                         nb,
+                         nk,
+                         0,
+                         -std::numeric_limits<double>::infinity(),
+                         -std::numeric_limits<double>::infinity(),
+                         ""};
+    try {
+      IdentifyRequest r = request;
+      r.na = na;
+      r.nb = nb;
+      r.nk = nk;
+      const IdentifiedModel m = IdentifyNonlinear(method, estimation, r, fixed);
+      const Eigen::VectorXd yhat =
+          SimulateModel(m, *scored, request.input, request.output, InitialCondition::kEstimate);
+      const double fit = ScoreSimulation(*scored, request.output, yhat, score_from).fit_percent;
+      if (std::isfinite(fit)) c.fit_percent = fit;
+      if (std::isfinite(m.fit_percent)) c.record_fit_percent = m.fit_percent;
+    } catch (const std::exception& e) {
+      c.error = e.what();
+    }
+    out.candidates.push_back(c);
+    return c.record_fit_percent;
+  };
+  // 1. The delay with first-order dynamics: candidates of equal size, so the
+  //    fit on the estimation part decides (a held-out part is dominated by
+  //    the map between the levels it adds, not by the delay).
+  int best_nk = 0;
+  double best = -std::numeric_limits<double>::infinity();
+  for (int nk = 0; nk <= options.max_delay; ++nk) {
+    const double f = try_one(1, 1, nk);
+    if (f > best) {
+      best = f;
+      best_nk = nk;
+    }
+  }
+  best = -std::numeric_limits<double>::infinity();
+  // 2. The orders with that delay.
+  for (int na = 1; na <= 3; ++na)
+    for (int nb = 1; nb <= 3; ++nb)
+      if (na > 1 || nb > 1) try_one(na, nb, best_nk);
+  // 3. The most parsimonious within 0.1 point of the best held-out fit, among
+  //    the candidates with the chosen delay.
+  for (const StructureCandidate& c : out.candidates)
+    if (c.nk == best_nk) best = std::max(best, c.fit_percent);
+  PNEUMID_CHECK(std::isfinite(best), "{}: no structure could be estimated ({})", method,
+                out.candidates.front().error);
+  const StructureCandidate* pick = nullptr;
+  for (const StructureCandidate& c : out.candidates) {
+    if (c.nk != best_nk || !(c.fit_percent >= best - 0.1)) continue;
+    if (pick == nullptr || c.na + c.nb < pick->na + pick->nb ||
+        (c.na + c.nb == pick->na + pick->nb && c.na < pick->na))
+      pick = &c;
+  }
+  out.na = pick->na;
+  out.nb = pick->nb;
+  out.nk = pick->nk;
+  out.fit_percent = pick->fit_percent;
+  return out;
+}
+
+IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data,
+                                  const IdentifyRequest& request, const NonlinearOptions& options,
+                                  const Dataset* held_out) {
+  if (options.choose_structure && (IsBlockMethod(method) || method == "narx")) {
+    StructureChoice c;
+    try {
+      c = ChooseBlockStructure(method, data, request, options, held_out);
+    } catch (const InvalidArgument& e) {
+      // No held-out part to choose on (too short, no excitation): the
+      // request's orders, and a note that says why.
+      NonlinearOptions o = options;
+      o.choose_structure = false;
+      IdentifiedModel m = IdentifyNonlinear(method, data, request, o);
+      m.notes.insert(m.notes.begin(),
+                     fmt::format("warning: structure not chosen on held-out data ({}); the default "
+                                 "orders na = {}, nb = {}, nk = {} are used",
+                                 e.what(), request.na, request.nb, request.nk));
+      return m;
+    }
+    IdentifyRequest r = request;
+    r.na = c.na;
+    r.nb = c.nb;
+    r.nk = c.nk;
+    NonlinearOptions o = options;
+    o.choose_structure = false;
+    if (c.terms > 0) o.narx.max_terms = c.terms;
+    IdentifiedModel m = IdentifyNonlinear(method, data, r, o);
+    if (!std::isfinite(m.fit_percent) && held_out == nullptr) {
+      // The refit on all the data does not simulate: keep the model the
+      // search scored, estimated on the first part, scored on all the data.
+      IdentifiedModel part =
+          IdentifyNonlinear(method, SplitDataset(data, options.structure_split).first, r, o);
+      ScoreModel(data, request.input, request.output, &part);
+      if (std::isfinite(part.fit_percent)) {
+        part.notes.insert(part.notes.begin(),
+                          fmt::format("the refit on all the data does not simulate (not "
+                                      "finite): the model estimated on the first {:.0f} % is kept",
+                                      100.0 * options.structure_split));
+        m = std::move(part);
+      }
+    }
+    m.notes.insert(m.notes.begin(), "structure chosen on held-out data: " + c.Describe());
+    return m;
+  }
+  std::string why;
+  PNEUMID_CHECK(IsNonlinearMethod(method), "unknown nonlinear method '{}' (valid: {})", method,
+                fmt::join(NonlinearMethodNames(), ", "));
+  PNEUMID_CHECK(request.IsValid(&why), "invalid identify request: {}", why);
+  PNEUMID_CHECK(options.IsValid(&why), "{}", why);
+  PNEUMID_CHECK(request.input >= 0 && request.input < data.num_inputs() && request.output >= 0 &&
+                    request.output < data.num_outputs(),
+                "input column {} / output column {} do not exist (the data have {} input(s) and "
+                "{} output(s))",
+                request.input, request.output, data.num_inputs(), data.num_outputs());
+  data.RequireUniform();
+  const Eigen::VectorXd u = data.u(request.input), y = data.y(request.output);
+  const double Ts = data.SampleTime();
+  IdentifiedModel m;
+  m.method = method;
+  if (method == "static-map") {
+    const StaticMapFitResult r = FitStaticMap(u, y, Ts, options.static_map);
+    m.structure = "static map";
+    m.input_map = r.map;
+    m.discrete = TransferFunction::Discrete({1.0}, {1.0}, Ts);
+    m.tf = TransferFunction();
+    m.params = {{"knots", static_cast<int>(r.map.size())},
+                {"segments", r.summary.segments_used},
+                {"Ts", Ts}};
+    m.termination = r.summary.termination;
+    m.notes.push_back(MapNote("map", r.map));
+    m.notes.push_back(r.summary.BriefReport());
+  } else if (method == "hammerstein" || method == "wiener") {
+    const BlockModelOptions o = BlockOptions(request, options);
+    const bool hammerstein = method == "hammerstein";
+    const BlockModelResult r =
+        hammerstein ? EstimateHammerstein(u, y, Ts, o) : EstimateWiener(u, y, Ts, o);
+    m.structure = hammerstein ? "Hammerstein" : "Wiener";
+    (hammerstein ? m.input_map : m.output_map) = r.map;
+    SetLinearPart(r.linear, &m);
+    m.notes.push_back(MapNote(hammerstein ? "input map f(u)" : "output map f(x)", r.map));
+    AddSummary(r.summary, &m);
+  } else if (method == "hw") {
+    const BlockModelResult r = EstimateHammersteinWiener(u, y, Ts, BlockOptions(request, options));
+    m.structure = "Hammerstein-Wiener";
+    m.input_map = r.map;
+    m.output_map = r.output_map;
+    SetLinearPart(r.linear, &m);
+    m.notes.push_back(MapNote("input map f(u)", r.map));
+    m.notes.push_back(MapNote("output map g(x)", *r.output_map));
+    AddSummary(r.summary, &m);
+  } else if (method == "affine-narx") {
+    AffineNarxOptions o;
+    o.degree = options.narx.degree;
+    o.nk = request.nk;
+    o.knots = options.block.knots;
+    o.num_knots = options.block.num_knots;
+    const AffineNarxResult r = EstimateAffineNarx(u, y, Ts, o);
+    m.structure = "input-affine NARX";
+    m.narx = r.narx;
+    m.input_map = r.map;
+    m.discrete = TransferFunction::Discrete({1.0}, {1.0}, Ts);
+    m.tf = TransferFunction();
+    m.params = {
+        {"degree", o.degree}, {"nk", o.nk}, {"knots", static_cast<int>(r.map.size())}, {"Ts", Ts}};
+    m.notes.push_back(MapNote("input map f(u)", r.map));
+    m.notes.push_back(r.narx.Equation() + " (u: the mapped input f(u))");
+    m.notes.push_back(fmt::format("{}; one-step fit {:.2f} %, simulation fit {:.2f} %",
+                                  r.summary.message, r.one_step_fit_percent,
+                                  r.simulation_fit_percent));
+    for (const std::string& w : r.summary.warnings) m.notes.push_back(w);
+    m.termination = r.summary.termination;
+  } else {  // narx
+    NarxOptions o = options.narx;
+    o.ny = request.na;
+    o.nu = std::max(1, request.nb);
+    o.nk = request.nk;
+    const NarxResult r = EstimateNarx(u, y, Ts, o);
+    m.structure = "NARX";
+    m.narx = r.model;
+    m.discrete = TransferFunction::Discrete({1.0}, {1.0}, Ts);
+    m.tf = TransferFunction();
+    m.params = {{"ny", o.ny},
+                {"nu", o.nu},
+                {"nk", o.nk},
+                {"degree", o.degree},
+                {"terms", static_cast<int>(r.model.terms.size())},
+                {"Ts", Ts}};
+    std::vector<std::string> terms;
+    for (std::size_t i = 0; i < r.model.terms.size(); ++i)
+      terms.push_back(
+          fmt::format("{} (ERR {:.4g})", r.model.TermName(r.model.terms[i]), r.model.err[i]));
+    m.notes.push_back(fmt::format("selected terms: {}", fmt::join(terms, ", ")));
+    m.notes.push_back(r.model.Equation());
+    m.notes.push_back(fmt::format("{}; one-step fit {:.2f} %, simulation fit {:.2f} %",
+                                  r.summary.message, r.one_step_fit_percent,
+                                  r.simulation_fit_percent));
+    for (const std::string& w : r.summary.warnings) m.notes.push_back(w);
+    m.termination = r.summary.termination;
+  }
+  if (m.input_map)
+    for (const MapGap& gap : FindMapGaps(*m.input_map, u))
+      m.notes.push_back("input map: " + gap.Describe());
+  ScoreModel(data, request.input, request.output, &m);
+  return m;
+}
+
+std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, const Dataset& data,
+                                               int input) {
+  std::vector<std::string> w;
+  if (!model.input_map || input < 0 || input >= data.num_inputs() || data.size() == 0) return w;
+  const Eigen::VectorXd u = data.u(input);
+  const double c1 = model.input_map->u().front(), cm = model.input_map->u().back();
+  const double margin = 0.05 * (cm - c1);
+  const double lo = u.minCoeff(), hi = u.maxCoeff();
+  if (lo < c1 - margin || hi > cm + margin) {
+    const Eigen::Index outside = (u.array() < c1 - margin || u.array() > cm + margin).count();
+    w.push_back(fmt::format(
+        "the input reaches [{:g}, {:g}], beyond the input map's range [{:g}, {:g}] that the "
+        "model{} was estimated on ({} of {} samples more than 5 % of that range outside): the "
+        "map is held at its end values there, an extrapolation the data do not support",
+        lo, hi, c1, cm, model.method.empty() ? "" : " '" + model.method + "'", outside, u.size()));
+  }
+  return w;
+}
+
+Eigen::VectorXd SimulateNonlinear(const IdentifiedModel& model, const Dataset& data, int input,
+                                  int output) {
+  PNEUMID_CHECK(IsNonlinearModel(model), "the model{} has no nonlinear part",
+                model.method.empty() ? "" : " '" + model.method + "'");
+  PNEUMID_CHECK(input >= 0 && input < data.num_inputs(),
+                "input column {} does not exist (the data have {} input(s))", input,
+                data.num_inputs());
+  const double Ts = data.SampleTime();
+  const double model_Ts = model.narx ? model.narx->Ts : model.discrete ? model.discrete->Ts() : Ts;
+  PNEUMID_CHECK(std::abs(model_Ts - Ts) <= 1e-6 * Ts,
+                "the model{} has sample time {} s, the data{} {} s",
+                model.method.empty() ? "" : " '" + model.method + "'", model_Ts,
+                data.source().empty() ? "" : " of " + data.source(), Ts);
+  const Eigen::VectorXd u = data.u(input);
+  if (model.narx) {
+    PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
+                  "a NARX simulation starts from the measured output: output column {} does "
+                  "not exist (the data have {} output(s))",
+                  output, data.num_outputs());
+    // affine-narx: the NARX runs on the mapped input f(u).
+    if (model.input_map) return model.narx->Simulate(model.input_map->Evaluate(u), data.y(output));
+    return model.narx->Simulate(u, data.y(output));
+  }
+  PNEUMID_CHECK(model.discrete.has_value(),
+                "the block-oriented model{} has no discrete linear part",
+                model.method.empty() ? "" : " '" + model.method + "'");
+  const TransferFunction g(model.discrete->num(), model.discrete->den(), Ts,
+                           model.discrete->delay());
+  // At rest at the first measured output when there is one (the record
+  // starts at rest, wherever), else at rest at the first input.
+  std::optional<double> y_first;
+  if (output >= 0 && output < data.num_outputs() && data.size() > 0 &&
+      std::isfinite(data.y(output)[0]))
+    y_first = data.y(output)[0];
+  const double dc = g.DcGain();
+  const bool gain = std::isfinite(dc) && std::abs(dc) > 1e-9;
+  const Eigen::VectorXd v = model.input_map ? model.input_map->Evaluate(u) : u;
+  if (v.size() == 0) return v;
+  // x = dc v_rest + G (v - v_rest): the linear part at rest with input v_rest.
+  auto linear = [&](double v_rest) {
+    return (Lsim(g, (v.array() - v_rest).matrix(), Ts).array() + dc * v_rest).matrix().eval();
+  };
+  if (model.output_map) {
+    const StaticMap& out = *model.output_map;
+    double v_rest = v[0];
+    if (y_first && gain &&
+        (out.Direction() == Monotonicity::kIncreasing ||
+         out.Direction() == Monotonicity::kDecreasing)) {
+      const auto [lo, hi] = std::minmax_element(out.y().begin(), out.y().end());
+      if (*y_first > *lo && *y_first < *hi) v_rest = out.Inverse(*y_first) / dc;
+    }
+    return out.Evaluate(linear(v_rest));
+  }
+  return linear(y_first && gain ? *y_first / dc : v[0]);
+}
+
+}  // namespace pneumid

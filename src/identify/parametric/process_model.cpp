@@ -1,0 +1,803 @@
+#include "pneumid/identify/parametric/process_model.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include <ceres/ceres.h>
+#include <fmt/format.h>
+
+#include "../ceres_logging.hpp"
+#include "pneumid/common/check.hpp"
+#include "pneumid/common/enum_names.hpp"
+#include "pneumid/identify/step/reaction_curve.hpp"
+#include "pneumid/identify/step/sopdt.hpp"
+#include "pneumid/identify/step/step_analysis.hpp"
+#include "pneumid/lti/response.hpp"
+
+namespace pneumid {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+enum Slot { kK, kT1, kT2, kT3, kTw, kZeta, kTz, kTheta, kY0 };
+
+double ProcessParams::*Member(Slot s) {
+  switch (s) {
+    case kK:
+      return &ProcessParams::K;
+    case kT1:
+      return &ProcessParams::T1;
+    case kT2:
+      return &ProcessParams::T2;
+    case kT3:
+      return &ProcessParams::T3;
+    case kTw:
+      return &ProcessParams::Tw;
+    case kZeta:
+      return &ProcessParams::zeta;
+    case kTz:
+      return &ProcessParams::Tz;
+    case kTheta:
+      return &ProcessParams::theta;
+    case kY0:
+      return &ProcessParams::y0;
+  }
+  return &ProcessParams::K;
+}
+
+std::vector<Slot> Slots(ProcessStructure s, bool zero, bool offset) {
+  std::vector<Slot> v{kK};
+  switch (s) {
+    case ProcessStructure::kP1D:
+    case ProcessStructure::kP1DI:
+      v.push_back(kT1);
+      break;
+    case ProcessStructure::kP2D:
+      v.insert(v.end(), {kT1, kT2});
+      break;
+    case ProcessStructure::kP2DU:
+      v.insert(v.end(), {kTw, kZeta});
+      break;
+    case ProcessStructure::kP3D:
+      v.insert(v.end(), {kT1, kT2, kT3});
+      break;
+  }
+  if (zero) v.push_back(kTz);
+  v.push_back(kTheta);
+  if (offset) v.push_back(kY0);
+  return v;
+}
+
+std::string SlotName(ProcessStructure s, Slot slot) {
+  const bool one = s == ProcessStructure::kP1D || s == ProcessStructure::kP1DI;
+  switch (slot) {
+    case kK:
+      return "K";
+    case kT1:
+      return one ? "tau" : "tau1";
+    case kT2:
+      return "tau2";
+    case kT3:
+      return "tau3";
+    case kTw:
+      return "Tw";
+    case kZeta:
+      return "zeta";
+    case kTz:
+      return "Tz";
+    case kTheta:
+      return "theta";
+    case kY0:
+      return "y0";
+  }
+  return "?";
+}
+
+// Input before its first change, and the index of that change (n if none).
+std::pair<double, Eigen::Index> InitialInput(const Eigen::VectorXd& u) {
+  const double tol = 1e-12 * std::max(1.0, u.cwiseAbs().maxCoeff());
+  Eigen::Index k = 0;
+  while (k < u.size() && std::abs(u[k] - u[0]) <= tol) ++k;
+  return {u[0], k};
+}
+
+// Robust noise standard deviation from first differences (MAD).
+double RobustNoise(const Eigen::VectorXd& y) {
+  if (y.size() < 3) return 0.0;
+  std::vector<double> d(static_cast<std::size_t>(y.size() - 1));
+  for (Eigen::Index k = 1; k < y.size(); ++k) d[k - 1] = y[k] - y[k - 1];
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  const double m = median(d);
+  for (double& x : d) x = std::abs(x - m);
+  return 1.4826 * median(d) / std::sqrt(2.0);
+}
+
+// Simulates the model for a parameter vector (physical units); shared by the
+// residual blocks through a cache keyed on the parameter values.
+class Simulator {
+ public:
+  Simulator(ProcessStructure structure, bool zero, std::vector<Slot> slots, ProcessParams fixed,
+            Eigen::VectorXd du, Eigen::VectorXd y, double Ts, Eigen::VectorXd scale,
+            Eigen::VectorXd lower, Eigen::VectorXd upper)
+      : structure_(structure),
+        zero_(zero),
+        slots_(std::move(slots)),
+        fixed_(fixed),
+        du_(std::move(du)),
+        y_(std::move(y)),
+        Ts_(Ts),
+        scale_(std::move(scale)),
+        lower_(std::move(lower)),
+        upper_(std::move(upper)) {}
+
+  int num_params() const { return static_cast<int>(slots_.size()); }
+  Eigen::Index num_samples() const { return y_.size(); }
+
+  ProcessParams ToParams(const double* x) const {
+    ProcessParams p = fixed_;
+    for (std::size_t i = 0; i < slots_.size(); ++i) p.*Member(slots_[i]) = x[i] * scale_[i];
+    return p;
+  }
+
+  // Response of the model with unit gain and no offset to the input steps du
+  // (the output is linear in K and y0: yhat = K h + y0); false when invalid.
+  bool UnitResponse(const double* x, Eigen::VectorXd* h) const {
+    ProcessParams p = ToParams(x);
+    p.K = 1.0;
+    try {
+      *h = Lsim(ProcessTransferFunction(structure_, zero_, p), du_, Ts_);
+      return h->allFinite();
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+
+  // Residuals y - yhat for scaled parameters x; false when the model is invalid.
+  bool Residuals(const double* x, Eigen::VectorXd* r) const {
+    Eigen::VectorXd h;
+    if (!UnitResponse(x, &h)) return false;
+    const ProcessParams p = ToParams(x);
+    *r = y_ - (p.K * h.array() + p.y0).matrix();
+    return r->allFinite();
+  }
+
+  // Evaluates residuals (and the Jacobian when wanted) at x, caching the result.
+  // K and y0 enter linearly and have exact columns (-h scale_K, -scale_y0); the
+  // lags, zero and delay have forward differences of K h (step 1e-7 relative,
+  // backward at an upper bound): one simulation per parameter.
+  bool Evaluate(const double* x, bool want_jacobian) {
+    const int np = num_params();
+    const bool same = valid_ && std::equal(x, x + np, x_.data());
+    if (same && (!want_jacobian || jacobian_valid_)) return ok_;
+    x_ = Eigen::Map<const Eigen::VectorXd>(x, np);
+    valid_ = true;
+    jacobian_valid_ = false;
+    ok_ = UnitResponse(x, &h_);
+    if (!ok_) return ok_;
+    const ProcessParams p = ToParams(x);
+    r_ = y_ - (p.K * h_.array() + p.y0).matrix();
+    ok_ = r_.allFinite();
+    if (!ok_ || !want_jacobian) return ok_;
+    J_.resize(r_.size(), np);
+    Eigen::VectorXd xp = x_, hp, hm;
+    for (int j = 0; j < np; ++j) {
+      if (slots_[j] == kK) {
+        J_.col(j) = -scale_[j] * h_;
+        continue;
+      }
+      if (slots_[j] == kY0) {
+        J_.col(j).setConstant(-scale_[j]);
+        continue;
+      }
+      const double step = 1e-7 * std::max(1.0, std::abs(x_[j]));
+      const bool can_up = x_[j] + step <= upper_[j];
+      const bool can_down = x_[j] - step >= lower_[j];
+      double hu = can_up ? step : 0.0, hd = can_down && !can_up ? step : 0.0;
+      if (!can_up && !can_down) hu = step;  // degenerate bounds: step outside anyway
+      xp = x_;
+      xp[j] = x_[j] + hu;
+      if (hu > 0.0) {
+        if (!UnitResponse(xp.data(), &hp)) return ok_ = false;
+      } else {
+        hp = h_;
+      }
+      xp[j] = x_[j] - hd;
+      if (hd > 0.0) {
+        if (!UnitResponse(xp.data(), &hm)) return ok_ = false;
+      } else {
+        hm = h_;
+      }
+      J_.col(j) = (-p.K / (hu + hd)) * (hp - hm);
+    }
+    jacobian_valid_ = true;
+    return ok_;
+  }
+
+  const Eigen::VectorXd& residuals() const { return r_; }
+  const Eigen::MatrixXd& jacobian() const { return J_; }
+
+ private:
+  ProcessStructure structure_;
+  bool zero_;
+  std::vector<Slot> slots_;
+  ProcessParams fixed_;
+  Eigen::VectorXd du_, y_;
+  double Ts_;
+  Eigen::VectorXd scale_, lower_, upper_;
+  Eigen::VectorXd x_, r_, h_;
+  Eigen::MatrixXd J_;
+  bool valid_ = false, jacobian_valid_ = false, ok_ = false;
+};
+
+// One sample's residual; all blocks share the Simulator (single-threaded solve).
+class SampleResidual : public ceres::CostFunction {
+ public:
+  SampleResidual(Simulator* sim, Eigen::Index k) : sim_(sim), k_(k) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(sim->num_params());
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const bool want_j = jacobians != nullptr && jacobians[0] != nullptr;
+    if (!sim_->Evaluate(parameters[0], want_j)) return false;
+    residuals[0] = sim_->residuals()[k_];
+    if (want_j) {
+      for (int j = 0; j < sim_->num_params(); ++j) jacobians[0][j] = sim_->jacobian()(k_, j);
+    }
+    return true;
+  }
+
+ private:
+  Simulator* sim_;
+  Eigen::Index k_;
+};
+
+// All samples' residuals in one block (least squares without a robust loss):
+// one simulation per evaluation and a dense N x np Jacobian, without the
+// per-block overhead of N one-sample blocks.
+class RecordResidual : public ceres::CostFunction {
+ public:
+  explicit RecordResidual(Simulator* sim) : sim_(sim) {
+    set_num_residuals(static_cast<int>(sim->num_samples()));
+    mutable_parameter_block_sizes()->push_back(sim->num_params());
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const bool want_j = jacobians != nullptr && jacobians[0] != nullptr;
+    if (!sim_->Evaluate(parameters[0], want_j)) return false;
+    const Eigen::Index n = sim_->num_samples();
+    Eigen::Map<Eigen::VectorXd>(residuals, n) = sim_->residuals();
+    if (want_j) {
+      using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+      Eigen::Map<RowMajor>(jacobians[0], n, sim_->num_params()) = sim_->jacobian();
+    }
+    return true;
+  }
+
+ private:
+  Simulator* sim_;
+};
+
+}  // namespace
+
+namespace {
+constexpr EnumName<ProcessStructure> kProcessStructureNames[] = {
+    {ProcessStructure::kP1D, "P1D"},   {ProcessStructure::kP2D, "P2D"},
+    {ProcessStructure::kP2DU, "P2DU"}, {ProcessStructure::kP3D, "P3D"},
+    {ProcessStructure::kP1DI, "P1DI"},
+};
+constexpr EnumName<RobustLoss> kRobustLossNames[] = {
+    {RobustLoss::kNone, "none"}, {RobustLoss::kHuber, "huber"}, {RobustLoss::kCauchy, "cauchy"}};
+}  // namespace
+
+std::string ToString(ProcessStructure structure) {
+  return std::string(EnumToString(kProcessStructureNames, structure));
+}
+
+ProcessStructure ProcessStructureFromString(const std::string& name, bool* zero) {
+  // A trailing Z (no structure name ends in Z) adds a zero: P2DZ = P2D with (1 + Tz s).
+  const bool z = !name.empty() && (name.back() == 'z' || name.back() == 'Z');
+  const auto s = EnumLookup(kProcessStructureNames,
+                            std::string_view(name).substr(0, name.size() - (z ? 1 : 0)),
+                            /*ignore_case=*/true);
+  PNEUMID_CHECK(s.has_value(),
+                "unknown process model structure '{}' (valid: {}, each optionally followed by Z "
+                "for a zero)",
+                name, EnumNameList(kProcessStructureNames));
+  if (zero) *zero = z;
+  return *s;
+}
+
+std::string ToString(RobustLoss loss) { return std::string(EnumToString(kRobustLossNames, loss)); }
+
+RobustLoss RobustLossFromString(const std::string& name) {
+  return EnumFromString(kRobustLossNames, name, "robust loss", /*ignore_case=*/true);
+}
+
+bool ProcessFitOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error) *error = m;
+    return false;
+  };
+  if (!(loss_scale >= 0.0 && std::isfinite(loss_scale)))
+    return fail(fmt::format("loss_scale must be >= 0, got {}", loss_scale));
+  if (!(max_delay >= 0.0 && std::isfinite(max_delay)))
+    return fail(fmt::format("max_delay must be >= 0 s, got {}", max_delay));
+  if (max_iterations < 1)
+    return fail(fmt::format("max_iterations must be >= 1, got {}", max_iterations));
+  if (!(function_tolerance > 0.0))
+    return fail(fmt::format("function_tolerance must be > 0, got {}", function_tolerance));
+  if (!(parameter_tolerance > 0.0))
+    return fail(fmt::format("parameter_tolerance must be > 0, got {}", parameter_tolerance));
+  return true;
+}
+
+std::string ProcessFitSummary::BriefReport() const {
+  return fmt::format(
+      "process fit: {} after {} iterations, cost {:.6g} -> {:.6g}, residual std "
+      "{:.4g}, initial guess from {}{}",
+      ToString(termination), iterations, initial_cost, final_cost, sigma, initial_guess,
+      message.empty() ? "" : " (" + message + ")");
+}
+
+TransferFunction ProcessTransferFunction(ProcessStructure structure, bool zero,
+                                         const ProcessParams& p) {
+  PNEUMID_CHECK(std::isfinite(p.K), "process model: K must be finite, got {}", p.K);
+  PNEUMID_CHECK(std::isfinite(p.theta) && p.theta >= 0.0,
+                "process model: delay theta must be >= 0 s, got {}", p.theta);
+  auto lag = [](double T, const char* name) {
+    PNEUMID_CHECK(std::isfinite(T) && T > 0.0, "process model: {} must be > 0 s, got {}", name, T);
+    Eigen::VectorXd v(2);
+    v << T, 1.0;
+    return v;
+  };
+  Eigen::VectorXd den(1);
+  den << 1.0;
+  switch (structure) {
+    case ProcessStructure::kP1D:
+      den = lag(p.T1, "tau");
+      break;
+    case ProcessStructure::kP2D:
+      den = poly::Multiply(lag(p.T1, "tau1"), lag(p.T2, "tau2"));
+      break;
+    case ProcessStructure::kP3D:
+      den = poly::Multiply(poly::Multiply(lag(p.T1, "tau1"), lag(p.T2, "tau2")), lag(p.T3, "tau3"));
+      break;
+    case ProcessStructure::kP2DU:
+      PNEUMID_CHECK(std::isfinite(p.Tw) && p.Tw > 0.0, "process model: Tw must be > 0 s, got {}",
+                    p.Tw);
+      PNEUMID_CHECK(std::isfinite(p.zeta) && p.zeta >= 0.0,
+                    "process model: zeta must be >= 0, got {}", p.zeta);
+      den.resize(3);
+      den << p.Tw * p.Tw, 2.0 * p.zeta * p.Tw, 1.0;
+      break;
+    case ProcessStructure::kP1DI: {
+      Eigen::VectorXd s(2);
+      s << 1.0, 0.0;
+      den = poly::Multiply(s, lag(p.T1, "tau"));
+      break;
+    }
+  }
+  Eigen::VectorXd num(1);
+  num << p.K;
+  if (zero) {
+    PNEUMID_CHECK(std::isfinite(p.Tz), "process model: Tz must be finite, got {}", p.Tz);
+    num.resize(2);
+    num << p.K * p.Tz, p.K;
+    if (p.Tz == 0.0) {
+      num.resize(1);
+      num << p.K;
+    }
+  }
+  return TransferFunction(num, den, 0.0, p.theta);
+}
+
+std::vector<std::pair<std::string, double>> NamedParams(ProcessStructure structure, bool zero,
+                                                        const ProcessParams& p) {
+  std::vector<std::pair<std::string, double>> v;
+  for (Slot s : Slots(structure, zero, true)) v.emplace_back(SlotName(structure, s), p.*Member(s));
+  return v;
+}
+
+ProcessParams InitialProcessGuess(const Dataset& data, int input, int output,
+                                  ProcessStructure structure, bool zero, std::string* source) {
+  const Eigen::VectorXd u = data.u(input), y = data.y(output), t = data.time();
+  const Eigen::Index n = data.size();
+  const double duration = t[n - 1] - t[0];
+  const auto [u0, k0] = InitialInput(u);
+  ProcessParams p;
+  p.y0 = k0 > 0 ? y.head(k0).mean() : y[0];
+  std::string from;
+  if (structure == ProcessStructure::kP1DI) {
+    // Final ramp: y ~ y0 + K du (t - t_s - theta - T1) over the last 30 %.
+    const Eigen::Index m = std::max<Eigen::Index>(3, n * 3 / 10);
+    const Eigen::VectorXd tt = t.tail(m), yy = y.tail(m);
+    const double tm = tt.mean(), ym = yy.mean();
+    const double slope =
+        ((tt.array() - tm) * (yy.array() - ym)).sum() / (tt.array() - tm).square().sum();
+    const double du = u.tail(m).mean() - u0;
+    const double ts = k0 < n ? t[k0] : t[0];
+    p.K = du != 0.0 ? slope / du : 1.0;
+    const double tx = slope != 0.0 ? tm - (ym - p.y0) / slope : ts + 0.1 * duration;
+    const double lag = std::clamp(tx - ts, 0.01 * duration, 0.5 * duration);
+    p.T1 = 0.7 * lag;
+    p.theta = 0.3 * lag;
+    from = "the final ramp";
+  } else {
+    // The first step of the record (up to the next input change), when it is
+    // a clean settled step, gives the graphical initial guess.
+    Eigen::Index k1 = k0;
+    const double utol = 0.05 * std::abs(k0 < n ? u[k0] - u0 : 0.0);
+    while (k1 < n && std::abs(u[k1] - u[k0]) <= utol) ++k1;
+    Dataset first = data;
+    if (k1 < n && k1 >= 10) {
+      first = Dataset(t.head(k1), data.inputs().topRows(k1), data.outputs().topRows(k1),
+                      data.input_channels(), data.output_channels());
+      first.set_source(data.source());
+    }
+    bool have_step = false;
+    try {
+      const StepAnalysis s = AnalyzeStep(first, input, output);
+      p.y0 = s.y0;
+      if (structure == ProcessStructure::kP1D) {
+        const FopdtParams f = ReactionCurve(s);
+        p.K = f.K;
+        p.T1 = f.tau;
+        p.theta = f.theta;
+        from = k1 < n ? "the reaction curve of the first step" : "the reaction curve";
+      } else {
+        const ThreePointSopdtResult so = ThreePointSopdt(s);
+        p.K = so.params.K;
+        p.T1 = so.params.tau1;
+        p.T2 = std::max(so.params.tau2, 0.05 * so.params.tau1);
+        p.theta = so.params.theta;
+        from = k1 < n ? "the three-point SOPDT of the first step" : "the three-point SOPDT";
+        if (structure == ProcessStructure::kP3D) {
+          p.T3 = 0.5 * p.T2;
+          p.theta = std::max(0.0, p.theta - p.T3);
+        } else if (structure == ProcessStructure::kP2DU) {
+          p.Tw = std::sqrt(p.T1 * p.T2);
+          p.zeta = std::min(1.0, (p.T1 + p.T2) / (2.0 * p.Tw));
+          const double peak = s.r.maxCoeff();
+          if (peak > 1.0 + s.band) {
+            const double lo = std::log(peak - 1.0);
+            p.zeta = -lo / std::sqrt(M_PI * M_PI + lo * lo);
+            Eigen::Index kp;
+            s.r.maxCoeff(&kp);
+            const double tp = std::max(s.t[kp] - s.departure_time, 2.0 * s.Ts);
+            p.Tw = tp * std::sqrt(1.0 - p.zeta * p.zeta) / M_PI;
+            p.theta = s.departure_time;
+          }
+          p.zeta = std::clamp(p.zeta, 0.05, 0.99);
+        }
+      }
+      have_step = true;
+    } catch (const std::exception&) {  // not a clean step: fall back to the grid
+      have_step = false;
+    }
+    if (!have_step) {
+      // Grid search: lags T (geometric, 2 Ts .. half the record) and delays
+      // theta in {0, 0.1, 0.3, 1} T; K and y0 by linear least squares each.
+      const Eigen::VectorXd du = (u.array() - u0).matrix();
+      const double Ts = data.SampleTime();
+      double best = std::numeric_limits<double>::infinity();
+      const int nT = 16;
+      for (int i = 0; i < nT; ++i) {
+        const double T =
+            2.0 * Ts * std::pow(0.25 * duration / Ts, static_cast<double>(i) / (nT - 1));
+        for (double f : {0.0, 0.1, 0.3, 1.0}) {
+          ProcessParams q;
+          q.K = 1.0;
+          q.T1 = T;
+          q.T2 = 0.5 * T;
+          q.T3 = 0.25 * T;
+          q.Tw = 0.5 * T;
+          q.zeta = 0.7;
+          q.theta = std::min(f * T, 0.5 * duration);
+          Eigen::VectorXd h;
+          try {
+            h = Lsim(ProcessTransferFunction(structure, false, q), du, Ts);
+          } catch (const std::exception&) {
+            continue;
+          }
+          Eigen::MatrixXd A(n, 2);
+          A.col(0) = h;
+          A.col(1).setOnes();
+          const Eigen::Vector2d c = A.colPivHouseholderQr().solve(y);
+          const double cost = (A * c - y).squaredNorm();
+          if (std::isfinite(cost) && cost < best && c[0] != 0.0) {
+            best = cost;
+            q.K = c[0];
+            q.y0 = c[1];
+            p = q;
+          }
+        }
+      }
+      from = "a grid search over lag and delay";
+    }
+  }
+  if (p.K == 0.0) p.K = 1.0;
+  if (zero) p.Tz = 0.0;
+  if (source) *source = from;
+  return p;
+}
+
+ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
+                                 const ProcessFitOptions& options, const ProcessParams* initial) {
+  std::string why;
+  PNEUMID_CHECK(options.IsValid(&why), "invalid ProcessFitOptions: {}", why);
+  PNEUMID_CHECK(input >= 0 && input < data.num_inputs(),
+                "input column {} out of range (the data has {} inputs)", input, data.num_inputs());
+  PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
+                "output column {} out of range (the data has {} outputs)", output,
+                data.num_outputs());
+  const std::string src = data.source().empty() ? "data" : data.source();
+  data.RequireSamples(10, "process-model fit");
+  data.RequireUniform();
+  const Eigen::VectorXd u = data.u(input), y = data.y(output);
+  if (!u.allFinite() || !y.allFinite()) {
+    throw DataError(fmt::format("{}: the data contain NaN or Inf", src));
+  }
+  const auto [u0, k0] = InitialInput(u);
+  if (k0 >= data.size()) {
+    throw DataError(fmt::format("{}: the input never changes (u = {}); nothing to fit", src, u0));
+  }
+  const double Ts = data.SampleTime();
+  const double duration = data.time()[data.size() - 1] - data.time()[0];
+
+  ProcessFitResult res;
+  res.structure = options.structure;
+  res.zero = options.zero;
+  ProcessParams p0;
+  if (initial) {
+    p0 = *initial;
+    res.summary.initial_guess = "the caller";
+  } else if (options.zero) {
+    // A zero is fitted from the converged model without it, started with
+    // Tz = 0 and with Tz = +-Tm (Tm = the second lag, at least T1 / 5, the
+    // faster lags raised to Tm); the lowest cost wins.
+    ProcessFitOptions no_zero = options;
+    no_zero.zero = false;
+    const ProcessFitResult first = FitProcessModel(data, input, output, no_zero);
+    const double T1 =
+        options.structure == ProcessStructure::kP2DU ? first.params.Tw : first.params.T1;
+    const double Tm = std::max(first.params.T2, 0.2 * T1);
+    ProcessFitResult best;
+    bool have = false;
+    for (double sign : {0.0, 1.0, -1.0}) {
+      ProcessParams start = first.params;
+      start.Tz = sign * Tm;
+      if (sign != 0.0) {
+        start.T2 = std::max(start.T2, Tm);
+        start.T3 = std::max(start.T3, 0.5 * Tm);
+      }
+      ProcessFitResult r = FitProcessModel(data, input, output, options, &start);
+      if (r.summary.termination != Termination::kFailure &&
+          (!have || r.summary.final_cost < best.summary.final_cost)) {
+        best = std::move(r);
+        have = true;
+      }
+    }
+    if (have) {
+      best.summary.initial_guess = "the fitted " + ToString(options.structure) +
+                                   " without zero, Tz started at 0 and +-" +
+                                   fmt::format("{:.4g}", Tm) + " s";
+      return best;
+    }
+    p0 = first.params;
+    p0.Tz = 0.0;
+    res.summary.initial_guess = "the fitted " + ToString(options.structure) + " without zero";
+  } else {
+    p0 = InitialProcessGuess(data, input, output, options.structure, false,
+                             &res.summary.initial_guess);
+  }
+  if (!options.estimate_offset) p0.y0 = k0 > 0 ? y.head(k0).mean() : y[0];
+
+  const std::vector<Slot> slots = Slots(options.structure, options.zero, options.estimate_offset);
+  const int np = static_cast<int>(slots.size());
+  if (data.size() <= np) {
+    throw DataError(
+        fmt::format("{}: {} samples are too few for {} parameters", src, data.size(), np));
+  }
+  // Scales and bounds (physical), then the scaled start.
+  const double max_delay = options.max_delay > 0.0 ? options.max_delay : 0.5 * duration;
+  const double t_scale = std::max({p0.T1, p0.Tw, 10.0 * Ts});
+  const double y_scale = std::max({y.cwiseAbs().maxCoeff(), std::abs(p0.y0), 1e-300});
+  Eigen::VectorXd scale(np), lo(np), hi(np), x(np);
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < np; ++i) {
+    double s = 1.0, l = -inf, h = inf;
+    switch (slots[i]) {
+      case kK:
+        s = std::abs(p0.K) > 0.0 ? std::abs(p0.K) : 1.0;
+        break;
+      case kT1:
+      case kT2:
+      case kT3:
+      case kTw:
+        s = t_scale;
+        l = 1e-3 * Ts;
+        h = 100.0 * duration;
+        break;
+      case kZeta:
+        s = 1.0;
+        l = 1e-3;
+        h = 1.0;
+        break;
+      case kTz:
+        s = t_scale;
+        l = -10.0 * duration;
+        h = 10.0 * duration;
+        break;
+      case kTheta:
+        s = t_scale;
+        l = 0.0;
+        h = max_delay;
+        break;
+      case kY0:
+        s = y_scale;
+        break;
+    }
+    scale[i] = s;
+    lo[i] = l / s;
+    hi[i] = h / s;
+    x[i] = std::clamp(p0.*Member(slots[i]) / s, lo[i], hi[i]);
+  }
+  ProcessParams fixed = p0;
+  Simulator sim(options.structure, options.zero, slots, fixed, (u.array() - u0).matrix(), y, Ts,
+                scale, lo, hi);
+
+  const double noise = RobustNoise(y);
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  if (options.loss == RobustLoss::kNone) {
+    problem.AddResidualBlock(new RecordResidual(&sim), nullptr, x.data());
+  }
+  for (Eigen::Index k = 0; options.loss != RobustLoss::kNone && k < data.size(); ++k) {
+    ceres::LossFunction* loss = nullptr;
+    const double a = options.loss_scale > 0.0
+                         ? options.loss_scale
+                         : std::max(noise, 1e-12 * y_scale) *
+                               (options.loss == RobustLoss::kHuber ? 1.345 : 2.385);
+    if (options.loss == RobustLoss::kHuber) loss = new ceres::HuberLoss(a);
+    if (options.loss == RobustLoss::kCauchy) loss = new ceres::CauchyLoss(a);
+    problem.AddResidualBlock(new SampleResidual(&sim, k), loss, x.data());
+  }
+  for (int i = 0; i < np; ++i) {
+    if (std::isfinite(lo[i])) problem.SetParameterLowerBound(x.data(), i, lo[i]);
+    if (std::isfinite(hi[i])) problem.SetParameterUpperBound(x.data(), i, hi[i]);
+  }
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // J^T J: O(N np^2), N >> np
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.parameter_tolerance = options.parameter_tolerance;
+  solver_options.gradient_tolerance = 1e-14;
+  solver_options.num_threads = 1;
+  // Trust-region steps are clamped to the bounds by Ceres; its projected line
+  // search on top of that evaluates the full Jacobian (2 simulations per lag
+  // or delay parameter) at every trial point, doubling the cost on long
+  // records for no gain in the fitted values.
+  solver_options.max_num_line_search_step_size_iterations = 0;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  internal::SilenceCeresLogging();
+  ceres::Solve(solver_options, &problem, &summary);
+
+  res.summary.iterations = static_cast<int>(summary.iterations.size());
+  res.summary.initial_cost = summary.initial_cost;
+  res.summary.final_cost = summary.final_cost;
+  res.summary.message = summary.message;
+  if (summary.termination_type == ceres::CONVERGENCE) {
+    res.summary.termination = Termination::kConvergence;
+  } else if (summary.termination_type == ceres::NO_CONVERGENCE) {
+    res.summary.termination = Termination::kNoConvergence;
+  } else {
+    res.summary.termination = Termination::kFailure;
+  }
+  res.params = sim.ToParams(x.data());
+  res.tf = ProcessTransferFunction(options.structure, options.zero, res.params);
+  Eigen::VectorXd r;
+  if (sim.Residuals(x.data(), &r)) {
+    res.yhat = y - r;
+    res.summary.sigma = std::sqrt(r.squaredNorm() / static_cast<double>(data.size() - np));
+  } else {
+    res.yhat = Eigen::VectorXd::Constant(data.size(), kNaN);
+    res.summary.termination = Termination::kFailure;
+  }
+
+  // Standard deviations: sigma^2 (J^T J)^-1 (Ceres Covariance), in physical units.
+  ProcessParams sd;
+  for (Slot s : Slots(options.structure, options.zero, true)) sd.*Member(s) = kNaN;
+  if (!options.estimate_offset) sd.y0 = 0.0;
+  ceres::Covariance::Options cov_options;
+  cov_options.algorithm_type = ceres::DENSE_SVD;
+  cov_options.null_space_rank = -1;
+  cov_options.min_reciprocal_condition_number = 1e-14;
+  ceres::Covariance covariance(cov_options);
+  std::vector<std::pair<const double*, const double*>> blocks{{x.data(), x.data()}};
+  Eigen::MatrixXd C(np, np);
+  bool have_covariance = false;
+  if (res.summary.termination != Termination::kFailure) {
+    if (options.loss == RobustLoss::kNone) {
+      // The same pseudo-inverse as Ceres' DENSE_SVD covariance (eigenvalues of
+      // J^T J below 1e-14 of the largest dropped), from the np x np normal
+      // matrix instead of an SVD of the N x np Jacobian.
+      have_covariance = sim.Evaluate(x.data(), true);
+      if (have_covariance) {
+        const Eigen::MatrixXd JtJ = sim.jacobian().transpose() * sim.jacobian();
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(JtJ);
+        const Eigen::VectorXd lambda = eig.eigenvalues();
+        const double lmax = lambda.maxCoeff();
+        Eigen::VectorXd inv = Eigen::VectorXd::Zero(np);
+        for (int i = 0; i < np; ++i)
+          if (lmax > 0.0 && lambda[i] / lmax >= cov_options.min_reciprocal_condition_number)
+            inv[i] = 1.0 / lambda[i];
+        C = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+      }
+    } else {
+      have_covariance = covariance.Compute(blocks, &problem);
+      if (have_covariance) covariance.GetCovarianceBlock(x.data(), x.data(), C.data());
+    }
+  }
+  if (have_covariance) {
+    const double s2 = 2.0 * summary.final_cost / static_cast<double>(data.size() - np);
+    bool ok = true;
+    for (int i = 0; i < np; ++i) {
+      const double v = C(i, i) * s2;
+      ok = ok && std::isfinite(v) && v >= 0.0;
+      sd.*Member(slots[i]) = std::sqrt(std::max(v, 0.0)) * scale[i];
+    }
+    res.summary.covariance_ok = ok;
+    if (ok) {
+      res.covariance = (scale.asDiagonal() * C * scale.asDiagonal()) * s2;
+      for (Slot slot : slots) res.covariance_names.push_back(SlotName(options.structure, slot));
+    }
+  }
+  // Lags in decreasing order (with their standard deviations).
+  if (options.structure == ProcessStructure::kP2D || options.structure == ProcessStructure::kP3D) {
+    std::vector<std::pair<double, double>> lags{{res.params.T1, sd.T1}, {res.params.T2, sd.T2}};
+    if (options.structure == ProcessStructure::kP3D) lags.emplace_back(res.params.T3, sd.T3);
+    // The covariance follows the lags: the row of the lag that becomes tau_k
+    // moves to tau_k's position.
+    if (res.covariance.size() > 0) {
+      std::vector<int> order(lags.size());
+      for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+      std::stable_sort(order.begin(), order.end(),
+                       [&lags](int a, int b) { return lags[a].first > lags[b].first; });
+      const std::vector<Slot> lag_slots{kT1, kT2, kT3};
+      std::vector<int> pos(lags.size());  // index of each lag slot in the covariance
+      for (std::size_t i = 0; i < lags.size(); ++i)
+        pos[i] =
+            static_cast<int>(std::find(slots.begin(), slots.end(), lag_slots[i]) - slots.begin());
+      Eigen::VectorXi perm = Eigen::VectorXi::LinSpaced(np, 0, np - 1);
+      for (std::size_t k = 0; k < lags.size(); ++k) perm[pos[k]] = pos[order[k]];
+      Eigen::MatrixXd P(np, np);
+      for (int i = 0; i < np; ++i)
+        for (int j = 0; j < np; ++j) P(i, j) = res.covariance(perm[i], perm[j]);
+      res.covariance = P;
+    }
+    std::sort(lags.begin(), lags.end(), [](auto a, auto b) { return a.first > b.first; });
+    res.params.T1 = lags[0].first;
+    sd.T1 = lags[0].second;
+    res.params.T2 = lags[1].first;
+    sd.T2 = lags[1].second;
+    if (lags.size() > 2) {
+      res.params.T3 = lags[2].first;
+      sd.T3 = lags[2].second;
+    }
+    res.tf = ProcessTransferFunction(options.structure, options.zero, res.params);
+  }
+  res.param_std = sd;
+  return res;
+}
+
+}  // namespace pneumid
