@@ -57,166 +57,213 @@ std::string FormatValue(double v, double sd, const std::string& unit) {
   return fmt::format("{:.6g} {} (std n/a)", v, unit);
 }
 
-void Run(const CalibrateArgs& a) {
+/// The calibration options of the command line (without progress callback).
+IpaCalibrationOptions CalibrationOptions(const CalibrateArgs& args) {
   IpaCalibrationOptions options;
   // --mode position starts from the position rig's defaults (a file's keys
   // replace them), as `--plant ipa-position` does.
-  const IpaMode mode = a.mode.empty() ? IpaMode::kForce : IpaModeFromString(a.mode);
-  options.start =
-      a.plant_config.empty() ? DefaultIpaParameters(mode) : LoadIpaParameters(a.plant_config, mode);
-  if (!a.mode.empty()) options.start.mode = mode;
-  if (!a.pwm_mode.empty()) options.start.pwm_mode = PwmModeFromString(a.pwm_mode);
-  if (!a.free.empty())
-    for (const auto& name : Split(a.free, ','))
+  const IpaMode mode = args.mode.empty() ? IpaMode::kForce : IpaModeFromString(args.mode);
+  options.start = args.plant_config.empty() ? DefaultIpaParameters(mode)
+                                            : LoadIpaParameters(args.plant_config, mode);
+  if (!args.mode.empty()) options.start.mode = mode;
+  if (!args.pwm_mode.empty()) options.start.pwm_mode = PwmModeFromString(args.pwm_mode);
+  if (!args.free.empty())
+    for (const auto& name : Split(args.free, ','))
       if (!Trim(name).empty()) options.free.emplace_back(Trim(name));
-  for (const auto& b : a.bounds) options.bounds.insert(ParseBound(b));
-  options.initial_state = CalibrationInitialStateFromString(a.initial_state);
-  options.max_iterations = a.max_iterations;
-  options.num_threads = a.threads;
+  for (const auto& bound : args.bounds) options.bounds.insert(ParseBound(bound));
+  options.initial_state = CalibrationInitialStateFromString(args.initial_state);
+  options.max_iterations = args.max_iterations;
+  options.num_threads = args.threads;
+  return options;
+}
 
-  PNEUMID_CHECK(a.weights.empty() || a.weights.size() == a.files.size(),
+/// The data file `path`, read with the command's data options.
+Dataset LoadDataFile(const CalibrateArgs& args, const std::string& path) {
+  DataOptions data = args.data;
+  data.path = path;
+  return LoadFromOptions(data);
+}
+
+/// The experiments to calibrate on, each with its weight.
+std::vector<CalibrationExperiment> LoadExperiments(const CalibrateArgs& args) {
+  PNEUMID_CHECK(args.weights.empty() || args.weights.size() == args.files.size(),
                 "--weights: {} weights for {} data files; give one per file, in their order",
-                a.weights.size(), a.files.size());
+                args.weights.size(), args.files.size());
   std::vector<CalibrationExperiment> experiments;
-  for (std::size_t i = 0; i < a.files.size(); ++i) {
-    DataOptions d = a.data;
-    d.path = a.files[i];
-    experiments.push_back({LoadFromOptions(d), a.files[i], a.weights.empty() ? 1.0 : a.weights[i]});
+  for (std::size_t i = 0; i < args.files.size(); ++i) {
+    experiments.push_back({LoadDataFile(args, args.files[i]), args.files[i],
+                           args.weights.empty() ? 1.0 : args.weights[i]});
   }
-  ProgressBar bar("calibrate", a.progress || StderrIsTerminal());
+  return experiments;
+}
+
+/// The calibrated twin on the held-out experiments.
+struct HeldOutResults {
+  std::vector<Dataset> data;               ///< one per --validation file
+  std::vector<double> fit;                 ///< NRMSE fit in %, when the calibration succeeded
+  std::vector<Eigen::VectorXd> simulated;  ///< the twin's output, likewise
+};
+
+/// Simulates the calibrated twin on the held-out experiments (none when the
+/// calibration failed).
+void SimulateHeldOut(const IpaCalibrationOptions& options, const IpaCalibrationSummary& summary,
+                     HeldOutResults& held_out) {
+  if (summary.termination == Termination::kFailure) return;
+  for (const auto& data : held_out.data) {
+    held_out.simulated.push_back(SimulateIpaOnData(summary.parameters, data, options.initial_state,
+                                                   options.warmup, options.integration_tolerance));
+    held_out.fit.push_back(NrmseFit(data.y(0), held_out.simulated.back()));
+  }
+}
+
+/// Writes the calibrated parameters as TOML, with a comment saying where they come from.
+void WriteTwin(const std::string& path, const IpaCalibrationSummary& summary) {
+  std::string comment =
+      fmt::format("IPA parameters calibrated by `pneumid calibrate` ({}, {} iterations) from:",
+                  ToString(summary.termination), summary.iterations);
+  for (const auto& e : summary.experiments)
+    comment += fmt::format("\n  {} (fit {:.2f} %)", e.name, e.fit_percent);
+  std::string free;
+  for (const auto& e : summary.estimates) free += (free.empty() ? "" : ", ") + e.name;
+  comment += "\nfree parameters: " + free;
+  std::ofstream out(path);
+  if (!out) throw DataError(fmt::format("{}: cannot open for writing", path));
+  out << IpaParametersToToml(summary.parameters, comment);
+  if (!out) throw DataError(fmt::format("{}: write failed", path));
+}
+
+/// Plots measured and simulated output: one panel per experiment, then the
+/// held-out ones, at most four panels.
+void PlotCalibration(const CalibrateArgs& args, const IpaCalibrationOptions& options,
+                     const IpaCalibrationSummary& summary,
+                     const std::vector<CalibrationExperiment>& experiments,
+                     const HeldOutResults& held_out) {
+  const std::size_t fitted = std::min<std::size_t>(summary.experiments.size(), 3);
+  const std::size_t shown_held_out = std::min<std::size_t>(held_out.simulated.size(), 4 - fitted);
+  Figure fig(static_cast<int>(fitted + shown_held_out));
+  fig.title = "IPA twin calibration: measured and simulated output";
+  const std::string ylabel =
+      options.start.mode == IpaMode::kForce ? "Force F [N]" : "Position x [m]";
+  auto panel = [&](std::size_t i, const std::string& title, const Dataset& data,
+                   const Eigen::VectorXd& simulated) {
+    auto& ax = fig.axes(static_cast<int>(i));
+    ax.title = title;
+    ax.xlabel = "Time t [s]";
+    ax.ylabel = ylabel;
+    ax.AddLine(data.time(), data.y(0), "measured");
+    if (simulated.size() == data.size()) ax.AddLine(data.time(), simulated, "calibrated twin");
+  };
+  for (std::size_t i = 0; i < fitted; ++i) {
+    const auto& e = summary.experiments[i];
+    panel(i,
+          fmt::format("{}: fit {:.2f} % (start {:.2f} %)", e.name, e.fit_percent,
+                      e.initial_fit_percent),
+          experiments[i].data, e.simulated);
+  }
+  for (std::size_t i = 0; i < shown_held_out; ++i)
+    panel(fitted + i,
+          fmt::format("{} (held out): fit {:.2f} %", args.validation[i], held_out.fit[i]),
+          held_out.data[i], held_out.simulated[i]);
+  fig.Save(args.plot);
+}
+
+void PrintJson(const CalibrateArgs& args, const IpaCalibrationOptions& options,
+               const IpaCalibrationSummary& summary, const std::vector<double>& validation_fit) {
+  nlohmann::ordered_json j;
+  nlohmann::ordered_json params = nlohmann::ordered_json::object();
+  for (const auto& e : summary.estimates)
+    params[e.name] = {{"value", e.value},           {"std", JsonNumber(e.std)}, {"unit", e.unit},
+                      {"start", e.start},           {"lower", e.lower},         {"upper", e.upper},
+                      {"determined", e.determined}, {"at_bound", e.at_bound}};
+  j["parameters"] = params;
+  nlohmann::ordered_json experiments = nlohmann::ordered_json::array();
+  for (const auto& e : summary.experiments)
+    experiments.push_back({{"file", e.name},
+                           {"samples", e.samples},
+                           {"fit_percent", JsonNumber(e.fit_percent)},
+                           {"initial_fit_percent", JsonNumber(e.initial_fit_percent)}});
+  j["experiments"] = experiments;
+  nlohmann::ordered_json validation = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < validation_fit.size(); ++i)
+    validation.push_back(
+        {{"file", args.validation[i]}, {"fit_percent", JsonNumber(validation_fit[i])}});
+  j["validation"] = validation;
+  nlohmann::ordered_json correlations = nlohmann::ordered_json::array();
+  for (const auto& c : summary.correlations)
+    correlations.push_back(
+        {{"first", c.first}, {"second", c.second}, {"correlation", c.correlation}});
+  j["correlations"] = correlations;
+  j["warnings"] = summary.warnings;
+  j["termination"] = ToString(summary.termination);
+  j["message"] = summary.message;
+  j["iterations"] = summary.iterations;
+  j["initial_cost"] = JsonNumber(summary.initial_cost);
+  j["final_cost"] = JsonNumber(summary.final_cost);
+  j["simulations"] = summary.simulations;
+  j["seconds"] = summary.seconds;
+  j["mode"] = ToString(options.start.mode);
+  j["pwm_mode"] = ToString(options.start.pwm_mode);
+  j["initial_state"] = ToString(options.initial_state);
+  if (!args.output.empty() && summary.termination != Termination::kFailure)
+    j["output"] = args.output;
+  if (!args.plot.empty()) j["plot"] = args.plot;
+  std::cout << j.dump(2) << "\n";
+}
+
+void PrintText(const CalibrateArgs& args, const IpaCalibrationOptions& options,
+               const IpaCalibrationSummary& summary, const std::vector<double>& validation_fit) {
+  std::cout << fmt::format(
+      "IPA calibration ({} mode, {} PWM): {} after {} iterations, "
+      "{} simulations, {:.2f} s\n",
+      ToString(options.start.mode), ToString(options.start.pwm_mode), ToString(summary.termination),
+      summary.iterations, summary.simulations, summary.seconds);
+  if (!summary.message.empty()) std::cout << "  " << summary.message << "\n";
+  if (!summary.experiments.empty()) std::cout << "experiments (NRMSE fit, start -> calibrated):\n";
+  for (const auto& e : summary.experiments)
+    std::cout << fmt::format("  {:<30} {:>7} samples  {:7.2f} % -> {:7.2f} %\n", e.name, e.samples,
+                             e.initial_fit_percent, e.fit_percent);
+  for (std::size_t i = 0; i < validation_fit.size(); ++i)
+    std::cout << fmt::format("  {:<30} validation          {:7.2f} %\n", args.validation[i],
+                             validation_fit[i]);
+  if (!summary.estimates.empty()) std::cout << "parameters (value +- standard deviation):\n";
+  for (const auto& e : summary.estimates)
+    std::cout << fmt::format("  {:<32} {}{}\n", e.name, FormatValue(e.value, e.std, e.unit),
+                             e.determined ? "" : "  (not determined by the data)");
+  for (const auto& c : summary.correlations)
+    std::cout << fmt::format("correlated: {} and {}: {:+.3f}\n", c.first, c.second, c.correlation);
+  if (!args.output.empty() && summary.termination != Termination::kFailure)
+    std::cout << "twin written to " << args.output << "\n";
+  if (!args.plot.empty()) std::cout << "plot written to " << args.plot << "\n";
+}
+
+void Run(const CalibrateArgs& args) {
+  IpaCalibrationOptions options = CalibrationOptions(args);
+  const std::vector<CalibrationExperiment> experiments = LoadExperiments(args);
+  ProgressBar bar("calibrate", args.progress || StderrIsTerminal());
   options.progress = [&](int iteration, double cost) {
-    bar(std::min(1.0, static_cast<double>(iteration) / std::max(1, a.max_iterations)),
+    bar(std::min(1.0, static_cast<double>(iteration) / std::max(1, args.max_iterations)),
         fmt::format("iteration {}, cost {:.4g}", iteration, cost));
   };
-  std::vector<Dataset> held_out;
-  for (const auto& file : a.validation) {
-    DataOptions d = a.data;
-    d.path = file;
-    held_out.push_back(LoadFromOptions(d));
-  }
-  const IpaCalibrationSummary s = CalibrateIpa(experiments, options);
+  HeldOutResults held_out;
+  for (const auto& file : args.validation) held_out.data.push_back(LoadDataFile(args, file));
+  const IpaCalibrationSummary summary = CalibrateIpa(experiments, options);
   options.progress = nullptr;
-  // The calibrated twin on the held-out experiments.
-  std::vector<double> validation_fit;
-  std::vector<Eigen::VectorXd> validation_sim;
-  if (s.termination != Termination::kFailure)
-    for (const auto& d : held_out) {
-      validation_sim.push_back(SimulateIpaOnData(s.parameters, d, options.initial_state,
-                                                 options.warmup, options.integration_tolerance));
-      validation_fit.push_back(NrmseFit(d.y(0), validation_sim.back()));
-    }
+  SimulateHeldOut(options, summary, held_out);
 
-  if (s.termination != Termination::kFailure && !a.output.empty()) {
-    std::string comment =
-        fmt::format("IPA parameters calibrated by `pneumid calibrate` ({}, {} iterations) from:",
-                    ToString(s.termination), s.iterations);
-    for (const auto& e : s.experiments)
-      comment += fmt::format("\n  {} (fit {:.2f} %)", e.name, e.fit_percent);
-    std::string free;
-    for (const auto& e : s.estimates) free += (free.empty() ? "" : ", ") + e.name;
-    comment += "\nfree parameters: " + free;
-    std::ofstream out(a.output);
-    if (!out) throw DataError(fmt::format("{}: cannot open for writing", a.output));
-    out << IpaParametersToToml(s.parameters, comment);
-    if (!out) throw DataError(fmt::format("{}: write failed", a.output));
+  if (summary.termination != Termination::kFailure && !args.output.empty()) {
+    WriteTwin(args.output, summary);
   }
-  if (!a.plot.empty() && !s.experiments.empty()) {
-    // One panel per experiment, then the held-out ones: at most four panels.
-    const std::size_t fitted = std::min<std::size_t>(s.experiments.size(), 3);
-    const std::size_t shown_held_out = std::min<std::size_t>(validation_sim.size(), 4 - fitted);
-    Figure fig(static_cast<int>(fitted + shown_held_out));
-    fig.title = "IPA twin calibration: measured and simulated output";
-    const std::string ylabel =
-        options.start.mode == IpaMode::kForce ? "Force F [N]" : "Position x [m]";
-    auto panel = [&](std::size_t i, const std::string& title, const Dataset& d,
-                     const Eigen::VectorXd& simulated) {
-      auto& ax = fig.axes(static_cast<int>(i));
-      ax.title = title;
-      ax.xlabel = "Time t [s]";
-      ax.ylabel = ylabel;
-      ax.AddLine(d.time(), d.y(0), "measured");
-      if (simulated.size() == d.size()) ax.AddLine(d.time(), simulated, "calibrated twin");
-    };
-    for (std::size_t i = 0; i < fitted; ++i) {
-      const auto& e = s.experiments[i];
-      panel(i,
-            fmt::format("{}: fit {:.2f} % (start {:.2f} %)", e.name, e.fit_percent,
-                        e.initial_fit_percent),
-            experiments[i].data, e.simulated);
-    }
-    for (std::size_t i = 0; i < shown_held_out; ++i)
-      panel(fitted + i,
-            fmt::format("{} (held out): fit {:.2f} %", a.validation[i], validation_fit[i]),
-            held_out[i], validation_sim[i]);
-    fig.Save(a.plot);
+  if (!args.plot.empty() && !summary.experiments.empty()) {
+    PlotCalibration(args, options, summary, experiments, held_out);
   }
-
-  if (a.json) {
-    nlohmann::ordered_json j;
-    nlohmann::ordered_json params = nlohmann::ordered_json::object();
-    for (const auto& e : s.estimates)
-      params[e.name] = {
-          {"value", e.value},           {"std", JsonNumber(e.std)}, {"unit", e.unit},
-          {"start", e.start},           {"lower", e.lower},         {"upper", e.upper},
-          {"determined", e.determined}, {"at_bound", e.at_bound}};
-    j["parameters"] = params;
-    nlohmann::ordered_json ex = nlohmann::ordered_json::array();
-    for (const auto& e : s.experiments)
-      ex.push_back({{"file", e.name},
-                    {"samples", e.samples},
-                    {"fit_percent", JsonNumber(e.fit_percent)},
-                    {"initial_fit_percent", JsonNumber(e.initial_fit_percent)}});
-    j["experiments"] = ex;
-    nlohmann::ordered_json val = nlohmann::ordered_json::array();
-    for (std::size_t i = 0; i < validation_fit.size(); ++i)
-      val.push_back({{"file", a.validation[i]}, {"fit_percent", JsonNumber(validation_fit[i])}});
-    j["validation"] = val;
-    nlohmann::ordered_json corr = nlohmann::ordered_json::array();
-    for (const auto& c : s.correlations)
-      corr.push_back({{"first", c.first}, {"second", c.second}, {"correlation", c.correlation}});
-    j["correlations"] = corr;
-    j["warnings"] = s.warnings;
-    j["termination"] = ToString(s.termination);
-    j["message"] = s.message;
-    j["iterations"] = s.iterations;
-    j["initial_cost"] = JsonNumber(s.initial_cost);
-    j["final_cost"] = JsonNumber(s.final_cost);
-    j["simulations"] = s.simulations;
-    j["seconds"] = s.seconds;
-    j["mode"] = ToString(options.start.mode);
-    j["pwm_mode"] = ToString(options.start.pwm_mode);
-    j["initial_state"] = ToString(options.initial_state);
-    if (!a.output.empty() && s.termination != Termination::kFailure) j["output"] = a.output;
-    if (!a.plot.empty()) j["plot"] = a.plot;
-    std::cout << j.dump(2) << "\n";
+  if (args.json) {
+    PrintJson(args, options, summary, held_out.fit);
   } else {
-    std::cout << fmt::format(
-        "IPA calibration ({} mode, {} PWM): {} after {} iterations, "
-        "{} simulations, {:.2f} s\n",
-        ToString(options.start.mode), ToString(options.start.pwm_mode), ToString(s.termination),
-        s.iterations, s.simulations, s.seconds);
-    if (!s.message.empty()) std::cout << "  " << s.message << "\n";
-    if (!s.experiments.empty()) std::cout << "experiments (NRMSE fit, start -> calibrated):\n";
-    for (const auto& e : s.experiments)
-      std::cout << fmt::format("  {:<30} {:>7} samples  {:7.2f} % -> {:7.2f} %\n", e.name,
-                               e.samples, e.initial_fit_percent, e.fit_percent);
-    for (std::size_t i = 0; i < validation_fit.size(); ++i)
-      std::cout << fmt::format("  {:<30} validation          {:7.2f} %\n", a.validation[i],
-                               validation_fit[i]);
-    if (!s.estimates.empty()) std::cout << "parameters (value +- standard deviation):\n";
-    for (const auto& e : s.estimates)
-      std::cout << fmt::format("  {:<32} {}{}\n", e.name, FormatValue(e.value, e.std, e.unit),
-                               e.determined ? "" : "  (not determined by the data)");
-    for (const auto& c : s.correlations)
-      std::cout << fmt::format("correlated: {} and {}: {:+.3f}\n", c.first, c.second,
-                               c.correlation);
-    if (!a.output.empty() && s.termination != Termination::kFailure)
-      std::cout << "twin written to " << a.output << "\n";
-    if (!a.plot.empty()) std::cout << "plot written to " << a.plot << "\n";
+    PrintText(args, options, summary, held_out.fit);
   }
-  for (const auto& w : s.warnings) std::cerr << "pneumid calibrate: warning: " << w << "\n";
-  if (s.termination == Termination::kFailure) {
-    std::cerr << "pneumid calibrate: error: " << s.message << "\n";
+  for (const auto& w : summary.warnings) std::cerr << "pneumid calibrate: warning: " << w << "\n";
+  if (summary.termination == Termination::kFailure) {
+    std::cerr << "pneumid calibrate: error: " << summary.message << "\n";
     throw ExitCode{1};
   }
 }

@@ -14,12 +14,12 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/preprocess.hpp"
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
-#include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
-#include "pneumid/identify/nonlinear/nonlinear.hpp"
-#include "pneumid/identify/parametric/parametric_model.hpp"
 #include "pneumid/identify/evaluation/residual_analysis.hpp"
 #include "pneumid/identify/evaluation/validation.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/nonlinear/nonlinear.hpp"
+#include "pneumid/identify/parametric/parametric_model.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/report/plot.hpp"
 #include "validators.hpp"
@@ -60,7 +60,7 @@ void WriteTrace(const std::string& path, const Dataset& data, const CompareResul
 std::optional<PolynomialModel> PolynomialOf(const IdentifiedModel& m) {
   if (!m.params.contains("a") || !m.params.contains("b") || !m.params.contains("Ts"))
     return std::nullopt;
-  return PolynomialModel::FromParamsJson(ToJson(m.params), m.structure);
+  return PolynomialModelFromParams(m.params, m.structure);
 }
 
 // Runs a residual analysis; returns why it is undefined (a constant input or
@@ -90,147 +90,179 @@ CompareResult SimulateIdentified(const IdentifiedModel& m, const Dataset& data, 
   return r;
 }
 
-void Run(const ValidateArgs& a) {
-  PNEUMID_CHECK(a.horizon >= 0, "--horizon must be >= 0 (0 = simulation), got {}", a.horizon);
-  std::string label = a.model;
-  const std::optional<IdentifiedModel> identified = ReadIdentified(a.model);
-  // The data get the command's preprocessing, then the model's own (recorded
-  // when it was identified, with its offsets): together they would remove
-  // offsets twice, so only a window may be added to a model's preprocessing.
-  const PreprocessOptions prep = ToPreprocessOptions(a.preprocess);
-  Dataset data = Preprocess(LoadFromOptions(a.data), prep);
+/// The data to validate on: the command's preprocessing, then the model's own
+/// (recorded when it was identified, with its offsets): together they would
+/// remove offsets twice, so only a window may be added to a model's preprocessing.
+Dataset LoadValidationData(const ValidateArgs& args,
+                           const std::optional<IdentifiedModel>& identified) {
+  const PreprocessOptions prep = ToPreprocessOptions(args.preprocess);
+  Dataset data = Preprocess(LoadFromOptions(args.data), prep);
   if (identified && identified->preprocessing) {
     PreprocessOptions rest = prep;
     rest.window = {};
     PNEUMID_CHECK(rest.IsIdentity(),
                   "{} carries the preprocessing it was identified with ({}); it is applied to "
                   "the data, so give no other preprocessing flag than --window",
-                  a.model, fmt::join(identified->preprocessing->steps, "; "));
+                  args.model, fmt::join(identified->preprocessing->steps, "; "));
     data = ApplyRecorded(data, *identified->preprocessing);
   }
-  std::optional<PolynomialModel> poly;
-  if (identified) {
-    label = fmt::format("{} {}", identified->method, identified->structure);
-    poly = PolynomialOf(*identified);
-  }
-  const InitialCondition initial = InitialConditionFromString(a.initial_state);
-  CompareOptions co;
-  co.skip = a.skip;
-  ResidualAnalysisOptions ro;
-  ro.max_lag = a.max_lag;
-  CompareResult sim, pred;
-  std::vector<std::string> warnings;
-  ResidualAnalysis res;
-  std::string residuals_unavailable;  // why the residual tests are undefined (constant input)
+  return data;
+}
+
+/// The fits and residual tests of a model on the data.
+struct ValidationResult {
+  CompareResult sim;   ///< simulation
+  CompareResult pred;  ///< k-step prediction, when have_pred
   bool have_pred = false;
-  if (identified) {
-    sim = SimulateIdentified(*identified, data, a.skip, initial);
-    warnings = ExtrapolationWarnings(*identified, data, 0);
-    for (const std::string& w : warnings) std::cerr << "pneumid validate: warning: " << w << "\n";
-    PNEUMID_CHECK(a.horizon == 0 || poly,
-                  "--horizon needs a polynomial model with a noise model; '{}' is a {} model "
-                  "(simulation only)",
-                  a.model, identified->structure);
-    // The polynomial form acts on the deviations from the model's operating point.
-    OperatingPoint op{Eigen::VectorXd::Zero(data.num_inputs()),
-                      Eigen::VectorXd::Zero(data.num_outputs())};
-    op.u0[co.input] = identified->u0;
-    op.y0[co.output] = identified->y0;
-    const Dataset deviations = SubtractOperatingPoint(data, op);
-    if (a.horizon > 0) {
-      co.horizon = a.horizon;
-      pred = Compare(*poly, deviations, co);
-      pred.y.array() += identified->y0;
-      pred.yhat.array() += identified->y0;
-      have_pred = true;
-    }
-    residuals_unavailable = TryResiduals(&res, [&] {
-      return poly ? AnalyzeResiduals(*poly, deviations, ro)
-                  : AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro);
-    });
+  std::vector<std::string> warnings;  ///< the data leave the model's identification range
+  ResidualAnalysis residuals;
+  std::string residuals_unavailable;  ///< why the residual tests are undefined (constant input)
+};
+
+/// Validates an identified model: simulation, k-step prediction (polynomial
+/// models with --horizon) and residual tests.
+ValidationResult ValidateIdentified(const ValidateArgs& args, const IdentifiedModel& identified,
+                                    const std::optional<PolynomialModel>& poly, const Dataset& data,
+                                    InitialCondition initial) {
+  CompareOptions compare;
+  compare.skip = args.skip;
+  ResidualAnalysisOptions residual_options;
+  residual_options.max_lag = args.max_lag;
+  ValidationResult result;
+  result.sim = SimulateIdentified(identified, data, args.skip, initial);
+  result.warnings = ExtrapolationWarnings(identified, data, 0);
+  for (const std::string& w : result.warnings) {
+    std::cerr << "pneumid validate: warning: " << w << "\n";
+  }
+  PNEUMID_CHECK(args.horizon == 0 || poly,
+                "--horizon needs a polynomial model with a noise model; '{}' is a {} model "
+                "(simulation only)",
+                args.model, identified.structure);
+  // The polynomial form acts on the deviations from the model's operating point.
+  OperatingPoint op{Eigen::VectorXd::Zero(data.num_inputs()),
+                    Eigen::VectorXd::Zero(data.num_outputs())};
+  op.u0[compare.input] = identified.u0;
+  op.y0[compare.output] = identified.y0;
+  const Dataset deviations = SubtractOperatingPoint(data, op);
+  if (args.horizon > 0) {
+    compare.horizon = args.horizon;
+    result.pred = Compare(*poly, deviations, compare);
+    result.pred.y.array() += identified.y0;
+    result.pred.yhat.array() += identified.y0;
+    result.have_pred = true;
+  }
+  const CompareResult& sim = result.sim;
+  result.residuals_unavailable = TryResiduals(&result.residuals, [&] {
+    return poly ? AnalyzeResiduals(*poly, deviations, residual_options)
+                : AnalyzeResiduals(sim.y - sim.yhat, data.u(0), residual_options);
+  });
+  return result;
+}
+
+/// Validates a model spec (a transfer function): simulation and residual tests.
+ValidationResult ValidateModelSpec(const ValidateArgs& args, const Dataset& data,
+                                   InitialCondition initial) {
+  PNEUMID_CHECK(args.horizon == 0,
+                "--horizon needs a polynomial model with a noise model; '{}' is a transfer "
+                "function (simulation only)",
+                args.model);
+  CompareOptions compare;
+  compare.skip = args.skip;
+  ResidualAnalysisOptions residual_options;
+  residual_options.max_lag = args.max_lag;
+  ValidationResult result;
+  const TransferFunction g = ParseModelSpec(args.model);
+  if (initial == InitialCondition::kZero) {
+    result.sim = Compare(g, data, compare);
   } else {
-    PNEUMID_CHECK(a.horizon == 0,
-                  "--horizon needs a polynomial model with a noise model; '{}' is a transfer "
-                  "function (simulation only)",
-                  a.model);
-    const TransferFunction g = ParseModelSpec(a.model);
-    if (initial == InitialCondition::kZero) {
-      sim = Compare(g, data, co);
-    } else {
-      IdentifiedModel m;  // a model spec acts on the signals as they are (u0 = y0 = 0)
-      m.method = a.model;
-      m.tf = g;
-      sim = SimulateIdentified(m, data, a.skip, initial);
-    }
-    residuals_unavailable =
-        TryResiduals(&res, [&] { return AnalyzeResiduals(sim.y - sim.yhat, data.u(0), ro); });
+    IdentifiedModel m;  // a model spec acts on the signals as they are (u0 = y0 = 0)
+    m.method = args.model;
+    m.tf = g;
+    result.sim = SimulateIdentified(m, data, args.skip, initial);
   }
-  if (!a.output.empty()) WriteTrace(a.output, data, sim, have_pred ? &pred : nullptr, a.horizon);
-  if (!a.plot.empty()) {
-    Figure fig(residuals_unavailable.empty() ? 3 : 1);
-    fig.title = fmt::format("Validation of {}", label);
-    auto& ax = fig.axes(0);
-    ax.title = fmt::format("simulation fit {:.2f} %", sim.fit_percent);
-    ax.xlabel = "time [s]";
-    ax.ylabel = "output";
-    ax.AddLine(sim.t, sim.y, "data");
-    ax.AddLine(sim.t, sim.yhat, "simulated");
-    if (have_pred)
-      ax.AddLine(pred.t, pred.yhat, fmt::format("{}-step prediction", a.horizon),
-                 LineStyle::kDashed);
-    if (residuals_unavailable.empty()) {
-      auto& ac = fig.axes(1);
-      ac.title =
-          fmt::format("residual autocorrelation: {}", res.whiteness_passed ? "pass" : "fail");
-      ac.xlabel = "lag [samples]";
-      ac.AddLine(res.lags_auto, res.autocorr, "r_e");
-      ac.AddHorizontalLine(res.bound, "99 % bound");
-      ac.AddHorizontalLine(-res.bound);
-      auto& xc = fig.axes(2);
-      xc.title = fmt::format("residual-input cross-correlation: {}",
-                             res.independence_passed ? "pass" : "fail");
-      xc.xlabel = "lag [samples]";
-      xc.AddLine(res.lags_cross, res.crosscorr, "r_eu");
-      xc.AddHorizontalLine(res.bound, "99 % bound");
-      xc.AddHorizontalLine(-res.bound);
-    }
-    fig.Save(a.plot);
+  const CompareResult& sim = result.sim;
+  result.residuals_unavailable = TryResiduals(&result.residuals, [&] {
+    return AnalyzeResiduals(sim.y - sim.yhat, data.u(0), residual_options);
+  });
+  return result;
+}
+
+/// Plots data, simulation (and prediction) and, when defined, the residual correlations.
+void PlotValidation(const ValidateArgs& args, const std::string& label,
+                    const ValidationResult& result) {
+  const CompareResult& sim = result.sim;
+  const ResidualAnalysis& res = result.residuals;
+  const bool show_residuals = result.residuals_unavailable.empty();
+  Figure fig(show_residuals ? 3 : 1);
+  fig.title = fmt::format("Validation of {}", label);
+  auto& ax = fig.axes(0);
+  ax.title = fmt::format("simulation fit {:.2f} %", sim.fit_percent);
+  ax.xlabel = "time [s]";
+  ax.ylabel = "output";
+  ax.AddLine(sim.t, sim.y, "data");
+  ax.AddLine(sim.t, sim.yhat, "simulated");
+  if (result.have_pred)
+    ax.AddLine(result.pred.t, result.pred.yhat, fmt::format("{}-step prediction", args.horizon),
+               LineStyle::kDashed);
+  if (show_residuals) {
+    auto& ac = fig.axes(1);
+    ac.title = fmt::format("residual autocorrelation: {}", res.whiteness_passed ? "pass" : "fail");
+    ac.xlabel = "lag [samples]";
+    ac.AddLine(res.lags_auto, res.autocorr, "r_e");
+    ac.AddHorizontalLine(res.bound, "99 % bound");
+    ac.AddHorizontalLine(-res.bound);
+    auto& xc = fig.axes(2);
+    xc.title = fmt::format("residual-input cross-correlation: {}",
+                           res.independence_passed ? "pass" : "fail");
+    xc.xlabel = "lag [samples]";
+    xc.AddLine(res.lags_cross, res.crosscorr, "r_eu");
+    xc.AddHorizontalLine(res.bound, "99 % bound");
+    xc.AddHorizontalLine(-res.bound);
   }
-  if (a.json) {
-    nlohmann::json j;
-    j["model"] = label;
-    j["samples"] = data.size();
-    j["fit_percent"] = sim.fit_percent;
-    j["warnings"] = warnings;
-    j["initial_state"] = ToString(initial);
-    j["rmse"] = sim.rmse;
-    if (have_pred) {
-      j["prediction"] = {
-          {"horizon", a.horizon}, {"fit_percent", pred.fit_percent}, {"rmse", pred.rmse}};
-    }
-    if (residuals_unavailable.empty()) {
-      j["residuals"] = res.ToJson();
-    } else {
-      j["residuals"] = nullptr;
-      j["residuals_unavailable"] = residuals_unavailable;
-    }
-    if (!a.plot.empty()) j["plot"] = a.plot;
-    std::cout << j.dump(2) << "\n";
-    return;
+  fig.Save(args.plot);
+}
+
+void PrintJson(const ValidateArgs& args, const std::string& label, const Dataset& data,
+               InitialCondition initial, const ValidationResult& result) {
+  nlohmann::json j;
+  j["model"] = label;
+  j["samples"] = data.size();
+  j["fit_percent"] = result.sim.fit_percent;
+  j["warnings"] = result.warnings;
+  j["initial_state"] = ToString(initial);
+  j["rmse"] = result.sim.rmse;
+  if (result.have_pred) {
+    j["prediction"] = {{"horizon", args.horizon},
+                       {"fit_percent", result.pred.fit_percent},
+                       {"rmse", result.pred.rmse}};
   }
+  if (result.residuals_unavailable.empty()) {
+    j["residuals"] = result.residuals.ToJson();
+  } else {
+    j["residuals"] = nullptr;
+    j["residuals_unavailable"] = result.residuals_unavailable;
+  }
+  if (!args.plot.empty()) j["plot"] = args.plot;
+  std::cout << j.dump(2) << "\n";
+}
+
+void PrintText(const ValidateArgs& args, const std::string& label, const Dataset& data,
+               const ValidationResult& result) {
+  const CompareResult& sim = result.sim;
+  const ResidualAnalysis& res = result.residuals;
   std::cout << fmt::format("model: {}\ndata: {} samples, Ts = {:g} s\n", label, data.size(),
                            data.SampleTime());
   std::cout << fmt::format("simulation fit: {:.2f} % (NRMSE), RMSE {:.6g}\n", sim.fit_percent,
                            sim.rmse);
-  if (have_pred)
-    std::cout << fmt::format("{}-step prediction fit: {:.2f} %, RMSE {:.6g}\n", a.horizon,
-                             pred.fit_percent, pred.rmse);
-  if (!residuals_unavailable.empty()) {
-    std::cout << "residual analysis: not available: " << residuals_unavailable << "\n";
-    if (!a.plot.empty()) std::cout << "plot written to " << a.plot << "\n";
+  if (result.have_pred)
+    std::cout << fmt::format("{}-step prediction fit: {:.2f} %, RMSE {:.6g}\n", args.horizon,
+                             result.pred.fit_percent, result.pred.rmse);
+  if (!result.residuals_unavailable.empty()) {
+    std::cout << "residual analysis: not available: " << result.residuals_unavailable << "\n";
+    if (!args.plot.empty()) std::cout << "plot written to " << args.plot << "\n";
     return;
   }
-  std::cout << fmt::format("residual analysis (max lag {}, 99 % bound +-{:.4g}):\n", a.max_lag,
+  std::cout << fmt::format("residual analysis (max lag {}, 99 % bound +-{:.4g}):\n", args.max_lag,
                            res.bound);
   std::cout << fmt::format(
       "  whiteness:    {} (Q = {:.4g}, chi2 limit {:.4g}; {} of {} lags outside)\n",
@@ -241,7 +273,33 @@ void Run(const ValidateArgs& a) {
       res.independence_passed ? "pass" : "FAIL", res.independence_statistic,
       res.independence_threshold, res.cross_outside, res.crosscorr.size());
   std::cout << fmt::format("verdict: {}\n", res.passed() ? "pass" : "FAIL");
-  if (!a.plot.empty()) std::cout << "plot written to " << a.plot << "\n";
+  if (!args.plot.empty()) std::cout << "plot written to " << args.plot << "\n";
+}
+
+void Run(const ValidateArgs& args) {
+  PNEUMID_CHECK(args.horizon >= 0, "--horizon must be >= 0 (0 = simulation), got {}", args.horizon);
+  std::string label = args.model;
+  const std::optional<IdentifiedModel> identified = ReadIdentified(args.model);
+  const Dataset data = LoadValidationData(args, identified);
+  std::optional<PolynomialModel> poly;
+  if (identified) {
+    label = fmt::format("{} {}", identified->method, identified->structure);
+    poly = PolynomialOf(*identified);
+  }
+  const InitialCondition initial = InitialConditionFromString(args.initial_state);
+  const ValidationResult result = identified
+                                      ? ValidateIdentified(args, *identified, poly, data, initial)
+                                      : ValidateModelSpec(args, data, initial);
+  if (!args.output.empty()) {
+    WriteTrace(args.output, data, result.sim, result.have_pred ? &result.pred : nullptr,
+               args.horizon);
+  }
+  if (!args.plot.empty()) PlotValidation(args, label, result);
+  if (args.json) {
+    PrintJson(args, label, data, initial, result);
+  } else {
+    PrintText(args, label, data, result);
+  }
 }
 
 static Registrar reg(

@@ -478,18 +478,66 @@ void PFX_applied(PFX_state* s, PFX_real u) {{
                   ny, nu, rows, nT, nF, nG, free, fmt::format(fmt::runtime(move), 0, 0, rows));
 }
 
-void GenerateMpc(const MpcController& c, Module& m) {
-  PNEUMID_CHECK(!c.integrating(),
-                "generated C of an MPC on an integrating model is not available (its target "
-                "and reset have no static gain to use); generate the PD (--controller pid) for a "
-                "position loop");
+// The sizes and options the MPC's generated code depends on.
+struct MpcCodeLayout {
+  int P = 0, M = 0;
+  int nx = 0;      // model states (delay states included)
+  int nz = 0;      // augmented states
+  int rows_F = 0;  // rows of F emitted: unconstrained, only the first move is used
+  bool constrained = false;
+  bool soft = false;    // a finite soft output bound
+  bool u_rows = false;  // a finite bound on u
+  // Single precision: the moves are computed from the deviation of the state
+  // and input from the target's steady state (EmitMpcModelData).
+  bool deviation = false;
+};
+
+MpcCodeLayout MakeMpcCodeLayout(const MpcController& c, const Module& m) {
   const MpcOptions& o = c.options();
-  const int P = o.P, M = o.M, nx = c.num_model_states();
-  const int nz = static_cast<int>(c.Az().rows());
-  const bool constrained = c.constrained();
-  const bool soft = std::isfinite(o.y_min) || std::isfinite(o.y_max);
-  const bool u_rows = std::isfinite(o.limits.u_min) || std::isfinite(o.limits.u_max);
-  const int rows_F = constrained ? M : 1;  // unconstrained: only the first move is used
+  MpcCodeLayout layout;
+  layout.P = o.P;
+  layout.M = o.M;
+  layout.nx = c.num_model_states();
+  layout.nz = static_cast<int>(c.Az().rows());
+  layout.constrained = c.constrained();
+  layout.soft = std::isfinite(o.y_min) || std::isfinite(o.y_max);
+  layout.u_rows = std::isfinite(o.limits.u_min) || std::isfinite(o.limits.u_max);
+  layout.rows_F = layout.constrained ? layout.M : 1;
+  layout.deviation = m.is_float();
+  return layout;
+}
+
+// The cancellation the deviation form relies on, checked on the design: at a
+// steady state on target the moves vanish, per unit target and per unit
+// disturbance.
+void CheckMovesVanishOnTarget(const MpcController& c, const MpcCodeLayout& layout) {
+  const MpcOptions& o = c.options();
+  const int nx = layout.nx;
+  const Eigen::MatrixXd& Fz = c.moves_state();
+  const Eigen::VectorXd xs0 = c.unit_steady_state();
+  const double G0 = c.static_gain();
+  const bool with_disturbance = layout.nz > nx;
+  for (int i = 0; i < layout.M; ++i) {
+    const double fx = Fz.row(i).head(nx).dot(xs0);
+    const double fd = with_disturbance ? Fz(i, nx) : 0.0;
+    double per_us = fx + c.moves_input()(i) + c.moves_setpoint()(i) * G0 + c.moves_target()(i);
+    double per_d = 0.0;
+    if (o.disturbance == DisturbanceModel::kOutput) per_d = fd + c.moves_setpoint()(i);
+    if (o.disturbance == DisturbanceModel::kInput) per_d = fx + fd + c.moves_setpoint()(i) * G0;
+    const double scale = Fz.row(i).cwiseAbs().sum() * (1.0 + xs0.cwiseAbs().maxCoeff()) +
+                         std::abs(c.moves_input()(i)) +
+                         std::abs(c.moves_setpoint()(i)) * (1.0 + std::abs(G0)) +
+                         std::abs(c.moves_target()(i));
+    PNEUMID_CHECK(std::abs(per_us) <= 1e-8 * scale && std::abs(per_d) <= 1e-8 * scale,
+                  "the MPC's moves do not vanish at a steady state on target (row {}: {} per "
+                  "unit target, {} per unit disturbance)",
+                  i, per_us, per_d);
+  }
+}
+
+// The model, observer and unconstrained-move tables and the state members.
+void EmitMpcModelData(const MpcController& c, const MpcCodeLayout& layout, Module& m) {
+  const int nx = layout.nx, nz = layout.nz, rows_F = layout.rows_F;
   m.dot_ = m.gemv_col_ = true;
   m.Array("Az", c.Az(), "augmented A (column-major)");
   m.Array("Bz", c.Bz(), "augmented B");
@@ -501,42 +549,21 @@ void GenerateMpc(const MpcController& c, Module& m) {
   // at a steady state on target), so that the rounding of the gains causes no
   // bias that the input's integrator would accumulate; xs and G are those of
   // the rounded A, B, C, for the same reason.
-  const bool deviation = m.is_float();
   Eigen::VectorXd xs = c.unit_steady_state();
   double G = c.static_gain();
-  if (deviation) {
+  if (layout.deviation) {
     const Eigen::MatrixXd A = c.Az().topLeftCorner(nx, nx).cast<float>().cast<double>();
     const Eigen::VectorXd B = c.Bz().head(nx).cast<float>().cast<double>();
     const Eigen::RowVectorXd C = c.Cz().head(nx).cast<float>().cast<double>();
     xs = (Eigen::MatrixXd::Identity(nx, nx) - A).partialPivLu().solve(B);
     G = C.dot(xs);
-    // The cancellation the deviation form relies on, checked on the design.
-    const Eigen::MatrixXd& Fz = c.moves_state();
-    const Eigen::VectorXd xs0 = c.unit_steady_state();
-    const double G0 = c.static_gain();
-    const int d = nz > nx ? 1 : 0;
-    for (int i = 0; i < M; ++i) {
-      const double fx = Fz.row(i).head(nx).dot(xs0);
-      const double fd = d ? Fz(i, nx) : 0.0;
-      double per_us = fx + c.moves_input()(i) + c.moves_setpoint()(i) * G0 + c.moves_target()(i);
-      double per_d = 0.0;
-      if (o.disturbance == DisturbanceModel::kOutput) per_d = fd + c.moves_setpoint()(i);
-      if (o.disturbance == DisturbanceModel::kInput) per_d = fx + fd + c.moves_setpoint()(i) * G0;
-      const double scale = Fz.row(i).cwiseAbs().sum() * (1.0 + xs0.cwiseAbs().maxCoeff()) +
-                           std::abs(c.moves_input()(i)) +
-                           std::abs(c.moves_setpoint()(i)) * (1.0 + std::abs(G0)) +
-                           std::abs(c.moves_target()(i));
-      PNEUMID_CHECK(std::abs(per_us) <= 1e-8 * scale && std::abs(per_d) <= 1e-8 * scale,
-                    "the MPC's moves do not vanish at a steady state on target (row {}: {} per "
-                    "unit target, {} per unit disturbance)",
-                    i, per_us, per_d);
-    }
+    CheckMovesVanishOnTarget(c, layout);
   }
   m.Array("xs", xs, "(I - A)^-1 B");
   m.Scalar("G", G, "static gain C (I - A)^-1 B");
   m.Array("Fz", c.moves_state().topRows(rows_F), "moves per state estimate (column-major)");
   m.Array("Fu", c.moves_input().head(rows_F), "moves per u_{k-1}");
-  if (!deviation) {
+  if (!layout.deviation) {
     m.Array("Fr", c.moves_setpoint().head(rows_F), "moves per set-point");
     m.Array("Fs", c.moves_target().head(rows_F), "moves per target input u_s");
   }
@@ -546,91 +573,104 @@ void GenerateMpc(const MpcController& c, Module& m) {
   m.Member({Field::kReal, "moves", rows_F, "planned moves"});
   m.Member({Field::kReal, "u_prev", 0, "last input"});
   m.Member({Field::kReal, "us", 0, "target input u_s"});
-  if (constrained) {
-    m.dot_strided_ = true;
-    if (soft) {
-      m.Array("Psi", c.free_response_matrix(), "Psi (P x nz, column-major)");
-      m.Array("Ups", c.input_response(), "Ups (P)");
-      m.Member({Field::kReal, "free", P, "free response"});
-      m.Array("Theta", c.dynamic_matrix(), "Theta (P x M, column-major)");
-    }
-    m.Array("Gz", c.gradient_state(), "QP linear term per state (column-major)");
-    m.Array("Gu", c.gradient_input(), "QP linear term per u_{k-1}");
-    if (!deviation) {
-      m.Array("Gr", c.gradient_setpoint(), "QP linear term per set-point");
-      m.Array("Gs", c.gradient_target(), "QP linear term per target input");
-    }
-    m.Scalar("RHO1", o.slack_linear_weight, "linear slack weight");
-    m.Member({Field::kInt, "last_active", 0, "the last step solved the QP"});
-    EmitQpData(m, c.qp_solver(), o.limits, soft);
+}
+
+// The constrained form's tables (free response, QP linear term) and the QP.
+void EmitMpcQpData(const MpcController& c, const MpcCodeLayout& layout, Module& m) {
+  const MpcOptions& o = c.options();
+  m.dot_strided_ = true;
+  if (layout.soft) {
+    m.Array("Psi", c.free_response_matrix(), "Psi (P x nz, column-major)");
+    m.Array("Ups", c.input_response(), "Ups (P)");
+    m.Member({Field::kReal, "free", layout.P, "free response"});
+    m.Array("Theta", c.dynamic_matrix(), "Theta (P x M, column-major)");
   }
-  EmitClip(m, o.limits);
-  // Reset: the observer at the steady state of u0 (mpc.cpp).
-  std::string reset;
-  switch (o.disturbance) {
+  m.Array("Gz", c.gradient_state(), "QP linear term per state (column-major)");
+  m.Array("Gu", c.gradient_input(), "QP linear term per u_{k-1}");
+  if (!layout.deviation) {
+    m.Array("Gr", c.gradient_setpoint(), "QP linear term per set-point");
+    m.Array("Gs", c.gradient_target(), "QP linear term per target input");
+  }
+  m.Scalar("RHO1", o.slack_linear_weight, "linear slack weight");
+  m.Member({Field::kInt, "last_active", 0, "the last step solved the QP"});
+  EmitQpData(m, c.qp_solver(), o.limits, layout.soft);
+}
+
+// Reset: the observer at the steady state of u0 (mpc.cpp).
+std::string MpcResetCode(DisturbanceModel disturbance, int nx) {
+  switch (disturbance) {
     case DisturbanceModel::kOutput:
-      reset = fmt::format(
+      return fmt::format(
           "  for (i = 0; i < {0}; ++i) s->z_prior[i] = PFX_xs[i] * u0;\n"
           "  s->z_prior[{0}] = y0 - PFX_dot(PFX_Cz, s->z_prior, {0});\n",
           nx);
-      break;
     case DisturbanceModel::kInput:
-      reset = fmt::format(
+      return fmt::format(
           "  {{\n    const PFX_real d = y0 / PFX_G - u0;\n"
           "    for (i = 0; i < {0}; ++i) s->z_prior[i] = PFX_xs[i] * (u0 + d);\n"
           "    s->z_prior[{0}] = d;\n  }}\n",
           nx);
-      break;
     case DisturbanceModel::kNone:
-      reset = fmt::format(
+      return fmt::format(
           "  (void)y0;\n  for (i = 0; i < {0}; ++i) s->z_prior[i] = PFX_xs[i] * u0;\n", nx);
-      break;
   }
-  std::string target;
-  switch (o.disturbance) {
+  return "";
+}
+
+// The target input u_s from the set-point and the disturbance estimate.
+std::string MpcTargetCode(DisturbanceModel disturbance, int nx) {
+  switch (disturbance) {
     case DisturbanceModel::kOutput:
-      target = fmt::format("  us = (setpoint - s->z_post[{}]) / PFX_G;\n", nx);
-      break;
+      return fmt::format("  us = (setpoint - s->z_post[{}]) / PFX_G;\n", nx);
     case DisturbanceModel::kInput:
-      target = fmt::format("  us = setpoint / PFX_G - s->z_post[{}];\n", nx);
-      break;
+      return fmt::format("  us = setpoint / PFX_G - s->z_post[{}];\n", nx);
     case DisturbanceModel::kNone:
-      target = "  us = setpoint / PFX_G;\n";
-      break;
+      return "  us = setpoint / PFX_G;\n";
   }
-  std::string moves;
-  if (deviation) {
-    switch (o.disturbance) {
-      case DisturbanceModel::kOutput:
-        moves = fmt::format(
-            "  for (i = 0; i < {0}; ++i) s->z_tmp[i] = s->z_post[i] - PFX_xs[i] * us;\n"
-            "  s->z_tmp[{0}] = PFX_ZERO;\n",
-            nx);
-        break;
-      case DisturbanceModel::kInput:
-        moves = fmt::format(
-            "  for (i = 0; i < {0}; ++i) s->z_tmp[i] = s->z_post[i] - PFX_xs[i] * (us + "
-            "s->z_post[{0}]);\n"
-            "  s->z_tmp[{0}] = PFX_ZERO;\n",
-            nx);
-        break;
-      case DisturbanceModel::kNone:
-        moves = fmt::format(
-            "  for (i = 0; i < {0}; ++i) s->z_tmp[i] = s->z_post[i] - PFX_xs[i] * us;\n", nx);
-        break;
-    }
-    moves += fmt::format(
-        "  PFX_gemv_col(PFX_Fz, {0}, {0}, {1}, s->z_tmp, s->moves, 0, PFX_ONE);\n"
-        "  for (i = 0; i < {0}; ++i) s->moves[i] += PFX_Fu[i] * (s->u_prev - us);\n",
-        rows_F, nz);
-  } else {
-    moves = fmt::format(
+  return "";
+}
+
+// The unconstrained moves, in the deviation form or from Fz z + Fu u_{k-1} + Fr r + Fs u_s.
+std::string MpcMovesCode(DisturbanceModel disturbance, const MpcCodeLayout& layout) {
+  const int nx = layout.nx;
+  if (!layout.deviation) {
+    return fmt::format(
         "  PFX_gemv_col(PFX_Fz, {0}, {0}, {1}, s->z_post, s->moves, 0, PFX_ONE);\n"
         "  for (i = 0; i < {0}; ++i)\n"
         "    s->moves[i] += PFX_Fu[i] * s->u_prev + PFX_Fr[i] * setpoint + PFX_Fs[i] * us;\n",
-        rows_F, nz);
+        layout.rows_F, layout.nz);
   }
-  m.code_ += fmt::format(
+  std::string moves;
+  switch (disturbance) {
+    case DisturbanceModel::kOutput:
+      moves = fmt::format(
+          "  for (i = 0; i < {0}; ++i) s->z_tmp[i] = s->z_post[i] - PFX_xs[i] * us;\n"
+          "  s->z_tmp[{0}] = PFX_ZERO;\n",
+          nx);
+      break;
+    case DisturbanceModel::kInput:
+      moves = fmt::format(
+          "  for (i = 0; i < {0}; ++i) s->z_tmp[i] = s->z_post[i] - PFX_xs[i] * (us + "
+          "s->z_post[{0}]);\n"
+          "  s->z_tmp[{0}] = PFX_ZERO;\n",
+          nx);
+      break;
+    case DisturbanceModel::kNone:
+      moves = fmt::format(
+          "  for (i = 0; i < {0}; ++i) s->z_tmp[i] = s->z_post[i] - PFX_xs[i] * us;\n", nx);
+      break;
+  }
+  moves += fmt::format(
+      "  PFX_gemv_col(PFX_Fz, {0}, {0}, {1}, s->z_tmp, s->moves, 0, PFX_ONE);\n"
+      "  for (i = 0; i < {0}; ++i) s->moves[i] += PFX_Fu[i] * (s->u_prev - us);\n",
+      layout.rows_F, layout.nz);
+  return moves;
+}
+
+// PFX_reset, and PFX_step up to the unconstrained moves.
+std::string MpcResetAndMovesCode(const MpcController& c, const MpcCodeLayout& layout) {
+  const DisturbanceModel disturbance = c.options().disturbance;
+  return fmt::format(
       R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {{
   int i;
 {0}  for (i = 0; i < {1}; ++i) s->z_post[i] = s->z_prior[i];
@@ -645,80 +685,110 @@ PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {{
   int i;
   for (i = 0; i < {1}; ++i) s->z_post[i] = s->z_prior[i] + PFX_L[i] * innovation;
 {4}{5})C",
-      reset, nz, rows_F,
-      constrained ? "  s->qp_failures = 0;\n  s->last_active = 0;\n  s->qp.nwarm = 0;\n" : "",
-      target, moves);
-  if (constrained) {
-    m.code_ += "  s->last_active = 0;\n";
-    if (soft)
-      m.code_ += fmt::format(
-          "  PFX_gemv_col(PFX_Psi, {0}, {0}, {1}, s->z_post, s->free, 0, PFX_ONE);\n"
-          "  for (i = 0; i < {0}; ++i) s->free[i] += PFX_Ups[i] * s->u_prev;\n",
-          P, nz);
-    // UnconstrainedMovesFeasible().
-    std::string check;
-    const InputLimits& lim = o.limits;
-    std::vector<std::string> tests;
-    if (std::isfinite(lim.du_max))
-      tests.push_back(fmt::format("!(PFX_FABS(du) <= {})", m.Literal(lim.du_max)));
-    if (std::isfinite(lim.u_min)) tests.push_back(fmt::format("!(uj >= {})", m.Literal(lim.u_min)));
-    if (std::isfinite(lim.u_max)) tests.push_back(fmt::format("!(uj <= {})", m.Literal(lim.u_max)));
-    check += "  {\n    int feasible = 1;\n";
-    if (!tests.empty()) {
-      std::string cond;
-      for (std::size_t k = 0; k < tests.size(); ++k) cond += (k ? " || " : "") + tests[k];
-      check += fmt::format(
-          "    PFX_real uj = s->u_prev;\n    for (i = 0; i < {} && feasible; ++i) {{\n"
-          "      const PFX_real du = s->moves[i];\n      uj += du;\n"
-          "      if ({}) feasible = 0;\n    }}\n",
-          M, cond);
-    }
-    if (soft) {
-      std::vector<std::string> ytests;
-      if (std::isfinite(o.y_min)) ytests.push_back(fmt::format("!(y >= {})", m.Literal(o.y_min)));
-      if (std::isfinite(o.y_max)) ytests.push_back(fmt::format("!(y <= {})", m.Literal(o.y_max)));
-      std::string cond;
-      for (std::size_t k = 0; k < ytests.size(); ++k) cond += (k ? " || " : "") + ytests[k];
-      check += fmt::format(
-          "    for (i = 0; i < {0} && feasible; ++i) {{\n"
-          "      const int n = i + 1 < {1} ? i + 1 : {1};\n"
-          "      const PFX_real y = s->free[i] + PFX_dot_strided(PFX_Theta + i, {0}, s->moves, "
-          "n);\n"
-          "      if ({2}) feasible = 0;\n    }}\n",
-          P, M, cond);
-    }
-    check += "    if (!feasible) {\n      s->last_active = 1;\n";
-    check +=
-        deviation
-            ? fmt::format(
-                  "      PFX_gemv_col(PFX_Gz, {0}, {0}, {1}, s->z_tmp, s->qp.g, 0, PFX_ONE);\n"
-                  "      for (i = 0; i < {0}; ++i) s->qp.g[i] += PFX_Gu[i] * (s->u_prev - us);\n",
-                  M, nz)
-            : fmt::format(
-                  "      PFX_gemv_col(PFX_Gz, {0}, {0}, {1}, s->z_post, s->qp.g, 0, PFX_ONE);\n"
-                  "      for (i = 0; i < {0}; ++i)\n"
-                  "        s->qp.g[i] += PFX_Gu[i] * s->u_prev + PFX_Gr[i] * setpoint + PFX_Gs[i] "
-                  "* us;\n",
-                  M, nz);
-    if (soft) check += fmt::format("      s->qp.g[{}] = PFX_RHO1;\n", M);
-    std::string bounds = QpBoundsCode(m, u_rows, lim, o.y_min, o.y_max, M, P, "s->free");
-    // Indent the bounds code one level further.
-    std::string indented;
-    std::size_t start = 0;
-    while (start < bounds.size()) {
-      const std::size_t end = bounds.find('\n', start);
-      indented += "    " + bounds.substr(start, end - start + 1);
-      start = end + 1;
-    }
-    check += indented;
+      MpcResetCode(disturbance, layout.nx), layout.nz, layout.rows_F,
+      layout.constrained ? "  s->qp_failures = 0;\n  s->last_active = 0;\n  s->qp.nwarm = 0;\n"
+                         : "",
+      MpcTargetCode(disturbance, layout.nx), MpcMovesCode(disturbance, layout));
+}
+
+// " || "-joined conditions.
+std::string JoinedWithOr(const std::vector<std::string>& tests) {
+  std::string cond;
+  for (std::size_t k = 0; k < tests.size(); ++k) cond += (k ? " || " : "") + tests[k];
+  return cond;
+}
+
+// UnconstrainedMovesFeasible(): opens a block that sets `feasible`.
+std::string MpcFeasibilityCode(const MpcOptions& o, const MpcCodeLayout& layout, const Module& m) {
+  const InputLimits& lim = o.limits;
+  std::vector<std::string> tests;
+  if (std::isfinite(lim.du_max))
+    tests.push_back(fmt::format("!(PFX_FABS(du) <= {})", m.Literal(lim.du_max)));
+  if (std::isfinite(lim.u_min)) tests.push_back(fmt::format("!(uj >= {})", m.Literal(lim.u_min)));
+  if (std::isfinite(lim.u_max)) tests.push_back(fmt::format("!(uj <= {})", m.Literal(lim.u_max)));
+  std::string check = "  {\n    int feasible = 1;\n";
+  if (!tests.empty()) {
     check += fmt::format(
-        "      if (PFX_qp_solve(&s->qp) == PFX_QP_SOLVED)\n"
-        "        for (i = 0; i < {}; ++i) s->moves[i] = s->qp.x[i];\n"
-        "      else\n        ++s->qp_failures;\n    }}\n  }}\n",
-        M);
-    m.code_ += check;
+        "    PFX_real uj = s->u_prev;\n    for (i = 0; i < {} && feasible; ++i) {{\n"
+        "      const PFX_real du = s->moves[i];\n      uj += du;\n"
+        "      if ({}) feasible = 0;\n    }}\n",
+        layout.M, JoinedWithOr(tests));
   }
-  m.code_ += fmt::format(R"C(  u = PFX_clip(s->u_prev + s->moves[0], s->u_prev);
+  if (layout.soft) {
+    std::vector<std::string> ytests;
+    if (std::isfinite(o.y_min)) ytests.push_back(fmt::format("!(y >= {})", m.Literal(o.y_min)));
+    if (std::isfinite(o.y_max)) ytests.push_back(fmt::format("!(y <= {})", m.Literal(o.y_max)));
+    check += fmt::format(
+        "    for (i = 0; i < {0} && feasible; ++i) {{\n"
+        "      const int n = i + 1 < {1} ? i + 1 : {1};\n"
+        "      const PFX_real y = s->free[i] + PFX_dot_strided(PFX_Theta + i, {0}, s->moves, "
+        "n);\n"
+        "      if ({2}) feasible = 0;\n    }}\n",
+        layout.P, layout.M, JoinedWithOr(ytests));
+  }
+  return check;
+}
+
+// Each line of `code` indented by `indent`.
+std::string Indented(const std::string& code, const std::string& indent) {
+  std::string indented;
+  std::size_t start = 0;
+  while (start < code.size()) {
+    const std::size_t end = code.find('\n', start);
+    indented += indent + code.substr(start, end - start + 1);
+    start = end + 1;
+  }
+  return indented;
+}
+
+// The QP of a step whose unconstrained moves are infeasible, closing the
+// block MpcFeasibilityCode opened.
+std::string MpcQpSolveCode(const MpcOptions& o, const MpcCodeLayout& layout, const Module& m) {
+  const int M = layout.M, nz = layout.nz;
+  std::string code = "    if (!feasible) {\n      s->last_active = 1;\n";
+  code +=
+      layout.deviation
+          ? fmt::format(
+                "      PFX_gemv_col(PFX_Gz, {0}, {0}, {1}, s->z_tmp, s->qp.g, 0, PFX_ONE);\n"
+                "      for (i = 0; i < {0}; ++i) s->qp.g[i] += PFX_Gu[i] * (s->u_prev - us);\n",
+                M, nz)
+          : fmt::format(
+                "      PFX_gemv_col(PFX_Gz, {0}, {0}, {1}, s->z_post, s->qp.g, 0, PFX_ONE);\n"
+                "      for (i = 0; i < {0}; ++i)\n"
+                "        s->qp.g[i] += PFX_Gu[i] * s->u_prev + PFX_Gr[i] * setpoint + PFX_Gs[i] "
+                "* us;\n",
+                M, nz);
+  if (layout.soft) code += fmt::format("      s->qp.g[{}] = PFX_RHO1;\n", M);
+  // The bounds code indented one level further.
+  code += Indented(
+      QpBoundsCode(m, layout.u_rows, o.limits, o.y_min, o.y_max, M, layout.P, "s->free"), "    ");
+  code += fmt::format(
+      "      if (PFX_qp_solve(&s->qp) == PFX_QP_SOLVED)\n"
+      "        for (i = 0; i < {}; ++i) s->moves[i] = s->qp.x[i];\n"
+      "      else\n        ++s->qp_failures;\n    }}\n  }}\n",
+      M);
+  return code;
+}
+
+// The constrained part of PFX_step: the free response, the feasibility of
+// the unconstrained moves, and the QP when they are not.
+std::string MpcConstrainedStepCode(const MpcController& c, const MpcCodeLayout& layout,
+                                   const Module& m) {
+  const MpcOptions& o = c.options();
+  std::string code = "  s->last_active = 0;\n";
+  if (layout.soft)
+    code += fmt::format(
+        "  PFX_gemv_col(PFX_Psi, {0}, {0}, {1}, s->z_post, s->free, 0, PFX_ONE);\n"
+        "  for (i = 0; i < {0}; ++i) s->free[i] += PFX_Ups[i] * s->u_prev;\n",
+        layout.P, layout.nz);
+  code += MpcFeasibilityCode(o, layout, m);
+  code += MpcQpSolveCode(o, layout, m);
+  return code;
+}
+
+// The end of PFX_step (clip, observer prediction) and PFX_applied.
+std::string MpcStepEndAndAppliedCode(int nz) {
+  return fmt::format(R"C(  u = PFX_clip(s->u_prev + s->moves[0], s->u_prev);
   PFX_gemv_col(PFX_Az, {0}, {0}, {0}, s->z_post, s->z_tmp, 0, PFX_ONE);
   for (i = 0; i < {0}; ++i) s->z_prior[i] = s->z_tmp[i] + PFX_Bz[i] * u;
   s->u_prev = u;
@@ -734,7 +804,21 @@ void PFX_applied(PFX_state* s, PFX_real u) {{
   s->u_prev = u;
 }}
 )C",
-                         nz);
+                     nz);
+}
+
+void GenerateMpc(const MpcController& c, Module& m) {
+  PNEUMID_CHECK(!c.integrating(),
+                "generated C of an MPC on an integrating model is not available (its target "
+                "and reset have no static gain to use); generate the PD (--controller pid) for a "
+                "position loop");
+  const MpcCodeLayout layout = MakeMpcCodeLayout(c, m);
+  EmitMpcModelData(c, layout, m);
+  if (layout.constrained) EmitMpcQpData(c, layout, m);
+  EmitClip(m, c.options().limits);
+  m.code_ += MpcResetAndMovesCode(c, layout);
+  if (layout.constrained) m.code_ += MpcConstrainedStepCode(c, layout, m);
+  m.code_ += MpcStepEndAndAppliedCode(layout.nz);
 }
 
 // Makes the entry points generated so far (PFX_reset, PFX_step, PFX_applied,
@@ -1086,57 +1170,78 @@ struct StepCost {
   const QpSolver* qp = nullptr;
 };
 
-void AddStepCost(const Controller& controller, StepCost* cost) {
-  auto map_cost = [](const StaticMap& f) { return 6.0 * static_cast<double>(f.size()) + 10.0; };
-  // A matrix-vector product and an inner product, with their loop overheads.
-  auto gemv = [](double rows, double cols) { return rows * (cols + 4.0); };
-  auto dot = [](double n) { return n + 4.0; };
-  if (dynamic_cast<const PidController*>(&controller)) {
-    cost->base += 30.0;
-  } else if (const auto* dmc = dynamic_cast<const DmcController*>(&controller)) {
-    const double N = static_cast<double>(dmc->step_coefficients().size());
-    const double P = dmc->options().P, M = dmc->options().M;
-    cost->base += 2.0 * N + 2.0 * P + dot(P) + 30.0;
-    if (dmc->options().constrained) {
-      cost->base += gemv(M, P) + 4.0 * P + 2.0 * M;
-      cost->qp = &dmc->qp_solver();
+// The step cost of each controller class; a layer adds its own and its inner
+// controller's.
+class StepCostVisitor final : public ControllerVisitor {
+ public:
+  explicit StepCostVisitor(StepCost* cost) : cost_(cost) {}
+
+  void Visit(const PidController&) override { cost_->base += 30.0; }
+  void Visit(const DmcController& dmc) override {
+    const double N = static_cast<double>(dmc.step_coefficients().size());
+    const double P = dmc.options().P, M = dmc.options().M;
+    cost_->base += 2.0 * N + 2.0 * P + Dot(P) + 30.0;
+    if (dmc.options().constrained) {
+      cost_->base += Gemv(M, P) + 4.0 * P + 2.0 * M;
+      cost_->qp = &dmc.qp_solver();
     }
-  } else if (const auto* gpc = dynamic_cast<const GpcController*>(&controller)) {
-    const double rows = static_cast<double>(gpc->f_matrix().rows());
-    cost->base += gemv(rows, static_cast<double>(gpc->f_matrix().cols())) +
-                  gemv(rows, static_cast<double>(gpc->gamma_matrix().cols())) + dot(rows) + rows +
-                  2.0 * static_cast<double>(gpc->t_polynomial().size()) +
-                  2.0 * static_cast<double>(gpc->y_history_length() + gpc->move_history_length()) +
-                  30.0;
-  } else if (const auto* mpc = dynamic_cast<const MpcController*>(&controller)) {
-    const double nz = static_cast<double>(mpc->Az().rows());
-    const double P = mpc->options().P, M = mpc->options().M;
-    const double rows = mpc->constrained() ? M : 1.0;
-    cost->base += gemv(nz, nz) + gemv(rows, nz) + dot(nz) + 6.0 * nz + 2.0 * rows + 30.0;
-    if (mpc->constrained()) {
+  }
+  void Visit(const GpcController& gpc) override {
+    const double rows = static_cast<double>(gpc.f_matrix().rows());
+    cost_->base += Gemv(rows, static_cast<double>(gpc.f_matrix().cols())) +
+                   Gemv(rows, static_cast<double>(gpc.gamma_matrix().cols())) + Dot(rows) + rows +
+                   2.0 * static_cast<double>(gpc.t_polynomial().size()) +
+                   2.0 * static_cast<double>(gpc.y_history_length() + gpc.move_history_length()) +
+                   30.0;
+  }
+  void Visit(const MpcController& mpc) override {
+    const double nz = static_cast<double>(mpc.Az().rows());
+    const double P = mpc.options().P, M = mpc.options().M;
+    const double rows = mpc.constrained() ? M : 1.0;
+    cost_->base += Gemv(nz, nz) + Gemv(rows, nz) + Dot(nz) + 6.0 * nz + 2.0 * rows + 30.0;
+    if (mpc.constrained()) {
       // Free response, the feasibility test of the unconstrained moves, the
       // QP's linear term and row bounds.
-      cost->base += gemv(P, nz) + gemv(P, M) + gemv(M, nz) + 4.0 * P + 4.0 * M;
-      cost->qp = &mpc->qp_solver();
+      cost_->base += Gemv(P, nz) + Gemv(P, M) + Gemv(M, nz) + 4.0 * P + 4.0 * M;
+      cost_->qp = &mpc.qp_solver();
     }
-  } else if (const auto* im = dynamic_cast<const InverseMapController*>(&controller)) {
-    cost->base += 3.0 * map_cost(im->map()) + 10.0;
-    AddStepCost(im->inner(), cost);
-  } else if (const auto* sd = dynamic_cast<const ModulatedController*>(&controller)) {
-    cost->base += 4.0 * static_cast<double>(sd->modulator().gaps().size()) + 20.0;
-    AddStepCost(sd->inner(), cost);
-  } else if (const auto* om = dynamic_cast<const OutputMapController*>(&controller)) {
-    cost->base += 2.0 * map_cost(om->map()) + 10.0;
-    AddStepCost(om->inner(), cost);
-  } else if (const auto* nl = dynamic_cast<const NarxLinearizingController*>(&controller)) {
-    const InputAffineNarx& m = nl->model();
+  }
+  void Visit(const InverseMapController& layer) override {
+    cost_->base += 3.0 * MapCost(layer.map()) + 10.0;
+    layer.inner().Accept(*this);
+  }
+  void Visit(const OutputMapController& layer) override {
+    cost_->base += 2.0 * MapCost(layer.map()) + 10.0;
+    layer.inner().Accept(*this);
+  }
+  void Visit(const ModulatedController& layer) override {
+    cost_->base += 4.0 * static_cast<double>(layer.modulator().gaps().size()) + 20.0;
+    layer.inner().Accept(*this);
+  }
+  void Visit(const NarxLinearizingController& layer) override {
+    const InputAffineNarx& m = layer.model();
     const double poly =
         static_cast<double>(m.drift_coefficients().size() + m.gain_coefficients().size()) * 2.0;
     double maps = 0.0;
-    if (m.map()) maps = 2.0 * map_cost(*m.map()) + map_cost(*m.envelope());
-    cost->base += 2.0 * poly + maps + 40.0;
-    AddStepCost(nl->inner(), cost);
+    if (m.map()) maps = 2.0 * MapCost(*m.map()) + MapCost(*m.envelope());
+    cost_->base += 2.0 * poly + maps + 40.0;
+    layer.inner().Accept(*this);
   }
+  // GenerateLayers refuses other controllers before their cost is asked for.
+  void VisitOther(const Controller&) override {}
+
+ private:
+  static double MapCost(const StaticMap& f) { return 6.0 * static_cast<double>(f.size()) + 10.0; }
+  // A matrix-vector product and an inner product, with their loop overheads.
+  static double Gemv(double rows, double cols) { return rows * (cols + 4.0); }
+  static double Dot(double n) { return n + 4.0; }
+
+  StepCost* cost_;
+};
+
+void AddStepCost(const Controller& controller, StepCost* cost) {
+  StepCostVisitor visitor(cost);
+  controller.Accept(visitor);
 }
 
 // The certificate of `controller` and the QP's iteration cap in the module.
@@ -1210,50 +1315,78 @@ RealTimeCertificate Certify(const Controller& controller, const CodegenOptions& 
 }
 
 // The controller's code: a linear controller, or a layer (input map, output
-// map, NARX linearization) around its inner controller's code.
-void GenerateLayers(const Controller& controller, Module& m, int depth, CodegenResult* result) {
-  const std::string stem = fmt::format("l{}_", depth);
-  if (const auto* pid = dynamic_cast<const PidController*>(&controller)) {
-    result->type = ControllerType::kPid;
-    GeneratePid(*pid, m);
-  } else if (const auto* dmc = dynamic_cast<const DmcController*>(&controller)) {
-    result->type = ControllerType::kDmc;
-    result->constrained = dmc->options().constrained;
-    GenerateDmc(*dmc, m);
-  } else if (const auto* gpc = dynamic_cast<const GpcController*>(&controller)) {
-    result->type = ControllerType::kGpc;
-    GenerateGpc(*gpc, m);
-  } else if (const auto* mpc = dynamic_cast<const MpcController*>(&controller)) {
-    result->type = ControllerType::kMpc;
-    result->constrained = mpc->constrained();
-    GenerateMpc(*mpc, m);
-  } else if (const auto* im = dynamic_cast<const InverseMapController*>(&controller)) {
-    GenerateLayers(im->inner(), m, depth + 1, result);
-    HideEntryPoints(m, stem);
-    GenerateInverseMap(*im, m, stem);
-    result->layers.insert(result->layers.begin(), "input-map");
-  } else if (const auto* sd = dynamic_cast<const ModulatedController*>(&controller)) {
-    GenerateLayers(sd->inner(), m, depth + 1, result);
-    HideEntryPoints(m, stem);
-    GenerateModulator(*sd, m, stem);
-    result->layers.insert(result->layers.begin(), "sigma-delta");
-  } else if (const auto* om = dynamic_cast<const OutputMapController*>(&controller)) {
-    GenerateLayers(om->inner(), m, depth + 1, result);
-    HideEntryPoints(m, stem);
-    GenerateOutputMap(*om, m, stem);
-    result->layers.insert(result->layers.begin(), "output-map");
-  } else if (const auto* nl = dynamic_cast<const NarxLinearizingController*>(&controller)) {
-    GenerateLayers(nl->inner(), m, depth + 1, result);
-    HideEntryPoints(m, stem);
-    GenerateNarxLinearization(*nl, m, stem);
-    result->layers.insert(result->layers.begin(), "narx-linearization");
-  } else {
+// map, NARX linearization, sigma-delta modulator) around its inner
+// controller's code, one visit per layer.
+class LayerGenerator final : public ControllerVisitor {
+ public:
+  LayerGenerator(Module& module, int depth, CodegenResult* result)
+      : module_(module), depth_(depth), result_(result) {}
+
+  void Visit(const PidController& pid) override {
+    result_->type = ControllerType::kPid;
+    GeneratePid(pid, module_);
+  }
+  void Visit(const DmcController& dmc) override {
+    result_->type = ControllerType::kDmc;
+    result_->constrained = dmc.options().constrained;
+    GenerateDmc(dmc, module_);
+  }
+  void Visit(const GpcController& gpc) override {
+    result_->type = ControllerType::kGpc;
+    GenerateGpc(gpc, module_);
+  }
+  void Visit(const MpcController& mpc) override {
+    result_->type = ControllerType::kMpc;
+    result_->constrained = mpc.constrained();
+    GenerateMpc(mpc, module_);
+  }
+  void Visit(const InverseMapController& layer) override {
+    const std::string stem = Inner(layer.inner());
+    GenerateInverseMap(layer, module_, stem);
+    result_->layers.insert(result_->layers.begin(), "input-map");
+  }
+  void Visit(const ModulatedController& layer) override {
+    const std::string stem = Inner(layer.inner());
+    GenerateModulator(layer, module_, stem);
+    result_->layers.insert(result_->layers.begin(), "sigma-delta");
+  }
+  void Visit(const OutputMapController& layer) override {
+    const std::string stem = Inner(layer.inner());
+    GenerateOutputMap(layer, module_, stem);
+    result_->layers.insert(result_->layers.begin(), "output-map");
+  }
+  void Visit(const NarxLinearizingController& layer) override {
+    const std::string stem = Inner(layer.inner());
+    GenerateNarxLinearization(layer, module_, stem);
+    result_->layers.insert(result_->layers.begin(), "narx-linearization");
+  }
+  void VisitOther(const Controller& controller) override {
     PNEUMID_CHECK(false,
                   "code generation supports the dmc, gpc, pid and mpc controllers, alone or "
                   "behind an input map, an output map, a NARX linearization or a sigma-delta "
                   "modulator, not '{}'",
                   controller.Describe());
   }
+
+ private:
+  // Generates the inner controller one level deeper and hides its entry
+  // points under this layer's stem, which it returns.
+  std::string Inner(const Controller& inner) {
+    LayerGenerator deeper(module_, depth_ + 1, result_);
+    inner.Accept(deeper);
+    const std::string stem = fmt::format("l{}_", depth_);
+    HideEntryPoints(module_, stem);
+    return stem;
+  }
+
+  Module& module_;
+  int depth_;
+  CodegenResult* result_;
+};
+
+void GenerateLayers(const Controller& controller, Module& m, int depth, CodegenResult* result) {
+  LayerGenerator generator(m, depth, result);
+  controller.Accept(generator);
 }
 
 // PFX_name -> prefix_name, and PFX_MACRO -> PREFIX_MACRO for the macros.
@@ -1290,6 +1423,175 @@ std::string CertificateText(const RealTimeCertificate& c, const std::string& upp
         c.cpu_mhz, c.cycles_per_instruction, c.max_cycles, 1e3 * c.max_time, c.budget_cycles,
         c.utilization, 1e3 * c.period);
   return text + ".\n";
+}
+
+// The struct texts of a module: the QP's (empty without a QP) and the
+// state's body, with the state's size.
+struct ModuleStructs {
+  std::string qp_struct;
+  std::string state_body;
+  std::size_t state_bytes = 0;
+};
+
+ModuleStructs MakeModuleStructs(const Module& m) {
+  ModuleStructs structs;
+  std::size_t qp_bytes = 0;
+  if (m.qp_solver_) {
+    structs.qp_struct =
+        "typedef struct {\n" + m.StructText(m.qp_, "", 0, &qp_bytes) + "} PFX_qp;\n\n";
+  }
+  structs.state_body = m.StructText(
+      m.state_, m.qp_solver_ ? "  PFX_qp qp; /* QP solver data and work arrays */\n" : "", qp_bytes,
+      &structs.state_bytes);
+  return structs;
+}
+
+// The header PFX.h (before the prefix is applied).
+std::string HeaderText(const Module& m, const CodegenResult& result, double Ts,
+                       const ModuleStructs& structs) {
+  const std::string& name = result.prefix;
+  const std::string guard = internal::Upper(name) + "_H_";
+  const std::string real = m.is_float() ? "float" : "double";
+  std::string h;
+  h += fmt::format(
+      "/* {0}.h: {1}\n * Generated by pneumid codegen ({2} precision). C99, no dynamic memory;\n"
+      " * all state in {0}_state, which the caller owns (re-entrant).\n */\n",
+      name, result.description, real);
+  h += "#ifndef " + guard + "\n#define " + guard +
+       "\n\n#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
+  h += "typedef " + real + " PFX_real;\n\n";
+  h += fmt::format("#define PFX_TS {} /* sample time, s */\n", m.Literal(Ts));
+  h += fmt::format("#define PFX_STATE_BYTES {} /* sizeof(PFX_state) with 4-byte int */\n",
+                   result.ram_bytes);
+  h += "\n/* Fault of the last step (PFX_state.fault; PFX_state.faults counts them). */\n"
+       "#define PFX_FAULT_NONE 0\n#define PFX_FAULT_MEASUREMENT_NOT_FINITE 1\n"
+       "#define PFX_FAULT_MEASUREMENT_OUT_OF_RANGE 2\n#define PFX_FAULT_SETPOINT_NOT_FINITE 3\n"
+       "#define PFX_FAULT_OUTPUT_NOT_FINITE 4\n";
+  if (m.qp_solver_) {
+    h += "\n/* QP status (PFX_state.qp.status). */\n#define PFX_QP_SOLVED 0\n"
+         "#define PFX_QP_INFEASIBLE 1\n#define PFX_QP_MAX_ITERATIONS_REACHED 2\n";
+  }
+  h += "\n" + structs.qp_struct + "typedef struct {\n" + structs.state_body + "} PFX_state;\n\n";
+  h += R"C(/* Back to rest at u = 0, y = 0: PFX_reset(s, 0, 0). */
+void PFX_init(PFX_state* s);
+/* Back to rest at an operating point: input u0 applied long enough for the
+   output to settle at y0. */
+void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0);
+/* One control step: set-point and measured output at the current sample;
+   returns the input to hold over the next period (within the limits). A NaN
+   or infinite measurement or set-point, or a measurement outside
+   [PFX_Y_VALID_MIN, PFX_Y_VALID_MAX], is a fault: the state is not updated,
+   the last valid input (or PFX_SAFE_INPUT, when defined) is returned, and
+   s->fault and s->faults say so; the next valid sample resumes control. */
+PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement);
+/* The input actually applied after the last step, when a later layer changed
+   it (actuator saturation): the controller takes it as its own. */
+void PFX_applied(PFX_state* s, PFX_real u);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
+)C";
+  return h;
+}
+
+// The source PFX.c (before the prefix is applied): the common macros, the
+// module's constants, the kernels it calls and its code.
+std::string SourceText(const Module& m, const CodegenResult& result) {
+  const std::string& name = result.prefix;
+  const bool is_float = m.is_float();
+  const std::string real = is_float ? "float" : "double";
+  std::string c;
+  c += fmt::format("/* {0}.c: {1}\n * Generated by pneumid codegen ({2} precision). */\n", name,
+                   result.description, real);
+  c += fmt::format("#include \"{}.h\"\n\n#include <math.h>\n#include <string.h>\n\n", name);
+  c += fmt::format("#define PFX_ZERO {}\n#define PFX_ONE {}\n#define PFX_THOUSAND {}\n",
+                   m.Literal(0.0), m.Literal(1.0), m.Literal(1e3));
+  c += "#define PFX_INF ((PFX_real)INFINITY)\n";
+  c += fmt::format("#define PFX_EPSILON {}\n",
+                   is_float ? m.Literal(std::numeric_limits<float>::epsilon())
+                            : m.Literal(std::numeric_limits<double>::epsilon()));
+  c += is_float ? "#define PFX_FABS fabsf\n#define PFX_HYPOT hypotf\n"
+                : "#define PFX_FABS fabs\n#define PFX_HYPOT hypot\n";
+  c += "#define PFX_ISFINITE(x) isfinite(x)\n\n";
+  c += m.constants_ + "\n";
+  if (m.dot_) c += std::string(internal::kCDot).substr(1) + "\n";
+  if (m.dot_strided_) c += std::string(internal::kCDotStrided).substr(1) + "\n";
+  if (m.gemv_col_) c += std::string(internal::kCGemvCol).substr(1) + "\n";
+  if (m.qp_solver_) {
+    c += std::string(internal::kCGemvRow).substr(1) + "\n";
+    c += std::string(internal::kCTriangular).substr(1) + "\n";
+    c += std::string(internal::kCQp).substr(1) + "\n";
+  }
+  c += m.code_;
+  c += "\nvoid PFX_init(PFX_state* s) { PFX_reset(s, PFX_ZERO, PFX_ZERO); }\n";
+  return c;
+}
+
+// README.md: the interface, the sizes and the certificate.
+std::string ReadmeText(const CodegenResult& result, double Ts) {
+  const std::string& name = result.prefix;
+  const std::string real = result.precision == CodegenPrecision::kFloat ? "float" : "double";
+  return fmt::format(
+      R"(# {0}: generated controller
+
+{1}, generated by `pneumid codegen` in {2} precision.
+
+Files: `{0}.h` (interface), `{0}.c` (implementation). C99; no dynamic memory,
+no library beyond `<math.h>` and `<string.h>` (link with `-lm`). All state is
+in `{0}_state`, which the caller owns: the code is re-entrant, and several
+controllers can run side by side.
+
+```c
+#include "{0}.h"
+
+static {0}_state ctrl;          /* {3} bytes of RAM */
+
+void control_init(void) {{ {0}_init(&ctrl); }}   /* or {0}_reset(&ctrl, u0, y0) */
+
+/* Every {4} s: */
+{0}_real control_step({0}_real setpoint, {0}_real y) {{
+  {0}_real u = {0}_step(&ctrl, setpoint, y);
+  /* If the actuator applies another value (saturation): {0}_applied(&ctrl, u_applied); */
+  return u;
+}}
+```
+
+| function | what |
+|---|---|
+| `{0}_init(s)` | reset at rest, u = 0, y = 0 |
+| `{0}_reset(s, u0, y0)` | reset at an operating point: u0 applied long enough for y to settle at y0 |
+| `{0}_step(s, r, y)` | one sample: set-point r, measurement y -> input u within the limits |
+| `{0}_applied(s, u)` | the input actually applied (anti-windup), when it differs from the returned one |
+
+Sample time: `{7}_TS` = {4} s. State: `sizeof({0}_state)` = `{7}_STATE_BYTES` = {3} bytes;
+constant tables: {5} bytes (the code adds to the flash: measure it with
+`arm-none-eabi-size` of the compiled `{0}.o`, text + data).
+
+Bad measurements: a NaN or infinite measurement or set-point, or a measurement
+outside `[{7}_Y_VALID_MIN, {7}_Y_VALID_MAX]` (compile with `-D` to set them on
+the bench), is a fault: the state is not updated, `{0}_step` returns the last
+valid input (or `{7}_SAFE_INPUT` when it is defined, e.g. `-D{7}_SAFE_INPUT=0.0`),
+`s->fault` holds the `{7}_FAULT_*` code and `s->faults` counts the faulty
+samples since the last reset; the next valid sample resumes control.
+{6}{8}
+The arithmetic follows pneumid's library controller step by step (same
+formulas, same order of the sums), so that the double-precision module
+reproduces the library's inputs to rounding.
+)",
+      name, result.description, real, result.ram_bytes, Ts, result.const_bytes,
+      result.constrained
+          ? fmt::format(
+                "\nConstrained: every step may solve a dense QP (Goldfarb-Idnani dual active "
+                "set, warm-started) with an iteration cap; `s->qp.status` is `{1}_QP_SOLVED`, "
+                "`{1}_QP_INFEASIBLE` or `{1}_QP_MAX_ITERATIONS_REACHED`, `s->qp.iterations` the "
+                "work done; a step whose QP fails applies the clipped unconstrained move and "
+                "counts it in `s->qp_failures` (reset by `{0}_reset`).\n",
+                name, internal::Upper(name))
+          : std::string(),
+      internal::Upper(name), CertificateText(result.certificate, internal::Upper(name)));
 }
 
 }  // namespace
@@ -1374,22 +1676,9 @@ CodegenResult GenerateC(const Controller& controller, const CodegenOptions& opti
   GenerateLayers(controller, m, 1, &result);
   HideEntryPoints(m, "core_");
   GenerateGuard(controller, m);
-  const std::string name = options.prefix;
-  const std::string guard = internal::Upper(name) + "_H_";
-  const bool is_float = m.is_float();
-  const std::string real = is_float ? "float" : "double";
 
-  // Structs.
-  std::size_t qp_bytes = 0;
-  std::string qp_struct;
-  if (m.qp_solver_) {
-    qp_struct = "typedef struct {\n" + m.StructText(m.qp_, "", 0, &qp_bytes) + "} PFX_qp;\n\n";
-  }
-  std::size_t state_bytes = 0;
-  const std::string state_body = m.StructText(
-      m.state_, m.qp_solver_ ? "  PFX_qp qp; /* QP solver data and work arrays */\n" : "", qp_bytes,
-      &state_bytes);
-  result.ram_bytes = state_bytes;
+  const ModuleStructs structs = MakeModuleStructs(m);
+  result.ram_bytes = structs.state_bytes;
   result.const_bytes = m.const_bytes_;
   PNEUMID_CHECK(options.max_ram_bytes == 0 || result.ram_bytes <= options.max_ram_bytes,
                 "the {} controller's state needs {} bytes of RAM in {} precision, above the "
@@ -1397,138 +1686,11 @@ CodegenResult GenerateC(const Controller& controller, const CodegenOptions& opti
                 pneumid::ToString(result.type), result.ram_bytes, ToString(options.precision),
                 options.max_ram_bytes, result.description, RamHint(result.type));
 
-  // Header.
-  std::string h;
-  h += fmt::format(
-      "/* {0}.h: {1}\n * Generated by pneumid codegen ({2} precision). C99, no dynamic memory;\n"
-      " * all state in {0}_state, which the caller owns (re-entrant).\n */\n",
-      name, result.description, real);
-  h += "#ifndef " + guard + "\n#define " + guard +
-       "\n\n#ifdef __cplusplus\nextern \"C\" {\n#endif\n\n";
-  h += "typedef " + real + " PFX_real;\n\n";
-  h += fmt::format("#define PFX_TS {} /* sample time, s */\n", m.Literal(controller.Ts()));
-  h += fmt::format("#define PFX_STATE_BYTES {} /* sizeof(PFX_state) with 4-byte int */\n",
-                   result.ram_bytes);
-  h += "\n/* Fault of the last step (PFX_state.fault; PFX_state.faults counts them). */\n"
-       "#define PFX_FAULT_NONE 0\n#define PFX_FAULT_MEASUREMENT_NOT_FINITE 1\n"
-       "#define PFX_FAULT_MEASUREMENT_OUT_OF_RANGE 2\n#define PFX_FAULT_SETPOINT_NOT_FINITE 3\n"
-       "#define PFX_FAULT_OUTPUT_NOT_FINITE 4\n";
-  if (m.qp_solver_) {
-    h += "\n/* QP status (PFX_state.qp.status). */\n#define PFX_QP_SOLVED 0\n"
-         "#define PFX_QP_INFEASIBLE 1\n#define PFX_QP_MAX_ITERATIONS_REACHED 2\n";
-  }
-  h += "\n" + qp_struct + "typedef struct {\n" + state_body + "} PFX_state;\n\n";
-  h += R"C(/* Back to rest at u = 0, y = 0: PFX_reset(s, 0, 0). */
-void PFX_init(PFX_state* s);
-/* Back to rest at an operating point: input u0 applied long enough for the
-   output to settle at y0. */
-void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0);
-/* One control step: set-point and measured output at the current sample;
-   returns the input to hold over the next period (within the limits). A NaN
-   or infinite measurement or set-point, or a measurement outside
-   [PFX_Y_VALID_MIN, PFX_Y_VALID_MAX], is a fault: the state is not updated,
-   the last valid input (or PFX_SAFE_INPUT, when defined) is returned, and
-   s->fault and s->faults say so; the next valid sample resumes control. */
-PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement);
-/* The input actually applied after the last step, when a later layer changed
-   it (actuator saturation): the controller takes it as its own. */
-void PFX_applied(PFX_state* s, PFX_real u);
-
-#ifdef __cplusplus
-}
-#endif
-
-#endif
-)C";
-
-  // Source.
-  std::string c;
-  c += fmt::format("/* {0}.c: {1}\n * Generated by pneumid codegen ({2} precision). */\n", name,
-                   result.description, real);
-  c += fmt::format("#include \"{}.h\"\n\n#include <math.h>\n#include <string.h>\n\n", name);
-  c += fmt::format("#define PFX_ZERO {}\n#define PFX_ONE {}\n#define PFX_THOUSAND {}\n",
-                   m.Literal(0.0), m.Literal(1.0), m.Literal(1e3));
-  c += "#define PFX_INF ((PFX_real)INFINITY)\n";
-  c += fmt::format("#define PFX_EPSILON {}\n",
-                   is_float ? m.Literal(std::numeric_limits<float>::epsilon())
-                            : m.Literal(std::numeric_limits<double>::epsilon()));
-  c += is_float ? "#define PFX_FABS fabsf\n#define PFX_HYPOT hypotf\n"
-                : "#define PFX_FABS fabs\n#define PFX_HYPOT hypot\n";
-  c += "#define PFX_ISFINITE(x) isfinite(x)\n\n";
-  c += m.constants_ + "\n";
-  if (m.dot_) c += std::string(internal::kCDot).substr(1) + "\n";
-  if (m.dot_strided_) c += std::string(internal::kCDotStrided).substr(1) + "\n";
-  if (m.gemv_col_) c += std::string(internal::kCGemvCol).substr(1) + "\n";
-  if (m.qp_solver_) {
-    c += std::string(internal::kCGemvRow).substr(1) + "\n";
-    c += std::string(internal::kCTriangular).substr(1) + "\n";
-    c += std::string(internal::kCQp).substr(1) + "\n";
-  }
-  c += m.code_;
-  c += "\nvoid PFX_init(PFX_state* s) { PFX_reset(s, PFX_ZERO, PFX_ZERO); }\n";
   // The step uses PFX_ISFINITE only in some controllers; keep every macro used.
-  result.header = WithPrefix(h, name, m.macros_);
-  result.source = WithPrefix(c, name, m.macros_);
-
-  // README.
-  result.readme = fmt::format(
-      R"(# {0}: generated controller
-
-{1}, generated by `pneumid codegen` in {2} precision.
-
-Files: `{0}.h` (interface), `{0}.c` (implementation). C99; no dynamic memory,
-no library beyond `<math.h>` and `<string.h>` (link with `-lm`). All state is
-in `{0}_state`, which the caller owns: the code is re-entrant, and several
-controllers can run side by side.
-
-```c
-#include "{0}.h"
-
-static {0}_state ctrl;          /* {3} bytes of RAM */
-
-void control_init(void) {{ {0}_init(&ctrl); }}   /* or {0}_reset(&ctrl, u0, y0) */
-
-/* Every {4} s: */
-{0}_real control_step({0}_real setpoint, {0}_real y) {{
-  {0}_real u = {0}_step(&ctrl, setpoint, y);
-  /* If the actuator applies another value (saturation): {0}_applied(&ctrl, u_applied); */
-  return u;
-}}
-```
-
-| function | what |
-|---|---|
-| `{0}_init(s)` | reset at rest, u = 0, y = 0 |
-| `{0}_reset(s, u0, y0)` | reset at an operating point: u0 applied long enough for y to settle at y0 |
-| `{0}_step(s, r, y)` | one sample: set-point r, measurement y -> input u within the limits |
-| `{0}_applied(s, u)` | the input actually applied (anti-windup), when it differs from the returned one |
-
-Sample time: `{7}_TS` = {4} s. State: `sizeof({0}_state)` = `{7}_STATE_BYTES` = {3} bytes;
-constant tables: {5} bytes (the code adds to the flash: measure it with
-`arm-none-eabi-size` of the compiled `{0}.o`, text + data).
-
-Bad measurements: a NaN or infinite measurement or set-point, or a measurement
-outside `[{7}_Y_VALID_MIN, {7}_Y_VALID_MAX]` (compile with `-D` to set them on
-the bench), is a fault: the state is not updated, `{0}_step` returns the last
-valid input (or `{7}_SAFE_INPUT` when it is defined, e.g. `-D{7}_SAFE_INPUT=0.0`),
-`s->fault` holds the `{7}_FAULT_*` code and `s->faults` counts the faulty
-samples since the last reset; the next valid sample resumes control.
-{6}{8}
-The arithmetic follows pneumid's library controller step by step (same
-formulas, same order of the sums), so that the double-precision module
-reproduces the library's inputs to rounding.
-)",
-      name, result.description, real, result.ram_bytes, controller.Ts(), result.const_bytes,
-      result.constrained
-          ? fmt::format(
-                "\nConstrained: every step may solve a dense QP (Goldfarb-Idnani dual active "
-                "set, warm-started) with an iteration cap; `s->qp.status` is `{1}_QP_SOLVED`, "
-                "`{1}_QP_INFEASIBLE` or `{1}_QP_MAX_ITERATIONS_REACHED`, `s->qp.iterations` the "
-                "work done; a step whose QP fails applies the clipped unconstrained move and "
-                "counts it in `s->qp_failures` (reset by `{0}_reset`).\n",
-                name, internal::Upper(name))
-          : std::string(),
-      internal::Upper(name), CertificateText(result.certificate, internal::Upper(name)));
+  result.header =
+      WithPrefix(HeaderText(m, result, controller.Ts(), structs), options.prefix, m.macros_);
+  result.source = WithPrefix(SourceText(m, result), options.prefix, m.macros_);
+  result.readme = ReadmeText(result, controller.Ts());
   return result;
 }
 

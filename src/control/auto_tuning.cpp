@@ -46,6 +46,12 @@ constexpr double kOvershootTolerance = 0.05;  // percentage points
 constexpr double kTimeTolerance = 0.2;        // relative, response time vs t*
 constexpr double kLoadFraction = 0.2;         // load step / set-point step
 constexpr double kOffsetTolerance = 1e-3;     // |steady-state error| / |load|
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Names of the robustness rows, for Evaluator::plants[1..3].
+constexpr const char* kRobustnessRowNames[] = {"gain +20%", "gain -20%", "dead time +1 sample"};
+constexpr int kPlantCount = 4;  // nominal and the three robustness rows
 
 /// A set-point step from 0 to `to` at `at` (deviation variables).
 class StepSetpoint final : public Signal {
@@ -70,47 +76,48 @@ struct Evaluator {
   std::vector<TransferFunction> plants;  // nominal, gain +20 %, gain -20 %, dead time +1
   int evaluations = 0;
 
-  PredictedMetrics Run(Controller& c, int plant) {
+  PredictedMetrics Run(Controller& controller, int plant_index) {
     ++evaluations;
-    LinearPlant p(plants[plant], Ts);
-    StepSetpoint sp(step, t_step);
-    ClosedLoopOptions o;
-    o.duration = t_step + window;
-    o.actuator = limits;
-    const ClosedLoopResult r = SimulateClosedLoop(c, p, sp, o);
-    PredictedMetrics m;
-    m.rise_time = r.metrics.rise_time;
-    m.overshoot_percent = r.metrics.overshoot_percent;
-    m.settling_time = r.metrics.settling_time;
-    m.settled = r.metrics.settled && std::isfinite(r.metrics.settling_time);
-    m.response_time = measure == ResponseMeasure::kRise ? m.rise_time : m.settling_time;
-    m.u_min = r.metrics.u_min;
-    m.u_max = r.metrics.u_max;
+    LinearPlant plant(plants[plant_index], Ts);
+    StepSetpoint setpoint(step, t_step);
+    ClosedLoopOptions loop_options;
+    loop_options.duration = t_step + window;
+    loop_options.actuator = limits;
+    const ClosedLoopResult loop = SimulateClosedLoop(controller, plant, setpoint, loop_options);
+    PredictedMetrics metrics;
+    metrics.rise_time = loop.metrics.rise_time;
+    metrics.overshoot_percent = loop.metrics.overshoot_percent;
+    metrics.settling_time = loop.metrics.settling_time;
+    metrics.settled = loop.metrics.settled && std::isfinite(loop.metrics.settling_time);
+    metrics.response_time =
+        measure == ResponseMeasure::kRise ? metrics.rise_time : metrics.settling_time;
+    metrics.u_min = loop.metrics.u_min;
+    metrics.u_max = loop.metrics.u_max;
     // A loop that grows without bound has no meaningful overshoot.
-    if (!r.y.allFinite()) {
-      m.settled = false;
-      m.overshoot_percent = std::numeric_limits<double>::infinity();
+    if (!loop.y.allFinite()) {
+      metrics.settled = false;
+      metrics.overshoot_percent = kInf;
     }
-    return m;
+    return metrics;
   }
 
   /// Steady-state error after a constant output disturbance of
   /// kLoadFraction * step at constant set-point 0.
-  double LoadSteadyStateError(Controller& c) {
+  double LoadSteadyStateError(Controller& controller) {
     ++evaluations;
-    LinearPlant p(plants[0], Ts);
-    StepSetpoint sp(0.0, 0.0);
-    ClosedLoopOptions o;
-    o.duration = t_step + window;
-    o.actuator = limits;
-    o.load_steps = {{t_step, -kLoadFraction * step}};
-    const ClosedLoopResult r = SimulateClosedLoop(c, p, sp, o);
-    if (!r.y.allFinite()) return std::numeric_limits<double>::infinity();
-    return r.metrics.steady_state_error;
+    LinearPlant plant(plants[0], Ts);
+    StepSetpoint setpoint(0.0, 0.0);
+    ClosedLoopOptions loop_options;
+    loop_options.duration = t_step + window;
+    loop_options.actuator = limits;
+    loop_options.load_steps = {{t_step, -kLoadFraction * step}};
+    const ClosedLoopResult loop = SimulateClosedLoop(controller, plant, setpoint, loop_options);
+    if (!loop.y.allFinite()) return kInf;
+    return loop.metrics.steady_state_error;
   }
 };
 
-double OrInf(double v) { return std::isfinite(v) ? v : std::numeric_limits<double>::infinity(); }
+double OrInf(double v) { return std::isfinite(v) ? v : kInf; }
 
 bool Finite(const InputLimits& l) { return std::isfinite(l.u_min) || std::isfinite(l.u_max); }
 
@@ -119,58 +126,791 @@ std::string Seconds(double t) { return std::isfinite(t) ? fmt::format("{:.4g} s"
 /// Value of the discrete PID (without Kc) at z = e^{j w Ts}, as PidController computes it.
 std::complex<double> PidShape(double Ti, double Td, double N, double Ts, double w) {
   const std::complex<double> zinv = std::exp(std::complex<double>(0.0, -w * Ts));
-  std::complex<double> c = 1.0;
-  if (std::isfinite(Ti)) c += (Ts / Ti) * zinv / (1.0 - zinv);
+  std::complex<double> shape = 1.0;
+  if (std::isfinite(Ti)) shape += (Ts / Ti) * zinv / (1.0 - zinv);
   if (Td > 0.0) {
     const double beta = Td / (Td + N * Ts);
-    c += (N * Td / (Td + N * Ts)) * (1.0 - zinv) / (1.0 - beta * zinv);
+    shape += (N * Td / (Td + N * Ts)) * (1.0 - zinv) / (1.0 - beta * zinv);
   }
-  return c;
+  return shape;
 }
 
 struct LoopMargins {
-  double crossover = std::numeric_limits<double>::quiet_NaN();
-  double phase_margin = std::numeric_limits<double>::quiet_NaN();
-  double gain_margin = std::numeric_limits<double>::infinity();
+  double crossover = kNaN;
+  double phase_margin = kNaN;
+  double gain_margin = kInf;
 };
 
 /// Crossover, phase and gain margin of Kc C1(z) G(z) on a dense grid up to
 /// the Nyquist frequency: the first frequency where |L| falls through 1, the
 /// phase margin there, and the smallest 1/|L| where the phase crosses -180.
-LoopMargins DiscreteLoopMargins(const TransferFunction& Gd, const PidGains& g, double N,
+LoopMargins DiscreteLoopMargins(const TransferFunction& Gd, const PidGains& gains, double N,
                                 double Ts) {
   const double wn = kPi / Ts;
   const Eigen::VectorXd w = LogSpace(std::log10(wn) - 5.0, std::log10(wn * 0.9999), 4000);
-  const BodeData b = Bode(Gd, w);
-  const int n = static_cast<int>(w.size());
-  Eigen::VectorXd mag(n), ph(n);
-  for (int i = 0; i < n; ++i) {
-    const std::complex<double> c = g.Kc * PidShape(g.Ti, g.Td, N, Ts, w(i));
-    mag(i) = std::abs(c) * b.magnitude(i);
-    ph(i) = std::arg(c) * kDeg + b.phase_deg(i);
+  const BodeData plant = Bode(Gd, w);
+  const int count = static_cast<int>(w.size());
+  Eigen::VectorXd mag(count), phase(count);  // of the loop L
+  for (int i = 0; i < count; ++i) {
+    const std::complex<double> controller = gains.Kc * PidShape(gains.Ti, gains.Td, N, Ts, w(i));
+    mag(i) = std::abs(controller) * plant.magnitude(i);
+    phase(i) = std::arg(controller) * kDeg + plant.phase_deg(i);
   }
-  LoopMargins m;
-  for (int i = 1; i < n; ++i) {
-    if (std::isnan(m.crossover) && (mag(i - 1) - 1.0) * (mag(i) - 1.0) <= 0.0 && mag(i - 1) > 1.0) {
-      const double f = std::log(mag(i - 1)) / (std::log(mag(i - 1)) - std::log(mag(i)));
-      m.crossover = std::exp(std::log(w(i - 1)) + f * (std::log(w(i)) - std::log(w(i - 1))));
-      m.phase_margin = 180.0 + ph(i - 1) + f * (ph(i) - ph(i - 1));
+  LoopMargins margins;
+  for (int i = 1; i < count; ++i) {
+    if (std::isnan(margins.crossover) && (mag(i - 1) - 1.0) * (mag(i) - 1.0) <= 0.0 &&
+        mag(i - 1) > 1.0) {
+      const double frac = std::log(mag(i - 1)) / (std::log(mag(i - 1)) - std::log(mag(i)));
+      margins.crossover =
+          std::exp(std::log(w(i - 1)) + frac * (std::log(w(i)) - std::log(w(i - 1))));
+      margins.phase_margin = 180.0 + phase(i - 1) + frac * (phase(i) - phase(i - 1));
     }
-    const double a = ph(i - 1) + 180.0, c = ph(i) + 180.0;
-    if (a * c <= 0.0 && a != c) {
-      const double f = a / (a - c);
-      const double lm = std::log(mag(i - 1)) + f * (std::log(mag(i)) - std::log(mag(i - 1)));
-      m.gain_margin = std::min(m.gain_margin, std::exp(-lm));
+    const double above_prev = phase(i - 1) + 180.0, above = phase(i) + 180.0;
+    if (above_prev * above <= 0.0 && above_prev != above) {
+      const double frac = above_prev / (above_prev - above);
+      const double log_mag =
+          std::log(mag(i - 1)) + frac * (std::log(mag(i)) - std::log(mag(i - 1)));
+      margins.gain_margin = std::min(margins.gain_margin, std::exp(-log_mag));
     }
   }
-  return m;
+  return margins;
 }
 
 /// Unwrapped phase (deg) and magnitude of Gd at w.
 std::pair<double, double> PlantAt(const TransferFunction& Gd, double w) {
   const Eigen::VectorXd grid = LogSpace(std::log10(w) - 4.0, std::log10(w), 400);
-  const BodeData b = Bode(Gd, grid);
-  return {b.magnitude(b.magnitude.size() - 1), b.phase_deg(b.phase_deg.size() - 1)};
+  const BodeData bode = Bode(Gd, grid);
+  return {bode.magnitude(bode.magnitude.size() - 1), bode.phase_deg(bode.phase_deg.size() - 1)};
+}
+
+// ---------------------------------------------------------------------------
+// Specification and evaluation set-up
+
+/// The input before and after the evaluation step (absolute input units).
+struct InputStep {
+  double from = 0.0;
+  double to = 1.0;
+};
+
+/// The result with the specification as used: t_r (given or from the model's
+/// FOPDT description), t* after the knob, OS_rob and t_rob (file comment).
+AutoTuneResult SpecificationAsUsed(const TransferFunction& model, double Ts,
+                                   const AutoTuneOptions& options) {
+  AutoTuneResult result;
+  result.controller = options.controller;
+  result.Ts = Ts;
+  result.measure = options.measure;
+  result.max_overshoot = options.max_overshoot;
+  result.aggressiveness = options.aggressiveness;
+  result.fopdt = FopdtFromModel(model);
+  const FopdtEstimate& fopdt = result.fopdt;
+  const double a = options.aggressiveness;
+  result.response_time_target =
+      std::isnan(options.response_time)
+          ? (options.measure == ResponseMeasure::kRise ? fopdt.tau + fopdt.theta
+                                                       : 2.0 * fopdt.tau + fopdt.theta)
+          : options.response_time;
+  result.response_time_aimed = result.response_time_target * std::pow(1.5, 1.0 - 2.0 * a);
+  result.robust_overshoot = options.max_overshoot * (1.0 + 4.0 * a) + kOvershootTolerance;
+  result.robust_response_time = (1.5 + a) * result.response_time_aimed;
+  // mpc/dmc without a response time: the fastest robust design (file comment).
+  result.fastest = std::isnan(options.response_time) && options.controller != ControllerType::kPid;
+  return result;
+}
+
+/// The evaluation step in input space: 40 % to 60 % of the input range between
+/// two limits, one to two output units inside a single limit, else a unit
+/// output step.
+InputStep EvaluationInputStep(const InputLimits& limits, double K) {
+  InputStep input{0.0, 1.0 / K};
+  if (std::isfinite(limits.u_min) && std::isfinite(limits.u_max)) {
+    input.from = limits.u_min + 0.4 * (limits.u_max - limits.u_min);
+    input.to = limits.u_min + 0.6 * (limits.u_max - limits.u_min);
+  } else if (std::isfinite(limits.u_min)) {
+    input.from = limits.u_min + 1.0 / std::abs(K);
+    input.to = limits.u_min + 2.0 / std::abs(K);
+  } else if (std::isfinite(limits.u_max)) {
+    input.from = limits.u_max - 2.0 / std::abs(K);
+    input.to = limits.u_max - 1.0 / std::abs(K);
+  }
+  return input;
+}
+
+/// The evaluation in deviation variables: the step of `result`, the window of
+/// 10 max(t*, tau + theta) after it, the limits relative to the input before
+/// the step, and the nominal and perturbed plants of the robustness rows.
+Evaluator MakeEvaluator(const TransferFunction& model, double Ts, const AutoTuneOptions& options,
+                        const AutoTuneResult& result, double input_before_step) {
+  const FopdtEstimate& fopdt = result.fopdt;
+  Evaluator evaluator;
+  evaluator.Ts = Ts;
+  evaluator.step = result.step_to - result.step_from;
+  evaluator.t_step = 5.0 * Ts;
+  evaluator.window =
+      std::max(10.0 * std::max(result.response_time_aimed, fopdt.tau + fopdt.theta), 50.0 * Ts);
+  evaluator.limits = options.limits;
+  evaluator.limits.u_min -= input_before_step;
+  evaluator.limits.u_max -= input_before_step;
+  evaluator.measure = options.measure;
+  const double ts_model = model.IsContinuous() ? 0.0 : Ts;
+  evaluator.plants = {model,
+                      TransferFunction(model.num() * 1.2, model.den(), ts_model, model.delay()),
+                      TransferFunction(model.num() * 0.8, model.den(), ts_model, model.delay()),
+                      model.WithDelay(model.delay() + Ts)};
+  return evaluator;
+}
+
+/// The nominal step of a candidate: it settles and overshoots at most OS.
+bool NominalStepMeetsOvershoot(const PredictedMetrics& metrics, double max_overshoot) {
+  return metrics.settled && metrics.overshoot_percent <= max_overshoot + kOvershootTolerance;
+}
+
+/// A robustness row during the search: stability and overshoot only.
+bool RobustRowStable(const PredictedMetrics& metrics, double robust_overshoot) {
+  return metrics.settled && metrics.overshoot_percent <= robust_overshoot;
+}
+
+/// A robustness row of the chosen design: it settles, overshoots at most
+/// OS_rob and responds within t_rob.
+bool RobustRowPasses(const PredictedMetrics& metrics, const AutoTuneResult& result) {
+  return metrics.settled && metrics.overshoot_percent <= result.robust_overshoot &&
+         OrInf(metrics.response_time) <= result.robust_response_time;
+}
+
+/// What the candidate search settled on, for the final evaluation and the review.
+struct ChosenDesign {
+  /// A new controller of the chosen settings (each evaluation starts from rest).
+  std::function<std::unique_ptr<Controller>()> make_controller;
+  Eigen::MatrixXd hessian;  // QP Hessian of the chosen settings (mpc/dmc; empty for pid)
+  // mpc/dmc: lambda_f and its response time, the fastest robust design (NaN if none).
+  double lambda_fastest = kNaN;
+  double t_fastest = kNaN;
+};
+
+// ---------------------------------------------------------------------------
+// mpc/dmc: the search over the move suppression lambda
+
+/// The mpc or dmc controller of the horizons P, M for a move suppression lambda.
+struct PredictiveControllerFactory {
+  bool is_mpc = true;
+  int P = 0;
+  int M = 0;
+  InputLimits limits;  // deviation limits
+  DisturbanceModel disturbance = DisturbanceModel::kInput;
+  StateSpace state_space;                             // mpc
+  std::unique_ptr<PredictionModel> prediction_model;  // dmc
+
+  std::unique_ptr<Controller> Make(double lambda) const {
+    if (is_mpc) {
+      MpcOptions mpc_options;
+      mpc_options.P = P;
+      mpc_options.M = M;
+      mpc_options.lambda = lambda;
+      mpc_options.limits = limits;
+      mpc_options.disturbance = disturbance;
+      return std::make_unique<MpcController>(state_space, mpc_options);
+    }
+    DmcOptions dmc_options;
+    dmc_options.P = P;
+    dmc_options.M = M;
+    dmc_options.lambda = lambda;
+    dmc_options.limits = limits;
+    dmc_options.constrained = Finite(limits) || std::isfinite(limits.du_max);
+    return std::make_unique<DmcController>(*prediction_model, dmc_options);
+  }
+
+  /// The QP Hessian of lambda: the MPC's H, or A'A + lambda I for DMC.
+  Eigen::MatrixXd Hessian(double lambda) const {
+    const std::unique_ptr<Controller> controller = Make(lambda);
+    if (is_mpc) return static_cast<MpcController&>(*controller).hessian();
+    const Eigen::MatrixXd& A = static_cast<DmcController&>(*controller).dynamic_matrix();
+    return A.transpose() * A + lambda * Eigen::MatrixXd::Identity(A.cols(), A.cols());
+  }
+};
+
+/// Closed-loop evaluation of the lambda candidates of the search.
+class LambdaCandidates {
+ public:
+  LambdaCandidates(const PredictiveControllerFactory& factory, Evaluator& evaluator,
+                   double max_overshoot, double robust_overshoot)
+      : factory_(factory),
+        evaluator_(evaluator),
+        max_overshoot_(max_overshoot),
+        robust_overshoot_(robust_overshoot) {}
+
+  /// feasible(lambda): the nominal step meets OS and every robustness row
+  /// settles within OS_rob (the rows stop at the first that does not).
+  bool Feasible(double lambda) {
+    const std::unique_ptr<Controller> controller = factory_.Make(lambda);
+    bool feasible = NominalStepMeetsOvershoot(evaluator_.Run(*controller, 0), max_overshoot_);
+    for (int i = 1; feasible && i < kPlantCount; ++i)
+      feasible = RobustRowStable(evaluator_.Run(*controller, i), robust_overshoot_);
+    return feasible;
+  }
+
+  /// t(lambda): the nominal response time (infinite when there is none).
+  double ResponseTime(double lambda) {
+    const std::unique_ptr<Controller> controller = factory_.Make(lambda);
+    return OrInf(evaluator_.Run(*controller, 0).response_time);
+  }
+
+ private:
+  const PredictiveControllerFactory& factory_;
+  Evaluator& evaluator_;
+  double max_overshoot_;
+  double robust_overshoot_;
+};
+
+/// lambda_f, the smallest feasible lambda: an ascending scan of 4 points per
+/// decade over lambda_0 10^-6 .. lambda_0 10^4, refined by bisection of
+/// log lambda between the last infeasible and the first feasible point; NaN
+/// when no point of the scan is feasible.
+double SmallestFeasibleLambda(LambdaCandidates& candidates, double lambda0) {
+  const double lo_exp = -6.0, hi_exp = 4.0;
+  double lambda_feasible = kNaN;
+  double lambda_infeasible = kNaN;  // the scan point before it
+  for (int k = 0; lo_exp + 0.25 * k <= hi_exp + 1e-9; ++k) {
+    const double lambda = lambda0 * std::pow(10.0, lo_exp + 0.25 * k);
+    if (candidates.Feasible(lambda)) {
+      lambda_feasible = lambda;
+      break;
+    }
+    lambda_infeasible = lambda;
+  }
+  if (std::isnan(lambda_feasible) || std::isnan(lambda_infeasible)) return lambda_feasible;
+  double lo = std::log(lambda_infeasible), hi = std::log(lambda_feasible);
+  for (int i = 0; i < 12; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (candidates.Feasible(std::exp(mid)))
+      hi = mid;
+    else
+      lo = mid;
+  }
+  return std::exp(hi);
+}
+
+/// lambda* when lambda_f responds faster than t*: bracket t(lambda) = t* by
+/// decades above lambda_f (t grows with lambda), then bisect log lambda and
+/// take the end whose |ln(t / t*)| is smaller; the last decade tried when
+/// none brackets it.
+double LambdaForResponseTime(LambdaCandidates& candidates, double lambda_f, double t_aim) {
+  double lo = std::log(lambda_f), hi = lo;
+  bool bracketed = false;
+  for (int i = 0; i < 12 && !bracketed; ++i) {
+    lo = hi;
+    hi += std::log(10.0);
+    bracketed = candidates.ResponseTime(std::exp(hi)) >= t_aim;
+  }
+  if (!bracketed) return std::exp(hi);
+  for (int i = 0; i < 30 && hi - lo > 1e-4; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (candidates.ResponseTime(std::exp(mid)) < t_aim)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  const double t_lo = candidates.ResponseTime(std::exp(lo));
+  const double t_hi = candidates.ResponseTime(std::exp(hi));
+  return std::abs(std::log(t_lo / t_aim)) <= std::abs(std::log(t_hi / t_aim)) ? std::exp(lo)
+                                                                              : std::exp(hi);
+}
+
+/// lambda* when even lambda_f is too slow: the response is limited by the
+/// model, the horizons or the actuator, and flat in lambda. The largest lambda
+/// whose response time is at most t_ok (hardly slower than lambda_f) is better
+/// conditioned and as fast; it is taken when feasible, else lambda_f.
+double LargestLambdaAsFast(LambdaCandidates& candidates, double lambda_f, double t_ok) {
+  double lo = std::log(lambda_f), hi = lo;
+  bool bracketed = false;
+  for (int i = 0; i < 12 && !bracketed; ++i) {
+    lo = hi;
+    hi += std::log(10.0);
+    bracketed = candidates.ResponseTime(std::exp(hi)) > t_ok;
+  }
+  if (bracketed) {
+    for (int i = 0; i < 30 && hi - lo > 1e-3; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      if (candidates.ResponseTime(std::exp(mid)) <= t_ok)
+        lo = mid;
+      else
+        hi = mid;
+    }
+  }
+  return candidates.Feasible(std::exp(lo)) ? std::exp(lo) : lambda_f;
+}
+
+/// mpc/dmc (file comment): P and M by Shridhar-Cooper, then lambda* by the
+/// closed-loop search. Without a given response time the target becomes the
+/// response time of lambda_f, the fastest robust design.
+ChosenDesign SearchPredictiveDesign(const TransferFunction& model, double Ts,
+                                    const AutoTuneOptions& options, Evaluator& evaluator,
+                                    AutoTuneResult& result) {
+  auto factory = std::make_shared<PredictiveControllerFactory>();
+  factory->prediction_model = std::make_unique<PredictionModel>(model, Ts);
+  TuningOptions rule_options;
+  rule_options.rule = TuningRule::kShridharCooper;
+  rule_options.M = options.M;
+  const TuningResult base = Tune(*factory->prediction_model, rule_options);
+  result.P = factory->P = base.P;
+  result.M = factory->M = base.M;
+  const double lambda0 = base.lambda_condition;
+  factory->is_mpc = options.controller == ControllerType::kMpc;
+  if (factory->is_mpc) factory->state_space = SampledStateSpace(model, Ts);
+  factory->limits = evaluator.limits;
+  factory->disturbance = options.disturbance;
+
+  LambdaCandidates candidates(*factory, evaluator, options.max_overshoot, result.robust_overshoot);
+  ChosenDesign chosen;
+  // Nothing robust: take the Shridhar-Cooper value and let the review say why.
+  double lambda_star = lambda0;
+  const double lambda_f = SmallestFeasibleLambda(candidates, lambda0);
+  if (!std::isnan(lambda_f)) {
+    chosen.lambda_fastest = lambda_f;
+    chosen.t_fastest = candidates.ResponseTime(lambda_f);
+    if (result.fastest && std::isfinite(chosen.t_fastest)) {
+      // The target is the fastest robust response itself.
+      result.response_time_target = result.response_time_aimed = chosen.t_fastest;
+      result.robust_response_time = (1.5 + options.aggressiveness) * result.response_time_aimed;
+    }
+    const double t_aim = result.response_time_aimed;
+    if (chosen.t_fastest < t_aim) {
+      lambda_star = LambdaForResponseTime(candidates, lambda_f, t_aim);
+    } else {
+      // Hardly slower: 2 % of t* (0.5 % for the fastest robust design).
+      const double t_ok = chosen.t_fastest + (result.fastest ? 0.005 : 0.02) * t_aim;
+      lambda_star = LargestLambdaAsFast(candidates, lambda_f, t_ok);
+    }
+  }
+  result.lambda = lambda_star;
+  chosen.make_controller = [factory, lambda_star] { return factory->Make(lambda_star); };
+  chosen.hessian = factory->Hessian(lambda_star);
+  return chosen;
+}
+
+// ---------------------------------------------------------------------------
+// pid: loop shaping and the set-point weight
+
+/// The PID controller of the designed gains for a set-point weight b.
+struct PidControllerFactory {
+  double Ts = 0.0;
+  PidGains gains;
+  double N = 10.0;     // derivative filter
+  InputLimits limits;  // deviation limits
+
+  std::unique_ptr<Controller> Make(double setpoint_weight) const {
+    PidOptions pid_options;
+    pid_options.gains = gains;
+    pid_options.setpoint_weight = setpoint_weight;
+    pid_options.derivative_filter = N;
+    pid_options.limits = limits;
+    return std::make_unique<PidController>(Ts, pid_options);
+  }
+};
+
+/// arg C1(e^{j w Ts}) in degrees of a PI (Td = 0) or PID (Td = Ti/4) with Ti.
+double ControllerPhaseDeg(double Ti, bool use_pid, double N, double Ts, double w) {
+  return std::arg(PidShape(Ti, use_pid ? Ti / 4.0 : 0.0, N, Ts, w)) * kDeg;
+}
+
+struct IntegralTimeSolution {
+  double Ti = kNaN;
+  bool solved = false;  // false: Ti is the grid point closest to the phase asked for
+};
+
+/// Ti from arg C1(Ti) = phi_c at w: a log grid of Ti over 1e-4/w .. 1e4/w,
+/// the first step that brackets the solution, bisection within it.
+IntegralTimeSolution SolveIntegralTime(double phi_c, bool use_pid, double N, double Ts, double w) {
+  auto phase_error = [&](double log_Ti) {
+    return ControllerPhaseDeg(std::exp(log_Ti), use_pid, N, Ts, w) - phi_c;
+  };
+  const int grid_steps = 400;
+  double closest_Ti = kNaN, closest_error = 1e300;
+  const double lo = std::log(1e-4 / w), hi = std::log(1e4 / w);
+  double x_prev = lo, e_prev = phase_error(lo);
+  for (int i = 1; i <= grid_steps; ++i) {
+    const double x = lo + (hi - lo) * i / grid_steps;
+    const double e = phase_error(x);
+    if (std::abs(e) < closest_error) {
+      closest_error = std::abs(e);
+      closest_Ti = std::exp(x);
+    }
+    if (e_prev * e <= 0.0) {
+      double xa = x_prev, xb = x, ea = e_prev;
+      for (int k = 0; k < 60; ++k) {
+        const double xm = 0.5 * (xa + xb);
+        const double em = phase_error(xm);
+        if (ea * em <= 0.0)
+          xb = xm;
+        else {
+          xa = xm;
+          ea = em;
+        }
+      }
+      return {std::exp(0.5 * (xa + xb)), true};
+    }
+    x_prev = x;
+    e_prev = e;
+  }
+  return {closest_Ti, false};
+}
+
+/// The PID loop-shaping design point: what the response time asks for and
+/// where the loop was designed.
+struct PidDesignPoint {
+  double wc = kNaN;        // crossover the response time asks for, rad/s
+  double wn = kNaN;        // Nyquist frequency, rad/s
+  double w_design = kNaN;  // wc, at most half the Nyquist frequency
+  double phi_c = kNaN;     // phase the controller must supply at w_design, deg
+  bool use_pid = false;    // PID (Td = Ti/4), else PI
+  bool solved = false;     // Ti meets phi_c
+};
+
+/// The "loop shaping" review item of the PID design.
+ReviewItem LoopShapingItem(const PidDesignPoint& point, const AutoTuneResult& result) {
+  if (!point.solved || point.wc > 0.5 * point.wn) {
+    return {"loop shaping", ReviewStatus::kFail,
+            point.wc > 0.5 * point.wn
+                ? fmt::format("the crossover 2/t* = {:.4g} rad/s the response time asks for "
+                              "exceeds half the Nyquist frequency ({:.4g} rad/s): designed at "
+                              "{:.4g} rad/s; sample faster or ask for a slower response",
+                              point.wc, 0.5 * point.wn, point.w_design)
+                : fmt::format("a {} cannot give the phase margin {:.3g} deg at {:.4g} rad/s (the "
+                              "controller would need {:.1f} deg of phase); closest Ti taken",
+                              point.use_pid ? "PID" : "PI", result.phase_margin_target,
+                              point.w_design, point.phi_c)};
+  }
+  return {"loop shaping", ReviewStatus::kOk,
+          fmt::format("{} with crossover {:.4g} rad/s (target {:.4g}), phase "
+                      "margin {:.3g} deg (target {:.3g}), gain margin {:.3g}",
+                      point.use_pid ? "PID (Td = Ti/4)" : "PI", result.crossover,
+                      result.crossover_target, result.phase_margin, result.phase_margin_target,
+                      result.gain_margin)};
+}
+
+/// PID loop shaping (file comment): wc and PM from t* and the knob, PI or PID
+/// from the phase the controller must supply, Ti and Kc on the discrete loop,
+/// the margins it achieves and the "loop shaping" review item.
+void ShapePidLoop(const TransferFunction& model, double Ts, const AutoTuneOptions& options,
+                  AutoTuneResult& result) {
+  const TransferFunction Gd = LinearPlant(model, Ts).model();
+  const double sgn = result.fopdt.K > 0.0 ? 1.0 : -1.0;
+  PidDesignPoint point;
+  point.wn = kPi / Ts;
+  point.wc = (options.measure == ResponseMeasure::kRise ? 2.0 : 4.0) / result.response_time_aimed;
+  result.crossover_target = point.wc;
+  result.phase_margin_target = 75.0 - 30.0 * options.aggressiveness;
+  point.w_design = std::min(point.wc, 0.5 * point.wn);
+  const auto [plant_mag, plant_phase] = PlantAt(Gd, point.w_design);
+  const double phase_of_sgn_G = plant_phase - (sgn < 0.0 ? 180.0 : 0.0);  // design on sgn * G
+  point.phi_c = -180.0 + result.phase_margin_target - phase_of_sgn_G;
+  const double N = result.derivative_filter;
+  point.use_pid = point.phi_c > -10.0;
+  const IntegralTimeSolution Ti =
+      SolveIntegralTime(point.phi_c, point.use_pid, N, Ts, point.w_design);
+  point.solved = Ti.solved;
+  result.pid.Ti = Ti.Ti;
+  result.pid.Td = point.use_pid ? Ti.Ti / 4.0 : 0.0;
+  result.pid.Kc =
+      sgn / (std::abs(PidShape(Ti.Ti, result.pid.Td, N, Ts, point.w_design)) * plant_mag);
+  const LoopMargins margins = DiscreteLoopMargins(Gd, result.pid, N, Ts);
+  result.crossover = margins.crossover;
+  result.phase_margin = margins.phase_margin;
+  result.gain_margin = margins.gain_margin;
+  result.review.push_back(LoopShapingItem(point, result));
+}
+
+/// Set-point weight: the largest b in [0, 1] whose nominal step meets the
+/// overshoot spec (b = 1 when the loop itself does), by bisection.
+double SetpointWeightForOvershoot(const PidControllerFactory& factory, Evaluator& evaluator,
+                                  double max_overshoot) {
+  const std::unique_ptr<Controller> controller = factory.Make(1.0);
+  const PredictedMetrics metrics = evaluator.Run(*controller, 0);
+  if (!(metrics.overshoot_percent > max_overshoot + kOvershootTolerance)) return 1.0;
+  double b_lo = 0.0, b_hi = 1.0;
+  for (int i = 0; i < 20; ++i) {
+    const double b_mid = 0.5 * (b_lo + b_hi);
+    const std::unique_ptr<Controller> candidate = factory.Make(b_mid);
+    if (evaluator.Run(*candidate, 0).overshoot_percent <= max_overshoot)
+      b_lo = b_mid;
+    else
+      b_hi = b_mid;
+  }
+  return b_lo;
+}
+
+/// pid (file comment): loop shaping, then the set-point weight.
+ChosenDesign DesignPid(const TransferFunction& model, double Ts, const AutoTuneOptions& options,
+                       Evaluator& evaluator, AutoTuneResult& result) {
+  ShapePidLoop(model, Ts, options, result);
+  const PidControllerFactory factory{Ts, result.pid, result.derivative_filter, evaluator.limits};
+  const double b = SetpointWeightForOvershoot(factory, evaluator, options.max_overshoot);
+  result.setpoint_weight = b;
+  ChosenDesign chosen;
+  chosen.make_controller = [factory, b] { return factory.Make(b); };
+  return chosen;
+}
+
+// ---------------------------------------------------------------------------
+// The chosen design: final evaluation and review
+
+/// The chosen design on the nominal plant, the robustness rows and the load
+/// step, into `result`. Returns whether every robustness row passes.
+bool EvaluateChosenDesign(const ChosenDesign& design, Evaluator& evaluator,
+                          AutoTuneResult& result) {
+  {
+    const std::unique_ptr<Controller> controller = design.make_controller();
+    result.predicted = evaluator.Run(*controller, 0);
+  }
+  bool all_rows_pass = true;
+  for (int i = 1; i < kPlantCount; ++i) {
+    const std::unique_ptr<Controller> controller = design.make_controller();
+    RobustnessRow row;
+    row.name = kRobustnessRowNames[i - 1];
+    row.metrics = evaluator.Run(*controller, i);
+    row.pass = RobustRowPasses(row.metrics, result);
+    all_rows_pass = all_rows_pass && row.pass;
+    result.robustness.push_back(row);
+  }
+  {
+    const std::unique_ptr<Controller> controller = design.make_controller();
+    result.steady_state_error = evaluator.LoadSteadyStateError(*controller);
+  }
+  result.evaluations = evaluator.evaluations;
+  return all_rows_pass;
+}
+
+/// What the review looks at besides the result.
+struct ReviewContext {
+  const TransferFunction& model;
+  const AutoTuneOptions& options;
+  const Evaluator& evaluator;
+  const InputStep& input_step;
+  const ChosenDesign& design;
+};
+
+ReviewItem NominalStabilityItem(const PredictedMetrics& nominal, double window) {
+  if (nominal.settled)
+    return {
+        "nominal stability", ReviewStatus::kOk,
+        fmt::format("the set-point step settles (2 % band) in {}", Seconds(nominal.settling_time))};
+  return {"nominal stability", ReviewStatus::kFail,
+          fmt::format("the set-point step does not settle within {:.4g} s: the loop "
+                      "is unstable or too slow",
+                      window)};
+}
+
+/// Offset-free: a constant output disturbance `load` leaves |steady-state
+/// error| <= kOffsetTolerance of it.
+ReviewItem OffsetFreeItem(double steady_state_error, double load) {
+  if (std::abs(steady_state_error) <= kOffsetTolerance * load)
+    return {"offset-free", ReviewStatus::kOk,
+            fmt::format("a constant output disturbance of {:.4g} is removed: "
+                        "steady-state error {:.3g}",
+                        load, steady_state_error)};
+  return {"offset-free", ReviewStatus::kFail,
+          fmt::format("a constant output disturbance of {:.4g} leaves a "
+                      "steady-state error of {:.3g}",
+                      load, steady_state_error)};
+}
+
+/// Condition number of a symmetric matrix (infinite when it is singular).
+double ConditionNumber(const Eigen::MatrixXd& symmetric) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(symmetric, Eigen::EigenvaluesOnly);
+  const double eig_min = eig.eigenvalues().minCoeff(), eig_max = eig.eigenvalues().maxCoeff();
+  return eig_min > 0.0 ? eig_max / eig_min : kInf;
+}
+
+/// QP Hessian condition: ok <= 1e4, warning <= 1e8, else fail.
+ReviewItem HessianConditionItem(double condition, ControllerType controller) {
+  const ReviewStatus status = condition <= 1e4   ? ReviewStatus::kOk
+                              : condition <= 1e8 ? ReviewStatus::kWarning
+                                                 : ReviewStatus::kFail;
+  return {
+      "QP Hessian condition", status,
+      fmt::format("cond({}) = {:.3g}{}",
+                  controller == ControllerType::kDmc ? "A'A + lambda I" : "H", condition,
+                  status == ReviewStatus::kOk ? ""
+                                              : " (the moves are sensitive to noise and rounding; "
+                                                "a larger lambda or a smaller M conditions it)")};
+}
+
+/// Constraint conflicts: the set-points reachable at steady state, and a
+/// warning when the input saturates during the evaluation step.
+ReviewItem ConstraintConflictsItem(const ReviewContext& context, const AutoTuneResult& result) {
+  const InputLimits& limits = context.options.limits;
+  ReviewItem item{"constraint conflicts", ReviewStatus::kOk, ""};
+  if (!Finite(limits)) {
+    item.message = "no input limits: every set-point is reachable at steady state";
+    return item;
+  }
+  const double K = result.fopdt.K;
+  const double y_at_u_min = K * limits.u_min, y_at_u_max = K * limits.u_max;
+  item.message = fmt::format(
+      "set-points reachable at steady state: [{:.4g}, {:.4g}] for u in "
+      "[{:.4g}, {:.4g}]; evaluation step {:.4g} -> {:.4g}",
+      std::min(y_at_u_min, y_at_u_max), std::max(y_at_u_min, y_at_u_max), limits.u_min,
+      limits.u_max, result.step_from, result.step_to);
+  const double du_lo = context.evaluator.limits.u_min, du_hi = context.evaluator.limits.u_max;
+  const PredictedMetrics& nominal = result.predicted;
+  if (nominal.u_min <= du_lo + 1e-9 * (1 + std::abs(du_lo)) ||
+      nominal.u_max >= du_hi - 1e-9 * (1 + std::abs(du_hi))) {
+    item.status = ReviewStatus::kWarning;
+    item.message += "; the input saturates during the step (the actuator limits the speed)";
+  }
+  return item;
+}
+
+ReviewItem RobustnessItem(const AutoTuneResult& result, bool all_rows_pass) {
+  if (all_rows_pass)
+    return {"robustness", ReviewStatus::kOk,
+            fmt::format("gain +-20 % and one more sample of dead time: settled, "
+                        "overshoot <= {:.3g} %, response <= {:.4g} s",
+                        result.robust_overshoot, result.robust_response_time)};
+  std::string failing;
+  for (const RobustnessRow& row : result.robustness) {
+    if (!row.pass)
+      failing +=
+          fmt::format("{}{} (overshoot {:.3g} %, response {})", failing.empty() ? "" : "; ",
+                      row.name, row.metrics.overshoot_percent, Seconds(row.metrics.response_time));
+  }
+  return {"robustness", ReviewStatus::kFail,
+          fmt::format("fails (allowed overshoot {:.3g} %, response {:.4g} s): {}",
+                      result.robust_overshoot, result.robust_response_time, failing)};
+}
+
+/// Open loop with the input at its limit from the step on: the fastest
+/// response possible, as the rise (10-90 %) or settling (98 %) time of the
+/// evaluation step; NaN when it is not reached within the window.
+double OpenLoopResponseAtLimit(const TransferFunction& model, const Evaluator& evaluator,
+                               double u_limit) {
+  const double Ts = evaluator.Ts;
+  LinearPlant plant(model, Ts);
+  plant.Reset();
+  const bool rise = evaluator.measure == ResponseMeasure::kRise;
+  double t_10 = kNaN, response_time = kNaN;
+  for (int k = 0; k < static_cast<int>(evaluator.window / Ts) && std::isnan(response_time); ++k) {
+    const double fraction = plant.Measure() / evaluator.step;
+    if (std::isnan(t_10) && fraction >= 0.1) t_10 = k * Ts;
+    if (fraction >= (rise ? 0.9 : 0.98)) response_time = k * Ts - (rise ? t_10 : 0.0);
+    plant.Advance(u_limit);
+  }
+  return response_time;
+}
+
+/// Why the response cannot be faster than it is: the fastest robust design,
+/// the sample time and dead time, the actuator.
+std::vector<std::string> ReasonsTooSlow(const ReviewContext& context,
+                                        const AutoTuneResult& result) {
+  const AutoTuneOptions& options = context.options;
+  const ChosenDesign& design = context.design;
+  const double t_aim = result.response_time_aimed;
+  std::vector<std::string> reasons;
+  if (std::isfinite(design.t_fastest) && design.t_fastest > (1.0 + kTimeTolerance) * t_aim)
+    reasons.push_back(
+        fmt::format("the fastest design within the overshoot and robustness "
+                    "limits (lambda = {:.4g}) responds in {:.4g} s",
+                    design.lambda_fastest, design.t_fastest));
+  else if (options.controller != ControllerType::kPid && std::isnan(design.lambda_fastest))
+    reasons.push_back("no lambda meets the overshoot and robustness limits");
+  const double t_min_delay = result.fopdt.theta + result.Ts;
+  if (t_aim < t_min_delay)
+    reasons.push_back(
+        fmt::format("the target is shorter than the dead time plus one sample "
+                    "({:.4g} s)",
+                    t_min_delay));
+  const InputLimits& limits = options.limits;
+  if (Finite(limits)) {
+    const Evaluator& evaluator = context.evaluator;
+    const double u_limit =
+        evaluator.step * result.fopdt.K > 0 ? evaluator.limits.u_max : evaluator.limits.u_min;
+    if (std::isfinite(u_limit)) {
+      const double t_at_limit = OpenLoopResponseAtLimit(context.model, evaluator, u_limit);
+      if (std::isfinite(t_at_limit) && t_at_limit > t_aim)
+        reasons.push_back(
+            fmt::format("with the input held at its limit {:.4g} the model needs "
+                        "{:.4g} s (input limits [{:.4g}, {:.4g}])",
+                        u_limit + context.input_step.from, t_at_limit, limits.u_min, limits.u_max));
+    }
+  }
+  return reasons;
+}
+
+/// Specification: overshoot and response time within 20 % of t*.
+ReviewItem SpecificationItem(const ReviewContext& context, const AutoTuneResult& result) {
+  const AutoTuneOptions& options = context.options;
+  const PredictedMetrics& nominal = result.predicted;
+  const double t_aim = result.response_time_aimed;
+  std::vector<std::string> why;
+  bool warn_only = true;
+  if (!(nominal.overshoot_percent <= options.max_overshoot + kOvershootTolerance)) {
+    why.push_back(fmt::format("overshoot {:.3g} % > {:.3g} %", nominal.overshoot_percent,
+                              options.max_overshoot));
+    warn_only = false;
+  }
+  const double relative_error = OrInf(nominal.response_time) / t_aim - 1.0;
+  if (std::abs(relative_error) > kTimeTolerance) {
+    why.push_back(fmt::format("{} time {} is {} than the target {:.4g} s (+-{:.0f} %)",
+                              ToString(options.measure), Seconds(nominal.response_time),
+                              relative_error > 0 ? "slower" : "faster", t_aim,
+                              100 * kTimeTolerance));
+    // PID: the crossover rule sets the time only approximately.
+    if (options.controller != ControllerType::kPid || std::abs(relative_error) > 1.0)
+      warn_only = false;
+    if (relative_error > 0) {
+      const std::vector<std::string> reasons = ReasonsTooSlow(context, result);
+      why.insert(why.end(), reasons.begin(), reasons.end());
+    }
+  }
+  if (why.empty()) {
+    return {"specification", ReviewStatus::kOk,
+            fmt::format("overshoot {:.3g} % <= {:.3g} %, {} time {} within {:.0f} % "
+                        "of {:.4g} s",
+                        nominal.overshoot_percent, options.max_overshoot, ToString(options.measure),
+                        Seconds(nominal.response_time), 100 * kTimeTolerance, t_aim)};
+  }
+  std::string message;
+  for (const std::string& reason : why) message += (message.empty() ? "" : "; ") + reason;
+  return {"specification", warn_only ? ReviewStatus::kWarning : ReviewStatus::kFail, message};
+}
+
+/// Termination and message from the review: failure when the nominal step
+/// does not settle, spec_not_met when a check fails, else converged.
+void ConcludeReview(AutoTuneResult& result) {
+  bool any_fail = false;
+  std::string fails;
+  for (const ReviewItem& item : result.review) {
+    if (item.status == ReviewStatus::kFail) {
+      any_fail = true;
+      fails += (fails.empty() ? "" : "; ") + item.check + ": " + item.message;
+    }
+  }
+  if (!result.predicted.settled) {
+    result.termination = AutoTuneTermination::kFailure;
+    result.message = "no stable design found: " + fails;
+  } else if (any_fail) {
+    result.termination = AutoTuneTermination::kSpecNotMet;
+    result.message = "specification not met: " + fails;
+  } else {
+    result.termination = AutoTuneTermination::kConverged;
+    result.message =
+        fmt::format("specification met ({} closed-loop simulations)", result.evaluations);
+  }
+}
+
+/// The design review (file comment), appended to result.review, and the
+/// termination it leads to.
+void ReviewDesign(const ReviewContext& context, bool all_rows_pass, AutoTuneResult& result) {
+  result.review.push_back(NominalStabilityItem(result.predicted, context.evaluator.window));
+  result.review.push_back(
+      OffsetFreeItem(result.steady_state_error, kLoadFraction * std::abs(context.evaluator.step)));
+  if (context.design.hessian.size() > 0) {
+    result.hessian_condition = ConditionNumber(context.design.hessian);
+    result.review.push_back(HessianConditionItem(result.hessian_condition, result.controller));
+  }
+  result.review.push_back(ConstraintConflictsItem(context, result));
+  result.review.push_back(RobustnessItem(result, all_rows_pass));
+  result.review.push_back(SpecificationItem(context, result));
+  ConcludeReview(result);
 }
 
 }  // namespace
@@ -213,505 +953,21 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
   PNEUMID_CHECK(model.IsContinuous() || std::abs(model.Ts() - Ts) <= 1e-9 * Ts,
                 "a discrete model must have the controller's sample time {} s, got {} s", Ts,
                 model.Ts());
-  AutoTuneResult r;
-  r.controller = options.controller;
-  r.Ts = Ts;
-  r.measure = options.measure;
-  r.max_overshoot = options.max_overshoot;
-  r.aggressiveness = options.aggressiveness;
-  r.fopdt = FopdtFromModel(model);
-  const FopdtEstimate& f = r.fopdt;
-  const double a = options.aggressiveness;
-  r.response_time_target =
-      std::isnan(options.response_time)
-          ? (options.measure == ResponseMeasure::kRise ? f.tau + f.theta : 2.0 * f.tau + f.theta)
-          : options.response_time;
-  r.response_time_aimed = r.response_time_target * std::pow(1.5, 1.0 - 2.0 * a);
-  r.robust_overshoot = options.max_overshoot * (1.0 + 4.0 * a) + kOvershootTolerance;
-  r.robust_response_time = (1.5 + a) * r.response_time_aimed;
-  // mpc/dmc without a response time: the fastest robust design (file comment).
-  r.fastest = std::isnan(options.response_time) && options.controller != ControllerType::kPid;
-  double t_aim = r.response_time_aimed;
-
+  AutoTuneResult result = SpecificationAsUsed(model, Ts, options);
   // The evaluation step in input space, then deviation variables.
-  const InputLimits& L = options.limits;
-  const double K = f.K;
-  double u_from = 0.0, u_to = 1.0 / K;
-  if (std::isfinite(L.u_min) && std::isfinite(L.u_max)) {
-    u_from = L.u_min + 0.4 * (L.u_max - L.u_min);
-    u_to = L.u_min + 0.6 * (L.u_max - L.u_min);
-  } else if (std::isfinite(L.u_min)) {
-    u_from = L.u_min + 1.0 / std::abs(K);
-    u_to = L.u_min + 2.0 / std::abs(K);
-  } else if (std::isfinite(L.u_max)) {
-    u_from = L.u_max - 2.0 / std::abs(K);
-    u_to = L.u_max - 1.0 / std::abs(K);
-  }
-  r.step_from = K * u_from;
-  r.step_to = K * u_to;
+  const InputStep input_step = EvaluationInputStep(options.limits, result.fopdt.K);
+  result.step_from = result.fopdt.K * input_step.from;
+  result.step_to = result.fopdt.K * input_step.to;
+  Evaluator evaluator = MakeEvaluator(model, Ts, options, result, input_step.from);
 
-  Evaluator ev;
-  ev.Ts = Ts;
-  ev.step = r.step_to - r.step_from;
-  ev.t_step = 5.0 * Ts;
-  ev.window = std::max(10.0 * std::max(t_aim, f.tau + f.theta), 50.0 * Ts);
-  ev.limits = L;
-  ev.limits.u_min -= u_from;
-  ev.limits.u_max -= u_from;
-  ev.measure = options.measure;
-  const double ts_model = model.IsContinuous() ? 0.0 : Ts;
-  ev.plants = {model, TransferFunction(model.num() * 1.2, model.den(), ts_model, model.delay()),
-               TransferFunction(model.num() * 0.8, model.den(), ts_model, model.delay()),
-               model.WithDelay(model.delay() + Ts)};
-  const char* kRowNames[] = {"gain +20%", "gain -20%", "dead time +1 sample"};
+  const ChosenDesign design =
+      options.controller == ControllerType::kMpc || options.controller == ControllerType::kDmc
+          ? SearchPredictiveDesign(model, Ts, options, evaluator, result)
+          : DesignPid(model, Ts, options, evaluator, result);
 
-  auto row_pass = [&](const PredictedMetrics& m) {
-    return m.settled && m.overshoot_percent <= r.robust_overshoot &&
-           OrInf(m.response_time) <= r.robust_response_time;
-  };
-  auto robust_ok = [&](const PredictedMetrics& m) {  // stability and overshoot only
-    return m.settled && m.overshoot_percent <= r.robust_overshoot;
-  };
-  auto nominal_ok = [&](const PredictedMetrics& m) {
-    return m.settled && m.overshoot_percent <= options.max_overshoot + kOvershootTolerance;
-  };
-
-  std::function<std::unique_ptr<Controller>()> make_final;
-  Eigen::MatrixXd hessian;
-  std::unique_ptr<PredictionModel> pm_ptr;  // outlive make_final
-  // mpc/dmc: the response time of lambda_f, the fastest robust design.
-  double t_fastest = std::numeric_limits<double>::quiet_NaN();
-  double lambda_fastest = t_fastest;
-  StateSpace ss;
-
-  if (options.controller == ControllerType::kMpc || options.controller == ControllerType::kDmc) {
-    pm_ptr = std::make_unique<PredictionModel>(model, Ts);
-    const PredictionModel& pm = *pm_ptr;
-    TuningOptions to;
-    to.rule = TuningRule::kShridharCooper;
-    to.M = options.M;
-    const TuningResult base = Tune(pm, to);
-    r.P = base.P;
-    r.M = base.M;
-    const double lambda0 = base.lambda_condition;
-    const bool is_mpc = options.controller == ControllerType::kMpc;
-    if (is_mpc) ss = SampledStateSpace(model, Ts);
-    auto make = [&, is_mpc](double lambda) -> std::unique_ptr<Controller> {
-      if (is_mpc) {
-        MpcOptions o;
-        o.P = r.P;
-        o.M = r.M;
-        o.lambda = lambda;
-        o.limits = ev.limits;
-        o.disturbance = options.disturbance;
-        return std::make_unique<MpcController>(ss, o);
-      }
-      DmcOptions o;
-      o.P = r.P;
-      o.M = r.M;
-      o.lambda = lambda;
-      o.limits = ev.limits;
-      o.constrained = Finite(ev.limits) || std::isfinite(ev.limits.du_max);
-      return std::make_unique<DmcController>(*pm_ptr, o);
-    };
-    struct Eval {
-      PredictedMetrics nominal;
-      bool feasible = false;
-    };
-    auto evaluate = [&](double lambda) {
-      Eval e;
-      auto c = make(lambda);
-      e.nominal = ev.Run(*c, 0);
-      e.feasible = nominal_ok(e.nominal);
-      for (int i = 1; e.feasible && i < 4; ++i) e.feasible = robust_ok(ev.Run(*c, i));
-      return e;
-    };
-    // Smallest feasible lambda: ascending scan in log lambda, then bisection.
-    const double lo_exp = -6.0, hi_exp = 4.0;
-    double lambda_f = std::numeric_limits<double>::quiet_NaN();
-    double prev = std::numeric_limits<double>::quiet_NaN();
-    for (int k = 0; lo_exp + 0.25 * k <= hi_exp + 1e-9; ++k) {
-      const double lambda = lambda0 * std::pow(10.0, lo_exp + 0.25 * k);
-      if (evaluate(lambda).feasible) {
-        lambda_f = lambda;
-        break;
-      }
-      prev = lambda;
-    }
-    double lambda_star;
-    if (std::isnan(lambda_f)) {
-      // Nothing robust: take the Shridhar-Cooper value and let the review say why.
-      lambda_star = lambda0;
-    } else {
-      if (!std::isnan(prev)) {
-        double lo = std::log(prev), hi = std::log(lambda_f);
-        for (int i = 0; i < 12; ++i) {
-          const double mid = 0.5 * (lo + hi);
-          if (evaluate(std::exp(mid)).feasible)
-            hi = mid;
-          else
-            lo = mid;
-        }
-        lambda_f = std::exp(hi);
-      }
-      lambda_star = lambda_f;
-      auto time_of = [&](double lambda) {
-        auto c = make(lambda);
-        return OrInf(ev.Run(*c, 0).response_time);
-      };
-      lambda_fastest = lambda_f;
-      t_fastest = time_of(lambda_f);
-      if (r.fastest && std::isfinite(t_fastest)) {
-        // The target is the fastest robust response itself.
-        r.response_time_target = r.response_time_aimed = t_aim = t_fastest;
-        r.robust_response_time = (1.5 + a) * t_aim;
-      }
-      if (t_fastest < t_aim) {
-        // Bracket t(lambda) = t* above lambda_f, then bisect in log lambda.
-        double lo = std::log(lambda_f), hi = lo;
-        bool bracketed = false;
-        for (int i = 0; i < 12 && !bracketed; ++i) {
-          lo = hi;
-          hi += std::log(10.0);
-          bracketed = time_of(std::exp(hi)) >= t_aim;
-        }
-        if (bracketed) {
-          for (int i = 0; i < 30 && hi - lo > 1e-4; ++i) {
-            const double mid = 0.5 * (lo + hi);
-            if (time_of(std::exp(mid)) < t_aim)
-              lo = mid;
-            else
-              hi = mid;
-          }
-          const double tl = time_of(std::exp(lo)), th = time_of(std::exp(hi));
-          lambda_star = std::abs(std::log(tl / t_aim)) <= std::abs(std::log(th / t_aim))
-                            ? std::exp(lo)
-                            : std::exp(hi);
-        } else {
-          lambda_star = std::exp(hi);
-        }
-      } else {
-        // Even lambda_f is too slow: the response is limited by the model,
-        // the horizons or the actuator, and flat in lambda. Take the largest
-        // lambda that is hardly slower (2 % of t*): better conditioned, as fast.
-        const double t_f = t_fastest;
-        const double t_ok = t_f + (r.fastest ? 0.005 : 0.02) * t_aim;
-        double lo = std::log(lambda_f), hi = lo;
-        bool bracketed = false;
-        for (int i = 0; i < 12 && !bracketed; ++i) {
-          lo = hi;
-          hi += std::log(10.0);
-          bracketed = time_of(std::exp(hi)) > t_ok;
-        }
-        if (bracketed) {
-          for (int i = 0; i < 30 && hi - lo > 1e-3; ++i) {
-            const double mid = 0.5 * (lo + hi);
-            if (time_of(std::exp(mid)) <= t_ok)
-              lo = mid;
-            else
-              hi = mid;
-          }
-        }
-        if (evaluate(std::exp(lo)).feasible) lambda_star = std::exp(lo);
-      }
-    }
-    r.lambda = lambda_star;
-    make_final = [make, lambda_star] { return make(lambda_star); };
-    auto c = make(lambda_star);
-    if (is_mpc) {
-      hessian = static_cast<MpcController&>(*c).hessian();
-    } else {
-      const Eigen::MatrixXd& A = static_cast<DmcController&>(*c).dynamic_matrix();
-      hessian = A.transpose() * A + lambda_star * Eigen::MatrixXd::Identity(A.cols(), A.cols());
-    }
-  } else {  // pid
-    const TransferFunction Gd = LinearPlant(model, Ts).model();
-    const double sgn = K > 0.0 ? 1.0 : -1.0;
-    const double wn = kPi / Ts;
-    double wc = (options.measure == ResponseMeasure::kRise ? 2.0 : 4.0) / t_aim;
-    r.crossover_target = wc;
-    r.phase_margin_target = 75.0 - 30.0 * a;
-    const double w_design = std::min(wc, 0.5 * wn);
-    const auto [gmag, gph0] = PlantAt(Gd, w_design);
-    const double gph = gph0 - (sgn < 0.0 ? 180.0 : 0.0);  // design on sgn * G
-    const double phi_c = -180.0 + r.phase_margin_target - gph;
-    const double N = r.derivative_filter;
-    auto arg_c = [&](double Ti, bool pid) {
-      return std::arg(PidShape(Ti, pid ? Ti / 4.0 : 0.0, N, Ts, w_design)) * kDeg;
-    };
-    const bool use_pid = phi_c > -10.0;
-    // Ti from arg C1(Ti) = phi_c: log grid, first bracket, bisection.
-    const int n = 400;
-    double best_Ti = std::numeric_limits<double>::quiet_NaN(), best_err = 1e300;
-    double lo = std::log(1e-4 / w_design), hi = std::log(1e4 / w_design);
-    double Ti_sol = std::numeric_limits<double>::quiet_NaN();
-    double x_prev = lo, e_prev = arg_c(std::exp(lo), use_pid) - phi_c;
-    for (int i = 1; i <= n && std::isnan(Ti_sol); ++i) {
-      const double x = lo + (hi - lo) * i / n;
-      const double e = arg_c(std::exp(x), use_pid) - phi_c;
-      if (std::abs(e) < best_err) {
-        best_err = std::abs(e);
-        best_Ti = std::exp(x);
-      }
-      if (e_prev * e <= 0.0) {
-        double xa = x_prev, xb = x, ea = e_prev;
-        for (int k = 0; k < 60; ++k) {
-          const double xm = 0.5 * (xa + xb);
-          const double em = arg_c(std::exp(xm), use_pid) - phi_c;
-          if (ea * em <= 0.0)
-            xb = xm;
-          else {
-            xa = xm;
-            ea = em;
-          }
-        }
-        Ti_sol = std::exp(0.5 * (xa + xb));
-      }
-      x_prev = x;
-      e_prev = e;
-    }
-    const bool solved = !std::isnan(Ti_sol);
-    const double Ti = solved ? Ti_sol : best_Ti;
-    r.pid.Ti = Ti;
-    r.pid.Td = use_pid ? Ti / 4.0 : 0.0;
-    r.pid.Kc = sgn / (std::abs(PidShape(Ti, r.pid.Td, N, Ts, w_design)) * gmag);
-    const LoopMargins lm = DiscreteLoopMargins(Gd, r.pid, N, Ts);
-    r.crossover = lm.crossover;
-    r.phase_margin = lm.phase_margin;
-    r.gain_margin = lm.gain_margin;
-    if (!solved || wc > 0.5 * wn) {
-      r.review.push_back(
-          {"loop shaping", ReviewStatus::kFail,
-           wc > 0.5 * wn
-               ? fmt::format("the crossover 2/t* = {:.4g} rad/s the response time asks for exceeds "
-                             "half the Nyquist frequency ({:.4g} rad/s): designed at {:.4g} rad/s; "
-                             "sample faster or ask for a slower response",
-                             wc, 0.5 * wn, w_design)
-               : fmt::format("a {} cannot give the phase margin {:.3g} deg at {:.4g} rad/s (the "
-                             "controller would need {:.1f} deg of phase); closest Ti taken",
-                             use_pid ? "PID" : "PI", r.phase_margin_target, w_design, phi_c)});
-    } else {
-      r.review.push_back(
-          {"loop shaping", ReviewStatus::kOk,
-           fmt::format("{} with crossover {:.4g} rad/s (target {:.4g}), phase "
-                       "margin {:.3g} deg (target {:.3g}), gain margin {:.3g}",
-                       use_pid ? "PID (Td = Ti/4)" : "PI", r.crossover, r.crossover_target,
-                       r.phase_margin, r.phase_margin_target, r.gain_margin)});
-    }
-    auto make = [&, N](double b) -> std::unique_ptr<Controller> {
-      PidOptions o;
-      o.gains = r.pid;
-      o.setpoint_weight = b;
-      o.derivative_filter = N;
-      o.limits = ev.limits;
-      return std::make_unique<PidController>(Ts, o);
-    };
-    // Set-point weight: the largest b in [0, 1] meeting the overshoot spec.
-    double b = 1.0;
-    {
-      auto c = make(1.0);
-      const PredictedMetrics m = ev.Run(*c, 0);
-      if (m.overshoot_percent > options.max_overshoot + kOvershootTolerance) {
-        double blo = 0.0, bhi = 1.0;
-        for (int i = 0; i < 20; ++i) {
-          const double bm = 0.5 * (blo + bhi);
-          auto cm = make(bm);
-          if (ev.Run(*cm, 0).overshoot_percent <= options.max_overshoot)
-            blo = bm;
-          else
-            bhi = bm;
-        }
-        b = blo;
-      }
-    }
-    r.setpoint_weight = b;
-    make_final = [make, b] { return make(b); };
-  }
-
-  // Final design: nominal, robustness rows, load step, review.
-  {
-    auto c = make_final();
-    r.predicted = ev.Run(*c, 0);
-  }
-  bool all_rows = true;
-  for (int i = 1; i < 4; ++i) {
-    auto c = make_final();
-    RobustnessRow row;
-    row.name = kRowNames[i - 1];
-    row.metrics = ev.Run(*c, i);
-    row.pass = row_pass(row.metrics);
-    all_rows = all_rows && row.pass;
-    r.robustness.push_back(row);
-  }
-  {
-    auto c = make_final();
-    r.steady_state_error = ev.LoadSteadyStateError(*c);
-  }
-  r.evaluations = ev.evaluations;
-  const PredictedMetrics& m = r.predicted;
-
-  r.review.push_back(
-      m.settled
-          ? ReviewItem{"nominal stability", ReviewStatus::kOk,
-                       fmt::format("the set-point step settles (2 % band) in {}",
-                                   Seconds(m.settling_time))}
-          : ReviewItem{"nominal stability", ReviewStatus::kFail,
-                       fmt::format("the set-point step does not settle within {:.4g} s: the loop "
-                                   "is unstable or too slow",
-                                   ev.window)});
-  const double load = kLoadFraction * std::abs(ev.step);
-  r.review.push_back(
-      std::abs(r.steady_state_error) <= kOffsetTolerance * load
-          ? ReviewItem{"offset-free", ReviewStatus::kOk,
-                       fmt::format("a constant output disturbance of {:.4g} is removed: "
-                                   "steady-state error {:.3g}",
-                                   load, r.steady_state_error)}
-          : ReviewItem{"offset-free", ReviewStatus::kFail,
-                       fmt::format("a constant output disturbance of {:.4g} leaves a "
-                                   "steady-state error of {:.3g}",
-                                   load, r.steady_state_error)});
-  if (hessian.size() > 0) {
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(hessian, Eigen::EigenvaluesOnly);
-    const double lmin = eig.eigenvalues().minCoeff(), lmax = eig.eigenvalues().maxCoeff();
-    r.hessian_condition = lmin > 0.0 ? lmax / lmin : std::numeric_limits<double>::infinity();
-    const ReviewStatus s = r.hessian_condition <= 1e4   ? ReviewStatus::kOk
-                           : r.hessian_condition <= 1e8 ? ReviewStatus::kWarning
-                                                        : ReviewStatus::kFail;
-    r.review.push_back(
-        {"QP Hessian condition", s,
-         fmt::format("cond({}) = {:.3g}{}",
-                     options.controller == ControllerType::kDmc ? "A'A + lambda I" : "H",
-                     r.hessian_condition,
-                     s == ReviewStatus::kOk ? ""
-                                            : " (the moves are sensitive to noise and rounding; "
-                                              "a larger lambda or a smaller M conditions it)")});
-  }
-  {
-    ReviewItem item{"constraint conflicts", ReviewStatus::kOk, ""};
-    if (!Finite(L)) {
-      item.message = "no input limits: every set-point is reachable at steady state";
-    } else {
-      const double y1 = K * L.u_min, y2 = K * L.u_max;
-      item.message = fmt::format(
-          "set-points reachable at steady state: [{:.4g}, {:.4g}] for u in "
-          "[{:.4g}, {:.4g}]; evaluation step {:.4g} -> {:.4g}",
-          std::min(y1, y2), std::max(y1, y2), L.u_min, L.u_max, r.step_from, r.step_to);
-      const double du_lo = ev.limits.u_min, du_hi = ev.limits.u_max;
-      if (m.u_min <= du_lo + 1e-9 * (1 + std::abs(du_lo)) ||
-          m.u_max >= du_hi - 1e-9 * (1 + std::abs(du_hi))) {
-        item.status = ReviewStatus::kWarning;
-        item.message += "; the input saturates during the step (the actuator limits the speed)";
-      }
-    }
-    r.review.push_back(item);
-  }
-  {
-    std::string failing;
-    for (const RobustnessRow& row : r.robustness) {
-      if (!row.pass)
-        failing += fmt::format("{}{} (overshoot {:.3g} %, response {})",
-                               failing.empty() ? "" : "; ", row.name, row.metrics.overshoot_percent,
-                               Seconds(row.metrics.response_time));
-    }
-    r.review.push_back(
-        all_rows
-            ? ReviewItem{"robustness", ReviewStatus::kOk,
-                         fmt::format("gain +-20 % and one more sample of dead time: settled, "
-                                     "overshoot <= {:.3g} %, response <= {:.4g} s",
-                                     r.robust_overshoot, r.robust_response_time)}
-            : ReviewItem{"robustness", ReviewStatus::kFail,
-                         fmt::format("fails (allowed overshoot {:.3g} %, response {:.4g} s): {}",
-                                     r.robust_overshoot, r.robust_response_time, failing)});
-  }
-  {
-    // Specification: overshoot and response time within 20 % of t*.
-    std::vector<std::string> why;
-    bool warn_only = true;
-    if (!(m.overshoot_percent <= options.max_overshoot + kOvershootTolerance)) {
-      why.push_back(
-          fmt::format("overshoot {:.3g} % > {:.3g} %", m.overshoot_percent, options.max_overshoot));
-      warn_only = false;
-    }
-    const double t = OrInf(m.response_time);
-    const double rel = t / t_aim - 1.0;
-    if (std::abs(rel) > kTimeTolerance) {
-      why.push_back(fmt::format("{} time {} is {} than the target {:.4g} s (+-{:.0f} %)",
-                                ToString(options.measure), Seconds(m.response_time),
-                                rel > 0 ? "slower" : "faster", t_aim, 100 * kTimeTolerance));
-      // PID: the crossover rule sets the time only approximately.
-      if (options.controller != ControllerType::kPid || std::abs(rel) > 1.0) warn_only = false;
-      // Why it cannot be faster: sample time, dead time, actuator.
-      if (rel > 0) {
-        if (std::isfinite(t_fastest) && t_fastest > (1.0 + kTimeTolerance) * t_aim)
-          why.push_back(
-              fmt::format("the fastest design within the overshoot and robustness "
-                          "limits (lambda = {:.4g}) responds in {:.4g} s",
-                          lambda_fastest, t_fastest));
-        else if (options.controller != ControllerType::kPid && std::isnan(lambda_fastest))
-          why.push_back("no lambda meets the overshoot and robustness limits");
-        const double t_min_delay = f.theta + Ts;
-        if (t_aim < t_min_delay)
-          why.push_back(
-              fmt::format("the target is shorter than the dead time plus one sample "
-                          "({:.4g} s)",
-                          t_min_delay));
-        if (Finite(L)) {
-          // Open loop with the input at its limit from the step on: the fastest possible.
-          const double u_lim = ev.step * K > 0 ? ev.limits.u_max : ev.limits.u_min;
-          if (std::isfinite(u_lim)) {
-            LinearPlant p(model, Ts);
-            p.Reset();
-            const bool rise = options.measure == ResponseMeasure::kRise;
-            double t_lo = std::numeric_limits<double>::quiet_NaN(), t_fast = t_lo;
-            for (int k = 0; k < static_cast<int>(ev.window / Ts) && std::isnan(t_fast); ++k) {
-              const double frac = p.Measure() / ev.step;
-              if (std::isnan(t_lo) && frac >= 0.1) t_lo = k * Ts;
-              if (frac >= (rise ? 0.9 : 0.98)) t_fast = k * Ts - (rise ? t_lo : 0.0);
-              p.Advance(u_lim);
-            }
-            if (std::isfinite(t_fast) && t_fast > t_aim)
-              why.push_back(
-                  fmt::format("with the input held at its limit {:.4g} the model needs "
-                              "{:.4g} s (input limits [{:.4g}, {:.4g}])",
-                              u_lim + u_from, t_fast, L.u_min, L.u_max));
-          }
-        }
-      }
-    }
-    if (why.empty()) {
-      r.review.push_back(
-          {"specification", ReviewStatus::kOk,
-           fmt::format("overshoot {:.3g} % <= {:.3g} %, {} time {} within {:.0f} % "
-                       "of {:.4g} s",
-                       m.overshoot_percent, options.max_overshoot, ToString(options.measure),
-                       Seconds(m.response_time), 100 * kTimeTolerance, t_aim)});
-    } else {
-      std::string msg;
-      for (const std::string& s : why) msg += (msg.empty() ? "" : "; ") + s;
-      r.review.push_back(
-          {"specification", warn_only ? ReviewStatus::kWarning : ReviewStatus::kFail, msg});
-    }
-  }
-
-  bool any_fail = false;
-  std::string fails;
-  for (const ReviewItem& item : r.review) {
-    if (item.status == ReviewStatus::kFail) {
-      any_fail = true;
-      fails += (fails.empty() ? "" : "; ") + item.check + ": " + item.message;
-    }
-  }
-  if (!m.settled) {
-    r.termination = AutoTuneTermination::kFailure;
-    r.message = "no stable design found: " + fails;
-  } else if (any_fail) {
-    r.termination = AutoTuneTermination::kSpecNotMet;
-    r.message = "specification not met: " + fails;
-  } else {
-    r.termination = AutoTuneTermination::kConverged;
-    r.message = fmt::format("specification met ({} closed-loop simulations)", r.evaluations);
-  }
-  return r;
+  const bool all_rows_pass = EvaluateChosenDesign(design, evaluator, result);
+  ReviewDesign({model, options, evaluator, input_step, design}, all_rows_pass, result);
+  return result;
 }
 
 TuningResult AutoTuneResult::ToTuningResult() const {

@@ -106,43 +106,18 @@ void DmcController::Build() {
   err_.setZero(P);
 
   if (options_.constrained) {
-    const InputLimits& lim = options_.limits;
     soft_output_ = std::isfinite(options_.y_min) || std::isfinite(options_.y_max);
-    nvar_ = M + (soft_output_ ? 1 : 0);
-    const bool u_rows = std::isfinite(lim.u_min) || std::isfinite(lim.u_max);
-    const int rows = (u_rows ? M : 0) + (std::isfinite(options_.y_min) ? P : 0) +
-                     (std::isfinite(options_.y_max) ? P : 0);
-    Eigen::MatrixXd Hq = Eigen::MatrixXd::Zero(nvar_, nvar_);
-    Hq.topLeftCorner(M, M) = H;
-    if (soft_output_) Hq(M, M) = options_.slack_quadratic_weight;
-    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(rows, nvar_);
-    int row = 0;
-    if (u_rows) {
-      for (int j = 0; j < M; ++j) C.row(row + j).head(j + 1).setOnes();
-      row += M;
-    }
-    if (std::isfinite(options_.y_min)) {
-      C.block(row, 0, P, M) = A_;
-      C.block(row, M, P, 1).setOnes();  // A du + e >= y_min - f
-      row += P;
-    }
-    if (std::isfinite(options_.y_max)) {
-      C.block(row, 0, P, M) = A_;
-      C.block(row, M, P, 1).setConstant(-1.0);  // A du - e <= y_max - f
-      row += P;
-    }
+    const internal::MoveQp move_qp = internal::BuildMoveQp(
+        H, A_, options_.limits, options_.y_min, options_.y_max, options_.slack_quadratic_weight);
+    nvar_ = static_cast<int>(move_qp.hessian.rows());
     qp_ = std::make_unique<QpSolver>(options_.qp);
-    PNEUMID_CHECK(qp_->Setup(Hq, C), "the QDMC Hessian is not positive definite: {}",
-                  qp_->summary().BriefReport());
+    PNEUMID_CHECK(qp_->Setup(move_qp.hessian, move_qp.constraints),
+                  "the QDMC Hessian is not positive definite: {}", qp_->summary().BriefReport());
     g_.setZero(nvar_);
-    lb_.setZero(rows);
-    ub_.setZero(rows);
-    lbx_.setConstant(nvar_, -lim.du_max);
-    ubx_.setConstant(nvar_, lim.du_max);
-    if (soft_output_) {
-      lbx_(M) = 0.0;
-      ubx_(M) = std::numeric_limits<double>::infinity();
-    }
+    lb_.setZero(move_qp.constraints.rows());
+    ub_.setZero(move_qp.constraints.rows());
+    lbx_ = move_qp.lbx;
+    ubx_ = move_qp.ubx;
   } else {
     qp_ = std::make_unique<QpSolver>(options_.qp);  // summary reports "not set up"
   }

@@ -20,7 +20,6 @@ constexpr EnumName<DisturbanceModel> kDisturbanceModelNames[] = {
     {DisturbanceModel::kInput, "input"},
     {DisturbanceModel::kNone, "none"},
 };
-constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 std::string ToString(DisturbanceModel v) {
@@ -109,9 +108,13 @@ MpcController::MpcController(const TransferFunction& model, double Ts, const Mpc
 
 MpcController::~MpcController() = default;
 
-void MpcController::Build(const StateSpace& model_in) {
+namespace {
+
+// The options and the model as Build() needs them (before the delay becomes
+// states).
+void CheckOptionsAndModel(const MpcOptions& options, const StateSpace& model_in) {
   std::string error;
-  PNEUMID_CHECK(options_.IsValid(&error), "invalid MPC options: {}", error);
+  PNEUMID_CHECK(options.IsValid(&error), "invalid MPC options: {}", error);
   PNEUMID_CHECK(model_in.IsDiscrete(),
                 "MPC needs a discrete model (Ts > 0); sample a continuous one first "
                 "(SampledStateSpace or the TransferFunction constructor)");
@@ -122,12 +125,11 @@ void MpcController::Build(const StateSpace& model_in) {
   PNEUMID_CHECK(model_in.A().allFinite() && model_in.B().allFinite() && model_in.C().allFinite() &&
                     model_in.D().allFinite(),
                 "the model's matrices must be finite");
-  const StateSpace model = DelayAsStates(model_in);
-  PNEUMID_CHECK(model.D()(0, 0) == 0.0,
-                "MPC needs a strictly proper model: D = {} makes y_k depend on u_k, which is "
-                "computed from y_k (use an input delay of at least one sample, e.g. nk >= 1)",
-                model.D()(0, 0));
-  // Stable, or integrating: one pole at z = 1, the others inside the circle.
+}
+
+// True for an integrating model. Stable, or integrating: one pole at z = 1,
+// the others inside the circle; any other model is refused.
+bool IsIntegratingModel(const StateSpace& model) {
   const Eigen::VectorXcd poles = model.Poles();
   int at_one = 0;
   double outside = 0.0;
@@ -141,112 +143,218 @@ void MpcController::Build(const StateSpace& model_in) {
                 "MPC needs a stable or integrating model; the model has {}",
                 at_one > 1 ? fmt::format("{} poles at z = 1", at_one)
                            : fmt::format("a pole of magnitude {:.6g} (>= 1)", outside));
-  integrating_ = at_one == 1;
-  Ts_ = model.Ts();
+  return at_one == 1;
+}
+
+// The model's steady state per unit input (per unit output when integrating)
+// and its static gain.
+struct UnitSteadyState {
+  Eigen::VectorXd xs_unit;  // (I - A)^-1 B; integrating: x_s per unit r
+  double G = 0.0;           // static gain; infinite for an integrating model
+};
+
+UnitSteadyState ComputeUnitSteadyState(const StateSpace& model, bool integrating,
+                                       const MpcOptions& options) {
   const Eigen::MatrixXd& A = model.A();
-  nx_ = model.num_states();
-  if (!integrating_) {
-    xs_unit_ = (Eigen::MatrixXd::Identity(nx_, nx_) - A).partialPivLu().solve(model.B().col(0));
-    G_ = model.C().row(0).dot(xs_unit_);
-    PNEUMID_CHECK(std::isfinite(G_) && std::abs(G_) > 1e-12 * std::max(1.0, xs_unit_.norm()),
-                  "MPC needs a model with a nonzero static gain, got {}", G_);
-  } else {
-    // [I - A, -B; C, 0] [x_s; v_s] = [0; r] (file comment): x_s per unit r.
-    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nx_ + 1, nx_ + 1);
-    T.topLeftCorner(nx_, nx_) = Eigen::MatrixXd::Identity(nx_, nx_) - A;
-    T.topRightCorner(nx_, 1) = -model.B();
-    T.bottomLeftCorner(1, nx_) = model.C();
-    const Eigen::FullPivLU<Eigen::MatrixXd> lu(T);
-    // A pole at z = 1 cancelled (to rounding) by a zero there, as least
-    // squares can fit on noise-free data, leaves T all but singular.
-    PNEUMID_CHECK(lu.isInvertible() && lu.rcond() > 1e-9,
-                  "MPC needs a stable model, or an integrating one without a zero at z = 1; "
-                  "the model has a pole at z = 1 {}",
-                  lu.isInvertible()
-                      ? fmt::format("all but cancelled by a zero (rcond {:.3g})", lu.rcond())
-                      : std::string("cancelled by a zero"));
-    const Eigen::VectorXd col = lu.solve(Eigen::VectorXd::Unit(nx_ + 1, nx_));
-    xs_unit_ = col.head(nx_);
-    G_ = std::numeric_limits<double>::infinity();
-    PNEUMID_CHECK(options_.disturbance != DisturbanceModel::kOutput,
-                  "MPC on an integrating model needs the input disturbance model (or none): an "
-                  "output disturbance is not detectable behind the model's own integrator");
-    PNEUMID_CHECK(options_.disturbance != DisturbanceModel::kNone || options_.state_noise > 0.0,
-                  "MPC on an integrating model without a disturbance model needs process noise "
-                  "on its states (state_noise > 0, --state-noise): the Kalman filter has nothing "
-                  "else to follow the integrator with");
+  const int nx = model.num_states();
+  UnitSteadyState steady;
+  if (!integrating) {
+    steady.xs_unit = (Eigen::MatrixXd::Identity(nx, nx) - A).partialPivLu().solve(model.B().col(0));
+    steady.G = model.C().row(0).dot(steady.xs_unit);
+    PNEUMID_CHECK(std::isfinite(steady.G) &&
+                      std::abs(steady.G) > 1e-12 * std::max(1.0, steady.xs_unit.norm()),
+                  "MPC needs a model with a nonzero static gain, got {}", steady.G);
+    return steady;
   }
+  // [I - A, -B; C, 0] [x_s; v_s] = [0; r] (file comment): x_s per unit r.
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nx + 1, nx + 1);
+  T.topLeftCorner(nx, nx) = Eigen::MatrixXd::Identity(nx, nx) - A;
+  T.topRightCorner(nx, 1) = -model.B();
+  T.bottomLeftCorner(1, nx) = model.C();
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(T);
+  // A pole at z = 1 cancelled (to rounding) by a zero there, as least
+  // squares can fit on noise-free data, leaves T all but singular.
+  PNEUMID_CHECK(lu.isInvertible() && lu.rcond() > 1e-9,
+                "MPC needs a stable model, or an integrating one without a zero at z = 1; "
+                "the model has a pole at z = 1 {}",
+                lu.isInvertible()
+                    ? fmt::format("all but cancelled by a zero (rcond {:.3g})", lu.rcond())
+                    : std::string("cancelled by a zero"));
+  const Eigen::VectorXd col = lu.solve(Eigen::VectorXd::Unit(nx + 1, nx));
+  steady.xs_unit = col.head(nx);
+  steady.G = std::numeric_limits<double>::infinity();
+  PNEUMID_CHECK(options.disturbance != DisturbanceModel::kOutput,
+                "MPC on an integrating model needs the input disturbance model (or none): an "
+                "output disturbance is not detectable behind the model's own integrator");
+  PNEUMID_CHECK(options.disturbance != DisturbanceModel::kNone || options.state_noise > 0.0,
+                "MPC on an integrating model without a disturbance model needs process noise "
+                "on its states (state_noise > 0, --state-noise): the Kalman filter has nothing "
+                "else to follow the integrator with");
+  return steady;
+}
 
-  // Augmented model.
-  const DisturbanceModel dm = options_.disturbance;
+// z+ = Az z + Bz u, y = Cz z: the model and its disturbance (file comment).
+struct AugmentedModel {
+  Eigen::MatrixXd Az;
+  Eigen::VectorXd Bz;
+  Eigen::RowVectorXd Cz;
+};
+
+AugmentedModel AugmentWithDisturbance(const StateSpace& model, DisturbanceModel dm) {
+  const int nx = model.num_states();
   const int nd = dm == DisturbanceModel::kNone ? 0 : 1;
-  nz_ = nx_ + nd;
-  Az_.setZero(nz_, nz_);
-  Az_.topLeftCorner(nx_, nx_) = A;
-  Bz_.setZero(nz_);
-  Bz_.head(nx_) = model.B().col(0);
-  Cz_.setZero(nz_);
-  Cz_.head(nx_) = model.C().row(0);
+  const int nz = nx + nd;
+  AugmentedModel aug;
+  aug.Az.setZero(nz, nz);
+  aug.Az.topLeftCorner(nx, nx) = model.A();
+  aug.Bz.setZero(nz);
+  aug.Bz.head(nx) = model.B().col(0);
+  aug.Cz.setZero(nz);
+  aug.Cz.head(nx) = model.C().row(0);
   if (dm == DisturbanceModel::kOutput) {
-    Az_(nx_, nx_) = 1.0;
-    Cz_(nx_) = 1.0;
+    aug.Az(nx, nx) = 1.0;
+    aug.Cz(nx) = 1.0;
   } else if (dm == DisturbanceModel::kInput) {
-    Az_.block(0, nx_, nx_, 1) = model.B();
-    Az_(nx_, nx_) = 1.0;
+    aug.Az.block(0, nx, nx, 1) = model.B();
+    aug.Az(nx, nx) = 1.0;
   }
+  return aug;
+}
 
-  // Steady-state Kalman filter: X = DARE(Az', Cz', Qz, R).
-  const int n_plant = model_in.num_states();  // delay states get no process noise
-  Eigen::MatrixXd Qz = Eigen::MatrixXd::Zero(nz_, nz_);
-  Qz.diagonal().head(n_plant).setConstant(options_.state_noise);
-  if (nd) Qz(nx_, nx_) = options_.disturbance_noise;
-  const Eigen::MatrixXd Rm = Eigen::MatrixXd::Constant(1, 1, options_.measurement_noise);
-  const DareResult dare = SolveDare(Az_.transpose(), Cz_.transpose(), Qz, Rm, options_.dare);
-  dare_summary_ = dare.summary;
+// The estimator's a priori covariance X and gain L.
+struct KalmanDesign {
+  Eigen::MatrixXd X;
+  Eigen::VectorXd L;
+  DareSummary summary;
+};
+
+// Steady-state Kalman filter: X = DARE(Az', Cz', Qz, R). The first n_plant
+// states get process noise, the delay states none.
+KalmanDesign DesignKalmanFilter(const AugmentedModel& aug, int nx, int n_plant,
+                                const MpcOptions& options) {
+  const int nz = static_cast<int>(aug.Az.rows());
+  const bool with_disturbance = options.disturbance != DisturbanceModel::kNone;
+  Eigen::MatrixXd Qz = Eigen::MatrixXd::Zero(nz, nz);
+  Qz.diagonal().head(n_plant).setConstant(options.state_noise);
+  if (with_disturbance) Qz(nx, nx) = options.disturbance_noise;
+  const Eigen::MatrixXd Rm = Eigen::MatrixXd::Constant(1, 1, options.measurement_noise);
+  const DareResult dare = SolveDare(aug.Az.transpose(), aug.Cz.transpose(), Qz, Rm, options.dare);
   PNEUMID_CHECK(dare.summary.status == DareStatus::kConverged,
                 "the Kalman filter cannot be designed ({}): the disturbance model '{}' may not "
                 "be detectable for this plant",
-                dare.summary.BriefReport(), ToString(dm));
-  X_ = dare.X;
-  L_ = X_ * Cz_.transpose() / (Cz_.dot(X_ * Cz_.transpose()) + options_.measurement_noise);
+                dare.summary.BriefReport(), ToString(options.disturbance));
+  KalmanDesign kalman;
+  kalman.summary = dare.summary;
+  kalman.X = dare.X;
+  kalman.L = kalman.X * aug.Cz.transpose() /
+             (aug.Cz.dot(kalman.X * aug.Cz.transpose()) + options.measurement_noise);
+  return kalman;
+}
 
-  // Prediction matrices.
-  const int P = options_.P, M = options_.M;
-  Psi_.resize(P, nz_);
-  Ups_.resize(P);
-  Eigen::RowVectorXd row = Cz_;  // Cz Az^(i-1)
-  double s = 0.0;
+// y^ = Psi z_k|k + Ups u_{k-1} + Theta du over the horizon P with M moves.
+struct PredictionMatrices {
+  Eigen::MatrixXd Psi;    // P x nz
+  Eigen::VectorXd Ups;    // P
+  Eigen::MatrixXd Theta;  // P x M
+};
+
+PredictionMatrices ComputePredictionMatrices(const AugmentedModel& aug, int P, int M) {
+  PredictionMatrices pred;
+  pred.Psi.resize(P, aug.Az.rows());
+  pred.Ups.resize(P);
+  Eigen::RowVectorXd row = aug.Cz;  // Cz Az^(i-1)
+  double ups_sum = 0.0;
   for (int i = 0; i < P; ++i) {
-    s += row.dot(Bz_);
-    Ups_(i) = s;  // Ups_{i+1}
-    row = (row * Az_).eval();
-    Psi_.row(i) = row;  // Cz Az^(i+1)
+    ups_sum += row.dot(aug.Bz);
+    pred.Ups(i) = ups_sum;  // Ups_{i+1}
+    row = (row * aug.Az).eval();
+    pred.Psi.row(i) = row;  // Cz Az^(i+1)
   }
-  Theta_.setZero(P, M);
-  for (int l = 0; l < M; ++l) Theta_.col(l).tail(P - l) = Ups_.head(P - l);
+  pred.Theta.setZero(P, M);
+  for (int l = 0; l < M; ++l) pred.Theta.col(l).tail(P - l) = pred.Ups.head(P - l);
+  return pred;
+}
 
-  const double q = options_.output_weight, wu = options_.input_weight;
+// The cost 1/2 du' H du + g' du with g = Gz z + Gu u_{k-1} + Gr r + Gs u_s,
+// and its unconstrained minimizer du = Fz z + Fu u_{k-1} + Fr r + Fs u_s.
+struct MoveCost {
+  Eigen::MatrixXd H;
+  Eigen::MatrixXd Gz;
+  Eigen::VectorXd Gu, Gr, Gs;
+  Eigen::MatrixXd Fz;
+  Eigen::VectorXd Fu, Fr, Fs;
+};
+
+MoveCost ComputeMoveCost(const PredictionMatrices& pred, const MpcOptions& options) {
+  const int P = options.P, M = options.M;
+  const double q = options.output_weight, wu = options.input_weight;
+  // T: the M x M lower-triangular ones, the inputs being u_{k-1} 1 + T du.
   Eigen::MatrixXd T = Eigen::MatrixXd::Zero(M, M);
   for (int j = 0; j < M; ++j) T.row(j).head(j + 1).setOnes();
   const Eigen::VectorXd Tt1 = T.transpose() * Eigen::VectorXd::Ones(M);
-  H_ = q * Theta_.transpose() * Theta_;
-  H_.diagonal().array() += options_.lambda;
-  H_ += wu * T.transpose() * T;
-  Eigen::LLT<Eigen::MatrixXd> llt(H_);
+  MoveCost cost;
+  cost.H = q * pred.Theta.transpose() * pred.Theta;
+  cost.H.diagonal().array() += options.lambda;
+  cost.H += wu * T.transpose() * T;
+  Eigen::LLT<Eigen::MatrixXd> llt(cost.H);
   PNEUMID_CHECK(llt.info() == Eigen::Success && llt.matrixLLT().diagonal().minCoeff() >
-                                                    1e-10 * std::sqrt(H_.diagonal().maxCoeff()),
+                                                    1e-10 * std::sqrt(cost.H.diagonal().maxCoeff()),
                 "the MPC Hessian q Theta'Theta + lambda I is singular (the model's dead time "
                 "may exceed the horizon); increase lambda (now {}) or P (now {})",
-                options_.lambda, P);
-  Gz_ = q * Theta_.transpose() * Psi_;
-  Gu_ = q * Theta_.transpose() * Ups_ + wu * Tt1;
-  Gr_ = -q * Theta_.transpose() * Eigen::VectorXd::Ones(P);
-  Gs_ = -wu * Tt1;
+                options.lambda, P);
+  cost.Gz = q * pred.Theta.transpose() * pred.Psi;
+  cost.Gu = q * pred.Theta.transpose() * pred.Ups + wu * Tt1;
+  cost.Gr = -q * pred.Theta.transpose() * Eigen::VectorXd::Ones(P);
+  cost.Gs = -wu * Tt1;
   // F = -H^-1 G: the unconstrained moves; the gain is its first row.
-  Fz_ = -llt.solve(Gz_);
-  Fu_ = -llt.solve(Gu_);
-  Fr_ = -llt.solve(Gr_);
-  Fs_ = -llt.solve(Gs_);
+  cost.Fz = -llt.solve(cost.Gz);
+  cost.Fu = -llt.solve(cost.Gu);
+  cost.Fr = -llt.solve(cost.Gr);
+  cost.Fs = -llt.solve(cost.Gs);
+  return cost;
+}
+
+}  // namespace
+
+void MpcController::Build(const StateSpace& model_in) {
+  CheckOptionsAndModel(options_, model_in);
+  const StateSpace model = DelayAsStates(model_in);
+  PNEUMID_CHECK(model.D()(0, 0) == 0.0,
+                "MPC needs a strictly proper model: D = {} makes y_k depend on u_k, which is "
+                "computed from y_k (use an input delay of at least one sample, e.g. nk >= 1)",
+                model.D()(0, 0));
+  integrating_ = IsIntegratingModel(model);
+  Ts_ = model.Ts();
+  nx_ = model.num_states();
+  UnitSteadyState steady = ComputeUnitSteadyState(model, integrating_, options_);
+  xs_unit_ = std::move(steady.xs_unit);
+  G_ = steady.G;
+
+  AugmentedModel aug = AugmentWithDisturbance(model, options_.disturbance);
+  nz_ = static_cast<int>(aug.Az.rows());
+  // Process noise on the states of model_in only: the delay states get none.
+  KalmanDesign kalman = DesignKalmanFilter(aug, nx_, model_in.num_states(), options_);
+  dare_summary_ = kalman.summary;
+  X_ = std::move(kalman.X);
+  L_ = std::move(kalman.L);
+
+  PredictionMatrices pred = ComputePredictionMatrices(aug, options_.P, options_.M);
+  Az_ = std::move(aug.Az);
+  Bz_ = std::move(aug.Bz);
+  Cz_ = std::move(aug.Cz);
+  MoveCost cost = ComputeMoveCost(pred, options_);
+  Psi_ = std::move(pred.Psi);
+  Ups_ = std::move(pred.Ups);
+  Theta_ = std::move(pred.Theta);
+  H_ = std::move(cost.H);
+  Gz_ = std::move(cost.Gz);
+  Gu_ = std::move(cost.Gu);
+  Gr_ = std::move(cost.Gr);
+  Gs_ = std::move(cost.Gs);
+  Fz_ = std::move(cost.Fz);
+  Fu_ = std::move(cost.Fu);
+  Fr_ = std::move(cost.Fr);
+  Fs_ = std::move(cost.Fs);
   gain_.K_z = -Fz_.row(0);
   gain_.K_u = -Fu_(0);
   gain_.K_r = Fr_(0);
@@ -258,45 +366,22 @@ void MpcController::Build(const StateSpace& model_in) {
   u_rows_ = std::isfinite(lim.u_min) || std::isfinite(lim.u_max);
   constrained_ = u_rows_ || std::isfinite(lim.du_max) || soft_output_;
   qp_ = std::make_unique<QpSolver>(options_.qp);
-  moves_.setZero(M);
+  moves_.setZero(options_.M);
   z_prior_.setZero(nz_);
   z_post_.setZero(nz_);
   z_tmp_.setZero(nz_);
   if (constrained_) {
-    nvar_ = M + (soft_output_ ? 1 : 0);
-    const int rows = (u_rows_ ? M : 0) + (std::isfinite(options_.y_min) ? P : 0) +
-                     (std::isfinite(options_.y_max) ? P : 0);
-    Eigen::MatrixXd Hq = Eigen::MatrixXd::Zero(nvar_, nvar_);
-    Hq.topLeftCorner(M, M) = H_;
-    if (soft_output_) Hq(M, M) = options_.slack_quadratic_weight;
-    Eigen::MatrixXd Cq = Eigen::MatrixXd::Zero(rows, nvar_);
-    int r = 0;
-    if (u_rows_) {
-      Cq.block(0, 0, M, M) = T;
-      r += M;
-    }
-    if (std::isfinite(options_.y_min)) {
-      Cq.block(r, 0, P, M) = Theta_;
-      Cq.block(r, M, P, 1).setOnes();  // Theta du + e >= y_min - f
-      r += P;
-    }
-    if (std::isfinite(options_.y_max)) {
-      Cq.block(r, 0, P, M) = Theta_;
-      Cq.block(r, M, P, 1).setConstant(-1.0);  // Theta du - e <= y_max - f
-      r += P;
-    }
-    PNEUMID_CHECK(qp_->Setup(Hq, Cq), "the MPC QP Hessian is not positive definite: {}",
-                  qp_->summary().BriefReport());
+    const internal::MoveQp move_qp = internal::BuildMoveQp(
+        H_, Theta_, lim, options_.y_min, options_.y_max, options_.slack_quadratic_weight);
+    PNEUMID_CHECK(qp_->Setup(move_qp.hessian, move_qp.constraints),
+                  "the MPC QP Hessian is not positive definite: {}", qp_->summary().BriefReport());
+    nvar_ = static_cast<int>(move_qp.hessian.rows());
     g_.setZero(nvar_);
-    lb_.setZero(rows);
-    ub_.setZero(rows);
-    lbx_.setConstant(nvar_, -lim.du_max);
-    ubx_.setConstant(nvar_, lim.du_max);
-    if (soft_output_) {
-      lbx_(M) = 0.0;
-      ubx_(M) = kInf;
-    }
-    free_.setZero(P);
+    lb_.setZero(move_qp.constraints.rows());
+    ub_.setZero(move_qp.constraints.rows());
+    lbx_ = move_qp.lbx;
+    ubx_ = move_qp.ubx;
+    free_.setZero(options_.P);
   }
   Reset();
 }

@@ -13,6 +13,7 @@ namespace pneumid {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kEps = std::numeric_limits<double>::epsilon();
 }  // namespace
 
 namespace {
@@ -248,6 +249,33 @@ void QpSolver::Finish(QpStatus status) {
   summary_.objective = 0.5 * x_.dot(d_) + g_.dot(x_);
 }
 
+namespace {
+
+// The sizes and values Solve() accepts: PNEUMID_CHECK throws on a mismatch,
+// a NaN, or a lower bound above its upper bound.
+void CheckSolveData(int n, int m, const Eigen::Ref<const Eigen::VectorXd>& g,
+                    const Eigen::Ref<const Eigen::VectorXd>& lb,
+                    const Eigen::Ref<const Eigen::VectorXd>& ub,
+                    const Eigen::Ref<const Eigen::VectorXd>& lbx,
+                    const Eigen::Ref<const Eigen::VectorXd>& ubx) {
+  PNEUMID_CHECK(g.size() == n, "g must have {} entries, got {}", n, g.size());
+  PNEUMID_CHECK(lb.size() == m && ub.size() == m, "lb and ub must have {} entries, got {} and {}",
+                m, lb.size(), ub.size());
+  PNEUMID_CHECK(lbx.size() == n && ubx.size() == n,
+                "lbx and ubx must have {} entries, got {} and {}", n, lbx.size(), ubx.size());
+  PNEUMID_CHECK(g.allFinite(), "g has a non-finite entry");
+  for (int i = 0; i < m; ++i) {
+    PNEUMID_CHECK(!std::isnan(lb(i)) && !std::isnan(ub(i)) && lb(i) <= ub(i),
+                  "constraint row {}: need lb <= ub, got lb = {}, ub = {}", i, lb(i), ub(i));
+  }
+  for (int j = 0; j < n; ++j) {
+    PNEUMID_CHECK(!std::isnan(lbx(j)) && !std::isnan(ubx(j)) && lbx(j) <= ubx(j),
+                  "bound {}: need lbx <= ubx, got lbx = {}, ubx = {}", j, lbx(j), ubx(j));
+  }
+}
+
+}  // namespace
+
 const QpSummary& QpSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& g,
                                  const Eigen::Ref<const Eigen::VectorXd>& lb,
                                  const Eigen::Ref<const Eigen::VectorXd>& ub,
@@ -261,20 +289,7 @@ const QpSummary& QpSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& g,
     }
     return summary_;
   }
-  PNEUMID_CHECK(g.size() == n_, "g must have {} entries, got {}", n_, g.size());
-  PNEUMID_CHECK(lb.size() == m_ && ub.size() == m_, "lb and ub must have {} entries, got {} and {}",
-                m_, lb.size(), ub.size());
-  PNEUMID_CHECK(lbx.size() == n_ && ubx.size() == n_,
-                "lbx and ubx must have {} entries, got {} and {}", n_, lbx.size(), ubx.size());
-  PNEUMID_CHECK(g.allFinite(), "g has a non-finite entry");
-  for (int i = 0; i < m_; ++i) {
-    PNEUMID_CHECK(!std::isnan(lb(i)) && !std::isnan(ub(i)) && lb(i) <= ub(i),
-                  "constraint row {}: need lb <= ub, got lb = {}, ub = {}", i, lb(i), ub(i));
-  }
-  for (int j = 0; j < n_; ++j) {
-    PNEUMID_CHECK(!std::isnan(lbx(j)) && !std::isnan(ubx(j)) && lbx(j) <= ubx(j),
-                  "bound {}: need lbx <= ubx, got lbx = {}, ubx = {}", j, lbx(j), ubx(j));
-  }
+  CheckSolveData(n_, m_, g, lb, ub, lbx, ubx);
   g_ = g;
   lb_ = lb;
   ub_ = ub;
@@ -286,8 +301,6 @@ const QpSummary& QpSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& g,
   for (int k = 0; k < num_constraints; ++k) finite_sides += std::isfinite(Rhs(k)) ? 1 : 0;
   const int max_iter =
       options_.max_iterations > 0 ? options_.max_iterations : 10 * (n_ + finite_sides) + 10;
-  const double tol = options_.feasibility_tolerance;
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
 
   // Unconstrained minimum, empty active set.
   J_ = J0_;
@@ -296,123 +309,170 @@ const QpSummary& QpSolver::Solve(const Eigen::Ref<const Eigen::VectorXd>& g,
   x_ = -g_;
   llt_.solveInPlace(x_);
 
-  // Equality constraints first; they are never dropped.
+  if (!AddEqualityConstraints()) return summary_;
+  RunDualIterations(max_iter);
+  return summary_;
+}
+
+// d_ = J' n_p, the primal direction z_ = J2 J2' n_p and the dual direction
+// r_ = R^-1 J1' n_p for the normal np_ and the current active set.
+void QpSolver::ComputeStepDirections() {
+  d_.noalias() = J_.transpose() * np_;
+  z_.noalias() = J_.rightCols(n_ - q_) * d_.tail(n_ - q_);
+  r_.head(q_) = d_.head(q_);
+  R_.topLeftCorner(q_, q_).triangularView<Eigen::Upper>().solveInPlace(r_.head(q_));
+}
+
+// Equality constraints first; they are never dropped. Returns false (the
+// summary set to infeasible) for inconsistent equalities.
+bool QpSolver::AddEqualityConstraints() {
+  const int num_constraints = 2 * (m_ + n_);
+  const double tol = options_.feasibility_tolerance;
   for (int k = 0; k < num_constraints; k += 2) {
     if (!IsEquality(k) || !std::isfinite(Rhs(k))) continue;
     Normal(k, np_);
-    d_.noalias() = J_.transpose() * np_;
-    z_.noalias() = J_.rightCols(n_ - q_) * d_.tail(n_ - q_);
-    r_.head(q_) = d_.head(q_);
-    R_.topLeftCorner(q_, q_).triangularView<Eigen::Upper>().solveInPlace(r_.head(q_));
-    const double s = NormalDot(k, x_) - Rhs(k);
-    const double zn = z_.dot(np_);
-    if (std::abs(zn) <= 1e3 * kEps * np_.squaredNorm() || q_ == n_) {
+    ComputeStepDirections();
+    const double slack = NormalDot(k, x_) - Rhs(k);
+    const double z_normal = z_.dot(np_);  // z' n_k
+    if (std::abs(z_normal) <= 1e3 * kEps * np_.squaredNorm() || q_ == n_) {
       // Linearly dependent on the equalities already active.
-      if (std::abs(s) > tol * row_norm_(k)) {
+      if (std::abs(slack) > tol * row_norm_(k)) {
         Finish(QpStatus::kInfeasible);
         summary_.message = "inconsistent equality constraints";
-        return summary_;
+        return false;
       }
       continue;
     }
-    const double t = -s / zn;
+    const double t = -slack / z_normal;
     x_ += t * z_;
     u_.head(q_) -= t * r_.head(q_);
     AddToActive(k, t);
     ++summary_.iterations;
   }
+  return true;
+}
 
+// Repeats step 1 (choose a violated constraint) and step 2 (move towards
+// satisfying it) until every constraint holds, or the method stops; Finish()
+// sets the summary either way.
+void QpSolver::RunDualIterations(int max_iter) {
   std::size_t warm_next = 0;
   while (true) {
     // Step 1: choose a violated constraint p (previously active ones first).
     int p = -1;
-    if (options_.warm_start) {
-      while (warm_next < warm_.size() && p < 0) {
-        const int k = warm_[warm_next++];
-        if (is_active_[k] || !std::isfinite(Rhs(k))) continue;
-        if ((NormalDot(k, x_) - Rhs(k)) / row_norm_(k) < -tol) p = k;
-      }
-    }
-    if (p < 0) {
-      cx_.noalias() = C_ * x_;
-      double worst = -tol;
-      for (int k = 0; k < num_constraints; ++k) {
-        if (is_active_[k]) continue;
-        const double b = Rhs(k);
-        if (!std::isfinite(b)) continue;
-        if (k % 2 == 1 && IsEquality(k - 1)) continue;
-        double v;
-        if (k < 2 * m_) {
-          v = (k % 2) ? -cx_(k / 2) : cx_(k / 2);
-        } else {
-          v = (k % 2) ? -x_((k - 2 * m_) / 2) : x_((k - 2 * m_) / 2);
-        }
-        const double s = (v - b) / row_norm_(k);
-        if (s < worst) {
-          worst = s;
-          p = k;
-        }
-      }
-    }
+    if (options_.warm_start) p = NextViolatedWarmConstraint(&warm_next);
+    if (p < 0) p = MostViolatedConstraint();
     if (p < 0) {
       Finish(QpStatus::kSolved);
-      return summary_;
+      return;
     }
-
     // Step 2: move towards satisfying p.
-    Normal(p, np_);
-    double u_plus = 0.0;
-    while (true) {
-      if (summary_.iterations >= max_iter) {
-        Finish(QpStatus::kMaxIterations);
-        return summary_;
-      }
-      d_.noalias() = J_.transpose() * np_;
-      z_.noalias() = J_.rightCols(n_ - q_) * d_.tail(n_ - q_);
-      r_.head(q_) = d_.head(q_);
-      R_.topLeftCorner(q_, q_).triangularView<Eigen::Upper>().solveInPlace(r_.head(q_));
-      // Partial step length t1: largest dual step keeping multipliers >= 0.
-      double t1 = kInf;
-      int drop = -1;
-      for (int j = 0; j < q_; ++j) {
-        if (IsEquality(active_[j])) continue;
-        if (r_(j) > 0.0) {
-          const double ratio = u_(j) / r_(j);
-          if (ratio < t1) {
-            t1 = ratio;
-            drop = j;
-          }
-        }
-      }
-      // Full step length t2: makes p active.
-      const double zn = z_.dot(np_);
-      const double s = NormalDot(p, x_) - Rhs(p);
-      double t2 = kInf;
-      if (q_ < n_ && std::abs(zn) > 1e3 * kEps * np_.squaredNorm()) t2 = -s / zn;
-      if (t2 < 0.0) t2 = 0.0;  // roundoff: p is (just) satisfied already
-      if (!std::isfinite(t1) && !std::isfinite(t2)) {
-        Finish(QpStatus::kInfeasible);
-        return summary_;
-      }
-      if (!std::isfinite(t2)) {
-        // Step in dual space only, then drop.
-        u_.head(q_) -= t1 * r_.head(q_);
-        u_plus += t1;
-        DropFromActive(drop);
-        ++summary_.iterations;
-        continue;
-      }
-      const double t = std::min(t1, t2);
-      x_ += t * z_;
-      u_.head(q_) -= t * r_.head(q_);
-      u_plus += t;
-      ++summary_.iterations;
-      if (t2 <= t1) {
-        AddToActive(p, u_plus);
-        break;
-      }
-      DropFromActive(drop);
+    if (!MakeActive(p, max_iter)) return;
+  }
+}
+
+// The next constraint of the warm-start list, from *warm_next on, that is
+// inactive and violated; -1 when there is none.
+int QpSolver::NextViolatedWarmConstraint(std::size_t* warm_next) const {
+  const double tol = options_.feasibility_tolerance;
+  int p = -1;
+  while (*warm_next < warm_.size() && p < 0) {
+    const int k = warm_[(*warm_next)++];
+    if (is_active_[k] || !std::isfinite(Rhs(k))) continue;
+    if ((NormalDot(k, x_) - Rhs(k)) / row_norm_(k) < -tol) p = k;
+  }
+  return p;
+}
+
+// The inactive constraint with the most negative scaled slack below
+// -tolerance; -1 when every constraint holds.
+int QpSolver::MostViolatedConstraint() {
+  const int num_constraints = 2 * (m_ + n_);
+  int p = -1;
+  cx_.noalias() = C_ * x_;
+  double worst = -options_.feasibility_tolerance;
+  for (int k = 0; k < num_constraints; ++k) {
+    if (is_active_[k]) continue;
+    const double rhs = Rhs(k);
+    if (!std::isfinite(rhs)) continue;
+    if (k % 2 == 1 && IsEquality(k - 1)) continue;
+    double normal_dot_x;  // n_k' x
+    if (k < 2 * m_) {
+      normal_dot_x = (k % 2) ? -cx_(k / 2) : cx_(k / 2);
+    } else {
+      normal_dot_x = (k % 2) ? -x_((k - 2 * m_) / 2) : x_((k - 2 * m_) / 2);
     }
+    const double scaled_slack = (normal_dot_x - rhs) / row_norm_(k);
+    if (scaled_slack < worst) {
+      worst = scaled_slack;
+      p = k;
+    }
+  }
+  return p;
+}
+
+// Partial step length t1: the largest dual step keeping the multipliers of
+// the active inequalities >= 0 (infinite when none limits it); *drop is the
+// position of the one that reaches zero first.
+double QpSolver::PartialStepLength(int* drop) const {
+  double t1 = kInf;
+  *drop = -1;
+  for (int j = 0; j < q_; ++j) {
+    if (IsEquality(active_[j])) continue;
+    if (r_(j) > 0.0) {
+      const double ratio = u_(j) / r_(j);
+      if (ratio < t1) {
+        t1 = ratio;
+        *drop = j;
+      }
+    }
+  }
+  return t1;
+}
+
+// Step 2 for the violated constraint p: full steps make p active, partial
+// steps drop the active constraint whose multiplier reaches zero. Returns
+// true once p is active, false when the method stopped (Finish() called:
+// iteration cap or infeasible).
+bool QpSolver::MakeActive(int p, int max_iter) {
+  Normal(p, np_);
+  double u_plus = 0.0;
+  while (true) {
+    if (summary_.iterations >= max_iter) {
+      Finish(QpStatus::kMaxIterations);
+      return false;
+    }
+    ComputeStepDirections();
+    int drop = -1;
+    const double t1 = PartialStepLength(&drop);
+    // Full step length t2: makes p active.
+    const double z_normal = z_.dot(np_);  // z' n_p
+    const double slack = NormalDot(p, x_) - Rhs(p);
+    double t2 = kInf;
+    if (q_ < n_ && std::abs(z_normal) > 1e3 * kEps * np_.squaredNorm()) t2 = -slack / z_normal;
+    if (t2 < 0.0) t2 = 0.0;  // roundoff: p is (just) satisfied already
+    if (!std::isfinite(t1) && !std::isfinite(t2)) {
+      Finish(QpStatus::kInfeasible);
+      return false;
+    }
+    if (!std::isfinite(t2)) {
+      // Step in dual space only, then drop.
+      u_.head(q_) -= t1 * r_.head(q_);
+      u_plus += t1;
+      DropFromActive(drop);
+      ++summary_.iterations;
+      continue;
+    }
+    const double t = std::min(t1, t2);
+    x_ += t * z_;
+    u_.head(q_) -= t * r_.head(q_);
+    u_plus += t;
+    ++summary_.iterations;
+    if (t2 <= t1) {
+      AddToActive(p, u_plus);
+      return true;
+    }
+    DropFromActive(drop);
   }
 }
 

@@ -75,6 +75,37 @@ struct MeasurementGuard {
   ControllerFault Check(double setpoint, double measurement) const;
 };
 
+class Controller;
+class PidController;
+class DmcController;
+class GpcController;
+class MpcController;
+class InverseMapController;
+class OutputMapController;
+class ModulatedController;
+class NarxLinearizingController;
+
+/// Double dispatch over the toolkit's controller classes (after the visitor
+/// pattern): Controller::Accept calls the Visit of the controller's own class,
+/// so that code generation and analyses handle each class without a chain of
+/// casts. A class the visitor does not know (a user's own Controller) arrives
+/// at VisitOther.
+class ControllerVisitor {
+ public:
+  virtual ~ControllerVisitor() = default;
+  virtual void Visit(const PidController& controller) = 0;         ///< pid.hpp
+  virtual void Visit(const DmcController& controller) = 0;         ///< dmc.hpp (DMC, QDMC)
+  virtual void Visit(const GpcController& controller) = 0;         ///< gpc.hpp
+  virtual void Visit(const MpcController& controller) = 0;         ///< mpc.hpp
+  virtual void Visit(const InverseMapController& controller) = 0;  ///< inverse_map_controller.hpp
+  virtual void Visit(const OutputMapController& controller) = 0;   ///< inverse_map_controller.hpp
+  virtual void Visit(const ModulatedController& controller) = 0;   ///< duty_modulator.hpp
+  virtual void Visit(
+      const NarxLinearizingController& controller) = 0;  ///< narx_linearizing_controller.hpp
+  /// Any other Controller.
+  virtual void VisitOther(const Controller& controller) = 0;
+};
+
 /// The feedback controllers' interface. Update(), Reset() and Applied() are
 /// the guarded entry points (non-virtual); a controller implements DoReset(),
 /// DoUpdate() and DoApplied(), which see only valid samples.
@@ -101,6 +132,9 @@ class Controller {
   virtual double Ts() const = 0;
   /// Short description, e.g. "dmc P=126 M=5 lambda=2.25".
   virtual std::string Describe() const = 0;
+  /// Calls the visitor's Visit for this controller's class (VisitOther for
+  /// a class the visitor does not list).
+  virtual void Accept(ControllerVisitor& visitor) const { visitor.VisitOther(*this); }
 
   /// @throws InvalidArgument for an invalid guard (the message names the field).
   void SetMeasurementGuard(const MeasurementGuard& guard);

@@ -72,7 +72,7 @@ struct DmcOptions {
   /// Slack penalty rho1 e + rho2/2 e^2 (output units; rho1 >= 0, rho2 > 0).
   double slack_linear_weight = 1e4;
   double slack_quadratic_weight = 1e2;  ///< rho2 of the slack penalty (> 0, default 100)
-  QpSolverOptions qp;  ///< the active-set QP solver's settings (constrained only)
+  QpSolverOptions qp;                   ///< the active-set QP solver's settings (constrained only)
   /// True when 1 <= M <= P, lambda is finite and >= 0, the weight vectors are empty or of
   /// sizes P and M with positive entries, model_horizon >= 0, limits are valid, y_min <=
   /// y_max, the slack weights are as stated and qp is valid; otherwise false with the
@@ -97,6 +97,8 @@ class DmcController : public Controller {
 
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
+  /// Calls visitor.Visit(*this).
+  void Accept(ControllerVisitor& visitor) const override { visitor.Visit(*this); }
 
   const DmcOptions& options() const { return options_; }  ///< The options as designed.
   /// s_0..s_N.

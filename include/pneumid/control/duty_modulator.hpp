@@ -81,6 +81,9 @@ class ModulatedController : public Controller {
   /// The inner controller's description + " with sigma-delta modulation over
   /// the input gaps 0:15,85:100".
   std::string Describe() const override;
+  void Accept(ControllerVisitor& visitor) const override {
+    visitor.Visit(*this);
+  }                                                    ///< Visit(*this)
   const Controller& inner() const { return *inner_; }  ///< The controller behind the modulator.
   const DutyModulator& modulator() const { return modulator_; }  ///< Its modulator.
   /// The inner controller's request of the last Update() (before modulation).

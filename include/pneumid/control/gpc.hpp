@@ -96,6 +96,8 @@ class GpcController : public Controller {
 
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
+  /// Calls visitor.Visit(*this).
+  void Accept(ControllerVisitor& visitor) const override { visitor.Visit(*this); }
 
   const GpcOptions& options() const { return options_; }  ///< The options as designed.
   const CarimaModel& carima() const { return model_; }    ///< The CARIMA model A, B, Ts.

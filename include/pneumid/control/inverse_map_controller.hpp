@@ -55,6 +55,8 @@ class InverseMapController : public Controller {
   /// The inner controller's description + " with inverse map (N knots, u in
   /// [a, b])".
   std::string Describe() const override;
+  /// Calls visitor.Visit(*this).
+  void Accept(ControllerVisitor& visitor) const override { visitor.Visit(*this); }
 
   const Controller& inner() const { return *inner_; }  ///< The controller designed on G.
   const StaticMap& map() const { return map_; }        ///< The actuator's static map f (u -> v).
@@ -98,6 +100,8 @@ class OutputMapController : public Controller {
   double Ts() const override { return inner_->Ts(); }
   /// The inner controller's description + " on the inverse output map (N knots)".
   std::string Describe() const override;
+  /// Calls visitor.Visit(*this).
+  void Accept(ControllerVisitor& visitor) const override { visitor.Visit(*this); }
 
   const Controller& inner() const { return *inner_; }  ///< The controller designed on G.
   /// The monotone envelope of the output map that is inverted.

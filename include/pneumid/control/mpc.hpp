@@ -168,6 +168,8 @@ class MpcController : public Controller {
   double Ts() const override { return Ts_; }
   /// e.g. "mpc P=126 M=5 lambda=2.25 disturbance=output" (+ " constrained").
   std::string Describe() const override;
+  /// Calls visitor.Visit(*this).
+  void Accept(ControllerVisitor& visitor) const override { visitor.Visit(*this); }
 
   const MpcOptions& options() const { return options_; }  ///< The options as designed.
   /// Augmented model Az, Bz, Cz (file comment); nz = nx + delay + 1 (0 for none).

@@ -122,9 +122,11 @@ class NarxLinearizingController : public Controller {
   /// The inner controller's description + " behind a NARX linearization
   /// (tau = .. s)".
   std::string Describe() const override;
+  /// Calls visitor.Visit(*this).
+  void Accept(ControllerVisitor& visitor) const override { visitor.Visit(*this); }
 
-  const Controller& inner() const { return *inner_; }  ///< The controller designed on H.
-  double time_constant() const { return tau_; }  ///< tau of the reference model H, s.
+  const Controller& inner() const { return *inner_; }      ///< The controller designed on H.
+  double time_constant() const { return tau_; }            ///< tau of the reference model H, s.
   const InputAffineNarx& model() const { return model_; }  ///< The model linearized.
   /// The actuator's limits on u.
   const InputLimits& limits() const { return limits_; }

@@ -88,6 +88,9 @@ class PidController : public Controller {
 
   double Ts() const override { return Ts_; }
   std::string Describe() const override;
+  void Accept(ControllerVisitor& visitor) const override {
+    visitor.Visit(*this);
+  }                                                       ///< Visit(*this)
   const PidOptions& options() const { return options_; }  ///< The options as designed.
   /// Tracking time Tt (s) of the back-calculation actually used (0: none).
   double tracking_time() const { return Tt_; }

@@ -117,8 +117,8 @@ class QpSolver {
   const Eigen::VectorXd& y_constraints() const { return y_c_; }
   /// Multipliers of the simple bounds, same sign convention.
   const Eigen::VectorXd& y_bounds() const { return y_x_; }
-  const QpSummary& summary() const { return summary_; }  ///< Summary of the last call.
-  int num_variables() const { return n_; }  ///< n, set by Setup() (0 before).
+  const QpSummary& summary() const { return summary_; }        ///< Summary of the last call.
+  int num_variables() const { return n_; }                     ///< n, set by Setup() (0 before).
   const QpSolverOptions& options() const { return options_; }  ///< The options in use.
   /// The data fixed at Setup(): H, C, the Cholesky factor L of H = L L'
   /// (lower triangle, zeros above), J0 = L^-T, and the norms of the rows of
@@ -146,6 +146,14 @@ class QpSolver {
   void AddToActive(int k, double multiplier);
   void DropFromActive(int position);
   void Finish(QpStatus status);
+  // The stages of Solve() (qp_solver.cpp).
+  void ComputeStepDirections();
+  bool AddEqualityConstraints();
+  void RunDualIterations(int max_iter);
+  int NextViolatedWarmConstraint(std::size_t* warm_next) const;
+  int MostViolatedConstraint();
+  double PartialStepLength(int* drop) const;
+  bool MakeActive(int p, int max_iter);
 
   QpSolverOptions options_;
   int n_ = 0, m_ = 0;

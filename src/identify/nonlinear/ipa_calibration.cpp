@@ -1,4 +1,5 @@
-// Grey-box calibration of the IPA simulator (see include/pneumid/identify/nonlinear/ipa_calibration.hpp).
+// Grey-box calibration of the IPA simulator (see
+// include/pneumid/identify/nonlinear/ipa_calibration.hpp).
 #include "pneumid/identify/nonlinear/ipa_calibration.hpp"
 
 #include <algorithm>
@@ -318,13 +319,23 @@ std::string IpaCalibrationSummary::BriefReport() const {
   return s;
 }
 
-IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& experiments,
-                                   const IpaCalibrationOptions& options) {
-  std::string error;
-  PNEUMID_CHECK(options.IsValid(&error), "invalid calibration options: {}", error);
-  PNEUMID_CHECK(!experiments.empty(), "calibration needs at least one experiment");
+namespace {
 
-  // Free parameters, their ranges and scales.
+// The free parameters in their order: TOML keys and units, the scales that
+// make them of order one, the search ranges and values in scaled units, and
+// the physical start values.
+struct FreeParameters {
+  std::vector<std::string> keys, units;
+  Eigen::VectorXd scale;         // physical value of one scaled unit
+  Eigen::VectorXd lower, upper;  // search range, scaled
+  Eigen::VectorXd values;        // scaled: the start, then the solution
+  Eigen::VectorXd start;         // physical start values
+  int size() const { return static_cast<int>(keys.size()); }
+};
+
+// Keys of the free parameters (the options' or the defaults), each a
+// calibratable parameter named once; bounds may be given only for them.
+std::vector<std::string> FreeParameterKeys(const IpaCalibrationOptions& options) {
   std::vector<std::string> keys;
   for (const auto& name :
        options.free.empty() ? DefaultCalibrationParameters(options.start) : options.free) {
@@ -342,109 +353,140 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
     PNEUMID_CHECK(std::find(keys.begin(), keys.end(), key) != keys.end(),
                   "bounds given for '{}', which is not a free parameter", key);
   }
-  const int np = static_cast<int>(keys.size());
-  Eigen::VectorXd scale(np), lower(np), upper(np), z(np), start(np);
-  std::vector<std::string> units(np);
+  return keys;
+}
+
+// Free parameters, their ranges (physical or given bounds) and scales.
+FreeParameters ScaleFreeParameters(const IpaCalibrationOptions& options) {
+  FreeParameters free;
+  free.keys = FreeParameterKeys(options);
+  const int np = free.size();
+  free.scale.resize(np);
+  free.lower.resize(np);
+  free.upper.resize(np);
+  free.values.resize(np);
+  free.start.resize(np);
+  free.units.resize(np);
   for (int i = 0; i < np; ++i) {
-    const IpaParameterInfo& info = FindIpaParameter(keys[i]);
+    const std::string& key = free.keys[i];
+    const IpaParameterInfo& info = FindIpaParameter(key);
     double lo = info.lower, hi = info.upper;
     for (const auto& [name, range] : options.bounds)
-      if (FindIpaParameter(name).key == keys[i]) std::tie(lo, hi) = range;
-    const double v = GetIpaParameter(options.start, keys[i]);
+      if (FindIpaParameter(name).key == key) std::tie(lo, hi) = range;
+    const double value = GetIpaParameter(options.start, key);
     PNEUMID_CHECK(std::isfinite(lo) && std::isfinite(hi) && lo < hi,
-                  "bounds of '{}' must be finite with lower < upper, got {} .. {}", keys[i], lo,
-                  hi);
-    PNEUMID_CHECK(v >= lo && v <= hi,
-                  "the start value of '{}', {} {}, is outside its bounds {} .. {}", keys[i], v,
+                  "bounds of '{}' must be finite with lower < upper, got {} .. {}", key, lo, hi);
+    PNEUMID_CHECK(value >= lo && value <= hi,
+                  "the start value of '{}', {} {}, is outside its bounds {} .. {}", key, value,
                   info.unit, lo, hi);
-    scale[i] = v != 0.0 ? std::abs(v) : (hi - lo);
-    lower[i] = lo / scale[i];
-    upper[i] = hi / scale[i];
-    z[i] = v / scale[i];
-    start[i] = v;
-    units[i] = info.unit;
+    free.scale[i] = value != 0.0 ? std::abs(value) : (hi - lo);
+    free.lower[i] = lo / free.scale[i];
+    free.upper[i] = hi / free.scale[i];
+    free.values[i] = value / free.scale[i];
+    free.start[i] = value;
+    free.units[i] = info.unit;
   }
+  return free;
+}
 
-  // The experiments.
+// The experiments checked and prepared for the output-error cost.
+std::vector<PreparedExperiment> PrepareExperiments(
+    const std::vector<CalibrationExperiment>& experiments) {
   std::vector<PreparedExperiment> prepared;
-  Eigen::Index total = 0;
   for (std::size_t e = 0; e < experiments.size(); ++e) {
-    const Dataset& d = experiments[e].data;
+    const Dataset& data = experiments[e].data;
     const std::string name = !experiments[e].name.empty() ? experiments[e].name
-                             : !d.source().empty()        ? d.source()
+                             : !data.source().empty()     ? data.source()
                                                           : fmt::format("experiment {}", e + 1);
-    PNEUMID_CHECK(d.num_inputs() >= 1 && d.num_outputs() >= 1,
+    PNEUMID_CHECK(data.num_inputs() >= 1 && data.num_outputs() >= 1,
                   "{}: needs an input (PWM duty, %) and an output column", name);
-    PNEUMID_CHECK(d.size() >= 3, "{}: needs at least 3 samples, has {}", name, d.size());
-    d.RequireUniform();
-    PreparedExperiment p;
-    p.name = name;
-    p.u = d.u(0);
-    p.y = d.y(0);
-    p.Ts = d.SampleTime();
-    PNEUMID_CHECK(p.u.maxCoeff() > p.u.minCoeff(),
+    PNEUMID_CHECK(data.size() >= 3, "{}: needs at least 3 samples, has {}", name, data.size());
+    data.RequireUniform();
+    PreparedExperiment experiment;
+    experiment.name = name;
+    experiment.u = data.u(0);
+    experiment.y = data.y(0);
+    experiment.Ts = data.SampleTime();
+    PNEUMID_CHECK(experiment.u.maxCoeff() > experiment.u.minCoeff(),
                   "{}: no excitation: the input is constant ({} %) over all {} samples, so "
                   "the data say nothing about the dynamics; use a step, staircase or PRBS",
-                  name, p.u[0], d.size());
-    const double w = experiments[e].weight;
-    PNEUMID_CHECK(std::isfinite(w) && w > 0.0, "{}: the weight must be positive, got {}", name, w);
-    p.norm = (p.y.array() - p.y.mean()).matrix().norm();
-    PNEUMID_CHECK(p.norm > 0.0, "{}: the output is constant ({}), nothing to fit", name, p.y[0]);
-    p.norm /= std::sqrt(w);
-    p.weight = w;
-    total += d.size();
-    prepared.push_back(std::move(p));
+                  name, experiment.u[0], data.size());
+    const double weight = experiments[e].weight;
+    PNEUMID_CHECK(std::isfinite(weight) && weight > 0.0, "{}: the weight must be positive, got {}",
+                  name, weight);
+    experiment.norm = (experiment.y.array() - experiment.y.mean()).matrix().norm();
+    PNEUMID_CHECK(experiment.norm > 0.0, "{}: the output is constant ({}), nothing to fit", name,
+                  experiment.y[0]);
+    experiment.norm /= std::sqrt(weight);
+    experiment.weight = weight;
+    prepared.push_back(std::move(experiment));
   }
-  PNEUMID_CHECK(total > np, "{} samples in all cannot determine {} free parameters", total, np);
+  return prepared;
+}
 
-  const auto t_begin = std::chrono::steady_clock::now();
-  IpaCalibrationSummary out;
-  out.parameters = options.start;
-  Problem problem(prepared, options, keys, scale, lower, upper);
-  Eigen::VectorXd r0(total);
-  const bool start_ok = problem.Residuals(z.data(), r0.data());
-  // Initial fits.
-  auto fits = [&](const Eigen::VectorXd& r, bool initial) {
-    Eigen::Index offset = 0;
-    for (std::size_t e = 0; e < prepared.size(); ++e) {
-      const Eigen::Index n = prepared[e].y.size();
-      const double f = FitOf(r.segment(offset, n) / std::sqrt(prepared[e].weight));
-      if (initial) {
-        CalibrationExperimentFit fit;
-        fit.name = prepared[e].name;
-        fit.samples = n;
-        fit.initial_fit_percent = f;
-        out.experiments.push_back(fit);
-      } else {
-        out.experiments[e].fit_percent = f;
-        out.experiments[e].simulated = prepared[e].y + r.segment(offset, n) * prepared[e].norm;
-      }
-      offset += n;
-    }
-  };
-  if (!start_ok) {
-    std::string why;
-    try {
-      for (const auto& e : prepared)
-        Simulate(ModelParameters(options.start, options.integration_tolerance), e.u, e.y, e.Ts,
-                 options.initial_state, options.warmup);
-      why = "the simulated output is not finite";
-    } catch (const std::exception& ex) {
-      why = ex.what();
-    }
-    out.termination = Termination::kFailure;
-    out.message = "the simulation with the start parameters fails: " + why;
-    return out;
+Eigen::Index TotalSamples(const std::vector<PreparedExperiment>& prepared) {
+  Eigen::Index total = 0;
+  for (const auto& e : prepared) total += e.y.size();
+  return total;
+}
+
+// Why the simulation with the start parameters fails.
+std::string StartFailureReason(const std::vector<PreparedExperiment>& prepared,
+                               const IpaCalibrationOptions& options) {
+  try {
+    for (const auto& e : prepared)
+      Simulate(ModelParameters(options.start, options.integration_tolerance), e.u, e.y, e.Ts,
+               options.initial_state, options.warmup);
+    return "the simulated output is not finite";
+  } catch (const std::exception& ex) {
+    return ex.what();
   }
-  fits(r0, true);
+}
 
+// Fit of each experiment with the start parameters, from the weighted
+// residuals of all experiments.
+std::vector<CalibrationExperimentFit> InitialFits(const std::vector<PreparedExperiment>& prepared,
+                                                  const Eigen::VectorXd& residuals) {
+  std::vector<CalibrationExperimentFit> fits;
+  Eigen::Index offset = 0;
+  for (const auto& experiment : prepared) {
+    const Eigen::Index n = experiment.y.size();
+    CalibrationExperimentFit fit;
+    fit.name = experiment.name;
+    fit.samples = n;
+    fit.initial_fit_percent = FitOf(residuals.segment(offset, n) / std::sqrt(experiment.weight));
+    fits.push_back(fit);
+    offset += n;
+  }
+  return fits;
+}
+
+// Fit and simulated output of each experiment with the calibrated parameters.
+void StoreCalibratedFits(const std::vector<PreparedExperiment>& prepared,
+                         const Eigen::VectorXd& residuals,
+                         std::vector<CalibrationExperimentFit>* fits) {
+  Eigen::Index offset = 0;
+  for (std::size_t e = 0; e < prepared.size(); ++e) {
+    const Eigen::Index n = prepared[e].y.size();
+    (*fits)[e].fit_percent = FitOf(residuals.segment(offset, n) / std::sqrt(prepared[e].weight));
+    (*fits)[e].simulated = prepared[e].y + residuals.segment(offset, n) * prepared[e].norm;
+    offset += n;
+  }
+}
+
+// Levenberg-Marquardt on the output error within the bounds; the solution
+// replaces free->values.
+ceres::Solver::Summary SolveCalibration(const Problem& problem,
+                                        const IpaCalibrationOptions& options,
+                                        FreeParameters* free) {
+  double* values = free->values.data();
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem ceres_problem(problem_options);
-  ceres_problem.AddResidualBlock(new OutputErrorCost(&problem), nullptr, z.data());
-  for (int i = 0; i < np; ++i) {
-    ceres_problem.SetParameterLowerBound(z.data(), i, lower[i]);
-    ceres_problem.SetParameterUpperBound(z.data(), i, upper[i]);
+  ceres_problem.AddResidualBlock(new OutputErrorCost(&problem), nullptr, values);
+  for (int i = 0; i < free->size(); ++i) {
+    ceres_problem.SetParameterLowerBound(values, i, free->lower[i]);
+    ceres_problem.SetParameterUpperBound(values, i, free->upper[i]);
   }
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;
@@ -459,127 +501,200 @@ IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& exp
   ceres::Solver::Summary summary;
   internal::SilenceCeresLogging();
   ceres::Solve(solver_options, &ceres_problem, &summary);
+  return summary;
+}
 
-  out.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  out.initial_cost = summary.initial_cost;
-  out.final_cost = summary.final_cost;
-  out.termination = summary.termination_type == ceres::CONVERGENCE ? Termination::kConvergence
-                    : summary.termination_type == ceres::NO_CONVERGENCE
-                        ? Termination::kNoConvergence
-                        : Termination::kFailure;
-  out.message = summary.message;
+void RecordSolverSummary(const ceres::Solver::Summary& summary, IpaCalibrationSummary* out) {
+  out->iterations = static_cast<int>(summary.iterations.size()) - 1;
+  out->initial_cost = summary.initial_cost;
+  out->final_cost = summary.final_cost;
+  out->termination = summary.termination_type == ceres::CONVERGENCE ? Termination::kConvergence
+                     : summary.termination_type == ceres::NO_CONVERGENCE
+                         ? Termination::kNoConvergence
+                         : Termination::kFailure;
+  out->message = summary.message;
+}
+
+void AddPoorFitWarnings(double fit_warning_percent, IpaCalibrationSummary* out) {
+  for (const auto& e : out->experiments)
+    if (e.fit_percent < fit_warning_percent)
+      out->warnings.push_back(fmt::format(
+          "{}: the calibrated twin fits it by only {:.2f} % (start {:.2f} %): it does not "
+          "reproduce these data; check their units (u: PWM duty in %, y: force in N or "
+          "position in m), the initial state and the free parameters",
+          e.name, e.fit_percent, e.initial_fit_percent));
+}
+
+// Ceres stops with "convergence" on a zero gradient, which a flat region
+// also gives: a step that makes the twin stop responding to every free
+// parameter (e.g. a valve delay longer than the PWM pulses: no valve opens,
+// the force is constant). Such an end point is not a minimum: a failure.
+void RejectFlatRegion(const Eigen::MatrixXd& J, const Eigen::VectorXd& residuals,
+                      const std::vector<std::string>& keys, const std::string& ceres_message,
+                      IpaCalibrationSummary* out) {
+  const double flat = 1e-9 * std::max(residuals.norm(), 1e-300);
+  std::vector<std::string> responding;
+  for (Eigen::Index i = 0; i < J.cols(); ++i)
+    if (J.col(i).norm() > flat) responding.push_back(keys[i]);
+  if (!responding.empty()) return;
+  out->termination = Termination::kFailure;
+  out->message = fmt::format(
+      "the calibration stopped where the simulated output no longer responds to any free "
+      "parameter ({}): a flat region, not a minimum (Ceres: {}); free fewer parameters or "
+      "start closer to the actuator",
+      fmt::join(keys, ", "), ceres_message);
+}
+
+// Standard deviations (physical units, NaN when unknown) and whether the
+// data determine each free parameter.
+struct ParameterUncertainty {
+  Eigen::VectorXd std_dev;
+  std::vector<bool> determined;
+};
+
+// Uncertainty and identifiability from the Jacobian J of the weighted
+// residuals at the solution (header comment); strong correlations go to
+// *correlations.
+ParameterUncertainty UncertaintyFromJacobian(const Eigen::MatrixXd& J,
+                                             const Eigen::VectorXd& residuals,
+                                             const FreeParameters& free,
+                                             double correlation_threshold,
+                                             std::vector<ParameterCorrelation>* correlations) {
+  const int np = free.size();
+  ParameterUncertainty out{Eigen::VectorXd::Constant(np, kNaN), std::vector<bool>(np, true)};
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
+  const Eigen::VectorXd singular = svd.singularValues();
+  const Eigen::MatrixXd& V = svd.matrixV();
+  const double smax = singular.size() > 0 ? singular[0] : 0.0;
+  Eigen::VectorXd inv2 = Eigen::VectorXd::Zero(np);
+  for (int j = 0; j < np; ++j) {
+    if (smax > 0.0 && singular[j] > 1e-10 * smax) inv2[j] = 1.0 / (singular[j] * singular[j]);
+    if (!(smax > 0.0) || singular[j] < 1e-4 * smax)
+      for (int i = 0; i < np; ++i)
+        if (std::abs(V(i, j)) > 0.3) out.determined[i] = false;
+  }
+  const double dof = static_cast<double>(std::max<Eigen::Index>(residuals.size() - np, 1));
+  const double sigma2 = residuals.squaredNorm() / dof;
+  const Eigen::MatrixXd C = V * inv2.asDiagonal() * V.transpose() * sigma2;  // scaled units
+  for (int i = 0; i < np; ++i) out.std_dev[i] = std::sqrt(std::max(C(i, i), 0.0)) * free.scale[i];
+  for (int i = 0; i < np; ++i)
+    for (int j = i + 1; j < np; ++j) {
+      const double std_product = std::sqrt(C(i, i) * C(j, j));
+      if (!(std_product > 0.0)) continue;
+      const double rho = C(i, j) / std_product;
+      if (std::abs(rho) >= correlation_threshold)
+        correlations->push_back({free.keys[i], free.keys[j], rho});
+    }
+  return out;
+}
+
+std::string UndeterminedWarning(const std::vector<std::string>& undetermined) {
+  std::string list;
+  for (const auto& n : undetermined) list += (list.empty() ? "" : ", ") + n;
+  return undetermined.size() == 1
+             ? fmt::format(
+                   "the data do not determine {}: its effect on the output is too small "
+                   "or is taken up by the other free parameters; fix it (leave it out of "
+                   "the free parameters) or add an experiment that excites it",
+                   list)
+             : fmt::format(
+                   "the data do not determine {} separately (only a combination of "
+                   "them): fix one of them (leave it out of the free parameters) or add "
+                   "an experiment that separates them",
+                   list);
+}
+
+// One estimate per free parameter, with warnings for vague, undetermined
+// and bound-limited ones.
+void ReportEstimates(const FreeParameters& free, const ParameterUncertainty& uncertainty,
+                     IpaCalibrationSummary* out) {
+  std::vector<std::string> undetermined;
+  for (int i = 0; i < free.size(); ++i) {
+    CalibratedParameter c;
+    c.name = free.keys[i];
+    c.unit = free.units[i];
+    c.value = free.values[i] * free.scale[i];
+    c.start = free.start[i];
+    c.lower = free.lower[i] * free.scale[i];
+    c.upper = free.upper[i] * free.scale[i];
+    c.std = uncertainty.std_dev[i];
+    const double width = c.upper - c.lower;
+    c.at_bound = c.value - c.lower <= 1e-6 * width || c.upper - c.value <= 1e-6 * width;
+    const bool vague = std::isfinite(c.std) && c.value != 0.0 && c.std > 0.1 * std::abs(c.value);
+    c.determined = uncertainty.determined[i] && !vague && std::isfinite(c.std);
+    if (!uncertainty.determined[i])
+      undetermined.push_back(c.name);
+    else if (vague)
+      out->warnings.push_back(
+          fmt::format("{} is poorly determined by the data: {:.4g} +- {:.2g} {} ({:.0f} %)", c.name,
+                      c.value, c.std, c.unit, 100.0 * c.std / std::abs(c.value)));
+    if (c.at_bound)
+      out->warnings.push_back(
+          fmt::format("{} ended at its bound ({:.4g} {}, range {:.4g} .. {:.4g})", c.name, c.value,
+                      c.unit, c.lower, c.upper));
+    out->estimates.push_back(c);
+  }
+  if (!undetermined.empty()) out->warnings.push_back(UndeterminedWarning(undetermined));
+}
+
+}  // namespace
+
+IpaCalibrationSummary CalibrateIpa(const std::vector<CalibrationExperiment>& experiments,
+                                   const IpaCalibrationOptions& options) {
+  std::string error;
+  PNEUMID_CHECK(options.IsValid(&error), "invalid calibration options: {}", error);
+  PNEUMID_CHECK(!experiments.empty(), "calibration needs at least one experiment");
+  FreeParameters free = ScaleFreeParameters(options);
+  const int np = free.size();
+  const std::vector<PreparedExperiment> prepared = PrepareExperiments(experiments);
+  const Eigen::Index total = TotalSamples(prepared);
+  PNEUMID_CHECK(total > np, "{} samples in all cannot determine {} free parameters", total, np);
+
+  const auto t_begin = std::chrono::steady_clock::now();
+  IpaCalibrationSummary out;
   out.parameters = options.start;
-  for (int i = 0; i < np; ++i) SetIpaParameter(out.parameters, keys[i], z[i] * scale[i]);
+  Problem problem(prepared, options, free.keys, free.scale, free.lower, free.upper);
+  Eigen::VectorXd r0(total);
+  if (!problem.Residuals(free.values.data(), r0.data())) {
+    out.termination = Termination::kFailure;
+    out.message =
+        "the simulation with the start parameters fails: " + StartFailureReason(prepared, options);
+    return out;
+  }
+  out.experiments = InitialFits(prepared, r0);
+
+  const ceres::Solver::Summary summary = SolveCalibration(problem, options, &free);
+  RecordSolverSummary(summary, &out);
+  out.parameters = options.start;
+  for (int i = 0; i < np; ++i)
+    SetIpaParameter(out.parameters, free.keys[i], free.values[i] * free.scale[i]);
 
   Eigen::VectorXd r(total);
-  Eigen::MatrixXd J(total, np);
-  const bool have_r = problem.Residuals(z.data(), r.data());
-  if (!have_r) {
+  if (!problem.Residuals(free.values.data(), r.data())) {
     out.termination = Termination::kFailure;
     out.message = "the simulation with the calibrated parameters fails";
     out.parameters = options.start;
     return out;
   }
-  fits(r, false);
-  for (const auto& e : out.experiments)
-    if (e.fit_percent < options.fit_warning_percent)
-      out.warnings.push_back(fmt::format(
-          "{}: the calibrated twin fits it by only {:.2f} % (start {:.2f} %): it does not "
-          "reproduce these data; check their units (u: PWM duty in %, y: force in N or "
-          "position in m), the initial state and the free parameters",
-          e.name, e.fit_percent, e.initial_fit_percent));
-  const bool have_j = problem.Jacobian(z.data(), r.data(), J.data());
-  // Ceres stops with "convergence" on a zero gradient, which a flat region
-  // also gives: a step that makes the twin stop responding to every free
-  // parameter (e.g. a valve delay longer than the PWM pulses: no valve opens,
-  // the force is constant). Such an end point is not a minimum.
-  if (have_j && out.termination == Termination::kConvergence && J.allFinite()) {
-    const double flat = 1e-9 * std::max(r.norm(), 1e-300);
-    std::vector<std::string> responding;
-    for (int i = 0; i < np; ++i)
-      if (J.col(i).norm() > flat) responding.push_back(keys[i]);
-    if (responding.empty()) {
-      out.termination = Termination::kFailure;
-      out.message = fmt::format(
-          "the calibration stopped where the simulated output no longer responds to any free "
-          "parameter ({}): a flat region, not a minimum (Ceres: {}); free fewer parameters or "
-          "start closer to the actuator",
-          fmt::join(keys, ", "), summary.message);
-    }
-  }
+  StoreCalibratedFits(prepared, r, &out.experiments);
+  AddPoorFitWarnings(options.fit_warning_percent, &out);
+  Eigen::MatrixXd J(total, np);
+  const bool have_j = problem.Jacobian(free.values.data(), r.data(), J.data());
+  if (have_j && out.termination == Termination::kConvergence && J.allFinite())
+    RejectFlatRegion(J, r, free.keys, summary.message, &out);
 
   // Uncertainty and identifiability (header comment).
-  Eigen::VectorXd sd = Eigen::VectorXd::Constant(np, kNaN);
-  std::vector<bool> determined(np, true);
+  ParameterUncertainty uncertainty{Eigen::VectorXd::Constant(np, kNaN),
+                                   std::vector<bool>(np, true)};
   if (have_j && J.allFinite()) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
-    const Eigen::VectorXd s = svd.singularValues();
-    const Eigen::MatrixXd& V = svd.matrixV();
-    const double smax = s.size() > 0 ? s[0] : 0.0;
-    Eigen::VectorXd inv2 = Eigen::VectorXd::Zero(np);
-    for (int j = 0; j < np; ++j) {
-      if (smax > 0.0 && s[j] > 1e-10 * smax) inv2[j] = 1.0 / (s[j] * s[j]);
-      if (!(smax > 0.0) || s[j] < 1e-4 * smax)
-        for (int i = 0; i < np; ++i)
-          if (std::abs(V(i, j)) > 0.3) determined[i] = false;
-    }
-    const double dof = static_cast<double>(std::max<Eigen::Index>(total - np, 1));
-    const double s2 = r.squaredNorm() / dof;
-    const Eigen::MatrixXd C = V * inv2.asDiagonal() * V.transpose() * s2;  // scaled units
-    for (int i = 0; i < np; ++i) sd[i] = std::sqrt(std::max(C(i, i), 0.0)) * scale[i];
-    for (int i = 0; i < np; ++i)
-      for (int j = i + 1; j < np; ++j) {
-        const double d = std::sqrt(C(i, i) * C(j, j));
-        if (!(d > 0.0)) continue;
-        const double rho = C(i, j) / d;
-        if (std::abs(rho) >= options.correlation_threshold)
-          out.correlations.push_back({keys[i], keys[j], rho});
-      }
+    uncertainty =
+        UncertaintyFromJacobian(J, r, free, options.correlation_threshold, &out.correlations);
   } else {
     out.warnings.push_back(
         "the Jacobian at the solution could not be formed: no standard "
         "deviations");
   }
-  std::vector<std::string> undetermined;
-  for (int i = 0; i < np; ++i) {
-    CalibratedParameter c;
-    c.name = keys[i];
-    c.unit = units[i];
-    c.value = z[i] * scale[i];
-    c.start = start[i];
-    c.lower = lower[i] * scale[i];
-    c.upper = upper[i] * scale[i];
-    c.std = sd[i];
-    const double width = c.upper - c.lower;
-    c.at_bound = c.value - c.lower <= 1e-6 * width || c.upper - c.value <= 1e-6 * width;
-    const bool vague = std::isfinite(c.std) && c.value != 0.0 && c.std > 0.1 * std::abs(c.value);
-    c.determined = determined[i] && !vague && std::isfinite(c.std);
-    if (!determined[i])
-      undetermined.push_back(c.name);
-    else if (vague)
-      out.warnings.push_back(
-          fmt::format("{} is poorly determined by the data: {:.4g} +- {:.2g} {} ({:.0f} %)", c.name,
-                      c.value, c.std, c.unit, 100.0 * c.std / std::abs(c.value)));
-    if (c.at_bound)
-      out.warnings.push_back(
-          fmt::format("{} ended at its bound ({:.4g} {}, range {:.4g} .. {:.4g})", c.name, c.value,
-                      c.unit, c.lower, c.upper));
-    out.estimates.push_back(c);
-  }
-  if (!undetermined.empty()) {
-    std::string list;
-    for (const auto& n : undetermined) list += (list.empty() ? "" : ", ") + n;
-    out.warnings.push_back(
-        undetermined.size() == 1
-            ? fmt::format("the data do not determine {}: its effect on the output is too small "
-                          "or is taken up by the other free parameters; fix it (leave it out of "
-                          "the free parameters) or add an experiment that excites it",
-                          list)
-            : fmt::format("the data do not determine {} separately (only a combination of "
-                          "them): fix one of them (leave it out of the free parameters) or add "
-                          "an experiment that separates them",
-                          list));
-  }
+  ReportEstimates(free, uncertainty, &out);
   out.simulations = problem.simulations();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_begin).count();
   return out;

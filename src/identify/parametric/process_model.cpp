@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <tuple>
 
 #include <ceres/ceres.h>
 #include <fmt/format.h>
@@ -528,8 +530,20 @@ ProcessParams InitialProcessGuess(const Dataset& data, int input, int output,
   return p;
 }
 
-ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
-                                 const ProcessFitOptions& options, const ProcessParams* initial) {
+namespace {
+
+// The checked columns of a process-model fit and what the fit needs of the record.
+struct ProcessFitRecord {
+  std::string source;  // name of the data in messages
+  Eigen::VectorXd u, y;
+  double u0 = 0.0;      // input before its first change
+  Eigen::Index k0 = 0;  // index of the first input change
+  double Ts = 0.0;
+  double duration = 0.0;  // time span of the record
+};
+
+ProcessFitRecord CheckedProcessFitRecord(const Dataset& data, int input, int output,
+                                         const ProcessFitOptions& options) {
   std::string why;
   PNEUMID_CHECK(options.IsValid(&why), "invalid ProcessFitOptions: {}", why);
   PNEUMID_CHECK(input >= 0 && input < data.num_inputs(),
@@ -537,144 +551,164 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
   PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
                 "output column {} out of range (the data has {} outputs)", output,
                 data.num_outputs());
-  const std::string src = data.source().empty() ? "data" : data.source();
+  ProcessFitRecord record;
+  record.source = data.source().empty() ? "data" : data.source();
   data.RequireSamples(10, "process-model fit");
   data.RequireUniform();
-  const Eigen::VectorXd u = data.u(input), y = data.y(output);
-  if (!u.allFinite() || !y.allFinite()) {
-    throw DataError(fmt::format("{}: the data contain NaN or Inf", src));
+  record.u = data.u(input);
+  record.y = data.y(output);
+  if (!record.u.allFinite() || !record.y.allFinite()) {
+    throw DataError(fmt::format("{}: the data contain NaN or Inf", record.source));
   }
-  const auto [u0, k0] = InitialInput(u);
-  if (k0 >= data.size()) {
-    throw DataError(fmt::format("{}: the input never changes (u = {}); nothing to fit", src, u0));
+  std::tie(record.u0, record.k0) = InitialInput(record.u);
+  if (record.k0 >= data.size()) {
+    throw DataError(fmt::format("{}: the input never changes (u = {}); nothing to fit",
+                                record.source, record.u0));
   }
-  const double Ts = data.SampleTime();
-  const double duration = data.time()[data.size() - 1] - data.time()[0];
+  record.Ts = data.SampleTime();
+  record.duration = data.time()[data.size() - 1] - data.time()[0];
+  return record;
+}
 
-  ProcessFitResult res;
-  res.structure = options.structure;
-  res.zero = options.zero;
-  ProcessParams p0;
-  if (initial) {
-    p0 = *initial;
-    res.summary.initial_guess = "the caller";
-  } else if (options.zero) {
-    // A zero is fitted from the converged model without it, started with
-    // Tz = 0 and with Tz = +-Tm (Tm = the second lag, at least T1 / 5, the
-    // faster lags raised to Tm); the lowest cost wins.
-    ProcessFitOptions no_zero = options;
-    no_zero.zero = false;
-    const ProcessFitResult first = FitProcessModel(data, input, output, no_zero);
-    const double T1 =
-        options.structure == ProcessStructure::kP2DU ? first.params.Tw : first.params.T1;
-    const double Tm = std::max(first.params.T2, 0.2 * T1);
-    ProcessFitResult best;
-    bool have = false;
-    for (double sign : {0.0, 1.0, -1.0}) {
-      ProcessParams start = first.params;
-      start.Tz = sign * Tm;
-      if (sign != 0.0) {
-        start.T2 = std::max(start.T2, Tm);
-        start.T3 = std::max(start.T3, 0.5 * Tm);
-      }
-      ProcessFitResult r = FitProcessModel(data, input, output, options, &start);
-      if (r.summary.termination != Termination::kFailure &&
-          (!have || r.summary.final_cost < best.summary.final_cost)) {
-        best = std::move(r);
-        have = true;
-      }
+// A zero is fitted from the converged model without it, started with
+// Tz = 0 and with Tz = +-Tm (Tm = the second lag, at least T1 / 5, the
+// faster lags raised to Tm); the lowest cost wins. Without any fit that
+// does not fail: nullopt, with the model without zero (Tz = 0) in *start.
+std::optional<ProcessFitResult> FitZeroFromModelWithoutZero(const Dataset& data, int input,
+                                                            int output,
+                                                            const ProcessFitOptions& options,
+                                                            ProcessParams* start,
+                                                            std::string* source) {
+  ProcessFitOptions no_zero = options;
+  no_zero.zero = false;
+  const ProcessFitResult first = FitProcessModel(data, input, output, no_zero);
+  const double T1 =
+      options.structure == ProcessStructure::kP2DU ? first.params.Tw : first.params.T1;
+  const double Tm = std::max(first.params.T2, 0.2 * T1);
+  ProcessFitResult best;
+  bool have = false;
+  for (double sign : {0.0, 1.0, -1.0}) {
+    ProcessParams zero_start = first.params;
+    zero_start.Tz = sign * Tm;
+    if (sign != 0.0) {
+      zero_start.T2 = std::max(zero_start.T2, Tm);
+      zero_start.T3 = std::max(zero_start.T3, 0.5 * Tm);
     }
-    if (have) {
-      best.summary.initial_guess = "the fitted " + ToString(options.structure) +
-                                   " without zero, Tz started at 0 and +-" +
-                                   fmt::format("{:.4g}", Tm) + " s";
-      return best;
+    ProcessFitResult fit = FitProcessModel(data, input, output, options, &zero_start);
+    if (fit.summary.termination != Termination::kFailure &&
+        (!have || fit.summary.final_cost < best.summary.final_cost)) {
+      best = std::move(fit);
+      have = true;
     }
-    p0 = first.params;
-    p0.Tz = 0.0;
-    res.summary.initial_guess = "the fitted " + ToString(options.structure) + " without zero";
-  } else {
-    p0 = InitialProcessGuess(data, input, output, options.structure, false,
-                             &res.summary.initial_guess);
   }
-  if (!options.estimate_offset) p0.y0 = k0 > 0 ? y.head(k0).mean() : y[0];
+  if (have) {
+    best.summary.initial_guess = "the fitted " + ToString(options.structure) +
+                                 " without zero, Tz started at 0 and +-" +
+                                 fmt::format("{:.4g}", Tm) + " s";
+    return best;
+  }
+  *start = first.params;
+  start->Tz = 0.0;
+  *source = "the fitted " + ToString(options.structure) + " without zero";
+  return std::nullopt;
+}
 
-  const std::vector<Slot> slots = Slots(options.structure, options.zero, options.estimate_offset);
-  const int np = static_cast<int>(slots.size());
-  if (data.size() <= np) {
-    throw DataError(
-        fmt::format("{}: {} samples are too few for {} parameters", src, data.size(), np));
-  }
-  // Scales and bounds (physical), then the scaled start.
+// The estimated parameters in scaled units (of order one) and their bounds.
+struct ScaledParameters {
+  Eigen::VectorXd scale;         // physical value of one scaled unit
+  Eigen::VectorXd lower, upper;  // bounds, scaled
+  Eigen::VectorXd values;        // scaled: the start (clamped to the bounds), then the solution
+};
+
+// Scales and bounds (physical), then the scaled start.
+ScaledParameters ScaleAndBound(const std::vector<Slot>& slots, const ProcessParams& start,
+                               const ProcessFitOptions& options, const ProcessFitRecord& record,
+                               double y_scale) {
+  const double Ts = record.Ts, duration = record.duration;
   const double max_delay = options.max_delay > 0.0 ? options.max_delay : 0.5 * duration;
-  const double t_scale = std::max({p0.T1, p0.Tw, 10.0 * Ts});
-  const double y_scale = std::max({y.cwiseAbs().maxCoeff(), std::abs(p0.y0), 1e-300});
-  Eigen::VectorXd scale(np), lo(np), hi(np), x(np);
+  const double t_scale = std::max({start.T1, start.Tw, 10.0 * Ts});
+  const auto np = static_cast<Eigen::Index>(slots.size());
+  ScaledParameters scaled;
+  scaled.scale.resize(np);
+  scaled.lower.resize(np);
+  scaled.upper.resize(np);
+  scaled.values.resize(np);
   const double inf = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < np; ++i) {
-    double s = 1.0, l = -inf, h = inf;
-    switch (slots[i]) {
+  for (Eigen::Index i = 0; i < np; ++i) {
+    const Slot slot = slots[static_cast<std::size_t>(i)];
+    double scale = 1.0, lower = -inf, upper = inf;
+    switch (slot) {
       case kK:
-        s = std::abs(p0.K) > 0.0 ? std::abs(p0.K) : 1.0;
+        scale = std::abs(start.K) > 0.0 ? std::abs(start.K) : 1.0;
         break;
       case kT1:
       case kT2:
       case kT3:
       case kTw:
-        s = t_scale;
-        l = 1e-3 * Ts;
-        h = 100.0 * duration;
+        scale = t_scale;
+        lower = 1e-3 * Ts;
+        upper = 100.0 * duration;
         break;
       case kZeta:
-        s = 1.0;
-        l = 1e-3;
-        h = 1.0;
+        scale = 1.0;
+        lower = 1e-3;
+        upper = 1.0;
         break;
       case kTz:
-        s = t_scale;
-        l = -10.0 * duration;
-        h = 10.0 * duration;
+        scale = t_scale;
+        lower = -10.0 * duration;
+        upper = 10.0 * duration;
         break;
       case kTheta:
-        s = t_scale;
-        l = 0.0;
-        h = max_delay;
+        scale = t_scale;
+        lower = 0.0;
+        upper = max_delay;
         break;
       case kY0:
-        s = y_scale;
+        scale = y_scale;
         break;
     }
-    scale[i] = s;
-    lo[i] = l / s;
-    hi[i] = h / s;
-    x[i] = std::clamp(p0.*Member(slots[i]) / s, lo[i], hi[i]);
+    scaled.scale[i] = scale;
+    scaled.lower[i] = lower / scale;
+    scaled.upper[i] = upper / scale;
+    scaled.values[i] = std::clamp(start.*Member(slot) / scale, scaled.lower[i], scaled.upper[i]);
   }
-  ProcessParams fixed = p0;
-  Simulator sim(options.structure, options.zero, slots, fixed, (u.array() - u0).matrix(), y, Ts,
-                scale, lo, hi);
+  return scaled;
+}
 
+// Scale of the robust loss: the option, or 1.345 (Huber) or 2.385 (Cauchy)
+// times the robust noise estimate.
+double RobustLossScale(const ProcessFitOptions& options, const Eigen::VectorXd& y, double y_scale) {
   const double noise = RobustNoise(y);
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-  problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
+  return options.loss_scale > 0.0 ? options.loss_scale
+                                  : std::max(noise, 1e-12 * y_scale) *
+                                        (options.loss == RobustLoss::kHuber ? 1.345 : 2.385);
+}
+
+// The residual blocks (one for least squares, one per sample with a robust
+// loss) and the bounds of the scaled parameters.
+void AddProcessResiduals(ceres::Problem* problem, Simulator* sim, ScaledParameters* scaled,
+                         const ProcessFitOptions& options, double loss_scale) {
+  double* values = scaled->values.data();
   if (options.loss == RobustLoss::kNone) {
-    problem.AddResidualBlock(new RecordResidual(&sim), nullptr, x.data());
+    problem->AddResidualBlock(new RecordResidual(sim), nullptr, values);
   }
-  for (Eigen::Index k = 0; options.loss != RobustLoss::kNone && k < data.size(); ++k) {
+  for (Eigen::Index k = 0; options.loss != RobustLoss::kNone && k < sim->num_samples(); ++k) {
     ceres::LossFunction* loss = nullptr;
-    const double a = options.loss_scale > 0.0
-                         ? options.loss_scale
-                         : std::max(noise, 1e-12 * y_scale) *
-                               (options.loss == RobustLoss::kHuber ? 1.345 : 2.385);
-    if (options.loss == RobustLoss::kHuber) loss = new ceres::HuberLoss(a);
-    if (options.loss == RobustLoss::kCauchy) loss = new ceres::CauchyLoss(a);
-    problem.AddResidualBlock(new SampleResidual(&sim, k), loss, x.data());
+    if (options.loss == RobustLoss::kHuber) loss = new ceres::HuberLoss(loss_scale);
+    if (options.loss == RobustLoss::kCauchy) loss = new ceres::CauchyLoss(loss_scale);
+    problem->AddResidualBlock(new SampleResidual(sim, k), loss, values);
   }
-  for (int i = 0; i < np; ++i) {
-    if (std::isfinite(lo[i])) problem.SetParameterLowerBound(x.data(), i, lo[i]);
-    if (std::isfinite(hi[i])) problem.SetParameterUpperBound(x.data(), i, hi[i]);
+  for (int i = 0; i < sim->num_params(); ++i) {
+    if (std::isfinite(scaled->lower[i]))
+      problem->SetParameterLowerBound(values, i, scaled->lower[i]);
+    if (std::isfinite(scaled->upper[i]))
+      problem->SetParameterUpperBound(values, i, scaled->upper[i]);
   }
+}
+
+ceres::Solver::Summary SolveProcessProblem(ceres::Problem* problem,
+                                           const ProcessFitOptions& options) {
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // J^T J: O(N np^2), N >> np
   solver_options.max_num_iterations = options.max_iterations;
@@ -690,114 +724,189 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
   solver_options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   internal::SilenceCeresLogging();
-  ceres::Solve(solver_options, &problem, &summary);
+  ceres::Solve(solver_options, problem, &summary);
+  return summary;
+}
 
-  res.summary.iterations = static_cast<int>(summary.iterations.size());
-  res.summary.initial_cost = summary.initial_cost;
-  res.summary.final_cost = summary.final_cost;
-  res.summary.message = summary.message;
+void RecordSolverSummary(const ceres::Solver::Summary& summary, ProcessFitSummary* out) {
+  out->iterations = static_cast<int>(summary.iterations.size());
+  out->initial_cost = summary.initial_cost;
+  out->final_cost = summary.final_cost;
+  out->message = summary.message;
   if (summary.termination_type == ceres::CONVERGENCE) {
-    res.summary.termination = Termination::kConvergence;
+    out->termination = Termination::kConvergence;
   } else if (summary.termination_type == ceres::NO_CONVERGENCE) {
-    res.summary.termination = Termination::kNoConvergence;
+    out->termination = Termination::kNoConvergence;
   } else {
-    res.summary.termination = Termination::kFailure;
+    out->termination = Termination::kFailure;
   }
-  res.params = sim.ToParams(x.data());
-  res.tf = ProcessTransferFunction(options.structure, options.zero, res.params);
-  Eigen::VectorXd r;
-  if (sim.Residuals(x.data(), &r)) {
-    res.yhat = y - r;
-    res.summary.sigma = std::sqrt(r.squaredNorm() / static_cast<double>(data.size() - np));
-  } else {
-    res.yhat = Eigen::VectorXd::Constant(data.size(), kNaN);
-    res.summary.termination = Termination::kFailure;
-  }
+}
 
-  // Standard deviations: sigma^2 (J^T J)^-1 (Ceres Covariance), in physical units.
-  ProcessParams sd;
-  for (Slot s : Slots(options.structure, options.zero, true)) sd.*Member(s) = kNaN;
-  if (!options.estimate_offset) sd.y0 = 0.0;
+// (J^T J)^+ of the scaled parameters (the covariance up to sigma^2) into *C;
+// false when not available.
+bool ScaledCovariance(ceres::Problem* problem, Simulator* sim, double* values, RobustLoss loss,
+                      Eigen::MatrixXd* C) {
+  const int np = sim->num_params();
   ceres::Covariance::Options cov_options;
   cov_options.algorithm_type = ceres::DENSE_SVD;
   cov_options.null_space_rank = -1;
   cov_options.min_reciprocal_condition_number = 1e-14;
   ceres::Covariance covariance(cov_options);
-  std::vector<std::pair<const double*, const double*>> blocks{{x.data(), x.data()}};
+  std::vector<std::pair<const double*, const double*>> blocks{{values, values}};
+  if (loss != RobustLoss::kNone) {
+    if (!covariance.Compute(blocks, problem)) return false;
+    covariance.GetCovarianceBlock(values, values, C->data());
+    return true;
+  }
+  // The same pseudo-inverse as Ceres' DENSE_SVD covariance (eigenvalues of
+  // J^T J below 1e-14 of the largest dropped), from the np x np normal
+  // matrix instead of an SVD of the N x np Jacobian.
+  if (!sim->Evaluate(values, true)) return false;
+  const Eigen::MatrixXd JtJ = sim->jacobian().transpose() * sim->jacobian();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(JtJ);
+  const Eigen::VectorXd lambda = eig.eigenvalues();
+  const double lmax = lambda.maxCoeff();
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(np);
+  for (int i = 0; i < np; ++i)
+    if (lmax > 0.0 && lambda[i] / lmax >= cov_options.min_reciprocal_condition_number)
+      inv[i] = 1.0 / lambda[i];
+  *C = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+  return true;
+}
+
+// Standard deviations sqrt(sigma^2 C_ii) in physical units into *param_std;
+// with all of them finite, the covariance sigma^2 C in physical units and
+// its names into *result.
+void StoreCovariance(const Eigen::MatrixXd& C, double sigma2, const std::vector<Slot>& slots,
+                     const Eigen::VectorXd& scale, ProcessParams* param_std,
+                     ProcessFitResult* result) {
+  bool ok = true;
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    const auto index = static_cast<Eigen::Index>(i);
+    const double variance = C(index, index) * sigma2;
+    ok = ok && std::isfinite(variance) && variance >= 0.0;
+    param_std->*Member(slots[i]) = std::sqrt(std::max(variance, 0.0)) * scale[index];
+  }
+  result->summary.covariance_ok = ok;
+  if (ok) {
+    result->covariance = (scale.asDiagonal() * C * scale.asDiagonal()) * sigma2;
+    for (Slot slot : slots) result->covariance_names.push_back(SlotName(result->structure, slot));
+  }
+}
+
+// Lags in decreasing order (with their standard deviations) for P2D and P3D.
+void SortLagsDecreasing(const std::vector<Slot>& slots, ProcessParams* param_std,
+                        ProcessFitResult* result) {
+  const ProcessStructure structure = result->structure;
+  if (structure != ProcessStructure::kP2D && structure != ProcessStructure::kP3D) return;
+  ProcessParams& params = result->params;
+  std::vector<std::pair<double, double>> lags{{params.T1, param_std->T1},
+                                              {params.T2, param_std->T2}};
+  if (structure == ProcessStructure::kP3D) lags.emplace_back(params.T3, param_std->T3);
+  // The covariance follows the lags: the row of the lag that becomes tau_k
+  // moves to tau_k's position.
+  if (result->covariance.size() > 0) {
+    const int np = static_cast<int>(slots.size());
+    std::vector<int> order(lags.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    std::stable_sort(order.begin(), order.end(),
+                     [&lags](int a, int b) { return lags[a].first > lags[b].first; });
+    const std::vector<Slot> lag_slots{kT1, kT2, kT3};
+    std::vector<int> pos(lags.size());  // index of each lag slot in the covariance
+    for (std::size_t i = 0; i < lags.size(); ++i)
+      pos[i] =
+          static_cast<int>(std::find(slots.begin(), slots.end(), lag_slots[i]) - slots.begin());
+    Eigen::VectorXi perm = Eigen::VectorXi::LinSpaced(np, 0, np - 1);
+    for (std::size_t k = 0; k < lags.size(); ++k) perm[pos[k]] = pos[order[k]];
+    Eigen::MatrixXd permuted(np, np);
+    for (int i = 0; i < np; ++i)
+      for (int j = 0; j < np; ++j) permuted(i, j) = result->covariance(perm[i], perm[j]);
+    result->covariance = permuted;
+  }
+  std::sort(lags.begin(), lags.end(), [](auto a, auto b) { return a.first > b.first; });
+  params.T1 = lags[0].first;
+  param_std->T1 = lags[0].second;
+  params.T2 = lags[1].first;
+  param_std->T2 = lags[1].second;
+  if (lags.size() > 2) {
+    params.T3 = lags[2].first;
+    param_std->T3 = lags[2].second;
+  }
+  result->tf = ProcessTransferFunction(structure, result->zero, params);
+}
+
+}  // namespace
+
+ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
+                                 const ProcessFitOptions& options, const ProcessParams* initial) {
+  const ProcessFitRecord record = CheckedProcessFitRecord(data, input, output, options);
+  const Eigen::VectorXd& y = record.y;
+  const Eigen::Index k0 = record.k0;
+
+  ProcessFitResult result;
+  result.structure = options.structure;
+  result.zero = options.zero;
+  ProcessParams start;
+  if (initial) {
+    start = *initial;
+    result.summary.initial_guess = "the caller";
+  } else if (options.zero) {
+    std::optional<ProcessFitResult> best = FitZeroFromModelWithoutZero(
+        data, input, output, options, &start, &result.summary.initial_guess);
+    if (best) return std::move(*best);
+  } else {
+    start = InitialProcessGuess(data, input, output, options.structure, false,
+                                &result.summary.initial_guess);
+  }
+  if (!options.estimate_offset) start.y0 = k0 > 0 ? y.head(k0).mean() : y[0];
+
+  const std::vector<Slot> slots = Slots(options.structure, options.zero, options.estimate_offset);
+  const int np = static_cast<int>(slots.size());
+  if (data.size() <= np) {
+    throw DataError(fmt::format("{}: {} samples are too few for {} parameters", record.source,
+                                data.size(), np));
+  }
+  const double y_scale = std::max({y.cwiseAbs().maxCoeff(), std::abs(start.y0), 1e-300});
+  ScaledParameters scaled = ScaleAndBound(slots, start, options, record, y_scale);
+  double* values = scaled.values.data();
+  Simulator sim(options.structure, options.zero, slots, start,
+                (record.u.array() - record.u0).matrix(), y, record.Ts, scaled.scale, scaled.lower,
+                scaled.upper);
+
+  const double loss_scale = RobustLossScale(options, y, y_scale);
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  AddProcessResiduals(&problem, &sim, &scaled, options, loss_scale);
+  const ceres::Solver::Summary summary = SolveProcessProblem(&problem, options);
+
+  RecordSolverSummary(summary, &result.summary);
+  result.params = sim.ToParams(values);
+  result.tf = ProcessTransferFunction(options.structure, options.zero, result.params);
+  Eigen::VectorXd residuals;
+  if (sim.Residuals(values, &residuals)) {
+    result.yhat = y - residuals;
+    result.summary.sigma =
+        std::sqrt(residuals.squaredNorm() / static_cast<double>(data.size() - np));
+  } else {
+    result.yhat = Eigen::VectorXd::Constant(data.size(), kNaN);
+    result.summary.termination = Termination::kFailure;
+  }
+
+  // Standard deviations: sigma^2 (J^T J)^-1 (Ceres Covariance), in physical units.
+  ProcessParams param_std;
+  for (Slot slot : Slots(options.structure, options.zero, true)) param_std.*Member(slot) = kNaN;
+  if (!options.estimate_offset) param_std.y0 = 0.0;
   Eigen::MatrixXd C(np, np);
-  bool have_covariance = false;
-  if (res.summary.termination != Termination::kFailure) {
-    if (options.loss == RobustLoss::kNone) {
-      // The same pseudo-inverse as Ceres' DENSE_SVD covariance (eigenvalues of
-      // J^T J below 1e-14 of the largest dropped), from the np x np normal
-      // matrix instead of an SVD of the N x np Jacobian.
-      have_covariance = sim.Evaluate(x.data(), true);
-      if (have_covariance) {
-        const Eigen::MatrixXd JtJ = sim.jacobian().transpose() * sim.jacobian();
-        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(JtJ);
-        const Eigen::VectorXd lambda = eig.eigenvalues();
-        const double lmax = lambda.maxCoeff();
-        Eigen::VectorXd inv = Eigen::VectorXd::Zero(np);
-        for (int i = 0; i < np; ++i)
-          if (lmax > 0.0 && lambda[i] / lmax >= cov_options.min_reciprocal_condition_number)
-            inv[i] = 1.0 / lambda[i];
-        C = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
-      }
-    } else {
-      have_covariance = covariance.Compute(blocks, &problem);
-      if (have_covariance) covariance.GetCovarianceBlock(x.data(), x.data(), C.data());
-    }
+  if (result.summary.termination != Termination::kFailure &&
+      ScaledCovariance(&problem, &sim, values, options.loss, &C)) {
+    const double sigma2 = 2.0 * summary.final_cost / static_cast<double>(data.size() - np);
+    StoreCovariance(C, sigma2, slots, scaled.scale, &param_std, &result);
   }
-  if (have_covariance) {
-    const double s2 = 2.0 * summary.final_cost / static_cast<double>(data.size() - np);
-    bool ok = true;
-    for (int i = 0; i < np; ++i) {
-      const double v = C(i, i) * s2;
-      ok = ok && std::isfinite(v) && v >= 0.0;
-      sd.*Member(slots[i]) = std::sqrt(std::max(v, 0.0)) * scale[i];
-    }
-    res.summary.covariance_ok = ok;
-    if (ok) {
-      res.covariance = (scale.asDiagonal() * C * scale.asDiagonal()) * s2;
-      for (Slot slot : slots) res.covariance_names.push_back(SlotName(options.structure, slot));
-    }
-  }
-  // Lags in decreasing order (with their standard deviations).
-  if (options.structure == ProcessStructure::kP2D || options.structure == ProcessStructure::kP3D) {
-    std::vector<std::pair<double, double>> lags{{res.params.T1, sd.T1}, {res.params.T2, sd.T2}};
-    if (options.structure == ProcessStructure::kP3D) lags.emplace_back(res.params.T3, sd.T3);
-    // The covariance follows the lags: the row of the lag that becomes tau_k
-    // moves to tau_k's position.
-    if (res.covariance.size() > 0) {
-      std::vector<int> order(lags.size());
-      for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-      std::stable_sort(order.begin(), order.end(),
-                       [&lags](int a, int b) { return lags[a].first > lags[b].first; });
-      const std::vector<Slot> lag_slots{kT1, kT2, kT3};
-      std::vector<int> pos(lags.size());  // index of each lag slot in the covariance
-      for (std::size_t i = 0; i < lags.size(); ++i)
-        pos[i] =
-            static_cast<int>(std::find(slots.begin(), slots.end(), lag_slots[i]) - slots.begin());
-      Eigen::VectorXi perm = Eigen::VectorXi::LinSpaced(np, 0, np - 1);
-      for (std::size_t k = 0; k < lags.size(); ++k) perm[pos[k]] = pos[order[k]];
-      Eigen::MatrixXd P(np, np);
-      for (int i = 0; i < np; ++i)
-        for (int j = 0; j < np; ++j) P(i, j) = res.covariance(perm[i], perm[j]);
-      res.covariance = P;
-    }
-    std::sort(lags.begin(), lags.end(), [](auto a, auto b) { return a.first > b.first; });
-    res.params.T1 = lags[0].first;
-    sd.T1 = lags[0].second;
-    res.params.T2 = lags[1].first;
-    sd.T2 = lags[1].second;
-    if (lags.size() > 2) {
-      res.params.T3 = lags[2].first;
-      sd.T3 = lags[2].second;
-    }
-    res.tf = ProcessTransferFunction(options.structure, options.zero, res.params);
-  }
-  res.param_std = sd;
-  return res;
+  SortLagsDecreasing(slots, &param_std, &result);
+  result.param_std = param_std;
+  return result;
 }
 
 }  // namespace pneumid
