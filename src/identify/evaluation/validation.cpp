@@ -4,6 +4,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {
@@ -82,8 +83,11 @@ CompareResult Compare(const TransferFunction& model, const Dataset& data,
   if (model.IsDiscrete())
     PNEUMID_CHECK(std::abs(model.Ts() - Ts) <= 1e-6 * Ts,
                   "the model's sample time {} s differs from the data's {} s", model.Ts(), Ts);
-  const double dt = model.IsDiscrete() ? model.Ts() : Ts;
-  return Finish(data, data.y(options.output), Lsim(model, data.u(options.input), dt), options);
+  // The one simulation of a model on data (model_evaluation.hpp), at rest at 0.
+  IdentifiedModel at_rest;
+  at_rest.tf = model;
+  return Finish(data, data.y(options.output), SimulateModel(at_rest, data, options.input),
+                options);
 }
 
 Dataset SliceDataset(const Dataset& data, Eigen::Index begin, Eigen::Index end) {

@@ -11,6 +11,9 @@
 // SimulateNonlinear (nonlinear.hpp): the linear part at rest at the first
 // input sample, a NARX model from its first measured outputs (output column 0
 // in the three-argument SimulateModel, `output` elsewhere).
+// SimulateModel is the toolkit's one simulation of a model on data: the step
+// methods' SimulateOnData (step_methods.hpp) and Compare of a transfer
+// function (validation.hpp) go through it.
 // Fit: fit = 100 (1 - ||y - yhat|| / ||y - mean(y)||) (fit_metrics.hpp) over
 // the scored samples; with held-out data that continue the estimation record
 // (a split), the model is simulated over the whole record and scored on the

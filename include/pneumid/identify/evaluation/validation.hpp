@@ -52,8 +52,9 @@ struct CompareResult {
 CompareResult Compare(const PolynomialModel& model, const Dataset& data,
                       const CompareOptions& options = {});
 
-/// Fit of any transfer function (continuous models are simulated with a
-/// zero-order hold on the data's sample times; discrete models at their Ts).
+/// Fit of any transfer function, simulated at rest at 0 by SimulateModel
+/// (model_evaluation.hpp: continuous models with a zero-order hold on the
+/// data's sample times; discrete models at their Ts).
 /// Only simulation (horizon 0) is defined for a transfer function without a noise model.
 /// @throws InvalidArgument for horizon != 0, or a discrete model whose Ts
 ///         differs from the data's sample time.
