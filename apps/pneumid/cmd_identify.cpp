@@ -25,6 +25,7 @@
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
 #include "pneumid/report/plot.hpp"
+#include "pneumid/workflow/identify_workflow.hpp"
 #include "progress.hpp"
 
 namespace pneumid::cli {
@@ -110,52 +111,20 @@ std::string FlagNames(const IdentifiedModel& m) {
 
 }  // namespace
 
-IdentifyOutcome IdentifyData(const IdentifyArgs& args, const Dataset& raw,
-                             const Dataset* validation_raw, const IdentifyProgress& progress) {
-  std::string why;
-  PNEUMID_CHECK(args.request.IsValid(&why), "{}", why);
-  PNEUMID_CHECK(validation_raw == nullptr || args.split == 0.0,
-                "--validation and --split exclude each other: give held-out data as a file or "
-                "as a fraction of DATA");
-  PNEUMID_CHECK(args.split == 0.0 || (args.split > 0.0 && args.split < 1.0),
-                "--split must be a fraction in (0, 1), e.g. 0.7, got {}", args.split);
-  const std::vector<std::string> methods = ParseMethodList(args.methods);
-  const PreprocessOptions prep = ToPreprocessOptions(args.preprocess);
-  IdentifyOutcome out;
-  out.data = Preprocess(raw, prep, &out.record);
-  std::optional<Dataset> validation;
-  // The validation data get the estimation data's preprocessing, with the
-  // offsets measured on the estimation data (not re-estimated).
-  if (validation_raw) validation.emplace(ApplyRecorded(*validation_raw, out.record));
-  IdentifyOptions options;
-  options.step.fit.loss = RobustLossFromString(args.loss);
-  options.split = args.split;
-  options.nonlinear = args.nonlinear;
-  out.summary = IdentifyModels(methods, out.data, args.request, options,
-                               validation ? &*validation : nullptr, progress);
-  IdentificationSummary& summary = out.summary;
-  if (summary.models.empty()) return out;
-  if (!out.record.IsIdentity())
-    for (IdentifiedModel& m : summary.models) m.preprocessing = out.record;
-  const std::vector<IdentifiedModel>& models = summary.models;
-  const bool held_out = summary.validation_samples > 0;
-
-  nlohmann::json& j = out.json;
-  j["models"] = nlohmann::json::array();
-  for (const IdentifiedModel& m : models) {
-    j["models"].push_back(ToJson(m));
-    j["models"].back()["rank_reason"] = RankReason(m);
-  }
-  j["best"] = models.front().method;
-  j["ranked_by"] = held_out ? "validation_fit_percent" : "fit_percent";
-  j["estimation_samples"] = summary.estimation_samples;
-  j["validation_samples"] = summary.validation_samples;
-  j["failures"] = nlohmann::json::array();
-  for (const auto& [method, reason] : summary.failures)
-    j["failures"].push_back({{"method", method}, {"reason", reason}});
-  j["termination"] = ToString(summary.termination);
-  j["message"] = summary.message;
-  return out;
+IdentifyWorkflowOptions ToWorkflowOptions(const IdentifyArgs& args) {
+  IdentifyWorkflowOptions o;
+  o.methods = args.methods;
+  o.preprocess.window = args.preprocess.window;
+  o.preprocess.resample = args.preprocess.resample;
+  o.preprocess.remove_initial = args.preprocess.remove_initial;
+  o.preprocess.detrend = args.preprocess.detrend;
+  o.preprocess.filter = args.preprocess.filter;
+  o.preprocess.decimate = args.preprocess.decimate;
+  o.request = args.request;
+  o.loss = args.loss;
+  o.nonlinear = args.nonlinear;
+  o.split = args.split;
+  return o;
 }
 
 namespace {
@@ -167,14 +136,15 @@ void Run(const IdentifyArgs& args) {
     v.path = args.validation;
     validation_raw.emplace(LoadFromOptions(v));
   }
-  IdentifyOutcome outcome;
+  IdentifyWorkflowResult outcome;
   {
     ProgressBar bar("identify", args.progress || StderrIsTerminal());
     outcome =
-        IdentifyData(args, LoadFromOptions(args.data), validation_raw ? &*validation_raw : nullptr,
-                     [&bar](std::size_t done, std::size_t total, const std::string& method) {
-                       bar(static_cast<double>(done) / static_cast<double>(total), method);
-                     });
+        RunIdentifyWorkflow(ToWorkflowOptions(args), LoadFromOptions(args.data),
+                            validation_raw ? &*validation_raw : nullptr,
+                            [&bar](std::size_t done, std::size_t total, const std::string& method) {
+                              bar(static_cast<double>(done) / static_cast<double>(total), method);
+                            });
   }
   for (const auto& [method, reason] : outcome.summary.failures)
     std::cerr << fmt::format("pneumid identify: {} failed: {}\n", method, reason);
@@ -185,7 +155,7 @@ void Run(const IdentifyArgs& args) {
   const std::vector<IdentifiedModel>& models = summary.models;
   const bool held_out = summary.validation_samples > 0;
   const std::optional<Dataset>& validation = validation_raw;
-  const nlohmann::json& j = outcome.json;
+  const nlohmann::json j = outcome.ToJson();
   if (!args.output.empty()) WriteJsonFile(j, args.output);
   if (!args.plot.empty()) WritePlot(args.plot, data, args.request, models);
 

@@ -21,74 +21,47 @@
 
 #include "command.hpp"
 #include "command_json.hpp"
-#include "controller_options.hpp"
-#include "pneumid/common/check.hpp"
 #include "pneumid/control/auto_tuning.hpp"
 #include "pneumid/control/tuning.hpp"
-#include "pneumid/lti/model_io.hpp"
-#include "pneumid/plant/plant_factory.hpp"
+#include "pneumid/workflow/tune_workflow.hpp"
 #include "validators.hpp"
 
 namespace pneumid::cli {
-namespace {
 
-AutoTuneResult Auto(const TuneArgs& c, const TransferFunction& model) {
-  PNEUMID_CHECK(c.P == 0 && std::isnan(c.lambda),
-                "--rule auto chooses P and lambda itself; drop --P/--lambda");
-  AutoTuneOptions o;
-  if (!c.controller.empty()) o.controller = ControllerTypeFromString(c.controller);
-  o.response_time = c.response_time;
-  if (!c.measure.empty()) o.measure = ResponseMeasureFromString(c.measure);
-  if (!std::isnan(c.overshoot)) o.max_overshoot = c.overshoot;
-  if (!std::isnan(c.aggressiveness)) o.aggressiveness = c.aggressiveness;
-  o.limits.u_min = c.u_min;
-  o.limits.u_max = c.u_max;
-  o.limits.du_max = c.du_max;
-  // As `control --plant` designs: the two give the same settings.
-  if (!c.plant.empty())
-    ApplyPlantInputRange(*MakePlant(c.plant, c.Ts), o.limits.u_min, o.limits.u_max);
-  o.M = c.M;
-  return AutoTune(model, c.Ts, o);
-}
-
-void RunAuto(const TuneArgs& c, const TransferFunction& model) {
-  const AutoTuneResult r = Auto(c, model);
-  if (c.json) {
-    std::cout << r.ToJson().dump(2) << "\n";
-    return;
-  }
-  std::cout << r.FullReport();
-}
-
-// The settings of a rule other than auto.
-TuningResult Conventional(const TuneArgs& c, const TransferFunction& model) {
-  PNEUMID_CHECK(c.controller.empty() && std::isnan(c.response_time) && c.measure.empty() &&
-                    std::isnan(c.overshoot) && std::isnan(c.aggressiveness) &&
-                    std::isinf(c.u_min) && std::isinf(c.u_max) && std::isinf(c.du_max) &&
-                    c.plant.empty(),
-                "--controller, --response-time, --measure, --overshoot, --aggressiveness, "
-                "the input limits and --plant apply to --rule auto only");
-  TuningOptions o;
-  o.rule = TuningRuleFromString(c.rule);
+TuneWorkflowOptions ToWorkflowOptions(const TuneArgs& c) {
+  TuneWorkflowOptions o;
+  o.model = c.model;
+  o.Ts = c.Ts;
+  o.rule = c.rule;
   o.M = c.M;
   o.P = c.P;
   o.lambda = c.lambda;
-  o.tau_significant_digits = c.tau_digits;
-  return Tune(model, c.Ts, o);
+  o.tau_digits = c.tau_digits;
+  o.controller = c.controller;
+  o.response_time = c.response_time;
+  o.measure = c.measure;
+  o.overshoot = c.overshoot;
+  o.aggressiveness = c.aggressiveness;
+  o.u_min = c.u_min;
+  o.u_max = c.u_max;
+  o.du_max = c.du_max;
+  o.plant = c.plant;
+  return o;
 }
 
+namespace {
+
 void Run(const TuneArgs& c) {
-  PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
-  const TransferFunction model = ParseModelSpec(c.model);
-  if (c.rule == "auto") {
-    RunAuto(c, model);
-    return;
-  }
-  const TuningResult r = Conventional(c, model);
+  const TuneWorkflowResult result = RunTuneWorkflow(ToWorkflowOptions(c));
   if (c.json) {
-    std::cout << r.ToJson().dump(2) << "\n";
+    std::cout << result.ToJson().dump(2) << "\n";
     return;
   }
+  if (result.automatic) {
+    std::cout << result.automatic->FullReport();
+    return;
+  }
+  const TuningResult& r = *result.tuning;
   std::cout << fmt::format("rule    {}\nP       {}\nM       {}\nlambda  {:.6g}\n", ToString(r.rule),
                            r.P, r.M, r.lambda);
   if (r.rule == TuningRule::kShridharCooper) {
@@ -101,17 +74,6 @@ void Run(const TuneArgs& c) {
   }
   std::cout << "formula: " << r.formula << "\n";
 }
-
-}  // namespace
-
-nlohmann::ordered_json TuneJson(const TuneArgs& c) {
-  PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
-  const TransferFunction model = ParseModelSpec(c.model);
-  if (c.rule == "auto") return Auto(c, model).ToJson();
-  return Conventional(c, model).ToJson();
-}
-
-namespace {
 
 const Registrar reg(
     "tune", "Horizons and move suppression (P, M, lambda) of DMC/GPC from a model",

@@ -1,7 +1,9 @@
 // The results of `control`, `tune`, `identify` and `run` as data and JSON,
 // shared by those commands (their --json output) and by `pneumid app` (its
 // HTTP API answers with the same JSON). The structs hold the commands'
-// options; each function does the command's work without printing.
+// options; each function does the command's work without printing. The work
+// of `control`, `tune` and `identify` is the library's (workflow/*.hpp): here
+// only their flags and the conversion to the library's options.
 #pragma once
 
 #include <atomic>
@@ -14,7 +16,6 @@
 #include <nlohmann/json.hpp>
 
 #include "data_options.hpp"
-#include "pneumid/workflow/control_scenario.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/identify/identify.hpp"
@@ -22,6 +23,9 @@
 #include "pneumid/realtime/realtime_config.hpp"
 #include "pneumid/realtime/realtime_loop.hpp"
 #include "pneumid/realtime/spsc_ring_buffer.hpp"
+#include "pneumid/workflow/control_scenario.hpp"
+#include "pneumid/workflow/identify_workflow.hpp"
+#include "pneumid/workflow/tune_workflow.hpp"
 #include "realtime_options.hpp"
 
 namespace pneumid::cli {
@@ -88,8 +92,9 @@ struct TuneArgs {
   std::string plant;
 };
 
-/// What `tune --json` prints. @throws InvalidArgument as `tune` does.
-nlohmann::ordered_json TuneJson(const TuneArgs& c);
+/// The tuning of `tune`'s flags (workflow/tune_workflow.hpp: RunTuneWorkflow,
+/// whose ToJson is what `tune --json` prints).
+TuneWorkflowOptions ToWorkflowOptions(const TuneArgs& c);
 
 // ---------------------------------------------------------------- identify
 
@@ -108,23 +113,10 @@ struct IdentifyArgs {
   bool progress = false;
 };
 
-struct IdentifyOutcome {
-  Dataset data;  ///< after preprocessing
-  PreprocessRecord record;
-  IdentificationSummary summary;  ///< models with the preprocessing record
-  /// The model file: what `identify --json` prints and `-o FILE` writes.
-  nlohmann::json json;
-};
-
-/// Identifies the models of `raw` (loaded data, preprocessed here as
-/// args.preprocess says; `validation_raw` gets the same preprocessing).
-/// `progress` (may be empty) is called as IdentifyModels does.
-/// When no model could be identified, summary.models is empty (the reason in
-/// summary.message and failures) and json is null.
-/// @throws InvalidArgument for invalid settings.
-IdentifyOutcome IdentifyData(const IdentifyArgs& args, const Dataset& raw,
-                             const Dataset* validation_raw,
-                             const IdentifyProgress& progress = nullptr);
+/// The identification of `identify`'s flags, all but the data, the output
+/// files and --json (workflow/identify_workflow.hpp: RunIdentifyWorkflow, whose
+/// ToJson is what `identify --json` prints and -o writes).
+IdentifyWorkflowOptions ToWorkflowOptions(const IdentifyArgs& args);
 
 // ---------------------------------------------------------------- run
 
@@ -137,6 +129,9 @@ struct RunArgs {
   std::optional<int> frozen_samples;
   bool offline = false;
   std::vector<std::string> load_steps;
+  /// A model held in memory under the name `model` (the app's model objects:
+  /// ModelFileScope::Provide in the thread that runs the loop); none = a file or spec.
+  std::optional<nlohmann::json> model_document;
 };
 
 struct RunOutcome {

@@ -97,31 +97,6 @@ void AddPreprocessOptions(CLI::App& app, PreprocessArgs& args) {
       ->group(group);
 }
 
-PreprocessOptions ToPreprocessOptions(const PreprocessArgs& args) {
-  PreprocessOptions o;
-  auto flag = [](const char* name, auto&& parse) {
-    try {
-      return parse();
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument(fmt::format("{}: {}", name, e.what()));
-    }
-  };
-  if (!args.window.empty())
-    o.window = flag("--window", [&] { return TimeWindow::Parse(args.window); });
-  o.resample_ts = args.resample;
-  o.remove_initial = args.remove_initial;
-  o.detrend = flag("--detrend", [&] { return DetrendKindFromString(args.detrend); });
-  PNEUMID_CHECK(!(o.remove_initial && o.detrend != DetrendKind::kNone),
-                "--remove-initial and --detrend {} both remove offsets: give one of them",
-                args.detrend);
-  if (!args.filter.empty())
-    o.filter = flag("--filter", [&] { return FilterSpec::Parse(args.filter); });
-  PNEUMID_CHECK(args.decimate >= 1, "--decimate must be an integer factor >= 1, got {}",
-                args.decimate);
-  o.decimate = args.decimate;
-  std::string why;
-  PNEUMID_CHECK(o.IsValid(&why), "{}", why);
-  return o;
-}
+PreprocessOptions ToPreprocessOptions(const PreprocessArgs& args) { return args.ToOptions(); }
 
 }  // namespace pneumid::cli

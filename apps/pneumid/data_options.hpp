@@ -21,6 +21,7 @@
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/data/preprocess.hpp"
+#include "pneumid/workflow/identify_workflow.hpp"
 
 namespace pneumid::cli {
 
@@ -54,14 +55,8 @@ Dataset LoadFromOptions(const DataOptions& options);
 //   --detrend constant|linear   subtract the mean or the least-squares line
 //   --filter lowpass:F | bandpass:F1,F2   zero-phase Butterworth, Hz
 //   --decimate N         keep every N-th sample after an anti-alias filter
-struct PreprocessArgs {
-  std::string window;
-  double resample = 0.0;
-  bool remove_initial = false;
-  std::string detrend = "none";
-  std::string filter;
-  int decimate = 1;
-};
+/// The preprocessing flags as the library takes them (workflow/identify_workflow.hpp).
+using PreprocessArgs = PreprocessSettings;
 
 /// Adds the flags above to `app`.
 void AddPreprocessOptions(CLI::App& app, PreprocessArgs& args);

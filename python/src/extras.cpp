@@ -6,10 +6,16 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
+#include <variant>
+
+#include <fmt/format.h>
 
 #include "bindings.hpp"
+#include "pneumid/common/check.hpp"
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/control/tuning.hpp"
@@ -23,6 +29,7 @@
 #include "pneumid/workflow/commission.hpp"
 #include "pneumid/workflow/commission_files.hpp"
 #include "pneumid/workflow/control_scenario.hpp"
+#include "pneumid/workflow/tune_workflow.hpp"
 
 namespace py = pybind11;
 using namespace py::literals;
@@ -53,6 +60,31 @@ ControllerSettings Settings(const std::string& type, const std::string& rule, in
   s.disturbance = disturbance;
   s.input_gaps = input_gaps;
   return s;
+}
+
+// make_controller's settings keywords (with its defaults) as ControllerSettings,
+// for functions that take them as **kwargs. @throws InvalidArgument naming an
+// unknown keyword.
+ControllerSettings SettingsFromKeywords(const py::kwargs& keywords) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  auto get = [&keywords](const char* key, auto fallback) {
+    using T = decltype(fallback);
+    return keywords.contains(key) ? keywords[key].cast<T>() : fallback;
+  };
+  const std::vector<std::string> known = {"type",  "rule",  "M",           "P",         "lambda_",
+                                          "u_min", "u_max", "constrained", "Kc",        "Ti",
+                                          "Td",    "Kff",   "disturbance", "input_gaps"};
+  for (const auto& item : keywords) {
+    const std::string key = py::str(item.first);
+    PNEUMID_CHECK(std::find(known.begin(), known.end(), key) != known.end(),
+                  "unknown controller setting '{}' (settings: {})", key, fmt::join(known, ", "));
+  }
+  return Settings(get("type", std::string("dmc")), get("rule", std::string("shridhar-cooper")),
+                  get("M", 0), get("P", 0), get("lambda_", nan), get("u_min", -inf),
+                  get("u_max", inf), get("constrained", false), get("Kc", nan), get("Ti", nan),
+                  get("Td", nan), get("Kff", nan), get("disturbance", std::string("input")),
+                  get("input_gaps", std::string()));
 }
 
 // TuningResult::ToJson (as `pneumid tune --json`), plus the keys earlier
@@ -172,6 +204,55 @@ void BindExtras(py::module_& m) {
       "lambda_"_a = std::numeric_limits<double>::quiet_NaN(),
       "Horizons and move suppression: rule 'shridhar-cooper' (conventional), "
       "'paper-modified' or 'explicit' (dict with P, M, lambda, formula).");
+  m.def(
+      "tune_json",
+      [](const std::variant<std::string, TransferFunction>& model, double Ts,
+         const std::string& rule, int M, int P, double lambda, int tau_digits,
+         const std::string& controller, double response_time, const std::string& measure,
+         double overshoot, double aggressiveness, double u_min, double u_max, double du_max,
+         const std::string& plant) {
+        TuneWorkflowOptions o;
+        o.Ts = Ts;
+        o.rule = rule;
+        o.M = M;
+        o.P = P;
+        o.lambda = lambda;
+        o.tau_digits = tau_digits;
+        o.controller = controller;
+        o.response_time = response_time;
+        o.measure = measure;
+        o.overshoot = overshoot;
+        o.aggressiveness = aggressiveness;
+        o.u_min = u_min;
+        o.u_max = u_max;
+        o.du_max = du_max;
+        o.plant = plant;
+        std::string text;
+        {
+          py::gil_scoped_release release;
+          if (const auto* spec = std::get_if<std::string>(&model)) {
+            o.model = *spec;
+            text = RunTuneWorkflow(o).ToJson().dump();
+          } else {
+            text = RunTuneWorkflow(o, std::get<TransferFunction>(model)).ToJson().dump();
+          }
+        }
+        return py::module_::import("json").attr("loads")(text);
+      },
+      "model"_a, "Ts"_a, "rule"_a = "shridhar-cooper", "M"_a = 0, "P"_a = 0,
+      "lambda_"_a = std::numeric_limits<double>::quiet_NaN(), "tau_digits"_a = 2,
+      "controller"_a = "", "response_time"_a = std::numeric_limits<double>::quiet_NaN(),
+      "measure"_a = "", "overshoot"_a = std::numeric_limits<double>::quiet_NaN(),
+      "aggressiveness"_a = std::numeric_limits<double>::quiet_NaN(),
+      "u_min"_a = -std::numeric_limits<double>::infinity(),
+      "u_max"_a = std::numeric_limits<double>::infinity(),
+      "du_max"_a = std::numeric_limits<double>::infinity(), "plant"_a = "",
+      "The tuning of `pneumid tune --json` (workflow/tune_workflow.hpp): model a spec "
+      "('fopdt-paper', 'FILE.json#fit-p1d', ...) or a TransferFunction; rule "
+      "'shridhar-cooper', 'paper-modified', 'explicit' or 'auto' (then controller 'mpc', 'dmc' "
+      "or 'pid', response_time, measure 'rise'|'settling', overshoot, aggressiveness, input "
+      "limits u_min, u_max, du_max, and a plant spec whose input range bounds the design; NaN "
+      "or empty: the command's defaults). Returns the dict `tune --json` prints.");
   py::class_<Controller>(m, "Controller", "A sampled controller (DMC, GPC, PID, MPC).")
       .def("reset", &Controller::Reset, "u0"_a = 0.0, "y0"_a = 0.0,
            "Back to rest at an operating point: input u0 applied long enough for the output to "
@@ -238,10 +319,7 @@ void BindExtras(py::module_& m) {
       "simulate_control",
       [](const std::string& model, const std::string& plant, double Ts, const std::string& setpoint,
          double duration, const std::vector<std::pair<double, double>>& load_steps, double noise,
-         std::uint64_t seed, const std::vector<std::string>& compare, const std::string& type,
-         const std::string& rule, int M, int P, double lambda, double u_min, double u_max,
-         bool constrained, double Kc, double Ti, double Td, double Kff,
-         const std::string& disturbance, const std::string& input_gaps) {
+         std::uint64_t seed, const std::vector<std::string>& compare, const py::kwargs& settings) {
         ControlScenarioOptions o;
         o.model = model;
         o.plant = plant;
@@ -252,8 +330,7 @@ void BindExtras(py::module_& m) {
         o.noise = noise;
         o.seed = seed;
         o.compare_rules = compare;
-        o.controller = Settings(type, rule, M, P, lambda, u_min, u_max, constrained, Kc, Ti, Td,
-                                Kff, disturbance, input_gaps);
+        o.controller = SettingsFromKeywords(settings);
         std::string text;
         {
           py::gil_scoped_release release;
@@ -263,20 +340,14 @@ void BindExtras(py::module_& m) {
       },
       "model"_a, "plant"_a = "", "Ts"_a = 0.01, "setpoint"_a, "duration"_a,
       "load_steps"_a = std::vector<std::pair<double, double>>{}, "noise"_a = 0.0, "seed"_a = 1,
-      "compare"_a = std::vector<std::string>{}, "type"_a = "dmc", "rule"_a = "shridhar-cooper",
-      "M"_a = 0, "P"_a = 0, "lambda_"_a = std::numeric_limits<double>::quiet_NaN(),
-      "u_min"_a = -std::numeric_limits<double>::infinity(),
-      "u_max"_a = std::numeric_limits<double>::infinity(), "constrained"_a = false,
-      "Kc"_a = std::numeric_limits<double>::quiet_NaN(),
-      "Ti"_a = std::numeric_limits<double>::quiet_NaN(),
-      "Td"_a = std::numeric_limits<double>::quiet_NaN(),
-      "Kff"_a = std::numeric_limits<double>::quiet_NaN(), "disturbance"_a = "input",
-      "input_gaps"_a = "",
+      "compare"_a = std::vector<std::string>{},
       "The closed-loop scenario of `pneumid control` (workflow/control_scenario.hpp): a "
       "controller designed from the model spec, run against the plant spec (empty: the model) "
       "through the set-point spec with load_steps = [(at_s, size), ...]; compare = rule names "
       "runs one per rule. Returns the dict `pneumid control --json` prints (the same numbers). "
-      "Input limits left open take the plant's range; controller settings as make_controller.");
+      "Controller settings are the keywords of make_controller after `Ts` (type, rule, M, P, "
+      "lambda_, u_min, u_max, constrained, Kc, Ti, Td, Kff, disturbance, input_gaps), with its "
+      "defaults; input limits left open take the plant's range.");
   m.def(
       "simulate_closed_loop",
       [](Controller& controller, Plant& plant, const std::string& setpoint, double duration,

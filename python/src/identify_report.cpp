@@ -1,5 +1,8 @@
 // Bindings of the identify and report areas.
 #include <optional>
+#include <string>
+#include <variant>
+#include <vector>
 
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
@@ -10,17 +13,18 @@
 #include "pneumid/data/preprocess.hpp"
 #include "pneumid/data/preprocess_io.hpp"
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/initial_state.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/identify/evaluation/initial_state.hpp"
-#include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/step/step_analysis.hpp"
 #include "pneumid/identify/step/step_methods.hpp"
 #include "pneumid/report/figures.hpp"
 #include "pneumid/report/identification_report.hpp"
 #include "pneumid/report/paper.hpp"
 #include "pneumid/report/plot.hpp"
+#include "pneumid/workflow/identify_workflow.hpp"
 
 namespace py = pybind11;
 using namespace py::literals;
@@ -260,6 +264,84 @@ void BindIdentify(py::module_& m) {
       "flagged and ranked (unflagged first; by validation fit with `split` or `validation` "
       "data). Returns {'models': [IdentifiedModel, best first], 'failures': [{'method', "
       "'reason'}], 'best', 'termination', 'message'}.");
+  m.def(
+      "identify_json",
+      [](const Dataset& data, const std::variant<std::string, std::vector<std::string>>& methods,
+         int input, int output, int order, std::optional<int> na, std::optional<int> nb,
+         std::optional<int> nk, int nc, int nd, int nf, bool feedthrough,
+         const std::string& n4sid_weight, const std::string& operating_point,
+         const std::string& loss, double split, std::optional<Dataset> validation,
+         const std::string& window, double resample, bool remove_initial,
+         const std::string& detrend, const std::string& filter, int decimate,
+         std::optional<int> knots, bool monotone_map, std::optional<double> settle,
+         std::optional<double> min_segment, std::optional<int> degree, std::optional<int> max_terms,
+         std::optional<double> err_tolerance) {
+        IdentifyWorkflowOptions o;
+        if (const auto* list = std::get_if<std::vector<std::string>>(&methods)) {
+          std::string joined;
+          for (const std::string& name : *list) joined += (joined.empty() ? "" : ",") + name;
+          o.methods = joined;
+        } else {
+          o.methods = std::get<std::string>(methods);
+        }
+        o.preprocess.window = window;
+        o.preprocess.resample = resample;
+        o.preprocess.remove_initial = remove_initial;
+        o.preprocess.detrend = detrend;
+        o.preprocess.filter = filter;
+        o.preprocess.decimate = decimate;
+        IdentifyRequest& r = o.request;
+        r.input = input;
+        r.output = output;
+        r.order = order;
+        if (na) r.na = *na;
+        if (nb) r.nb = *nb;
+        if (nk) r.nk = *nk;
+        r.nc = nc;
+        r.nd = nd;
+        r.nf = nf;
+        r.feedthrough = feedthrough;
+        r.n4sid_weight = SubspaceWeightingFromString(n4sid_weight);
+        r.operating_point = OperatingPointKindFromString(operating_point);
+        o.loss = loss;
+        o.split = split;
+        // As `pneumid identify`: without na, nb, nk the nonlinear structures are chosen.
+        o.nonlinear.choose_structure = !na && !nb && !nk;
+        if (knots) o.nonlinear.block.num_knots = *knots;
+        o.nonlinear.block.monotone_map = monotone_map;
+        if (settle) o.nonlinear.static_map.settle_fraction = *settle;
+        if (min_segment) o.nonlinear.static_map.min_segment_duration = *min_segment;
+        if (degree) o.nonlinear.narx.degree = *degree;
+        if (max_terms) {
+          o.nonlinear.narx.max_terms = *max_terms;
+          o.nonlinear.max_narx_terms = *max_terms;
+        }
+        if (err_tolerance) o.nonlinear.narx.err_tolerance = *err_tolerance;
+        std::string text;
+        {
+          py::gil_scoped_release release;
+          const IdentifyWorkflowResult result =
+              RunIdentifyWorkflow(o, data, validation ? &*validation : nullptr);
+          if (result.summary.models.empty()) throw DataError(result.summary.message);
+          text = result.ToJson().dump();
+        }
+        return py::module_::import("json").attr("loads")(text);
+      },
+      "data"_a, "methods"_a = "reaction-curve", "input"_a = 0, "output"_a = 0, "order"_a = 2,
+      "na"_a = py::none(), "nb"_a = py::none(), "nk"_a = py::none(), "nc"_a = 1, "nd"_a = 1,
+      "nf"_a = 3, "feedthrough"_a = false, "n4sid_weight"_a = "moesp", "operating_point"_a = "auto",
+      "loss"_a = "none", "split"_a = 0.0, "validation"_a = py::none(), "window"_a = "",
+      "resample"_a = 0.0, "remove_initial"_a = false, "detrend"_a = "none", "filter"_a = "",
+      "decimate"_a = 1, "knots"_a = py::none(), "monotone_map"_a = false, "settle"_a = py::none(),
+      "min_segment"_a = py::none(), "degree"_a = py::none(), "max_terms"_a = py::none(),
+      "err_tolerance"_a = py::none(),
+      "The identification of `pneumid identify DATA --json` (workflow/identify_workflow.hpp): "
+      "methods as a list or the --method text ('fit-p1d,arx', 'all'), the flags' settings by "
+      "their names (na, nb, nk None as when the flags are not given: hammerstein, wiener, hw "
+      "and narx then choose their structure; knots, settle, min_segment, degree, max_terms, "
+      "err_tolerance None: the command's defaults). Returns the dict `identify --json` prints "
+      "(the model file: 'models' best first, 'best', 'ranked_by', 'failures', 'termination', "
+      "...). Raises DataError when no method produced a model.");
   m.def(
       "simulate_model",
       [](const IdentifiedModel& model, const Dataset& data, int input) {

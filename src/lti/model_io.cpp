@@ -96,8 +96,8 @@ TransferFunction FromModelJson(const nlohmann::json& j_in, const std::string& wh
       tustin = j.at("continuous_form") == "tustin";
     } else if (j.contains("notes") && j.at("notes").is_array()) {
       for (const auto& note : j.at("notes"))
-        tustin |= note.is_string() &&
-                  note.get<std::string>().find("tustin d2c") != std::string::npos;
+        tustin |=
+            note.is_string() && note.get<std::string>().find("tustin d2c") != std::string::npos;
     }
     if (tustin) return TransferFunctionFromJson(j.at("discrete"));
   }
@@ -123,6 +123,15 @@ struct ScopedModelFile {
   nlohmann::json json;
 };
 thread_local std::map<std::string, ScopedModelFile>* t_model_files = nullptr;
+// The model documents provided in memory to the current scope, by name.
+thread_local std::map<std::string, nlohmann::json>* t_provided_models = nullptr;
+
+// The document provided under `path` in the current scope, or null.
+const nlohmann::json* ProvidedModel(const std::string& path) {
+  if (t_provided_models == nullptr) return nullptr;
+  const auto it = t_provided_models->find(path);
+  return it == t_provided_models->end() ? nullptr : &it->second;
+}
 
 bool Unchanged(const ScopedModelFile& f, const struct stat& st) {
   return f.device == st.st_dev && f.inode == st.st_ino && f.size == st.st_size &&
@@ -144,6 +153,7 @@ nlohmann::json ReadModelFile(const std::string& spec, std::string* path_out,
   }
   *path_out = path;
   *select_out = select;
+  if (const nlohmann::json* provided = ProvidedModel(path)) return *provided;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     throw DataError(fmt::format("{}: is a directory, not a model file", path));
@@ -302,7 +312,8 @@ std::optional<nlohmann::json> ReadModelFileIfAny(const std::string& spec, std::s
                                                  std::string* select) {
   std::error_code ec;
   const std::string p = SpecPath(spec);
-  if (p.empty() || !std::filesystem::is_regular_file(p, ec)) return std::nullopt;
+  if (p.empty() || (ProvidedModel(p) == nullptr && !std::filesystem::is_regular_file(p, ec)))
+    return std::nullopt;
   return ReadModelFile(spec, path, select);
 }
 
@@ -321,13 +332,26 @@ std::optional<nlohmann::json> ReadModelEntry(const std::string& spec, std::strin
 }
 
 ModelFileScope::ModelFileScope() : outermost_(t_model_files == nullptr) {
-  if (outermost_) t_model_files = new std::map<std::string, ScopedModelFile>();
+  if (outermost_) {
+    t_model_files = new std::map<std::string, ScopedModelFile>();
+    t_provided_models = new std::map<std::string, nlohmann::json>();
+  }
+}
+
+void ModelFileScope::Provide(const std::string& name, nlohmann::json document) {
+  PNEUMID_CHECK(t_provided_models != nullptr,
+                "a model document '{}' can only be provided inside a ModelFileScope", name);
+  PNEUMID_CHECK(!name.empty() && name.find('#') == std::string::npos,
+                "a provided model document needs a name without '#', got '{}'", name);
+  (*t_provided_models)[name] = std::move(document);
 }
 
 ModelFileScope::~ModelFileScope() {
   if (!outermost_) return;
   delete t_model_files;
   t_model_files = nullptr;
+  delete t_provided_models;
+  t_provided_models = nullptr;
 }
 
 std::optional<StaticMap> ParseModelInputMap(const std::string& spec) {
@@ -376,7 +400,7 @@ std::optional<NarxWithMap> ParseModelNarx(const std::string& spec) {
 StaticMap ReadStaticMap(const std::string& spec) {
   std::error_code ec;
   const std::string path = SpecPath(spec);
-  if (!std::filesystem::exists(path, ec))
+  if (ProvidedModel(path) == nullptr && !std::filesystem::exists(path, ec))
     throw DataError(
         fmt::format("{}: cannot open static map file: {}", path, std::strerror(ENOENT)));
   if (std::filesystem::is_directory(path, ec))

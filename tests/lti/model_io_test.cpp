@@ -197,6 +197,32 @@ long ReadsOf(Work work) {
 // Inside a ModelFileScope a spec consulted again is not read again (no read
 // system call), a file changed on disk is read again, and without a scope
 // every call reads the file.
+// A model document provided in memory reads as the file of its name inside
+// the scope (the app's model objects), and is gone when the scope closes.
+TEST(ModelIoTest, AScopeReadsModelDocumentsProvidedInMemory) {
+  const std::string name = "pneumid-provided-model.json";
+  const nlohmann::json document = nlohmann::json::parse(R"({"models": [
+    {"method": "fit-p1d", "tf": {"num": [2], "den": [1, 1], "Ts": 0, "delay": 0},
+     "input_map": {"u": [0, 50, 100], "y": [0, 40, 160]}}]})");
+  EXPECT_THAT([&] { ModelFileScope::Provide(name, document); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("inside a ModelFileScope")));
+  {
+    const ModelFileScope scope;
+    ModelFileScope::Provide(name, document);
+    EXPECT_DOUBLE_EQ(ParseModelSpec(name + "#fit-p1d").DcGain(), 2.0);
+    ASSERT_TRUE(ParseModelInputMap(name).has_value());
+    EXPECT_DOUBLE_EQ(ReadStaticMap(name).Evaluate(100.0), 160.0);
+    ASSERT_TRUE(ReadModelEntry(name).has_value());
+    EXPECT_THAT([&] { ParseModelSpec(name + "#arx"); },
+                ThrowsMessage<DataError>(HasSubstr("no model with method 'arx'")));
+    EXPECT_THAT([&] { ModelFileScope::Provide("a#b", document); },
+                ThrowsMessage<InvalidArgument>(HasSubstr("without '#'")));
+  }
+  // No such file once the scope has closed.
+  EXPECT_ANY_THROW(ParseModelSpec(name));
+  EXPECT_FALSE(ReadModelEntry(name).has_value());
+}
+
 TEST(ModelIoTest, AScopeReadsEachModelFileOnce) {
   if (ReadCalls() < 0) GTEST_SKIP() << "no /proc/self/io";
   const std::string path = ::testing::TempDir() + "pneumid_model_scope.json";

@@ -17,8 +17,8 @@
 #include "pneumid/common/version.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
-#include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/lti/frequency.hpp"
 #include "pneumid/lti/model_file_scope.hpp"
 #include "pneumid/lti/model_io.hpp"
@@ -564,7 +564,7 @@ nlohmann::json AppApi::Identify(const nlohmann::json& body, const std::atomic<bo
   std::shared_ptr<const DataSet> validation;
   if (body.contains("validation") && !body["validation"].is_null())
     validation = FindDataSet(body["validation"], "validation");
-  cli::IdentifyArgs args;
+  IdentifyWorkflowOptions args;
   if (body.contains("methods")) {
     const auto& m = body["methods"];
     if (m.is_string()) {
@@ -586,14 +586,15 @@ nlohmann::json AppApi::Identify(const nlohmann::json& body, const std::atomic<bo
   Get(body, "na", args.request.na);
   Get(body, "nb", args.request.nb);
   Get(body, "nk", args.request.nk);
-  cli::IdentifyOutcome out =
-      cli::IdentifyData(args, set->data, validation ? &validation->data : nullptr,
-                        [cancel](std::size_t, std::size_t, const std::string& method) {
-                          if (cancel != nullptr && cancel->load())
-                            throw Cancelled("identification stopped on request before " + method);
-                        });
+  const IdentifyWorkflowResult out =
+      RunIdentifyWorkflow(args, set->data, validation ? &validation->data : nullptr,
+                          [cancel](std::size_t, std::size_t, const std::string& method) {
+                            if (cancel != nullptr && cancel->load())
+                              throw Cancelled("identification stopped on request before " + method);
+                          });
   if (out.summary.models.empty()) throw HttpError(422, out.summary.message);
-  nlohmann::json j = out.json;
+  const nlohmann::json model_file = out.ToJson();
+  nlohmann::json j = model_file;
   nlohmann::json responses;
   responses["t"] = Decimate(out.data.time());
   for (const IdentifiedModel& m : out.summary.models) {
@@ -605,7 +606,7 @@ nlohmann::json AppApi::Identify(const nlohmann::json& body, const std::atomic<bo
     }
   }
   j["responses"] = std::move(responses);
-  j["model_file"] = out.json;
+  j["model_file"] = model_file;
   {
     std::lock_guard lock(mutex_);
     if (session_data_.is_object() && session_data_.value("id", "") == set->id) {
@@ -633,17 +634,16 @@ std::string AppApi::ModelSpec(const nlohmann::json& model) {
   if (model.is_string()) return FileSpec(model.get<std::string>());
   if (!model.is_object())
     throw HttpError(400, "field 'model' must be a model spec or a model object");
-  // A model object (an entry of a model file): read as a model file of one model.
+  // A model object (an entry of a model file): read as a model file of one
+  // model, held in memory by the request's ModelFileScope (no file written).
   int n;
   {
     std::lock_guard lock(mutex_);
     n = next_file_++;
   }
-  const fs::path file = options_.work / fmt::format("model{}.json", n);
-  std::ofstream out(file);
-  out << nlohmann::json{{"models", nlohmann::json::array({model})}}.dump(2) << "\n";
-  if (!out) throw DataError("cannot store the model");
-  return file.string();
+  const std::string name = fmt::format("request-model-{}.json", n);
+  ModelFileScope::Provide(name, nlohmann::json{{"models", nlohmann::json::array({model})}});
+  return name;
 }
 
 namespace {
@@ -694,15 +694,6 @@ nlohmann::json Trace(const ClosedLoopResult& r) {
   return {{"t", Decimate(r.t)}, {"r", Decimate(r.r)}, {"y", Decimate(r.y)}, {"u", Decimate(r.u)}};
 }
 
-// Removes a temporary model file of a request when the request is done.
-struct RemoveWhenDone {
-  std::string path;
-  ~RemoveWhenDone() {
-    std::error_code ec;
-    if (!path.empty()) fs::remove(path, ec);
-  }
-};
-
 // Bounded work per request: the sample time, the samples of a run and the
 // horizons (each with the limit it broke; 422).
 constexpr double kMinTs = 1e-4;      // s
@@ -727,10 +718,9 @@ void CheckWork(double Ts, double duration, int P, int M) {
 }  // namespace
 
 nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
-  cli::TuneArgs c;
+  TuneWorkflowOptions c;
   if (!b.contains("model")) throw HttpError(400, "field 'model' is missing");
   c.model = ModelSpec(b["model"]);
-  const RemoveWhenDone stored{b["model"].is_object() ? c.model : std::string()};
   c.Ts = 0.01;
   Get(b, "Ts", c.Ts);
   Get(b, "rule", c.rule);
@@ -754,7 +744,7 @@ nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
     // describes the controller that runs.
     if (Get(b, "plant", c.plant)) c.plant = PlantSpec(c.plant);
   }
-  return cli::TuneJson(c);
+  return RunTuneWorkflow(c).ToJson();
 }
 
 nlohmann::ordered_json AppApi::Control(const nlohmann::json& b, const std::atomic<bool>* cancel) {
@@ -762,7 +752,6 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b, const std::atomi
   c.stop = cancel;
   if (!b.contains("model")) throw HttpError(400, "field 'model' is missing");
   c.model = ModelSpec(b["model"]);
-  const RemoveWhenDone stored{b["model"].is_object() ? c.model : std::string()};
   ReadControllerSettings(b, c.controller);
   Get(b, "u_min", c.controller.limits.u_min);
   Get(b, "u_max", c.controller.limits.u_max);
@@ -956,7 +945,12 @@ Response AppApi::RunStart(const nlohmann::json& b) {
   if (run_.Running())
     return ErrorResponse(409, "a real-time run is going on (POST /api/run/stop ends it)");
   cli::RunArgs o;
-  if (b.contains("model")) o.model = ModelSpec(b["model"]);
+  if (b.contains("model")) {
+    o.model = ModelSpec(b["model"]);
+    // The run's thread reads a model object from its own scope.
+    if (b["model"].is_object())
+      o.model_document = nlohmann::json{{"models", nlohmann::json::array({b["model"]})}};
+  }
   ReadControllerSettings(b, o.controller);
   if (Get(b, "setpoint", o.setpoint)) o.setpoint = SignalSpec(o.setpoint);
   o.load_steps = LoadSteps(b);

@@ -76,6 +76,9 @@ class AppApi {
   nlohmann::json AddDataSet(DataSet set, bool session = true);
   std::shared_ptr<const DataSet> FindDataSet(const nlohmann::json& id, const char* field) const;
   std::filesystem::path Confine(const std::string& path) const;
+  /// The model spec of a request's "model": a spec string (files confined to
+  /// the root), or a model object provided in memory to the request's
+  /// ModelFileScope under a name that the spec then is.
   std::string ModelSpec(const nlohmann::json& model);
   std::string FileSpec(const std::string& spec) const;
   /// A set-point or input signal spec whose file (file:PATH,...) lies under

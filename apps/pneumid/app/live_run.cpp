@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "pneumid/lti/model_file_scope.hpp"
 #include "pneumid/realtime/realtime_loop.hpp"
 
 namespace pneumid::app {
@@ -40,6 +41,9 @@ bool LiveRun::Start(cli::RunArgs options, RealtimeConfig config) {
   options.rt.log = log_path_;
   options.rt.json = true;
   worker_ = std::thread([this, options = std::move(options), config = std::move(config)] {
+    // The run reads its model files once, and a model object from memory.
+    const ModelFileScope model_files;
+    if (options.model_document) ModelFileScope::Provide(options.model, *options.model_document);
     std::atomic<bool> loop_done{false};
     std::thread pump([&] {
       std::vector<LogRecord> scratch;
@@ -57,7 +61,7 @@ bool LiveRun::Start(cli::RunArgs options, RealtimeConfig config) {
       summary = out.json;
       state = out.summary.termination == Termination::kSuccess   ? "finished"
               : out.summary.termination == Termination::kStopped ? "stopped"
-                                                                     : "failed";
+                                                                 : "failed";
     } catch (const std::exception& e) {
       state = "failed";
       error = e.what();

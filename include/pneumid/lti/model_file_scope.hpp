@@ -4,6 +4,10 @@
 // a comparison).
 #pragma once
 
+#include <string>
+
+#include <nlohmann/json.hpp>
+
 namespace pneumid {
 
 /// While an object of this class lives, the model files read on its thread
@@ -19,6 +23,14 @@ class ModelFileScope {
   ModelFileScope();
   /// Closes the scope; the outermost one forgets the files it kept.
   ~ModelFileScope();
+  /// Holds `document` (the JSON of a model file) in memory under `name`:
+  /// until the outermost scope on this thread closes, the model specs
+  /// `name` and `name#method` read it as if it were that file, and no file
+  /// of that name is opened. The app passes the model objects of its
+  /// requests this way.
+  /// @throws InvalidArgument outside a scope, or for an empty name or one with '#'.
+  static void Provide(const std::string& name, nlohmann::json document);
+
   ModelFileScope(const ModelFileScope&) = delete;             ///< not copyable
   ModelFileScope& operator=(const ModelFileScope&) = delete;  ///< not assignable
 
