@@ -47,8 +47,8 @@ nlohmann::json ToJson(const IdentifiedModel& model);
 /// @throws InvalidArgument naming the key that is missing or malformed.
 IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j);
 
-/// The identified model a file spec FILE.json[#method] names (written by
-/// `pneumid identify -o` or `--json`; the first model without #method), read
+/// The identified model a file spec `FILE.json[#method]` names (written by
+/// `pneumid identify -o` or `--json`; the first model without `#method`), read
 /// through lti's model file reader (ReadModelEntry: once per ModelFileScope).
 /// std::nullopt when the spec is no JSON file name (built-in and inline
 /// specs) or the entry is a plain transfer function {"num", "den", ...}.

@@ -61,8 +61,8 @@ struct NarxWithMap {
 /// @throws DataError naming the file for an unreadable file or an invalid model.
 std::optional<NarxWithMap> ParseModelNarx(const std::string& spec);
 
-/// The JSON object of the model a file spec FILE[#method] names: the file's
-/// model, or the entry of its "models" list that #method selects (the first
+/// The JSON object of the model a file spec `FILE[#method]` names: the file's
+/// model, or the entry of its "models" list that `#method` selects (the first
 /// without one), as every reader of this header selects it; `path` (may be
 /// null) receives FILE. Read through the current ModelFileScope (once per
 /// scope). std::nullopt when the spec names no regular file (built-in and

@@ -34,12 +34,12 @@ namespace pneumid {
 ///   remove_initial, detrend none|constant|linear, filter "lowpass:F" |
 ///   "bandpass:F1,F2" (Hz), decimate N (>= 1).
 struct PreprocessSettings {
-  std::string window;
-  double resample = 0.0;
-  bool remove_initial = false;
-  std::string detrend = "none";
-  std::string filter;
-  int decimate = 1;
+  std::string window;            ///< --window "T0:T1" (empty = all samples)
+  double resample = 0.0;         ///< --resample Ts (0 = keep the sampling)
+  bool remove_initial = false;   ///< --remove-initial: subtract the levels before the step
+  std::string detrend = "none";  ///< --detrend none|constant|linear
+  std::string filter;            ///< --filter spec (empty = none)
+  int decimate = 1;              ///< --decimate factor (>= 1)
 
   /// The library options of these settings.
   /// @throws InvalidArgument naming the flag (--window, --detrend, ...) for a

@@ -48,7 +48,7 @@ struct TuneWorkflowOptions {
   double overshoot = std::numeric_limits<double>::quiet_NaN();       ///< percent; NaN = 5
   double aggressiveness = std::numeric_limits<double>::quiet_NaN();  ///< 0..1; NaN = 0.5
   double u_min = -std::numeric_limits<double>::infinity();           ///< input limits
-  double u_max = std::numeric_limits<double>::infinity();
+  double u_max = std::numeric_limits<double>::infinity();            ///< upper input limit
   double du_max = std::numeric_limits<double>::infinity();  ///< largest input change per sample
   /// Plant spec whose physical input range gives the limits u_min/u_max leave
   /// open (as `control --plant` designs); empty = none.
