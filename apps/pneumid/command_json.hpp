@@ -2,8 +2,8 @@
 // shared by those commands (their --json output) and by `pneumid app` (its
 // HTTP API answers with the same JSON). The structs hold the commands'
 // options; each function does the command's work without printing. The work
-// of `control`, `tune` and `identify` is the library's (workflow/*.hpp): here
-// only their flags and the conversion to the library's options.
+// of `control`, `tune`, `identify` and `run` is the library's (workflow/*.hpp):
+// here only their flags and the conversion to the library's options.
 #pragma once
 
 #include <atomic>
@@ -25,6 +25,7 @@
 #include "pneumid/realtime/spsc_ring_buffer.hpp"
 #include "pneumid/workflow/control_scenario.hpp"
 #include "pneumid/workflow/identify_workflow.hpp"
+#include "pneumid/workflow/run_workflow.hpp"
 #include "pneumid/workflow/tune_workflow.hpp"
 #include "realtime_options.hpp"
 
@@ -130,30 +131,19 @@ struct RunArgs {
   bool offline = false;
   std::vector<std::string> load_steps;
   /// A model held in memory under the name `model` (the app's model objects:
-  /// ModelFileScope::Provide in the thread that runs the loop); none = a file or spec.
+  /// RunWorkflowOptions::model_document); none = a file or spec.
   std::optional<nlohmann::json> model_document;
 };
 
-struct RunOutcome {
-  LoopSummary summary;
-  std::string controller;  ///< the controller's description
-  std::string io;          ///< the backend's description
-  std::int64_t log_rows = 0;
-  nlohmann::json metrics;  ///< closed-loop metrics, null unless the run completed
-  nlohmann::json offline;  ///< --offline metrics, or null
-  /// What `run --json` prints.
-  nlohmann::json json;
-};
+/// The run of `run`'s flags, all but the real-time configuration
+/// (workflow/run_workflow.hpp: RunRealtimeWorkflow, whose ToJson is what
+/// `run --json` prints); the status line when stderr is a terminal and no --json.
+/// @throws InvalidArgument for a bad --load-step.
+RunWorkflowOptions ToWorkflowOptions(const RunArgs& args);
 
-/// `run`'s safety settings: the configuration's with the flags applied.
+/// `run`'s safety settings: the configuration's with the flags applied
+/// (RunSafetyOverrides::ApplyTo).
 /// @throws InvalidArgument for invalid settings.
 void ApplySafetyFlags(const RunArgs& o, RealtimeConfig& config);
-
-/// Runs the loop of `run` with `config` (ResolveRealtimeConfig and
-/// ApplySafetyFlags applied). `live` (may be null) receives a copy of every
-/// logged record from the loop thread (LogWriterOptions::live).
-/// @throws InvalidArgument / DataError as RunSession does (before the run).
-RunOutcome RunRealtime(const RunArgs& o, const RealtimeConfig& config,
-                       SpscRingBuffer<LogRecord>* live = nullptr);
 
 }  // namespace pneumid::cli

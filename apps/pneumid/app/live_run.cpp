@@ -2,8 +2,8 @@
 
 #include <filesystem>
 
-#include "pneumid/lti/model_file_scope.hpp"
 #include "pneumid/realtime/realtime_loop.hpp"
+#include "pneumid/workflow/run_workflow.hpp"
 
 namespace pneumid::app {
 
@@ -23,7 +23,10 @@ bool LiveRun::Running() const {
   return state_ == "running";
 }
 
-bool LiveRun::Start(cli::RunArgs options, RealtimeConfig config) {
+bool LiveRun::Start(const cli::RunArgs& args, RealtimeConfig config) {
+  RunWorkflowOptions options = cli::ToWorkflowOptions(args);
+  options.log = log_path_;
+  options.live_status = false;
   {
     std::lock_guard lock(mutex_);
     if (state_ == "running") return false;
@@ -38,12 +41,7 @@ bool LiveRun::Start(cli::RunArgs options, RealtimeConfig config) {
   start_ = end_ = std::chrono::steady_clock::now();
   // Room for 10 s at 1 kHz between two drains (25 ms apart).
   ring_ = std::make_unique<SpscRingBuffer<LogRecord>>(1 << 14);
-  options.rt.log = log_path_;
-  options.rt.json = true;
   worker_ = std::thread([this, options = std::move(options), config = std::move(config)] {
-    // The run reads its model files once, and a model object from memory.
-    const ModelFileScope model_files;
-    if (options.model_document) ModelFileScope::Provide(options.model, *options.model_document);
     std::atomic<bool> loop_done{false};
     std::thread pump([&] {
       std::vector<LogRecord> scratch;
@@ -57,8 +55,8 @@ bool LiveRun::Start(cli::RunArgs options, RealtimeConfig config) {
     std::string state, error;
     nlohmann::json summary;
     try {
-      const cli::RunOutcome out = cli::RunRealtime(options, config, ring_.get());
-      summary = out.json;
+      const RunWorkflowResult out = RunRealtimeWorkflow(options, config, ring_.get());
+      summary = out.ToJson();
       state = out.summary.termination == Termination::kSuccess   ? "finished"
               : out.summary.termination == Termination::kStopped ? "stopped"
                                                                  : "failed";

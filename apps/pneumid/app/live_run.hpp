@@ -1,9 +1,9 @@
 // The real-time run of `pneumid app`: one at a time, on a worker thread, as
-// `pneumid run` does it (command_json.hpp RunRealtime), with its log in a
-// file and its samples kept for the live plots. The loop thread hands every
-// sample over through a lock-free ring buffer (LogWriterOptions::live); a
-// pump thread drains it every 25 ms into the history that the WebSocket
-// sessions read.
+// `pneumid run` does it (workflow/run_workflow.hpp RunRealtimeWorkflow), with
+// its log in a file and its samples kept for the live plots. The loop thread
+// hands every sample over through a lock-free ring buffer
+// (LogWriterOptions::live); a pump thread drains it every 25 ms into the
+// history that the WebSocket sessions read.
 #pragma once
 
 #include <atomic>
@@ -20,6 +20,7 @@
 
 #include "../command_json.hpp"
 #include "pneumid/realtime/log_writer.hpp"
+#include "pneumid/realtime/realtime_config.hpp"
 #include "pneumid/realtime/spsc_ring_buffer.hpp"
 
 namespace pneumid::app {
@@ -33,9 +34,11 @@ class LiveRun {
   LiveRun(const LiveRun&) = delete;
   LiveRun& operator=(const LiveRun&) = delete;
 
-  /// Starts a run of `options` (its log path is set here) with `config`.
+  /// Starts a run of `args` (cli::ToWorkflowOptions; the log path is set
+  /// here) with `config`.
   /// @returns false when a run is going on (nothing started).
-  bool Start(cli::RunArgs options, RealtimeConfig config);
+  /// @throws InvalidArgument for a bad load step (nothing started).
+  bool Start(const cli::RunArgs& args, RealtimeConfig config);
 
   /// True while a run is going on.
   bool Running() const;
