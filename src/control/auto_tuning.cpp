@@ -20,6 +20,7 @@
 #include "pneumid/lti/frequency.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
+#include "predictive_controller_design.hpp"
 
 namespace pneumid {
 
@@ -290,40 +291,30 @@ struct ChosenDesign {
 // ---------------------------------------------------------------------------
 // mpc/dmc: the search over the move suppression lambda
 
-/// The mpc or dmc controller of the horizons P, M for a move suppression lambda.
+/// The mpc or dmc controller of the horizons P, M for a move suppression
+/// lambda, built as MakeController builds it (MakePredictiveController) on
+/// the design's sampled model.
 struct PredictiveControllerFactory {
-  bool is_mpc = true;
-  int P = 0;
-  int M = 0;
-  InputLimits limits;  // deviation limits
-  DisturbanceModel disturbance = DisturbanceModel::kInput;
-  StateSpace state_space;                             // mpc
-  std::unique_ptr<PredictionModel> prediction_model;  // dmc
+  const PredictionModel* model = nullptr;  // sampled once for the design
+  /// type, the explicit rule with P and M, the deviation limits, dmc:
+  /// constrained, mpc: the disturbance model; lambda set by Make.
+  ControllerSpec spec;
 
   std::unique_ptr<Controller> Make(double lambda) const {
-    if (is_mpc) {
-      MpcOptions mpc_options;
-      mpc_options.P = P;
-      mpc_options.M = M;
-      mpc_options.lambda = lambda;
-      mpc_options.limits = limits;
-      mpc_options.disturbance = disturbance;
-      return std::make_unique<MpcController>(state_space, mpc_options);
-    }
-    DmcOptions dmc_options;
-    dmc_options.P = P;
-    dmc_options.M = M;
-    dmc_options.lambda = lambda;
-    dmc_options.limits = limits;
-    dmc_options.constrained = Finite(limits) || std::isfinite(limits.du_max);
-    return std::make_unique<DmcController>(*prediction_model, dmc_options);
+    ControllerSpec candidate = spec;
+    candidate.tuning.lambda = lambda;
+    return internal::MakePredictiveController(*model, candidate).controller;
   }
 
   /// The QP Hessian of lambda: the MPC's H, or A'A + lambda I for DMC.
   Eigen::MatrixXd Hessian(double lambda) const {
     const std::unique_ptr<Controller> controller = Make(lambda);
-    if (is_mpc) return static_cast<MpcController&>(*controller).hessian();
-    const Eigen::MatrixXd& A = static_cast<DmcController&>(*controller).dynamic_matrix();
+    if (const auto* mpc = dynamic_cast<const MpcController*>(controller.get()))
+      return mpc->hessian();
+    const auto* dmc = dynamic_cast<const DmcController*>(controller.get());
+    PNEUMID_CHECK(dmc != nullptr, "the auto-tuner designs mpc or dmc, got {}",
+                  controller->Describe());
+    const Eigen::MatrixXd& A = dmc->dynamic_matrix();
     return A.transpose() * A + lambda * Eigen::MatrixXd::Identity(A.cols(), A.cols());
   }
 };
@@ -442,22 +433,28 @@ double LargestLambdaAsFast(LambdaCandidates& candidates, double lambda_f, double
 /// mpc/dmc (file comment): P and M by Shridhar-Cooper, then lambda* by the
 /// closed-loop search. Without a given response time the target becomes the
 /// response time of lambda_f, the fastest robust design.
-ChosenDesign SearchPredictiveDesign(const TransferFunction& model, double Ts,
-                                    const AutoTuneOptions& options, Evaluator& evaluator,
-                                    AutoTuneResult& result) {
+ChosenDesign SearchPredictiveDesign(const PredictionModel& model, const AutoTuneOptions& options,
+                                    Evaluator& evaluator, AutoTuneResult& result) {
   auto factory = std::make_shared<PredictiveControllerFactory>();
-  factory->prediction_model = std::make_unique<PredictionModel>(model, Ts);
+  factory->model = &model;
   TuningOptions rule_options;
   rule_options.rule = TuningRule::kShridharCooper;
   rule_options.M = options.M;
-  const TuningResult base = Tune(*factory->prediction_model, rule_options);
-  result.P = factory->P = base.P;
-  result.M = factory->M = base.M;
+  const TuningResult base = Tune(model, rule_options);
+  result.P = base.P;
+  result.M = base.M;
   const double lambda0 = base.lambda_condition;
-  factory->is_mpc = options.controller == ControllerType::kMpc;
-  if (factory->is_mpc) factory->state_space = SampledStateSpace(model, Ts);
-  factory->limits = evaluator.limits;
-  factory->disturbance = options.disturbance;
+  ControllerSpec& spec = factory->spec;
+  spec.type = options.controller;
+  spec.tuning.rule = TuningRule::kExplicit;
+  spec.tuning.P = base.P;
+  spec.tuning.M = base.M;
+  spec.limits = evaluator.limits;
+  // DMC optimizes its moves under the limits (QDMC); the MPC does whenever a
+  // limit is finite.
+  spec.constrained = spec.type == ControllerType::kDmc &&
+                     (Finite(evaluator.limits) || std::isfinite(evaluator.limits.du_max));
+  spec.disturbance = options.disturbance;
 
   LambdaCandidates candidates(*factory, evaluator, options.max_overshoot, result.robust_overshoot);
   ChosenDesign chosen;
@@ -946,13 +943,22 @@ bool AutoTuneOptions::IsValid(std::string* error) const {
   return true;
 }
 
-AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTuneOptions& options) {
+namespace {
+
+void CheckAutoTuneArguments(const TransferFunction& model, double Ts,
+                            const AutoTuneOptions& options) {
   std::string error;
   PNEUMID_CHECK(options.IsValid(&error), "invalid auto-tuning options: {}", error);
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "Ts must be positive, got {}", Ts);
   PNEUMID_CHECK(model.IsContinuous() || std::abs(model.Ts() - Ts) <= 1e-9 * Ts,
                 "a discrete model must have the controller's sample time {} s, got {} s", Ts,
                 model.Ts());
+}
+
+/// AutoTune of `model` at Ts; `sampled` is the model sampled at Ts (mpc and
+/// dmc, the pid designs without it).
+AutoTuneResult TuneToSpecification(const TransferFunction& model, double Ts,
+                                   const AutoTuneOptions& options, const PredictionModel* sampled) {
   AutoTuneResult result = SpecificationAsUsed(model, Ts, options);
   // The evaluation step in input space, then deviation variables.
   const InputStep input_step = EvaluationInputStep(options.limits, result.fopdt.K);
@@ -960,14 +966,28 @@ AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTune
   result.step_to = result.fopdt.K * input_step.to;
   Evaluator evaluator = MakeEvaluator(model, Ts, options, result, input_step.from);
 
-  const ChosenDesign design =
-      options.controller == ControllerType::kMpc || options.controller == ControllerType::kDmc
-          ? SearchPredictiveDesign(model, Ts, options, evaluator, result)
-          : DesignPid(model, Ts, options, evaluator, result);
+  const ChosenDesign design = options.controller == ControllerType::kPid
+                                  ? DesignPid(model, Ts, options, evaluator, result)
+                                  : SearchPredictiveDesign(*sampled, options, evaluator, result);
 
   const bool all_rows_pass = EvaluateChosenDesign(design, evaluator, result);
   ReviewDesign({model, options, evaluator, input_step, design}, all_rows_pass, result);
   return result;
+}
+
+}  // namespace
+
+AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTuneOptions& options) {
+  CheckAutoTuneArguments(model, Ts, options);
+  if (options.controller == ControllerType::kPid)
+    return TuneToSpecification(model, Ts, options, nullptr);
+  const PredictionModel sampled(model, Ts);
+  return TuneToSpecification(model, Ts, options, &sampled);
+}
+
+AutoTuneResult AutoTune(const PredictionModel& model, const AutoTuneOptions& options) {
+  CheckAutoTuneArguments(model.model(), model.Ts(), options);
+  return TuneToSpecification(model.model(), model.Ts(), options, &model);
 }
 
 TuningResult AutoTuneResult::ToTuningResult() const {

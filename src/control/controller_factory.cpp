@@ -17,6 +17,7 @@
 #include "pneumid/control/inverse_map_controller.hpp"
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/lti/model_io.hpp"
+#include "predictive_controller_design.hpp"
 
 namespace pneumid {
 
@@ -145,6 +146,92 @@ nlohmann::ordered_json BuiltController::SettingsToJson() const {
 
 namespace {
 
+// dmc (QDMC when constrained) with the tuning of spec.
+BuiltController MakeDmc(const PredictionModel& model, const ControllerSpec& spec) {
+  BuiltController b;
+  b.tuning = Tune(model, spec.tuning);
+  DmcOptions o;
+  o.P = b.tuning.P;
+  o.M = b.tuning.M;
+  o.lambda = b.tuning.lambda;
+  o.limits = spec.limits;
+  o.constrained = spec.constrained;
+  o.y_min = spec.y_min;
+  o.y_max = spec.y_max;
+  b.controller = std::make_unique<DmcController>(model, o);
+  return b;
+}
+
+// gpc with N1 = 1, N2 = P, Nu = M and the T filter of spec.
+BuiltController MakeGpc(const PredictionModel& model, const ControllerSpec& spec) {
+  PNEUMID_CHECK(!spec.constrained,
+                "the constrained form is implemented for dmc (QDMC) and mpc; gpc clips its "
+                "input");
+  BuiltController b;
+  b.tuning = Tune(model, spec.tuning);
+  GpcOptions o;
+  o.N1 = 1;
+  o.N2 = b.tuning.P;
+  o.Nu = b.tuning.M;
+  o.lambda = b.tuning.lambda;
+  o.limits = spec.limits;
+  if (spec.t_filter == "A" || spec.t_filter == "a") {
+    o.t_equals_a = true;
+  } else if (spec.t_filter != "1" && !spec.t_filter.empty()) {
+    // '1', 'A' or coefficients such as '1 -0.8'.
+    const std::vector<double> coef = ParseNumberList("T filter", spec.t_filter);
+    o.t_polynomial = Eigen::Map<const Eigen::VectorXd>(coef.data(), coef.size());
+  }
+  b.controller = std::make_unique<GpcController>(model, o);
+  return b;
+}
+
+// The state-space mpc on the design's sampled state space.
+BuiltController MakeMpc(const PredictionModel& model, const ControllerSpec& spec) {
+  BuiltController b;
+  b.tuning = Tune(model, spec.tuning);
+  MpcOptions o;
+  o.P = b.tuning.P;
+  o.M = b.tuning.M;
+  o.lambda = b.tuning.lambda;
+  o.limits = spec.limits;
+  o.y_min = spec.y_min;
+  o.y_max = spec.y_max;
+  o.disturbance = spec.disturbance;
+  if (!std::isnan(spec.measurement_noise)) o.measurement_noise = spec.measurement_noise;
+  if (!std::isnan(spec.state_noise)) o.state_noise = spec.state_noise;
+  if (!std::isnan(spec.disturbance_noise)) o.disturbance_noise = spec.disturbance_noise;
+  b.controller = std::make_unique<MpcController>(model, o);
+  return b;
+}
+
+}  // namespace
+
+BuiltController internal::MakePredictiveController(const PredictionModel& model,
+                                                   const ControllerSpec& spec) {
+  PNEUMID_CHECK(!spec.auto_tune && !spec.input_map && !spec.output_map && !spec.narx_model,
+                "MakePredictiveController: resolve the rule auto and the model's maps first");
+  BuiltController b;
+  switch (spec.type) {
+    case ControllerType::kDmc:
+      b = MakeDmc(model, spec);
+      break;
+    case ControllerType::kGpc:
+      b = MakeGpc(model, spec);
+      break;
+    case ControllerType::kMpc:
+      b = MakeMpc(model, spec);
+      break;
+    case ControllerType::kPid:
+      PNEUMID_CHECK(false, "MakePredictiveController builds dmc, gpc or mpc, not pid");
+  }
+  b.type = spec.type;
+  b.pid_rule = spec.pid_rule;
+  return b;
+}
+
+namespace {
+
 BuiltController BuildController(const TransferFunction& model, double Ts,
                                 const ControllerSpec& spec);
 BuiltController BuildController(const PredictionModel& model, const ControllerSpec& spec);
@@ -209,6 +296,16 @@ AutoTuneResult AutoTuned(const TransferFunction& model, double Ts, const Control
   o.controller = spec.type;
   o.limits = spec.limits;
   return AutoTune(model, Ts, o);
+}
+
+// The same on the design's sampled model (mpc, dmc: no second sampling).
+AutoTuneResult AutoTuned(const PredictionModel& model, const ControllerSpec& spec) {
+  PNEUMID_CHECK(spec.type != ControllerType::kGpc,
+                "--rule auto tunes mpc, dmc and pid; for gpc give a tuning rule");
+  AutoTuneOptions o = spec.auto_options;
+  o.controller = spec.type;
+  o.limits = spec.limits;
+  return AutoTune(model, o);
 }
 
 }  // namespace
@@ -349,80 +446,23 @@ BuiltController BuildController(const PredictionModel& model, const ControllerSp
     return WithInverseMap(spec_in,
                           [&](const ControllerSpec& s) { return BuildController(unit, s); });
   }
-  if (spec_in.auto_tune && spec_in.type == ControllerType::kPid)
+  // A PID needs no sampled model (tuned from the FOPDT description or by the
+  // auto-tuner's loop shaping).
+  if (spec_in.type == ControllerType::kPid)
     return BuildController(model.model(), model.Ts(), spec_in);
+  if (!spec_in.auto_tune) return internal::MakePredictiveController(model, spec_in);
+  // The rule auto: the auto-tuner's P, M and lambda as explicit settings, on
+  // the same sampled model; its candidates were built by the same function.
+  const AutoTuneResult a = AutoTuned(model, spec_in);
   ControllerSpec spec = spec_in;
-  std::string auto_summary;
-  std::optional<TuningResult> auto_tuning;
-  if (spec.auto_tune) {
-    const AutoTuneResult a = AutoTuned(model.model(), model.Ts(), spec);
-    auto_tuning = a.ToTuningResult();
-    spec.auto_tune = false;
-    spec.tuning.rule = TuningRule::kExplicit;
-    spec.tuning.P = a.P;
-    spec.tuning.M = a.M;
-    spec.tuning.lambda = a.lambda;
-    auto_summary = a.message;
-  }
-  BuiltController b;
-  b.auto_summary = auto_summary;
-  b.type = spec.type;
-  b.pid_rule = spec.pid_rule;
-  switch (spec.type) {
-    case ControllerType::kDmc: {
-      b.tuning = Tune(model, spec.tuning);
-      DmcOptions o;
-      o.P = b.tuning.P;
-      o.M = b.tuning.M;
-      o.lambda = b.tuning.lambda;
-      o.limits = spec.limits;
-      o.constrained = spec.constrained;
-      o.y_min = spec.y_min;
-      o.y_max = spec.y_max;
-      b.controller = std::make_unique<DmcController>(model, o);
-      break;
-    }
-    case ControllerType::kGpc: {
-      PNEUMID_CHECK(!spec.constrained,
-                    "the constrained form is implemented for dmc (QDMC) and mpc; gpc clips its "
-                    "input");
-      b.tuning = Tune(model, spec.tuning);
-      GpcOptions o;
-      o.N1 = 1;
-      o.N2 = b.tuning.P;
-      o.Nu = b.tuning.M;
-      o.lambda = b.tuning.lambda;
-      o.limits = spec.limits;
-      if (spec.t_filter == "A" || spec.t_filter == "a") {
-        o.t_equals_a = true;
-      } else if (spec.t_filter != "1" && !spec.t_filter.empty()) {
-        // '1', 'A' or coefficients such as '1 -0.8'.
-        const std::vector<double> coef = ParseNumberList("T filter", spec.t_filter);
-        o.t_polynomial = Eigen::Map<const Eigen::VectorXd>(coef.data(), coef.size());
-      }
-      b.controller = std::make_unique<GpcController>(model, o);
-      break;
-    }
-    case ControllerType::kMpc: {
-      b.tuning = Tune(model, spec.tuning);
-      MpcOptions o;
-      o.P = b.tuning.P;
-      o.M = b.tuning.M;
-      o.lambda = b.tuning.lambda;
-      o.limits = spec.limits;
-      o.y_min = spec.y_min;
-      o.y_max = spec.y_max;
-      o.disturbance = spec.disturbance;
-      if (!std::isnan(spec.measurement_noise)) o.measurement_noise = spec.measurement_noise;
-      if (!std::isnan(spec.state_noise)) o.state_noise = spec.state_noise;
-      if (!std::isnan(spec.disturbance_noise)) o.disturbance_noise = spec.disturbance_noise;
-      b.controller = std::make_unique<MpcController>(model.model(), model.Ts(), o);
-      break;
-    }
-    case ControllerType::kPid:
-      return BuildController(model.model(), model.Ts(), spec);
-  }
-  if (auto_tuning) b.tuning = *auto_tuning;
+  spec.auto_tune = false;
+  spec.tuning.rule = TuningRule::kExplicit;
+  spec.tuning.P = a.P;
+  spec.tuning.M = a.M;
+  spec.tuning.lambda = a.lambda;
+  BuiltController b = internal::MakePredictiveController(model, spec);
+  b.auto_summary = a.message;
+  b.tuning = a.ToTuningResult();
   return b;
 }
 

@@ -106,6 +106,11 @@ MpcController::MpcController(const TransferFunction& model, double Ts, const Mpc
   Build(SampledStateSpace(model, Ts));
 }
 
+MpcController::MpcController(const PredictionModel& model, const MpcOptions& options)
+    : options_(options) {
+  Build(DelayAsStates(model.sampled_state_space()));
+}
+
 MpcController::~MpcController() = default;
 
 namespace {

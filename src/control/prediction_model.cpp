@@ -10,19 +10,26 @@ namespace pneumid {
 
 namespace {
 
-TransferFunction Sample(const TransferFunction& model, double Ts) {
+// The one discretization of a design: the zoh discretization of the
+// controllable canonical realization of a continuous model (what C2D of the
+// transfer function computes before converting back), the realization of a
+// discrete one at its own Ts.
+StateSpace SampleStateSpace(const TransferFunction& model, double Ts) {
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
-  if (model.IsContinuous()) return C2D(model, Ts, DiscretizationMethod::kZoh);
+  if (model.IsContinuous()) return C2D(ToStateSpace(model), Ts, DiscretizationMethod::kZoh);
   PNEUMID_CHECK(std::abs(model.Ts() - Ts) <= 1e-9 * Ts,
                 "the discrete model has Ts = {} s but the controller runs at Ts = {} s", model.Ts(),
                 Ts);
-  return model;
+  return ToStateSpace(model);
 }
 
 }  // namespace
 
 PredictionModel::PredictionModel(const TransferFunction& model, double Ts)
-    : model_(model), sampled_(Sample(model, Ts)), Ts_(Ts) {
+    : model_(model),
+      sampled_state_space_(SampleStateSpace(model, Ts)),
+      sampled_(model.IsContinuous() ? ToTransferFunction(sampled_state_space_) : model),
+      Ts_(Ts) {
   PNEUMID_CHECK(sampled_.den().size() > 0 && sampled_.den()(0) != 0.0,
                 "the discrete model needs a nonzero leading denominator coefficient a0");
 }

@@ -1,10 +1,12 @@
 // Tuning to specifications (auto_tuning.hpp): the designs meet their targets
 // on the model, survive the robustness cases, and a spec that cannot be met
-// is reported as such.
+// is reported as such; the candidates evaluated are the controllers
+// MakeController builds.
 #include "pneumid/control/auto_tuning.hpp"
 
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -292,6 +294,154 @@ TEST(AutoTuneTest, ZeroOvershootWithImpossibleTimeFails) {
   EXPECT_THAT(Find(r, "specification")->message,
               ::testing::HasSubstr("fastest design within the overshoot and robustness limits"));
   EXPECT_LE(r.predicted.overshoot_percent, 0.05);
+}
+
+// A set-point step from 0 to `to` at `at`, as the tuner's evaluation steps.
+class DeviationStep final : public Signal {
+ public:
+  DeviationStep(double to, double at) : to_(to), at_(at) {}
+  double operator()(double t) const override { return t >= at_ - 1e-12 ? to_ : 0.0; }
+  std::string ToString() const override { return fmt::format("step to {} at {}", to_, at_); }
+
+ private:
+  double to_, at_;
+};
+
+bool SameNumber(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+void ExpectSameMetrics(const ClosedLoopMetrics& loop, const PredictedMetrics& tuner) {
+  EXPECT_PRED2(SameNumber, loop.rise_time, tuner.rise_time);
+  EXPECT_PRED2(SameNumber, loop.overshoot_percent, tuner.overshoot_percent);
+  EXPECT_PRED2(SameNumber, loop.settling_time, tuner.settling_time);
+  EXPECT_EQ(loop.u_min, tuner.u_min);
+  EXPECT_EQ(loop.u_max, tuner.u_max);
+  EXPECT_EQ(loop.settled && std::isfinite(loop.settling_time), tuner.settled);
+}
+
+// The tuner's evaluation of its chosen candidate run again on the controller
+// MakeController builds for the reported P, M and lambda (as `pneumid
+// control` builds it): the loop of auto_tuning.cpp (the step of the result
+// at 5 Ts in deviation variables from the input before it, limits relative
+// to that input, the window max(10 max(t*, tau + theta), 50 Ts) after the
+// step with t* before the fastest design replaced it, exact-zoh plants), on
+// the nominal plant, each robustness row and the load step. The metrics
+// agree to the last bit only when the tuner's candidate is that controller:
+// same type, constrained form (QDMC under limits), disturbance model and
+// sampled model.
+void ExpectCandidateIsMakeControllers(const AutoTuneResult& r, const TransferFunction& model,
+                                      const AutoTuneOptions& o) {
+  SCOPED_TRACE(Describe(r));
+  const InputLimits& lim = o.limits;
+  const bool limited = std::isfinite(lim.u_min) || std::isfinite(lim.u_max);
+  ASSERT_TRUE(!limited || (std::isfinite(lim.u_min) && std::isfinite(lim.u_max)))
+      << "the test takes the evaluation step of two limits or none";
+  const double u_before = limited ? lim.u_min + 0.4 * (lim.u_max - lim.u_min) : 0.0;
+  ControllerSpec spec;
+  spec.type = r.controller;
+  spec.tuning.rule = TuningRule::kExplicit;
+  spec.tuning.P = r.P;
+  spec.tuning.M = r.M;
+  spec.tuning.lambda = r.lambda;
+  spec.limits = lim;
+  spec.limits.u_min -= u_before;
+  spec.limits.u_max -= u_before;
+  spec.constrained = r.controller == ControllerType::kDmc && limited;
+  spec.disturbance = o.disturbance;
+  const double t_given =
+      std::isnan(o.response_time) ? r.fopdt.tau + r.fopdt.theta : o.response_time;
+  const double t_aim_before = t_given * std::pow(1.5, 1.0 - 2.0 * o.aggressiveness);
+  const double window =
+      std::max(10.0 * std::max(t_aim_before, r.fopdt.tau + r.fopdt.theta), 50.0 * kTs);
+  const double t_step = 5.0 * kTs, step = r.step_to - r.step_from;
+  const double ts_model = model.IsContinuous() ? 0.0 : kTs;
+  const TransferFunction plants[] = {
+      model, TransferFunction(model.num() * 1.2, model.den(), ts_model, model.delay()),
+      TransferFunction(model.num() * 0.8, model.den(), ts_model, model.delay()),
+      model.WithDelay(model.delay() + kTs)};
+  auto run = [&](const TransferFunction& plant_model, double setpoint, double load) {
+    const BuiltController built = MakeController(model, kTs, spec);
+    EXPECT_EQ(built.tuning.lambda, r.lambda);
+    LinearPlant plant(plant_model, kTs);
+    ClosedLoopOptions lo;
+    lo.duration = t_step + window;
+    lo.actuator = spec.limits;
+    if (load != 0.0) lo.load_steps = {{t_step, load}};
+    return SimulateClosedLoop(*built.controller, plant, DeviationStep(setpoint, t_step), lo);
+  };
+  ExpectSameMetrics(run(plants[0], step, 0.0).metrics, r.predicted);
+  ASSERT_EQ(r.robustness.size(), 3u);
+  for (int i = 1; i < 4; ++i) {
+    SCOPED_TRACE(r.robustness[i - 1].name);
+    ExpectSameMetrics(run(plants[i], step, 0.0).metrics, r.robustness[i - 1].metrics);
+  }
+  EXPECT_EQ(run(plants[0], 0.0, -0.2 * step).metrics.steady_state_error, r.steady_state_error);
+}
+
+// The candidates the tuner evaluates are MakeController's controllers for
+// their P, M and lambda: mpc and dmc, with and without input limits (the
+// limits make the dmc a QDMC and the mpc solve its QP during the step), the
+// output disturbance model, and a discrete ARX model.
+TEST(AutoTuneTest, CandidatesAreTheControllersMakeControllerBuilds) {
+  struct Design {
+    const char* name;
+    TransferFunction model;
+    ControllerType type;
+    double response_time;
+    bool limited;
+    DisturbanceModel disturbance;
+  };
+  const double fastest = std::numeric_limits<double>::quiet_NaN();
+  const Design designs[] = {
+      {"mpc fastest", Fopdt(), ControllerType::kMpc, fastest, false, DisturbanceModel::kInput},
+      {"dmc fastest", Fopdt(), ControllerType::kDmc, fastest, false, DisturbanceModel::kInput},
+      {"qdmc", Fopdt(), ControllerType::kDmc, 0.05, true, DisturbanceModel::kInput},
+      {"mpc limited", SecondOrder(), ControllerType::kMpc, 0.3, true, DisturbanceModel::kInput},
+      {"mpc output", SecondOrder(), ControllerType::kMpc, 0.3, false, DisturbanceModel::kOutput},
+      {"mpc arx", PaperArxModel(), ControllerType::kMpc, fastest, true, DisturbanceModel::kInput},
+  };
+  for (const Design& d : designs) {
+    SCOPED_TRACE(d.name);
+    AutoTuneOptions o;
+    o.controller = d.type;
+    o.response_time = d.response_time;
+    o.disturbance = d.disturbance;
+    if (d.limited) {
+      o.limits.u_min = 0.0;
+      o.limits.u_max = 100.0;
+    }
+    const AutoTuneResult r = AutoTune(d.model, kTs, o);
+    ExpectCandidateIsMakeControllers(r, d.model, o);
+    // The limits bind during the evaluation step (so the constrained forms
+    // are tested): the input reaches u_max, 40 above the input before it.
+    if (d.limited) EXPECT_EQ(r.predicted.u_max, o.limits.u_max - 40.0) << "the limit does not bind";
+  }
+}
+
+// A design that has sampled its model passes it on: AutoTune of the
+// PredictionModel is AutoTune of the transfer function, and the factory's
+// rule auto designs with the tuner's P, M and lambda on the model it sampled.
+TEST(AutoTuneTest, OnTheSampledModelEqualsOnTheTransferFunction) {
+  for (ControllerType type : {ControllerType::kMpc, ControllerType::kDmc, ControllerType::kPid}) {
+    SCOPED_TRACE(ToString(type));
+    AutoTuneOptions o;
+    o.controller = type;
+    o.limits.u_min = 0.0;
+    o.limits.u_max = 100.0;
+    const AutoTuneResult own = AutoTune(SecondOrder(), kTs, o);
+    const PredictionModel sampled(SecondOrder(), kTs);
+    const AutoTuneResult shared = AutoTune(sampled, o);
+    EXPECT_EQ(own.ToJson().dump(), shared.ToJson().dump());
+    if (type == ControllerType::kPid) continue;
+    ControllerSpec spec;
+    spec.type = type;
+    spec.auto_tune = true;
+    spec.limits = o.limits;
+    const BuiltController built = MakeController(sampled, spec);
+    EXPECT_EQ(built.tuning.P, own.P);
+    EXPECT_EQ(built.tuning.M, own.M);
+    EXPECT_EQ(built.tuning.lambda, own.lambda);
+    EXPECT_EQ(built.auto_summary, own.message);
+  }
 }
 
 TEST(AutoTuneTest, JsonHasTheDocumentedKeys) {

@@ -292,6 +292,45 @@ TEST(MpcTest, TransferFunctionPathEqualsExplicitStateSpace) {
   EXPECT_LT(max_diff, 1e-9);
 }
 
+// An MPC from a design's sampled model (PredictionModel) is the MPC that
+// samples the transfer function itself: same matrices, same moves, for a
+// continuous model with a fractional delay and a discrete one with delay,
+// constrained and not.
+TEST(MpcTest, FromThePredictionModelEqualsFromTheTransferFunction) {
+  const TransferFunction models[] = {TransferFunction::Fopdt(1.6, 0.245, 0.001),
+                                     TransferFunction::Discrete({0.0, 0.1}, {1.0, -0.9}, kTs, 2)};
+  for (const TransferFunction& g : models) {
+    for (bool limited : {false, true}) {
+      SCOPED_TRACE(g.ToString() + (limited ? " limited" : ""));
+      MpcOptions o;
+      o.P = 60;
+      o.lambda = 0.5;
+      o.state_noise = 0.01;
+      if (limited) {
+        o.limits.u_min = -0.5;
+        o.limits.u_max = 0.8;
+      }
+      MpcController own(g, kTs, o);
+      MpcController shared(PredictionModel(g, kTs), o);
+      EXPECT_EQ(own.Az(), shared.Az());
+      EXPECT_EQ(own.Bz(), shared.Bz());
+      EXPECT_EQ(own.Cz(), shared.Cz());
+      EXPECT_EQ(own.kalman_gain(), shared.kalman_gain());
+      EXPECT_EQ(own.hessian(), shared.hessian());
+      EXPECT_EQ(own.constrained(), shared.constrained());
+      own.Reset(0.0, 0.0);
+      shared.Reset(0.0, 0.0);
+      double y = 0.0;
+      for (int k = 0; k < 200; ++k) {
+        const double r = k < 100 ? 1.0 : -0.3;
+        const double u_own = own.Update(r, y);
+        ASSERT_EQ(u_own, shared.Update(r, y)) << "k = " << k;
+        y = 0.93 * y + 0.1 * u_own;  // a plant other than the model
+      }
+    }
+  }
+}
+
 TEST(MpcTest, DiscreteTransferFunctionWithDelay) {
   // y(k) = 0.9 y(k-1) + 0.1 u(k-3): static gain 1, 3 samples of delay.
   const TransferFunction g = TransferFunction::Discrete({0.0, 0.1}, {1.0, -0.9}, kTs, 2);

@@ -2,7 +2,8 @@
 // zoh-sampled FOPDT, the dynamic matrix of the paper's tuning
 // (lambda_max(A'A)/500 = 2.250797, gen_dmc_reference.py), and one sampled
 // model serving tuning, DMC and GPC of a design with the results of the
-// designs that sampled the model themselves.
+// designs that sampled the model themselves; its state space is the MPC's
+// model (SampledStateSpace) from the same discretization.
 #include "pneumid/control/prediction_model.hpp"
 
 #include <cmath>
@@ -15,6 +16,7 @@
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/gpc.hpp"
+#include "pneumid/control/mpc.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/conversion.hpp"
 #include "pneumid/lti/model_io.hpp"
@@ -151,6 +153,37 @@ TEST(PredictionModelTest, FactoryDesignsFromOneSampledModel) {
   const BuiltController p = MakeController(pm, pid);
   EXPECT_EQ(p.fopdt.method, "exact");
   EXPECT_NEAR(p.fopdt.tau, 0.245, 1e-12);
+}
+
+// The one discretization of a design: the sampled state space is the zoh
+// discretization of the model's realization, its transfer function is
+// sampled() and, with the delay as states, it is the MPC's model
+// (SampledStateSpace), all to the last bit: a continuous model with a
+// fractional and with a whole-sample delay, and a discrete ARX with delay.
+TEST(PredictionModelTest, SampledStateSpaceIsTheOneDiscretization) {
+  const TransferFunction models[] = {
+      PaperFopdt(), TransferFunction::Sopdt(2.0, 0.4, 0.15, 0.03),
+      TransferFunction::Discrete({0.0, 0.1, 0.05}, {1.0, -1.2, 0.35}, kTs, 2)};
+  for (const TransferFunction& g : models) {
+    SCOPED_TRACE(g.ToString());
+    const PredictionModel pm(g, kTs);
+    const StateSpace& ss = pm.sampled_state_space();
+    EXPECT_EQ(ss.Ts(), kTs);
+    EXPECT_EQ(ss.delay(), pm.sampled().delay());
+    const TransferFunction expected_tf =
+        g.IsContinuous() ? C2D(g, kTs, DiscretizationMethod::kZoh) : g;
+    EXPECT_EQ(pm.sampled().num(), expected_tf.num());
+    EXPECT_EQ(pm.sampled().den(), expected_tf.den());
+    const StateSpace with_delay = DelayAsStates(ss);
+    const StateSpace mpc_model = SampledStateSpace(g, kTs);
+    EXPECT_EQ(with_delay.A(), mpc_model.A());
+    EXPECT_EQ(with_delay.B(), mpc_model.B());
+    EXPECT_EQ(with_delay.C(), mpc_model.C());
+    EXPECT_EQ(with_delay.D(), mpc_model.D());
+    EXPECT_EQ(with_delay.delay(), 0.0);
+    // The state space and the transfer function describe one model.
+    EXPECT_NEAR(ss.DcGain()(0, 0), pm.sampled().DcGain(), 1e-9 * std::abs(pm.sampled().DcGain()));
+  }
 }
 
 }  // namespace

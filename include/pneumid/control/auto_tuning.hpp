@@ -39,6 +39,10 @@
 //   lambda* = argmin_{lambda >= lambda_f} |ln(t(lambda) / t*)|, by bisection
 //             of log lambda on t(lambda) = t* (t grows with lambda) when
 //             t(lambda_f) < t*, else lambda_f (the fastest that is robust).
+// Each candidate is the controller MakeController (controller_factory.hpp)
+// builds for its P, M and lambda with the evaluation's input limits (dmc:
+// QDMC when a limit is finite; mpc: the disturbance model of the options),
+// designed on the model sampled once at Ts (PredictionModel).
 // Garriga and Soroush [4] review the rules; Maciejowski [3, ch. 7] the
 // trade-off that lambda sets between speed and robustness.
 //
@@ -88,6 +92,7 @@
 #include "pneumid/control/controller.hpp"
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
+#include "pneumid/control/prediction_model.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
@@ -155,7 +160,7 @@ struct PredictedMetrics {
 
 /// The evaluation step repeated on a perturbed plant (model error).
 struct RobustnessRow {
-  std::string name;  ///< "gain +20%", "gain -20%", "dead time +1 sample"
+  std::string name;          ///< "gain +20%", "gain -20%", "dead time +1 sample"
   PredictedMetrics metrics;  ///< step metrics on the perturbed plant
   /// The loop settles, overshoots at most OS_rob and responds within t_rob.
   bool pass = false;
@@ -163,7 +168,7 @@ struct RobustnessRow {
 
 /// One check of the design review.
 struct ReviewItem {
-  std::string check;  ///< e.g. "nominal stability"
+  std::string check;                        ///< e.g. "nominal stability"
   ReviewStatus status = ReviewStatus::kOk;  ///< ok, warning or fail
   std::string message;  ///< what was measured and, for a warning or fail, why it matters
 };
@@ -172,7 +177,7 @@ struct ReviewItem {
 /// behaviour, the robustness rows and the design review.
 struct AutoTuneResult {
   ControllerType controller = ControllerType::kMpc;  ///< the type designed (mpc, dmc or pid)
-  double Ts = 0.0;  ///< sample time of the design, s
+  double Ts = 0.0;                                   ///< sample time of the design, s
   /// mpc/dmc settings.
   int P = 0;
   int M = 0;  ///< control horizon, samples (mpc/dmc)
@@ -193,21 +198,21 @@ struct AutoTuneResult {
   /// mpc/dmc without a given response time: t_r = t* is the response time of
   /// the fastest robust design (JSON specification.response_time_source).
   bool fastest = false;
-  double response_time_aimed = 0.0;  ///< t* after the knob
+  double response_time_aimed = 0.0;                  ///< t* after the knob
   ResponseMeasure measure = ResponseMeasure::kRise;  ///< rise or settling time, as given
-  double max_overshoot = 0.0;   ///< OS, percent, as given
-  double aggressiveness = 0.0;  ///< a in [0, 1], as given
-  double robust_overshoot = 0.0;      ///< OS_rob
-  double robust_response_time = 0.0;  ///< t_rob
+  double max_overshoot = 0.0;                        ///< OS, percent, as given
+  double aggressiveness = 0.0;                       ///< a in [0, 1], as given
+  double robust_overshoot = 0.0;                     ///< OS_rob
+  double robust_response_time = 0.0;                 ///< t_rob
   FopdtEstimate fopdt;  ///< K, tau, theta of the model (FopdtFromModel)
   /// The evaluation step (deviation from the operating point at the start).
   double step_from = 0.0, step_to = 1.0;  ///< set-point after the step (output units)
-  PredictedMetrics predicted;  ///< nominal step metrics of the chosen settings
+  PredictedMetrics predicted;             ///< nominal step metrics of the chosen settings
   std::vector<RobustnessRow> robustness;  ///< gain +20 %, gain -20 %, dead time +1 sample
-  std::vector<ReviewItem> review;  ///< the checks of the design review (file comment)
+  std::vector<ReviewItem> review;         ///< the checks of the design review (file comment)
   double hessian_condition = std::numeric_limits<double>::quiet_NaN();   ///< mpc/dmc
   double steady_state_error = std::numeric_limits<double>::quiet_NaN();  ///< after the load step
-  int evaluations = 0;  ///< closed-loop simulations run
+  int evaluations = 0;                                              ///< closed-loop simulations run
   AutoTuneTermination termination = AutoTuneTermination::kFailure;  ///< see the review
   /// "specification met (N closed-loop simulations)", or the failed checks.
   std::string message;
@@ -232,5 +237,11 @@ struct AutoTuneResult {
 /// with another sample time, or a model FopdtFromModel rejects (unstable,
 /// zero static gain).
 AutoTuneResult AutoTune(const TransferFunction& model, double Ts, const AutoTuneOptions& options);
+/// AutoTune(model.model(), model.Ts(), options) on a model the design has
+/// sampled already: the mpc and dmc candidates are designed on `model`
+/// (its sampled transfer function and state space) instead of a second
+/// sampling, with the same result.
+/// @throws InvalidArgument as above.
+AutoTuneResult AutoTune(const PredictionModel& model, const AutoTuneOptions& options);
 
 }  // namespace pneumid

@@ -18,6 +18,11 @@
 //        soft output bounds (a QP whenever one is finite), the other options
 //        at their defaults (input disturbance model, Kalman noise R = 1,
 //        disturbance noise 1)
+//
+// A design samples its model once (PredictionModel): dmc, gpc, the tuning
+// rules and the mpc's state space all come from that one discretization, and
+// the auto-tuner (rule auto, auto_tuning.hpp) builds each candidate it
+// evaluates the way the dmc and mpc are built here, on that same model.
 #pragma once
 
 #include <limits>
@@ -197,9 +202,11 @@ struct BuiltController {
   nlohmann::ordered_json SettingsToJson() const;
 };
 
-/// Designs the controller from a sampled model (dmc and gpc use it as is; pid
-/// tunes from the FOPDT description of model.model(); mpc samples
-/// model.model() at model.Ts() as a state space, SampledStateSpace).
+/// Designs the controller from a sampled model (dmc and gpc use it as is; mpc
+/// its state space, model.sampled_state_space() with the delay as states,
+/// which equals SampledStateSpace(model.model(), model.Ts()); the rule auto
+/// tunes on it, AutoTune(model, ...), whose candidates are built as here; pid
+/// tunes from the FOPDT description of model.model()).
 /// @throws InvalidArgument for invalid settings (messages name the setting).
 BuiltController MakeController(const PredictionModel& model, const ControllerSpec& spec);
 /// dmc, gpc, mpc: MakeController(PredictionModel(model, Ts), spec), the

@@ -5,7 +5,9 @@
 // integrating (poles inside the unit circle and at z = 1); an
 // input delay of d samples becomes d states of a shift register
 // (DelayAsStates), a continuous transfer function with input delay is sampled
-// with an exact zero-order hold first (SampledStateSpace, lti/conversion.hpp):
+// with an exact zero-order hold first (SampledStateSpace, lti/conversion.hpp;
+// a design that has sampled its model already, PredictionModel, passes that
+// state space on):
 //   x+ = A x + B u,   y = C x.
 // Disturbance models [2, 3] (augmented state z = [x; d], d scalar):
 //   output:  x+ = A x + B u,        d+ = d + w_d,   y = C x + d + v
@@ -77,6 +79,7 @@
 
 #include "pneumid/control/controller.hpp"
 #include "pneumid/control/dare.hpp"
+#include "pneumid/control/prediction_model.hpp"
 #include "pneumid/control/qp_solver.hpp"
 #include "pneumid/lti/state_space.hpp"
 #include "pneumid/lti/transfer_function.hpp"
@@ -163,6 +166,13 @@ class MpcController : public Controller {
   /// @throws InvalidArgument as above, and for Ts <= 0 or a discrete model
   /// with another sample time.
   MpcController(const TransferFunction& model, double Ts, const MpcOptions& options);
+  /// Design from a model a design has sampled already: its state space
+  /// (PredictionModel::sampled_state_space) with the delay as states, the
+  /// same model as SampledStateSpace(model.model(), model.Ts()) without a
+  /// second discretization; the controller equals MpcController(model.model(),
+  /// model.Ts(), options).
+  /// @throws InvalidArgument as the design from a state space above.
+  MpcController(const PredictionModel& model, const MpcOptions& options);
   ~MpcController() override;
 
   double Ts() const override { return Ts_; }

@@ -4,7 +4,11 @@
 // A design samples its model once, at the controller's period Ts, and passes
 // the result down: a continuous model G(s) exp(-theta s) is discretized with
 // an exact zero-order hold (delay included, lti/conversion.hpp C2D), a
-// discrete one (e.g. ARX) is used at its own Ts. From the sampled model
+// discrete one (e.g. ARX) is used at its own Ts. The discretization is done
+// on the controllable canonical realization (ToStateSpace); that discrete
+// state space is kept (sampled_state_space(), the state-space MPC's model,
+// mpc.hpp) and the sampled transfer function is its transfer function, as
+// C2D of the transfer function computes it. From the sampled model
 //   b(q^-1) / a(q^-1) q^-d
 // follow
 //   * the unit step-response coefficients s_0..s_n, s_i = y(i Ts) for u = 1
@@ -27,6 +31,7 @@
 
 #include <Eigen/Core>
 
+#include "pneumid/lti/state_space.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
@@ -46,6 +51,14 @@ class PredictionModel {
   const TransferFunction& model() const { return model_; }
   /// The model sampled at Ts (discrete).
   const TransferFunction& sampled() const { return sampled_; }
+  /// The model sampled at Ts as a discrete state space, its delay a whole
+  /// number of samples of input delay: the zoh discretization of the
+  /// controllable canonical realization of a continuous model (sampled() is
+  /// its transfer function), the realization of a discrete one. With the
+  /// delay as states (DelayAsStates, mpc.hpp) it equals SampledStateSpace(
+  /// model(), Ts()) exactly: the MPC of a design uses it instead of sampling
+  /// the model again.
+  const StateSpace& sampled_state_space() const { return sampled_state_space_; }
   /// Controller sample time (s).
   double Ts() const { return Ts_; }
   /// Stability of the sampled model (poles inside the unit circle).
@@ -64,6 +77,7 @@ class PredictionModel {
 
  private:
   TransferFunction model_;
+  StateSpace sampled_state_space_;
   TransferFunction sampled_;
   double Ts_ = 0.0;
 };
