@@ -166,10 +166,13 @@ struct CommissionExperiment {
   /// Peak-to-peak output at rest (the last 80 % of the first second): the
   /// sensor's noise, the floor of the ripple criterion.
   double noise_peak_to_peak = 0.0;
+  /// Standard deviation of the output at rest (the same samples): the MPC's
+  /// Kalman filter takes its square as the measurement noise variance.
+  double noise_std = 0.0;
   double dwell = 0.0;                     ///< s per excitation level
   std::vector<double> estimation_levels;  ///< inputs of the estimation sequence
   std::vector<double> validation_levels;  ///< inputs of the held-out sequence
-  /// {duration, samples, probe, sweep, range, noise_peak_to_peak, dwell,
+  /// {duration, samples, probe, sweep, range, noise_peak_to_peak, noise_std, dwell,
   /// estimation_levels, validation_levels, estimation_samples, validation_samples}.
   nlohmann::ordered_json ToJson() const;
 };
