@@ -135,14 +135,6 @@ void PrintSummary(const CommissionResult& r, const std::string& dir) {
   std::cout << fmt::format("plant time {:.1f} s; files in {}\n", r.plant_time, dir);
 }
 
-// The loop period on a PWM actuator: the PWM period, or the smallest multiple
-// of it that is at least 3 ms (a faster PWM would give MPC horizons of
-// hundreds of samples for no gain).
-double PwmLoopPeriod(double pwm_frequency) {
-  const double T = 1.0 / pwm_frequency;
-  return std::ceil(0.003 / T - 1e-9) * T;
-}
-
 void Run(CommissionArgs& c) {
   PNEUMID_CHECK(c.Ts > 0.0 && std::isfinite(c.Ts), "--Ts must be positive, got {}", c.Ts);
   CommissionOptions& o = c.options;
@@ -255,8 +247,10 @@ const Registrar reg(
           ->capture_default_str();
       app.add_option("--plant-config", c->plant_config,
                      "IPA parameter file (TOML, see config/ipa_default.toml)");
-      c->ts_option = AddSampleTimeOption(
-          app, c->Ts, "Sample period in s (default 0.01; an IPA: its PWM period, or the smallest multiple of it of at least 3 ms)");
+      c->ts_option =
+          AddSampleTimeOption(app, c->Ts,
+                              "Sample period in s (default 0.01; an IPA: its PWM period, or the "
+                              "smallest multiple of it of at least 3 ms)");
       app.add_option("--range", c->range,
                      "Output range LO:HI the controller must serve (default: the reachable "
                      "range found by the sweep, less 5 % at each end)");

@@ -916,6 +916,13 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   return r;
 }
 
+double PwmLoopPeriod(double pwm_frequency) {
+  PNEUMID_CHECK(std::isfinite(pwm_frequency) && pwm_frequency > 0.0,
+                "PWM frequency must be finite and positive, got {} Hz", pwm_frequency);
+  const double T = 1.0 / pwm_frequency;
+  return std::ceil(0.003 / T - 1e-9) * T;
+}
+
 void SetInputGaps(CommissionOptions& options, const Plant& plant, const std::string& text) {
   if (text == "plant") return;
   if (text == "none") {

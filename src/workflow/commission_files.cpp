@@ -51,8 +51,7 @@ void WriteControllerToml(const std::string& path, const CommissionResult& r,
     out << "rule = \"auto\"\n"
         << fmt::format("overshoot = {}\n", s.overshoot)
         << fmt::format("aggressiveness = {}\n", s.aggressiveness);
-    if (std::isfinite(s.response_time))
-      out << fmt::format("response_time = {}\n", s.response_time);
+    if (std::isfinite(s.response_time)) out << fmt::format("response_time = {}\n", s.response_time);
   } else {  // a PD designed on an integrating model: its gains
     out << fmt::format("Kc = {}\nTd = {}\n", s.pid_kc, s.pid_td);
   }
