@@ -38,6 +38,8 @@ VARIANTS = {
     "dead volume -20 %": {"dead_volume_a": 0.8, "dead_volume_b": 0.8},
     "supply 0.5 MPa": {"pressure": ("=", 0.5e6)},
     "sensor filter 0 s": {"pressure_filter_time_constant": ("=", 0.0)},
+    "sensor filter 0.05 s": {"pressure_filter_time_constant": ("=", 0.05)},
+    "sensor filter 0.1 s": {"pressure_filter_time_constant": ("=", 0.1)},
     "sensor filter 0.25 s": {"pressure_filter_time_constant": ("=", 0.25)},
     "delay 1 sample": {"transport_delay_samples": ("=", 1)},
     "chamber-lag twin": "config/ipa_chamber_lag.toml",
@@ -79,7 +81,16 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("pneumid")
     ap.add_argument("--only", default="")
+    ap.add_argument("--scenario", default="",
+                    help="another scenario for control --config and the DMC, e.g. "
+                         "\"--setpoint staircase:levels=30 140 70,dwell=1.5 --duration 4.5\"")
+    ap.add_argument("--extra", default="",
+                    help="extra arguments for commission, e.g. \"--Ts 0.005\"")
     args = ap.parse_args()
+    scenario = args.scenario.split(" --") if args.scenario else []
+    scenario = SCENARIO if not scenario else [
+        a for i, s in enumerate(scenario)
+        for a in (("--" if i else "") + s).split(" ", 1)]
     print("| twin | chosen model | worst overshoot % | slowest settling s | ripple % (>= 20 N) "
           "| max abs sse N | IAE / DMC | commission wall s | plant time s | verdict |")
     print("|---|---|---|---|---|---|---|---|---|---|")
@@ -93,7 +104,8 @@ def main():
             write_variant(spec, toml)
             start = time.monotonic()
             c = subprocess.run([args.pneumid, "commission", "--plant", "ipa", "--plant-config",
-                                str(toml), "-o", str(work / "c"), "--json"],
+                                str(toml), "-o", str(work / "c"), "--json",
+                                *args.extra.split()],
                                capture_output=True, text=True)
             wall = time.monotonic() - start
             if c.returncode not in (0, 4):
@@ -101,11 +113,11 @@ def main():
                 continue
             cj = json.loads(c.stdout)
             run = subprocess.run([args.pneumid, "control", "--config",
-                                  str(work / "c" / "controller.toml"), *SCENARIO, "--json"],
+                                  str(work / "c" / "controller.toml"), *scenario, "--json"],
                                  capture_output=True, text=True, check=True)
             dmc = subprocess.run([args.pneumid, "control", "--controller", "dmc", "--model",
                                   "fopdt-paper", "--rule", "shridhar-cooper", "--plant",
-                                  f"ipa:config={toml}", *SCENARIO, "--json"],
+                                  f"ipa:config={toml}", *scenario, "--json"],
                                  capture_output=True, text=True, check=True)
             m = metrics(json.loads(run.stdout))
             iae_dmc = json.loads(dmc.stdout)["iae"]

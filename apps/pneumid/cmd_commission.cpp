@@ -153,16 +153,17 @@ void Run(CommissionArgs& c) {
     plant = MakePlant(c.plant, c.Ts, po);
     PNEUMID_CHECK(c.plant_config.empty() || dynamic_cast<IpaSimulator*>(plant.get()),
                   "--plant-config applies to the ipa plant only, not to '{}'", c.plant);
-    // A position loop samples once per PWM period: the valves' fastest action
-    // (docs/position.md).
+    // An IPA loop samples once per PWM period, the valves' fastest action
+    // (docs/position.md, docs/commission.md): the duty modulation across the
+    // valves' gaps then alternates per period, not per 10 ms.
     const auto* ipa = dynamic_cast<IpaSimulator*>(plant.get());
     if (ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition) {
       o.overshoot = 2.0;  // docs/position.md's targets, unless --spec says otherwise
       o.settling = 1.0;
-      if (c.ts_option->count() == 0) {
-        c.Ts = 1.0 / ipa->parameters().pwm_frequency;
-        plant = MakePlant(c.plant, c.Ts, po);
-      }
+    }
+    if (ipa != nullptr && c.ts_option->count() == 0) {
+      c.Ts = PwmLoopPeriod(ipa->parameters().pwm_frequency);
+      plant = MakePlant(c.plant, c.Ts, po);
     }
   } else {
     PNEUMID_CHECK(!c.fast || io.kind == IoKind::kUdp,
@@ -246,8 +247,10 @@ const Registrar reg(
           ->capture_default_str();
       app.add_option("--plant-config", c->plant_config,
                      "IPA parameter file (TOML, see config/ipa_default.toml)");
-      c->ts_option = AddSampleTimeOption(
-          app, c->Ts, "Sample period in s (default 0.01; an IPA in position mode: the PWM period)");
+      c->ts_option =
+          AddSampleTimeOption(app, c->Ts,
+                              "Sample period in s (default 0.01; an IPA: its PWM period, or the "
+                              "smallest multiple of it of at least 3 ms)");
       app.add_option("--range", c->range,
                      "Output range LO:HI the controller must serve (default: the reachable "
                      "range found by the sweep, less 5 % at each end)");

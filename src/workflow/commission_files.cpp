@@ -51,11 +51,14 @@ void WriteControllerToml(const std::string& path, const CommissionResult& r,
     out << "rule = \"auto\"\n"
         << fmt::format("overshoot = {}\n", s.overshoot)
         << fmt::format("aggressiveness = {}\n", s.aggressiveness);
+    if (std::isfinite(s.response_time)) out << fmt::format("response_time = {}\n", s.response_time);
   } else {  // a PD designed on an integrating model: its gains
     out << fmt::format("Kc = {}\nTd = {}\n", s.pid_kc, s.pid_td);
   }
   out << fmt::format("u_min = {}\nu_max = {}\n", s.limits.u_min, s.limits.u_max);
   if (!s.input_gaps.empty()) out << "input_gaps = " << TomlString(s.input_gaps) << "\n";
+  if (std::isfinite(s.measurement_noise))
+    out << fmt::format("measurement_noise = {}\n", s.measurement_noise);
   out << "\n[loop]\n"
       << fmt::format("period = {}\n", o.Ts)
       << fmt::format("duration = {}\n\n", r.attempts.back().result.t.size() * o.Ts);

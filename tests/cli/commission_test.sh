@@ -44,7 +44,13 @@ assert fits[j["chosen_model"]] > 90.0, fits
 # aggressiveness).
 assert v["overshoot_percent"] <= 5.0, v["overshoot_percent"]
 assert len(j["attempts"]) == 1, [a["aggressiveness"] for a in j["attempts"]]
+# The MPC's measurement noise is the noise measured at rest.
+assert 0.03 < e["noise_std"] < 0.15, e["noise_std"]
 PYEOF
+# One sample per PWM period (300 Hz), and the Kalman filter's measurement
+# variance in the configuration.
+grep -q '^period = 0.00333333' "$TMP/c/controller.toml" || fail "controller.toml: period $(grep period "$TMP/c/controller.toml")"
+grep -q '^measurement_noise = 0.00' "$TMP/c/controller.toml" || fail "controller.toml: no measurement_noise"
 
 # The configuration runs as written: control, codegen and run.
 "$PNEUMID" control --config "$TMP/c/controller.toml" --setpoint "staircase:levels=10 50 100 150 180 120 60 10,dwell=2" \

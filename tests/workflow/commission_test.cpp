@@ -86,6 +86,32 @@ TEST(Commission, TheProbeMeasuresAFirstOrderPlantWithDeadTime) {
   EXPECT_TRUE(j["experiment"].contains("duration"));
 }
 
+TEST(Commission, TheMpcWeighsTheMeasurementByTheNoiseMeasuredAtRest) {
+  // A noisy linear plant: the Kalman filter's measurement variance is the
+  // square of the output's standard deviation at rest, not the default 1.
+  PlantOptions po;
+  po.noise_sigma = 0.05;
+  auto plant = MakePlant("fopdt:K=2,tau=0.5,theta=0.1", 0.01, po);
+  CommissionOptions o = Options("fopdt-noise");
+  o.range_min = 2.0;
+  o.range_max = 18.0;
+  o.settling = 2.0;
+  o.controller = "mpc";
+  const CommissionResult r = Commission(*plant, o);
+  EXPECT_NEAR(r.experiment.noise_std, 0.05, 0.015);
+  EXPECT_NEAR(r.settings.measurement_noise, r.experiment.noise_std * r.experiment.noise_std, 1e-12);
+  EXPECT_DOUBLE_EQ(r.ToJson()["experiment"]["noise_std"].get<double>(), r.experiment.noise_std);
+}
+
+TEST(Commission, ThePwmLoopPeriodIsAWholeNumberOfPwmPeriodsOfAtLeast3Ms) {
+  EXPECT_DOUBLE_EQ(PwmLoopPeriod(300.0), 1.0 / 300.0);  // the IPA: one period
+  EXPECT_DOUBLE_EQ(PwmLoopPeriod(50.0), 0.02);
+  EXPECT_NEAR(PwmLoopPeriod(1000.0), 0.003, 1e-15);  // three periods
+  EXPECT_NEAR(PwmLoopPeriod(400.0), 0.005, 1e-15);   // two periods of 2.5 ms
+  EXPECT_THROW(PwmLoopPeriod(0.0), InvalidArgument);
+  EXPECT_THROW(PwmLoopPeriod(std::nan("")), InvalidArgument);
+}
+
 TEST(Commission, APlantThatDoesNotRespondIsNamed) {
   TestPlant plant(0.0, false);
   const CommissionResult r = Commission(plant, Options("dead"));
