@@ -460,6 +460,27 @@ bool IdentifyAndSave(CommissionResult& r, const CommissionOptions& o, double Ts)
 
 // Stage 5: the best-ranked model a controller can be built from with
 // `settings`. False (with r.message) when there is none.
+// The settings a design runs with. A GPC has no tuning to specifications of
+// its own: it takes the horizons and move suppression the auto-tuner finds
+// for a DMC on the same model and specification, with the T filter A (the
+// model's denominator, the DMC's disturbance model), and the verification
+// judges it as it runs. The other controllers run their settings as given.
+ControllerSettings DesignSettings(const ControllerSettings& s, const TransferFunction& model,
+                                  double Ts, const std::string& spec) {
+  if (s.controller != "gpc" || s.rule != "auto") return s;
+  ControllerSettings dmc = s;
+  dmc.controller = "dmc";
+  const BuiltController b =
+      MakeController(model, Ts, WithModelInputMap(ToControllerSpec(dmc), spec));
+  ControllerSettings g = s;
+  g.rule = "explicit";
+  g.P = b.tuning.P;
+  g.M = b.tuning.M;
+  g.lambda = b.tuning.lambda;
+  g.t_filter = "A";
+  return g;
+}
+
 bool ChooseModel(CommissionResult& r, const CommissionOptions& o,
                  const ControllerSettings& settings, double Ts, TransferFunction* model) {
   std::vector<std::string> skipped;
@@ -467,7 +488,9 @@ bool ChooseModel(CommissionResult& r, const CommissionOptions& o,
     const std::string spec = r.model_file + "#" + m.method;
     try {
       *model = ParseControllerModel(spec);
-      (void)MakeController(*model, Ts, WithModelInputMap(ToControllerSpec(settings), spec));
+      (void)MakeController(
+          *model, Ts,
+          WithModelInputMap(ToControllerSpec(DesignSettings(settings, *model, Ts, spec)), spec));
       r.chosen_model = m.method;
       r.controller_model = spec;
       r.chosen_reason = fmt::format(
@@ -525,8 +548,9 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     }
     CommissionAttempt a;
     a.aggressiveness = settings.aggressiveness;
-    BuiltController built = MakeController(
-        model, Ts, WithModelInputMap(ToControllerSpec(settings), r.controller_model));
+    const ControllerSettings design = DesignSettings(settings, model, Ts, r.controller_model);
+    BuiltController built =
+        MakeController(model, Ts, WithModelInputMap(ToControllerSpec(design), r.controller_model));
     a.design = built.Summary();
     a.settings = built.SettingsToJson();
     a.result = SimulateClosedLoop(*built.controller, plant, *setpoint, cl);
@@ -535,8 +559,8 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     a.failures = Judge(a.result.metrics, o, range, ex.noise_peak_to_peak, sse_share);
     a.passed = a.failures.empty();
     r.attempts.push_back(std::move(a));
-    tried.push_back(settings);
-    r.settings = settings;
+    tried.push_back(design);
+    r.settings = design;
     const bool overshoot_failed = std::any_of(
         r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
         [&](const std::string& f) {

@@ -47,7 +47,11 @@ void WriteControllerToml(const std::string& path, const CommissionResult& r,
   out << "[controller]\n"
       << "model = " << TomlString(ModelReference(r.controller_model)) << "\n"
       << "type = " << TomlString(s.controller) << "\n";
-  if (std::isnan(s.pid_kc)) {
+  if (s.rule == "explicit") {  // a GPC: the horizons and lambda of the DMC's auto design
+    out << "rule = \"explicit\"\n"
+        << fmt::format("P = {}\nM = {}\nlambda = {}\n", s.P, s.M, s.lambda)
+        << "t_filter = " << TomlString(s.t_filter) << "\n";
+  } else if (std::isnan(s.pid_kc)) {
     out << "rule = \"auto\"\n"
         << fmt::format("overshoot = {}\n", s.overshoot)
         << fmt::format("aggressiveness = {}\n", s.aggressiveness);

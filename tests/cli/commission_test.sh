@@ -93,6 +93,24 @@ rc=$?
 $PY -c 'import json,sys; j=json.load(open(sys.argv[1])); assert j["verification"]["steps"], j' "$TMP/v.json" \
   || fail "variant JSON"
 
+# A GPC has no tuning to specifications of its own: it runs the horizons and
+# move suppression of the DMC's auto design with the T filter A, written
+# explicitly, and its configuration runs as written.
+"$PNEUMID" commission --plant ipa --controller gpc -o "$TMP/g" --json > "$TMP/g.json"
+rc=$?
+[ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission --controller gpc exited $rc"
+for k in 'type = "gpc"' 'rule = "explicit"' 't_filter = "A"' '^P = ' '^lambda = '; do
+  grep -q "$k" "$TMP/g/controller.toml" || fail "gpc controller.toml: no '$k'"
+done
+"$PNEUMID" control --config "$TMP/g/controller.toml" --setpoint "staircase:levels=20 120 60,dwell=1.5" \
+  --duration 4.5 --json > "$TMP/gctl.json" || fail "control --config (gpc)"
+$PY - "$TMP/gctl.json" <<'PYEOF' || fail "gpc control metrics"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["controller"].startswith("gpc"), j["controller"]
+assert j["overshoot_percent"] < 10.0 and j["settled"], (j["overshoot_percent"], j["settled"])
+PYEOF
+
 # Errors: a range out of reach names the reachable one; a short budget says what it needs.
 out=$("$PNEUMID" commission --plant ipa --range 10:400 -o "$TMP/e1" 2>&1)
 [ $? -eq 1 ] || fail "unreachable range: exit status"
