@@ -297,7 +297,8 @@ struct ChosenDesign {
 struct PredictiveControllerFactory {
   const PredictionModel* model = nullptr;  // sampled once for the design
   /// type, the explicit rule with P and M, the deviation limits, dmc:
-  /// constrained, mpc: the disturbance model; lambda set by Make.
+  /// constrained, mpc: the disturbance model and the noise variances; lambda
+  /// set by Make.
   ControllerSpec spec;
 
   std::unique_ptr<Controller> Make(double lambda) const {
@@ -450,11 +451,14 @@ ChosenDesign SearchPredictiveDesign(const PredictionModel& model, const AutoTune
   spec.tuning.P = base.P;
   spec.tuning.M = base.M;
   spec.limits = evaluator.limits;
-  // DMC optimizes its moves under the limits (QDMC); the MPC does whenever a
-  // limit is finite.
+  // DMC optimizes its moves under the limits (QDMC), as the rule auto of
+  // MakeController deploys it; the MPC does whenever a limit is finite.
   spec.constrained = spec.type == ControllerType::kDmc &&
-                     (Finite(evaluator.limits) || std::isfinite(evaluator.limits.du_max));
+                     internal::AutoTunedDmcIsConstrained(evaluator.limits, options.constrained);
   spec.disturbance = options.disturbance;
+  spec.measurement_noise = options.measurement_noise;
+  spec.state_noise = options.state_noise;
+  spec.disturbance_noise = options.disturbance_noise;
 
   LambdaCandidates candidates(*factory, evaluator, options.max_overshoot, result.robust_overshoot);
   ChosenDesign chosen;
@@ -940,6 +944,16 @@ bool AutoTuneOptions::IsValid(std::string* error) const {
   if (limits.u_min == limits.u_max)
     return fail(fmt::format("input limits leave no range: u_min = u_max = {}", limits.u_min));
   if (M < 0) return fail(fmt::format("M must be >= 0 (0 = 5), got {}", M));
+  if (controller == ControllerType::kMpc) {
+    // The estimator's noises as the MPC checks them (NaN = its defaults; the
+    // other options at their defaults pass).
+    MpcOptions mpc;
+    mpc.disturbance = disturbance;
+    if (!std::isnan(measurement_noise)) mpc.measurement_noise = measurement_noise;
+    if (!std::isnan(state_noise)) mpc.state_noise = state_noise;
+    if (!std::isnan(disturbance_noise)) mpc.disturbance_noise = disturbance_noise;
+    if (!mpc.IsValid(&e)) return fail(e);
+  }
   return true;
 }
 

@@ -230,6 +230,11 @@ BuiltController internal::MakePredictiveController(const PredictionModel& model,
   return b;
 }
 
+bool internal::AutoTunedDmcIsConstrained(const InputLimits& limits, bool constrained) {
+  return constrained || std::isfinite(limits.u_min) || std::isfinite(limits.u_max) ||
+         std::isfinite(limits.du_max);
+}
+
 namespace {
 
 BuiltController BuildController(const TransferFunction& model, double Ts,
@@ -288,24 +293,32 @@ double VelocityGain(const TransferFunction& model) {
   return b.sum() / (da * model.Ts());
 }
 
-// The spec's tuning replaced by the auto-tuner's design (rule "auto").
-AutoTuneResult AutoTuned(const TransferFunction& model, double Ts, const ControllerSpec& spec) {
+// The auto-tuner's specification of `spec`: auto_options with the options
+// of the controller that will run (type, limits, dmc: the constrained form,
+// mpc: the disturbance model and the Kalman filter's noises), so that its
+// candidates are that controller.
+AutoTuneOptions AutoTuneOptionsOf(const ControllerSpec& spec) {
   PNEUMID_CHECK(spec.type != ControllerType::kGpc,
                 "--rule auto tunes mpc, dmc and pid; for gpc give a tuning rule");
   AutoTuneOptions o = spec.auto_options;
   o.controller = spec.type;
   o.limits = spec.limits;
-  return AutoTune(model, Ts, o);
+  o.constrained = spec.constrained;
+  o.disturbance = spec.disturbance;
+  o.measurement_noise = spec.measurement_noise;
+  o.state_noise = spec.state_noise;
+  o.disturbance_noise = spec.disturbance_noise;
+  return o;
+}
+
+// The spec's tuning replaced by the auto-tuner's design (rule "auto").
+AutoTuneResult AutoTuned(const TransferFunction& model, double Ts, const ControllerSpec& spec) {
+  return AutoTune(model, Ts, AutoTuneOptionsOf(spec));
 }
 
 // The same on the design's sampled model (mpc, dmc: no second sampling).
 AutoTuneResult AutoTuned(const PredictionModel& model, const ControllerSpec& spec) {
-  PNEUMID_CHECK(spec.type != ControllerType::kGpc,
-                "--rule auto tunes mpc, dmc and pid; for gpc give a tuning rule");
-  AutoTuneOptions o = spec.auto_options;
-  o.controller = spec.type;
-  o.limits = spec.limits;
-  return AutoTune(model, o);
+  return AutoTune(model, AutoTuneOptionsOf(spec));
 }
 
 }  // namespace
@@ -452,7 +465,9 @@ BuiltController BuildController(const PredictionModel& model, const ControllerSp
     return BuildController(model.model(), model.Ts(), spec_in);
   if (!spec_in.auto_tune) return internal::MakePredictiveController(model, spec_in);
   // The rule auto: the auto-tuner's P, M and lambda as explicit settings, on
-  // the same sampled model; its candidates were built by the same function.
+  // the same sampled model; its candidates were built by the same function
+  // with the same options: a dmc with a finite limit is the QDMC the tuner
+  // evaluated, not a clipping dmc.
   const AutoTuneResult a = AutoTuned(model, spec_in);
   ControllerSpec spec = spec_in;
   spec.auto_tune = false;
@@ -460,9 +475,15 @@ BuiltController BuildController(const PredictionModel& model, const ControllerSp
   spec.tuning.P = a.P;
   spec.tuning.M = a.M;
   spec.tuning.lambda = a.lambda;
+  const bool qdmc_for_limits = spec.type == ControllerType::kDmc && !spec.constrained &&
+                               internal::AutoTunedDmcIsConstrained(spec.limits, spec.constrained);
+  if (qdmc_for_limits) spec.constrained = true;
   BuiltController b = internal::MakePredictiveController(model, spec);
   b.auto_summary = a.message;
   b.tuning = a.ToTuningResult();
+  if (qdmc_for_limits)
+    b.tuning.formula +=
+        "; QDMC (moves optimized under the input limits), as the tuner evaluated it";
   return b;
 }
 

@@ -6,7 +6,10 @@
 // auto-tuner builds each candidate of its lambda search with it. So the
 // controllers the auto-tuner evaluates are the ones MakeController builds
 // for the same P, M and lambda, designed on the same sampled model
-// (PredictionModel, which also holds the state space of the mpc).
+// (PredictionModel, which also holds the state space of the mpc), and the
+// factory's rule auto deploys the tuned settings with the same options: the
+// constrained form of the dmc (AutoTunedDmcIsConstrained) and the mpc's
+// disturbance model and noise variances.
 #pragma once
 
 #include "pneumid/control/controller_factory.hpp"
@@ -24,5 +27,11 @@ namespace pneumid::internal {
 // @throws InvalidArgument for a pid or auto_tune spec, and for settings the
 // tuning or the controller rejects (messages name the setting).
 BuiltController MakePredictiveController(const PredictionModel& model, const ControllerSpec& spec);
+
+// Whether a dmc tuned by the rule auto is a QDMC: when any limit of `limits`
+// (u_min, u_max, du_max) is finite, or when `constrained` asks for it. The
+// auto-tuner evaluates its candidates so and the factory deploys the tuned
+// dmc so (a clipping dmc would not be the controller the tuner checked).
+bool AutoTunedDmcIsConstrained(const InputLimits& limits, bool constrained);
 
 }  // namespace pneumid::internal

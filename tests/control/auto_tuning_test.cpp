@@ -7,6 +7,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <map>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -319,15 +320,16 @@ void ExpectSameMetrics(const ClosedLoopMetrics& loop, const PredictedMetrics& tu
 }
 
 // The tuner's evaluation of its chosen candidate run again on the controller
-// MakeController builds for the reported P, M and lambda (as `pneumid
-// control` builds it): the loop of auto_tuning.cpp (the step of the result
-// at 5 Ts in deviation variables from the input before it, limits relative
-// to that input, the window max(10 max(t*, tau + theta), 50 Ts) after the
-// step with t* before the fastest design replaced it, exact-zoh plants), on
-// the nominal plant, each robustness row and the load step. The metrics
-// agree to the last bit only when the tuner's candidate is that controller:
-// same type, constrained form (QDMC under limits), disturbance model and
-// sampled model.
+// MakeController builds for the reported P, M and lambda, and on the one its
+// rule auto deploys for the same specification (as `pneumid control --rule
+// auto` builds it): the loop of auto_tuning.cpp (the step of the result at
+// 5 Ts in deviation variables from the input before it, limits relative to
+// that input, the window max(10 max(t*, tau + theta), 50 Ts) after the step
+// with t* before the fastest design replaced it, exact-zoh plants), on the
+// nominal plant, each robustness row and the load step. The metrics agree
+// to the last bit only when the tuner's candidate is that controller: same
+// type, constrained form (QDMC under limits), disturbance model, Kalman
+// noises and sampled model.
 void ExpectCandidateIsMakeControllers(const AutoTuneResult& r, const TransferFunction& model,
                                       const AutoTuneOptions& o) {
   SCOPED_TRACE(Describe(r));
@@ -347,6 +349,31 @@ void ExpectCandidateIsMakeControllers(const AutoTuneResult& r, const TransferFun
   spec.limits.u_max -= u_before;
   spec.constrained = r.controller == ControllerType::kDmc && limited;
   spec.disturbance = o.disturbance;
+  spec.measurement_noise = o.measurement_noise;
+  spec.state_noise = o.state_noise;
+  spec.disturbance_noise = o.disturbance_noise;
+  // What the rule auto deploys for the specification, in the same deviation
+  // variables (the evaluation does not depend on where the limits lie, only
+  // on the input before the step: the tuner finds the same design): the
+  // factory alone decides the constrained form and passes on the noises.
+  ControllerSpec deployed;
+  deployed.type = r.controller;
+  deployed.auto_tune = true;
+  deployed.auto_options = o;
+  deployed.limits = spec.limits;
+  deployed.disturbance = o.disturbance;
+  deployed.measurement_noise = o.measurement_noise;
+  deployed.state_noise = o.state_noise;
+  deployed.disturbance_noise = o.disturbance_noise;
+  {
+    const BuiltController candidate = MakeController(model, kTs, spec);
+    const BuiltController auto_built = MakeController(model, kTs, deployed);
+    EXPECT_EQ(auto_built.tuning.lambda, r.lambda);
+    EXPECT_EQ(auto_built.controller->Describe(), candidate.controller->Describe());
+    // A dmc tuned under limits runs as the QDMC it was evaluated as.
+    EXPECT_EQ(auto_built.controller->Describe().find(" constrained") != std::string::npos, limited)
+        << auto_built.controller->Describe();
+  }
   const double t_given =
       std::isnan(o.response_time) ? r.fopdt.tau + r.fopdt.theta : o.response_time;
   const double t_aim_before = t_given * std::pow(1.5, 1.0 - 2.0 * o.aggressiveness);
@@ -358,29 +385,36 @@ void ExpectCandidateIsMakeControllers(const AutoTuneResult& r, const TransferFun
       model, TransferFunction(model.num() * 1.2, model.den(), ts_model, model.delay()),
       TransferFunction(model.num() * 0.8, model.den(), ts_model, model.delay()),
       model.WithDelay(model.delay() + kTs)};
-  auto run = [&](const TransferFunction& plant_model, double setpoint, double load) {
-    const BuiltController built = MakeController(model, kTs, spec);
-    EXPECT_EQ(built.tuning.lambda, r.lambda);
-    LinearPlant plant(plant_model, kTs);
-    ClosedLoopOptions lo;
-    lo.duration = t_step + window;
-    lo.actuator = spec.limits;
-    if (load != 0.0) lo.load_steps = {{t_step, load}};
-    return SimulateClosedLoop(*built.controller, plant, DeviationStep(setpoint, t_step), lo);
-  };
-  ExpectSameMetrics(run(plants[0], step, 0.0).metrics, r.predicted);
-  ASSERT_EQ(r.robustness.size(), 3u);
-  for (int i = 1; i < 4; ++i) {
-    SCOPED_TRACE(r.robustness[i - 1].name);
-    ExpectSameMetrics(run(plants[i], step, 0.0).metrics, r.robustness[i - 1].metrics);
+  for (const ControllerSpec* s : {&spec, &deployed}) {
+    SCOPED_TRACE(s->auto_tune ? "deployed by the rule auto" : "built for P, M, lambda");
+    // A new controller for each loop, as the tuner runs each from rest.
+    auto run = [&](const TransferFunction& plant_model, double setpoint, double load) {
+      const BuiltController built = MakeController(model, kTs, *s);
+      EXPECT_EQ(built.tuning.lambda, r.lambda);
+      LinearPlant plant(plant_model, kTs);
+      ClosedLoopOptions lo;
+      lo.duration = t_step + window;
+      lo.actuator = spec.limits;
+      if (load != 0.0) lo.load_steps = {{t_step, load}};
+      return SimulateClosedLoop(*built.controller, plant, DeviationStep(setpoint, t_step), lo);
+    };
+    ExpectSameMetrics(run(plants[0], step, 0.0).metrics, r.predicted);
+    ASSERT_EQ(r.robustness.size(), 3u);
+    for (int i = 1; i < 4; ++i) {
+      SCOPED_TRACE(r.robustness[i - 1].name);
+      ExpectSameMetrics(run(plants[i], step, 0.0).metrics, r.robustness[i - 1].metrics);
+    }
+    EXPECT_EQ(run(plants[0], 0.0, -0.2 * step).metrics.steady_state_error, r.steady_state_error);
   }
-  EXPECT_EQ(run(plants[0], 0.0, -0.2 * step).metrics.steady_state_error, r.steady_state_error);
 }
 
 // The candidates the tuner evaluates are MakeController's controllers for
-// their P, M and lambda: mpc and dmc, with and without input limits (the
-// limits make the dmc a QDMC and the mpc solve its QP during the step), the
-// output disturbance model, and a discrete ARX model.
+// their P, M and lambda, and the controllers its rule auto deploys: mpc and
+// dmc, with and without input limits (the limits make the dmc a QDMC, also
+// when deployed without `constrained`, and the mpc solve its QP during the
+// step), the output disturbance model, the Kalman filter's noises given
+// (the tuner evaluates them: a measurement noise of 0.003 changes lambda),
+// and a discrete ARX model.
 TEST(AutoTuneTest, CandidatesAreTheControllersMakeControllerBuilds) {
   struct Design {
     const char* name;
@@ -389,32 +423,55 @@ TEST(AutoTuneTest, CandidatesAreTheControllersMakeControllerBuilds) {
     double response_time;
     bool limited;
     DisturbanceModel disturbance;
+    // mpc: measurement, state and disturbance noise variances (NaN = default).
+    double R = std::numeric_limits<double>::quiet_NaN();
+    double Qx = std::numeric_limits<double>::quiet_NaN();
+    double Qd = std::numeric_limits<double>::quiet_NaN();
   };
   const double fastest = std::numeric_limits<double>::quiet_NaN();
+  const DisturbanceModel input = DisturbanceModel::kInput;
   const Design designs[] = {
-      {"mpc fastest", Fopdt(), ControllerType::kMpc, fastest, false, DisturbanceModel::kInput},
-      {"dmc fastest", Fopdt(), ControllerType::kDmc, fastest, false, DisturbanceModel::kInput},
-      {"qdmc", Fopdt(), ControllerType::kDmc, 0.05, true, DisturbanceModel::kInput},
-      {"mpc limited", SecondOrder(), ControllerType::kMpc, 0.3, true, DisturbanceModel::kInput},
+      {"mpc fastest", Fopdt(), ControllerType::kMpc, fastest, false, input},
+      {"mpc fastest R", Fopdt(), ControllerType::kMpc, fastest, false, input, 0.003},
+      {"dmc fastest", Fopdt(), ControllerType::kDmc, fastest, false, input},
+      {"qdmc", Fopdt(), ControllerType::kDmc, 0.05, true, input},
+      {"qdmc fastest", Fopdt(), ControllerType::kDmc, fastest, true, input},
+      {"mpc limited", SecondOrder(), ControllerType::kMpc, 0.3, true, input},
+      {"mpc limited fastest", SecondOrder(), ControllerType::kMpc, fastest, true, input},
+      {"mpc limited fastest R", SecondOrder(), ControllerType::kMpc, fastest, true, input, 0.003},
+      {"mpc limited noises", SecondOrder(), ControllerType::kMpc, 0.3, true, input, 0.003, 1e-4,
+       0.1},
       {"mpc output", SecondOrder(), ControllerType::kMpc, 0.3, false, DisturbanceModel::kOutput},
-      {"mpc arx", PaperArxModel(), ControllerType::kMpc, fastest, true, DisturbanceModel::kInput},
+      {"mpc arx", PaperArxModel(), ControllerType::kMpc, fastest, true, input},
   };
+  std::map<std::string, double> lambda;
   for (const Design& d : designs) {
     SCOPED_TRACE(d.name);
     AutoTuneOptions o;
     o.controller = d.type;
     o.response_time = d.response_time;
     o.disturbance = d.disturbance;
+    o.measurement_noise = d.R;
+    o.state_noise = d.Qx;
+    o.disturbance_noise = d.Qd;
     if (d.limited) {
       o.limits.u_min = 0.0;
       o.limits.u_max = 100.0;
     }
     const AutoTuneResult r = AutoTune(d.model, kTs, o);
     ExpectCandidateIsMakeControllers(r, d.model, o);
+    lambda[d.name] = r.lambda;
     // The limits bind during the evaluation step (so the constrained forms
     // are tested): the input reaches u_max, 40 above the input before it.
     if (d.limited) EXPECT_EQ(r.predicted.u_max, o.limits.u_max - 40.0) << "the limit does not bind";
   }
+  // The noises are part of the design the tuner evaluates: with R = 0.003
+  // instead of 1 the Kalman filter trusts the measurement more, the loop
+  // meets model error otherwise, and the fastest robust lambda is another.
+  // (A response time given is met by the nominal step, which the estimator
+  // hardly changes: there lambda stays.)
+  EXPECT_NE(lambda["mpc fastest R"], lambda["mpc fastest"]);
+  EXPECT_NE(lambda["mpc limited fastest R"], lambda["mpc limited fastest"]);
 }
 
 // A design that has sampled its model passes it on: AutoTune of the
@@ -476,6 +533,11 @@ TEST(AutoTuneTest, BadOptionsThrow) {
   o.limits.u_min = 5.0;
   o.limits.u_max = 1.0;
   expect_throw(o, "input limits");
+  o = {};
+  o.measurement_noise = -1.0;
+  expect_throw(o, "measurement noise must be finite and > 0");
+  o.controller = ControllerType::kDmc;  // a dmc has no Kalman filter: not checked
+  EXPECT_NO_THROW(AutoTune(Fopdt(), kTs, o));
   EXPECT_THROW(AutoTune(Fopdt(), 0.0, AutoTuneOptions{}), InvalidArgument);
   // Unstable model.
   EXPECT_THROW(AutoTune(TransferFunction::Continuous({1.0}, {1.0, -1.0}), kTs, AutoTuneOptions{}),

@@ -113,6 +113,54 @@ TEST(BuiltControllerTest, LabelSummaryAndSettingsJson) {
   EXPECT_EQ(p["rule"], "simc");
 }
 
+// The rule auto deploys the controller its tuner evaluated, from settings as
+// `pneumid control` gives them: a dmc with input limits is the QDMC the
+// tuner checked (constrained without --constrained, and its formula says
+// why), and the mpc's Kalman noises (--measurement-noise ...) are those the
+// tuner's candidates had, so they change the tuned lambda.
+TEST(ControllerFactoryTest, RuleAutoDeploysTheControllerItsTunerEvaluated) {
+  ControllerSettings s;
+  s.controller = "dmc";
+  s.rule = "auto";
+  s.limits.u_min = 0.0;
+  s.limits.u_max = 100.0;
+  const BuiltController qdmc = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  EXPECT_EQ(qdmc.controller->Describe(),
+            fmt::format("dmc P=126 M=5 lambda={:g} N=508 constrained", qdmc.tuning.lambda));
+  EXPECT_THAT(qdmc.Summary(),
+              ::testing::HasSubstr("QDMC (moves optimized under the input limits)"));
+  EXPECT_THAT(qdmc.SettingsToJson()["formula"].get<std::string>(), ::testing::HasSubstr("QDMC"));
+  // Asked for, it is the same controller; its formula needs no explanation.
+  s.constrained = true;
+  const BuiltController asked = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  EXPECT_EQ(asked.controller->Describe(), qdmc.controller->Describe());
+  EXPECT_THAT(asked.tuning.formula, ::testing::Not(::testing::HasSubstr("QDMC")));
+  // Without limits the dmc clips nothing and stays unconstrained.
+  s.constrained = false;
+  s.limits = InputLimits{};
+  const BuiltController free = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  EXPECT_THAT(free.controller->Describe(), ::testing::Not(::testing::HasSubstr("constrained")));
+  EXPECT_THAT(free.tuning.formula, ::testing::Not(::testing::HasSubstr("QDMC")));
+
+  s.controller = "mpc";
+  const BuiltController r1 = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  s.measurement_noise = 0.003;
+  s.disturbance_noise = 0.5;
+  const BuiltController r3 = MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s));
+  AutoTuneOptions o;
+  o.measurement_noise = 0.003;
+  o.disturbance_noise = 0.5;
+  const AutoTuneResult tuned = AutoTune(PaperFopdtModel(), kTs, o);
+  EXPECT_EQ(r3.tuning.lambda, tuned.lambda);
+  EXPECT_EQ(r3.auto_summary, tuned.message);
+  EXPECT_NE(r3.tuning.lambda, r1.tuning.lambda);
+  // Noises the MPC rejects are rejected before the tuner runs, naming them.
+  s.measurement_noise = 0.0;
+  EXPECT_THAT([&] { MakeController(PaperFopdtModel(), kTs, ToControllerSpec(s)); },
+              ::testing::ThrowsMessage<InvalidArgument>(
+                  ::testing::HasSubstr("auto-tuning options: measurement noise")));
+}
+
 // A static input map puts every controller behind its inverse, designed on
 // the linear part with the map's image of the limits.
 TEST(ControllerFactoryTest, InputMapPutsEachControllerBehindTheInverse) {

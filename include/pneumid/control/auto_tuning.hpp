@@ -41,8 +41,11 @@
 //             t(lambda_f) < t*, else lambda_f (the fastest that is robust).
 // Each candidate is the controller MakeController (controller_factory.hpp)
 // builds for its P, M and lambda with the evaluation's input limits (dmc:
-// QDMC when a limit is finite; mpc: the disturbance model of the options),
-// designed on the model sampled once at Ts (PredictionModel).
+// QDMC when a limit is finite, or when the options ask for it; mpc: the
+// disturbance model and the Kalman filter's noise variances of the
+// options), designed on the model sampled once at Ts (PredictionModel).
+// The rule auto of MakeController deploys that same controller: a dmc tuned
+// with a finite input limit runs as a QDMC.
 // Garriga and Soroush [4] review the rules; Maciejowski [3, ch. 7] the
 // trade-off that lambda sets between speed and robustness.
 //
@@ -140,9 +143,20 @@ struct AutoTuneOptions {
   /// mpc: the estimator's disturbance model, used in the evaluation as in
   /// the controller it designs (mpc.hpp).
   DisturbanceModel disturbance = DisturbanceModel::kInput;
+  /// mpc: the Kalman filter's noise variances (MpcOptions::measurement_noise,
+  /// state_noise, disturbance_noise), used in the evaluation as in the
+  /// controller it designs; NaN = MpcOptions' defaults (1, 0, 1).
+  double measurement_noise = std::numeric_limits<double>::quiet_NaN();
+  double state_noise = std::numeric_limits<double>::quiet_NaN();  ///< mpc: see measurement_noise
+  double disturbance_noise = std::numeric_limits<double>::quiet_NaN();  ///< mpc: ditto
+  /// dmc: QDMC (the moves optimized under the limits) also when no input
+  /// limit is finite (ControllerSpec::constrained); with a finite limit the
+  /// dmc is a QDMC anyway (file comment).
+  bool constrained = false;
   /// True when the options are usable (controller not gpc, response_time NaN or > 0,
-  /// max_overshoot >= 0, aggressiveness in [0, 1], valid limits with u_min < u_max, M >= 0);
-  /// otherwise false and *error says why (when error is not null).
+  /// max_overshoot >= 0, aggressiveness in [0, 1], valid limits with u_min < u_max, M >= 0;
+  /// mpc: the noise variances NaN or as MpcOptions::IsValid wants them); otherwise false
+  /// and *error says why (when error is not null).
   bool IsValid(std::string* error) const;
 };
 

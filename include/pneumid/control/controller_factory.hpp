@@ -2,7 +2,9 @@
 // limits: the one place where the command line, the bindings and the
 // real-time loop turn settings into a Controller.
 //
-//   dmc  P, M, lambda from the tuning rule (tuning.hpp); QDMC when constrained
+//   dmc  P, M, lambda from the tuning rule (tuning.hpp); QDMC when constrained,
+//        and with the rule auto also whenever an input limit is finite (the
+//        auto-tuner evaluates a QDMC then)
 //   gpc  N1 = 1, N2 = P, Nu = M, lambda from the tuning rule; T filter "1",
 //        "A" (= the model's denominator, DMC's disturbance model) or
 //        coefficients "1 -0.8" (ascending powers of q^-1)
@@ -15,14 +17,16 @@
 //        tracked without lag
 //   mpc  state-space MPC (mpc.hpp) from the model with its delay as states:
 //        P, M, lambda from the tuning rule as for dmc, the input limits and
-//        soft output bounds (a QP whenever one is finite), the other options
-//        at their defaults (input disturbance model, Kalman noise R = 1,
-//        disturbance noise 1)
+//        soft output bounds (a QP whenever one is finite), the disturbance
+//        model and the Kalman filter's noises of the spec (defaults: input
+//        disturbance model, measurement noise R = 1, disturbance noise 1)
 //
 // A design samples its model once (PredictionModel): dmc, gpc, the tuning
 // rules and the mpc's state space all come from that one discretization, and
 // the auto-tuner (rule auto, auto_tuning.hpp) builds each candidate it
-// evaluates the way the dmc and mpc are built here, on that same model.
+// evaluates the way the dmc and mpc are built here, on that same model and
+// with the spec's options (limits, constrained form, disturbance model,
+// Kalman noises): the controller deployed is the one evaluated.
 #pragma once
 
 #include <limits>
@@ -74,8 +78,12 @@ struct ControllerSpec {
   double state_noise = std::numeric_limits<double>::quiet_NaN();        ///< (NaN = default 0)
   double disturbance_noise = std::numeric_limits<double>::quiet_NaN();  ///< (NaN = default 1)
   /// Tune from specifications (auto_tuning.hpp) instead of the tuning rule:
-  /// mpc and dmc get P, M, lambda, pid its gains; auto_options.controller and
-  /// .limits are taken from type and limits.
+  /// mpc and dmc get P, M, lambda, pid its gains. auto_options.controller,
+  /// .limits, .constrained, .disturbance and the noise variances are taken
+  /// from this spec (type, limits, ...), so the tuner evaluates the
+  /// controller that runs; a dmc with a finite input limit (u_min, u_max or
+  /// du_max) is then a QDMC, as the tuner evaluates it, also without
+  /// `constrained`.
   bool auto_tune = false;
   AutoTuneOptions auto_options;  ///< the specification when auto_tune is set
   /// The actuator's static map f (a Hammerstein model's input map): the
