@@ -306,6 +306,16 @@ static Registrar reg(
                          "the structure search tries, default 60)")
               ->capture_default_str()
               ->check(CLI::Range(1, 1000));
+      app.add_option_function<std::string>(
+             "--focus",
+             [args](const std::string& name) {
+               args->nonlinear.narx.focus = NarxFocusFromString(name);
+             },
+             "narx: criterion of the coefficients of the selected terms: prediction (one-step "
+             "least squares) or simulation (refined by the free-run simulation error; the "
+             "structure search then scores refined candidates)")
+          ->check(CLI::IsMember({"prediction", "simulation"}))
+          ->default_str("prediction");
       app.add_option("--err-tolerance", args->nonlinear.narx.err_tolerance,
                      "narx: stop when 1 - sum ERR falls below this")
           ->capture_default_str()

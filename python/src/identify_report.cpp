@@ -165,6 +165,10 @@ void BindIdentify(py::module_& m) {
             return r.output_map ? py::cast(*r.output_map) : py::none();
           },
           "StaticMap of a Wiener or Hammerstein-Wiener model, or None.")
+      .def_readonly("input_map_undetermined", &IdentifiedModel::input_map_undetermined,
+                    "Input intervals [(lo, hi), ...] between neighbouring levels of the "
+                    "estimation data across which the input map changes steeply with no "
+                    "sample inside: the data leave the map undetermined there.")
       .def_property_readonly(
           "narx",
           [](const IdentifiedModel& r) -> py::object {
@@ -275,7 +279,7 @@ void BindIdentify(py::module_& m) {
          const std::string& detrend, const std::string& filter, int decimate,
          std::optional<int> knots, bool monotone_map, std::optional<double> settle,
          std::optional<double> min_segment, std::optional<int> degree, std::optional<int> max_terms,
-         std::optional<double> err_tolerance) {
+         std::optional<double> err_tolerance, const std::string& focus) {
         IdentifyWorkflowOptions o;
         if (const auto* list = std::get_if<std::vector<std::string>>(&methods)) {
           std::string joined;
@@ -317,6 +321,7 @@ void BindIdentify(py::module_& m) {
           o.nonlinear.max_narx_terms = *max_terms;
         }
         if (err_tolerance) o.nonlinear.narx.err_tolerance = *err_tolerance;
+        o.nonlinear.narx.focus = NarxFocusFromString(focus);
         std::string text;
         {
           py::gil_scoped_release release;
@@ -334,12 +339,13 @@ void BindIdentify(py::module_& m) {
       "resample"_a = 0.0, "remove_initial"_a = false, "detrend"_a = "none", "filter"_a = "",
       "decimate"_a = 1, "knots"_a = py::none(), "monotone_map"_a = false, "settle"_a = py::none(),
       "min_segment"_a = py::none(), "degree"_a = py::none(), "max_terms"_a = py::none(),
-      "err_tolerance"_a = py::none(),
+      "err_tolerance"_a = py::none(), "focus"_a = "prediction",
       "The identification of `pneumid identify DATA --json` (workflow/identify_workflow.hpp): "
       "methods as a list or the --method text ('fit-p1d,arx', 'all'), the flags' settings by "
       "their names (na, nb, nk None as when the flags are not given: hammerstein, wiener, hw "
       "and narx then choose their structure; knots, settle, min_segment, degree, max_terms, "
-      "err_tolerance None: the command's defaults). Returns the dict `identify --json` prints "
+      "err_tolerance None: the command's defaults; focus 'prediction' or 'simulation' as "
+      "--focus). Returns the dict `identify --json` prints "
       "(the model file: 'models' best first, 'best', 'ranked_by', 'failures', 'termination', "
       "...). Raises DataError when no method produced a model.");
   m.def(

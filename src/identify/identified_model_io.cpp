@@ -128,6 +128,11 @@ nlohmann::json ToJson(const IdentifiedModel& model) {
   if (model.input_map) j["input_map"] = ToJson(*model.input_map);
   if (model.output_map) j["output_map"] = ToJson(*model.output_map);
   if (model.narx) j["narx"] = ToJson(*model.narx);
+  if (!model.input_map_undetermined.empty()) {
+    nlohmann::json gaps = nlohmann::json::array();
+    for (const auto& [lo, hi] : model.input_map_undetermined) gaps.push_back({lo, hi});
+    j["input_map_undetermined"] = std::move(gaps);
+  }
   return j;
 }
 
@@ -206,6 +211,18 @@ IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
   if (j.contains("input_map")) m.input_map = StaticMapFromJson(j.at("input_map"));
   if (j.contains("output_map")) m.output_map = StaticMapFromJson(j.at("output_map"));
   if (j.contains("narx")) m.narx = NarxModelFromJson(j.at("narx"));
+  if (j.contains("input_map_undetermined")) {
+    const nlohmann::json& gaps = j.at("input_map_undetermined");
+    PNEUMID_CHECK(gaps.is_array(), "model key 'input_map_undetermined' must be a list of "
+                       "[lo, hi] pairs, got {}", gaps.dump());
+    for (const nlohmann::json& g : gaps) {
+      PNEUMID_CHECK(g.is_array() && g.size() == 2 && g[0].is_number() && g[1].is_number() &&
+                             g[0].get<double>() < g[1].get<double>(),
+                         "model key 'input_map_undetermined': each entry must be [lo, hi] with "
+                         "lo < hi, got {}", g.dump());
+      m.input_map_undetermined.emplace_back(g[0].get<double>(), g[1].get<double>());
+    }
+  }
   return m;
 }
 

@@ -15,6 +15,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/identify/identify.hpp"
+#include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/identify/nonlinear/static_map_fit.hpp"
@@ -115,8 +116,22 @@ TEST(GeneralizationTest, HammersteinWithDefaultsHoldsOnExperimentsOfOtherDesigns
     EXPECT_GT(Fit(m, v, InitialCondition::kZero), 98.0) << name;
     EXPECT_GT(Fit(m, v, InitialCondition::kEstimate), 98.0) << name;
   }
-  // Where the estimation data leave the map undetermined, no model can hold.
-  EXPECT_LT(Fit(m, Recorded("gen_val_gap"), InitialCondition::kZero), 90.0);
+  // Where the estimation data leave the map undetermined, no model can hold,
+  // and simulating there is warned about; the model file keeps the intervals.
+  const Dataset gap = Recorded("gen_val_gap");
+  EXPECT_LT(Fit(m, gap, InitialCondition::kZero), 90.0);
+  EXPECT_EQ(m.input_map_undetermined,
+            (std::vector<std::pair<double, double>>{{10.0, 15.0}, {85.0, 95.0}}));
+  const std::vector<std::string> w = ExtrapolationWarnings(m, gap);
+  ASSERT_FALSE(w.empty());
+  EXPECT_THAT(w, Contains(HasSubstr("leave its input map undetermined")));
+  for (const char* name : {"gen_val_stairs", "gen_val_prbs"})
+    EXPECT_TRUE(ExtrapolationWarnings(m, Recorded(name)).empty()) << name;
+  EXPECT_EQ(IdentifiedModelFromJson(ToJson(m)).input_map_undetermined, m.input_map_undetermined);
+  nlohmann::json bad = ToJson(m);
+  bad["input_map_undetermined"] = {{95.0, 85.0}};
+  EXPECT_THAT([&] { IdentifiedModelFromJson(bad); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("input_map_undetermined")));
 }
 
 TEST(GeneralizationTest, TheBestRankedModelHoldsOnAThirdExperiment) {

@@ -158,6 +158,13 @@ struct IdentifiedModel {
   std::optional<StaticMap> input_map;
   std::optional<StaticMap> output_map;  ///< Wiener: g applied to the linear part's output
   std::optional<NarxModel> narx;        ///< NARX and affine NARX: the polynomial model
+  /// Input intervals {lo, hi} between neighbouring levels of the estimation
+  /// data across which the input map changes steeply with no sample inside
+  /// (FindMapGaps, nonlinear/static_map_fit.hpp): the data leave the map
+  /// undetermined there, and a simulation whose input visits them is a guess
+  /// (ExtrapolationWarnings warns). Model file key "input_map_undetermined",
+  /// [[lo, hi], ...]; empty for linear models and files that lack it.
+  std::vector<std::pair<double, double>> input_map_undetermined;
 };
 
 /// The operating point (u0, y0) the polynomial and state-space methods (arx,

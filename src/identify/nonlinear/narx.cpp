@@ -11,6 +11,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/nonlinear/narx_simulation_fit.hpp"
 
 namespace pneumid {
 
@@ -26,7 +27,54 @@ void AddCandidates(int n, int degree, int first, NarxTerm* prefix, std::vector<N
   }
 }
 
+// Summary, theta and fits of the chosen terms: columns S (normalised) of the
+// rows t = n0 .. N-1, theta by least squares, then refined by the simulation
+// error when the focus is kSimulation.
+void FinishNarx(const Eigen::MatrixXd& S, const Eigen::VectorXd& target, const Eigen::VectorXd& u,
+                const Eigen::VectorXd& y, const NarxOptions& o, const std::string& frols,
+                NarxResult* result) {
+  NarxModel& m = result->model;
+  const Eigen::Index rows = S.rows();
+  const Eigen::VectorXd theta = S.colPivHouseholderQr().solve(target);
+  m.theta.assign(theta.data(), theta.data() + theta.size());
+  EstimationSummary& s = result->summary;
+  s.termination = Termination::kConvergence;
+  s.num_rows = rows;
+  s.num_parameters = static_cast<int>(S.cols());
+  s.loss = m.y_scale * m.y_scale * (target - S * theta).squaredNorm() / static_cast<double>(rows);
+  s.message = frols;
+  if (o.focus == NarxFocus::kSimulation && !m.terms.empty()) {
+    NarxSimulationFitOptions so;
+    so.max_iterations = o.max_iterations;
+    const NarxSimulationFitResult r = FitNarxSimulation(&m, u, y, so);
+    s.termination = r.summary.termination;
+    s.iterations = r.summary.iterations;
+    s.initial_loss = r.summary.initial_loss;
+    s.loss = r.summary.loss;
+    s.message += fmt::format(
+        "; focus simulation: {} ({} iterations, mean squared simulation error {:.4g}, from {:.4g} "
+        "of the least-squares start)",
+        r.summary.message, r.summary.iterations, r.summary.loss, r.summary.initial_loss);
+    s.warnings.insert(s.warnings.end(), r.summary.warnings.begin(), r.summary.warnings.end());
+  }
+  const Eigen::VectorXd th =
+      Eigen::Map<const Eigen::VectorXd>(m.theta.data(), static_cast<Eigen::Index>(m.theta.size()));
+  result->one_step_fit_percent = NrmseFit(target, (S * th).eval());
+  result->simulation_fit_percent = NarxSimulationFit(m, u, y, rows, &s.warnings);
+}
+
 }  // namespace
+
+const char* ToString(NarxFocus focus) {
+  return focus == NarxFocus::kSimulation ? "simulation" : "prediction";
+}
+
+NarxFocus NarxFocusFromString(const std::string& name) {
+  if (name == "prediction") return NarxFocus::kPrediction;
+  PNEUMID_CHECK(name == "simulation", "unknown NARX focus '{}' (valid: prediction, simulation)",
+                name);
+  return NarxFocus::kSimulation;
+}
 
 bool NarxOptions::IsValid(std::string* error) const {
   auto fail = [error](std::string m) {
@@ -44,6 +92,8 @@ bool NarxOptions::IsValid(std::string* error) const {
     return fail(fmt::format("NarxOptions::err_tolerance must be in (0, 1), got {}", err_tolerance));
   if (max_terms < 1)
     return fail(fmt::format("NarxOptions::max_terms must be >= 1, got {}", max_terms));
+  if (max_iterations < 1)
+    return fail(fmt::format("NarxOptions::max_iterations must be >= 1, got {}", max_iterations));
   return true;
 }
 
@@ -193,17 +243,9 @@ NarxResult EstimateNarx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, doub
     m.terms.push_back(cand[chosen[i]]);
   }
   W.resize(0, 0);
-  const Eigen::VectorXd theta = S.colPivHouseholderQr().solve(target);
-  m.theta.assign(theta.data(), theta.data() + theta.size());
-
-  EstimationSummary& s = result.summary;
-  s.termination = Termination::kConvergence;
-  s.num_rows = rows;
-  s.num_parameters = static_cast<int>(chosen.size());
-  s.loss = m.y_scale * m.y_scale * (target - S * theta).squaredNorm() / static_cast<double>(rows);
-  s.message = fmt::format("FROLS: {} of {} candidate terms, stopped: {}", chosen.size(), M, stop);
-  result.one_step_fit_percent = NrmseFit(target, (S * theta).eval());
-  result.simulation_fit_percent = NarxSimulationFit(m, u, y, rows, &s.warnings);
+  FinishNarx(S, target, u, y, o,
+             fmt::format("FROLS: {} of {} candidate terms, stopped: {}", chosen.size(), M, stop),
+             &result);
   return result;
 }
 

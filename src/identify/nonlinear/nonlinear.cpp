@@ -12,6 +12,7 @@
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/evaluation/validation.hpp"
+#include "pneumid/identify/nonlinear/narx_simulation_fit.hpp"
 #include "pneumid/lti/conversion.hpp"
 #include "pneumid/lti/response.hpp"
 
@@ -118,6 +119,54 @@ bool IsBlockMethod(const std::string& method) {
   return method == "hammerstein" || method == "wiener" || method == "hw";
 }
 
+// Focus simulation in the NARX structure search: refines the prefix model
+// *m (least-squares theta) by the simulation error on the estimation part,
+// also from *previous (the previous prefix's refined theta, the new terms at
+// 0), and keeps the lower simulation error; *previous becomes the result.
+void RefineNarxPrefix(NarxModel* m, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                      const NarxOptions& o, std::vector<double>* previous) {
+  NarxSimulationFitOptions so;
+  so.max_iterations = o.max_iterations;
+  NarxSimulationFitResult best = FitNarxSimulation(m, u, y, so);
+  if (!previous->empty() && previous->size() < m->theta.size()) {
+    NarxModel warm = *m;
+    std::fill(warm.theta.begin(), warm.theta.end(), 0.0);
+    std::copy(previous->begin(), previous->end(), warm.theta.begin());
+    const NarxSimulationFitResult r = FitNarxSimulation(&warm, u, y, so);
+    if (best.diverges || (!r.diverges && r.summary.loss < best.summary.loss)) *m = std::move(warm);
+  }
+  *previous = m->theta;
+}
+
+// FROLS on (u, y) with options `no` (up to no.max_terms terms), then every
+// prefix of 1, 2, .., 10 terms and every 5th after, refitted by least squares
+// (focus simulation: refined by the simulation error, RefineNarxPrefix), is
+// passed to fn(k, model); fn returns false to stop.
+template <typename Fn>
+void ForEachNarxPrefix(const Eigen::VectorXd& ue, const Eigen::VectorXd& ye, double Ts,
+                       const NarxOptions& no, Fn&& fn) {
+  NarxOptions ls = no;
+  ls.focus = NarxFocus::kPrediction;  // the terms; each prefix is refined below
+  const NarxModel full = EstimateNarx(ue, ye, Ts, ls).model;
+  const Eigen::Index n0 = full.FirstSample(), rows = ye.size() - n0;
+  const auto K = static_cast<Eigen::Index>(full.terms.size());
+  Eigen::MatrixXd S(rows, K);
+  for (Eigen::Index i = 0; i < K; ++i)
+    for (Eigen::Index r = 0; r < rows; ++r)
+      S(r, i) = full.TermValue(full.terms[static_cast<std::size_t>(i)], r + n0, ye, ue);
+  const Eigen::VectorXd target = ye.tail(rows) / full.y_scale;
+  std::vector<double> previous;  // focus simulation: the previous prefix's theta
+  for (Eigen::Index k = std::min<Eigen::Index>(1, K);; k = std::min(K, k + (k < 10 ? 1 : 5))) {
+    NarxModel pm = full;
+    pm.terms.resize(static_cast<std::size_t>(k));
+    pm.err.resize(static_cast<std::size_t>(k));
+    const Eigen::VectorXd theta = S.leftCols(k).colPivHouseholderQr().solve(target);
+    pm.theta.assign(theta.data(), theta.data() + k);
+    if (no.focus == NarxFocus::kSimulation) RefineNarxPrefix(&pm, ue, ye, no, &previous);
+    if (!fn(static_cast<int>(k), pm) || k == K) break;
+  }
+}
+
 // The NARX part of ChooseBlockStructure (see nonlinear.hpp): `tail` is the
 // held-out record, simulated from its own first outputs.
 StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& tail,
@@ -135,32 +184,18 @@ StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& ta
       no.nk = nk;
       no.max_terms = options.max_narx_terms;
       try {
-        const NarxModel full = EstimateNarx(ue, ye, Ts, no).model;
-        const Eigen::Index n0 = full.FirstSample(), rows = ye.size() - n0;
-        const auto K = static_cast<Eigen::Index>(full.terms.size());
-        PNEUMID_CHECK(yv.size() > n0 + 2, "the held-out part has {} samples, {} start a simulation",
-                      yv.size(), n0);
-        Eigen::MatrixXd S(rows, K);
-        for (Eigen::Index i = 0; i < K; ++i)
-          for (Eigen::Index r = 0; r < rows; ++r)
-            S(r, i) = full.TermValue(full.terms[static_cast<std::size_t>(i)], r + n0, ye, ue);
-        const Eigen::VectorXd target = ye.tail(rows) / full.y_scale;
-        // Prefixes of 1, 2, .., 10 terms, then every 5th.
-        for (Eigen::Index k = std::min<Eigen::Index>(1, K);;
-             k = std::min(K, k + (k < 10 ? 1 : 5))) {
-          NarxModel pm = full;
-          pm.terms.resize(static_cast<std::size_t>(k));
-          pm.err.resize(static_cast<std::size_t>(k));
-          const Eigen::VectorXd theta = S.leftCols(k).colPivHouseholderQr().solve(target);
-          pm.theta.assign(theta.data(), theta.data() + k);
+        ForEachNarxPrefix(ue, ye, Ts, no, [&](int k, const NarxModel& pm) {
+          const Eigen::Index n0 = pm.FirstSample();
+          PNEUMID_CHECK(yv.size() > n0 + 2,
+                        "the held-out part has {} samples, {} start a simulation", yv.size(), n0);
           const Eigen::VectorXd sim = pm.Simulate(uv, yv);
           const Eigen::Index nv = yv.size() - n0;
           double fit = -inf;
           if (sim.allFinite()) fit = NrmseFit(yv.tail(nv).eval(), sim.tail(nv).eval());
           if (!std::isfinite(fit)) fit = -inf;
-          out.candidates.push_back({lag, lag, nk, static_cast<int>(k), fit, -inf, ""});
-          if (k == K) break;
-        }
+          out.candidates.push_back({lag, lag, nk, k, fit, -inf, ""});
+          return true;
+        });
       } catch (const std::exception& e) {
         out.candidates.push_back({lag, lag, nk, 0, -inf, -inf, e.what()});
       }
@@ -182,6 +217,72 @@ StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& ta
   out.terms = pick->terms;
   out.fit_percent = pick->fit_percent;
   return out;
+}
+
+// The narx IdentifiedModel parts of an estimate: structure, params, notes, termination.
+void SetNarxModel(const NarxResult& r, IdentifiedModel* m) {
+  const NarxModel& n = r.model;
+  m->structure = "NARX";
+  m->narx = n;
+  m->discrete = TransferFunction::Discrete({1.0}, {1.0}, n.Ts);
+  m->tf = TransferFunction();
+  m->params = {{"ny", n.ny},
+               {"nu", n.nu},
+               {"nk", n.nk},
+               {"degree", n.degree},
+               {"terms", static_cast<int>(n.terms.size())},
+               {"Ts", n.Ts}};
+  std::vector<std::string> terms;
+  for (std::size_t i = 0; i < n.terms.size(); ++i)
+    terms.push_back(fmt::format("{} (ERR {:.4g})", n.TermName(n.terms[i]), n.err[i]));
+  m->notes.push_back(fmt::format("selected terms: {}", fmt::join(terms, ", ")));
+  m->notes.push_back(n.Equation());
+  m->notes.push_back(fmt::format("{}; one-step fit {:.2f} %, simulation fit {:.2f} %",
+                                 r.summary.message, r.one_step_fit_percent,
+                                 r.simulation_fit_percent));
+  for (const std::string& w : r.summary.warnings) m->notes.push_back(w);
+  m->termination = r.summary.termination;
+}
+
+// narx with focus simulation after the structure search: the candidate the
+// search scored (its terms and refined theta, estimated on the estimation
+// part) refined by the simulation error on all of `data`.
+IdentifiedModel NarxFromChoice(const Dataset& data, const IdentifyRequest& request,
+                               const NonlinearOptions& options, const Dataset* held_out,
+                               const StructureChoice& c) {
+  const Dataset estimation = held_out ? data : SplitDataset(data, options.structure_split).first;
+  NarxOptions no = options.narx;
+  no.ny = c.na;
+  no.nu = c.nb;
+  no.nk = c.nk;
+  no.max_terms = options.max_narx_terms;
+  std::optional<NarxModel> chosen;
+  ForEachNarxPrefix(estimation.u(request.input), estimation.y(request.output),
+                    estimation.SampleTime(), no, [&](int k, const NarxModel& pm) {
+                      if (k == c.terms) chosen = pm;
+                      return k < c.terms;
+                    });
+  PNEUMID_CHECK(chosen.has_value(), "narx: the chosen candidate ({} terms) was not rebuilt",
+                c.terms);
+  const Eigen::VectorXd u = data.u(request.input), y = data.y(request.output);
+  NarxResult r;
+  r.model = *chosen;
+  NarxSimulationFitOptions so;
+  so.max_iterations = no.max_iterations;
+  const NarxSimulationFitResult f = FitNarxSimulation(&r.model, u, y, so);
+  r.summary = f.summary;
+  r.summary.message = fmt::format(
+      "the chosen candidate ({} terms, FROLS on the estimation part) refined on all the data: "
+      "{} ({} iterations, mean squared simulation error {:.4g}, from {:.4g})",
+      c.terms, f.summary.message, f.summary.iterations, f.summary.loss, f.summary.initial_loss);
+  const Eigen::Index n0 = r.model.FirstSample(), rows = y.size() - n0;
+  r.one_step_fit_percent = NrmseFit(y.tail(rows).eval(), r.model.Predict(y, u).tail(rows).eval());
+  r.simulation_fit_percent = NarxSimulationFit(r.model, u, y, rows, &r.summary.warnings);
+  IdentifiedModel m;
+  m.method = "narx";
+  SetNarxModel(r, &m);
+  ScoreModel(data, request.input, request.output, &m);
+  return m;
 }
 
 }  // namespace
@@ -338,7 +439,9 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
     NonlinearOptions o = options;
     o.choose_structure = false;
     if (c.terms > 0) o.narx.max_terms = c.terms;
-    IdentifiedModel m = IdentifyNonlinear(method, data, r, o);
+    IdentifiedModel m = method == "narx" && options.narx.focus == NarxFocus::kSimulation
+                            ? NarxFromChoice(data, request, options, held_out, c)
+                            : IdentifyNonlinear(method, data, r, o);
     if (!std::isfinite(m.fit_percent) && held_out == nullptr) {
       // The refit on all the data does not simulate: keep the model the
       // search scored, estimated on the first part, scored on all the data.
@@ -428,32 +531,13 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
     o.ny = request.na;
     o.nu = std::max(1, request.nb);
     o.nk = request.nk;
-    const NarxResult r = EstimateNarx(u, y, Ts, o);
-    m.structure = "NARX";
-    m.narx = r.model;
-    m.discrete = TransferFunction::Discrete({1.0}, {1.0}, Ts);
-    m.tf = TransferFunction();
-    m.params = {{"ny", o.ny},
-                {"nu", o.nu},
-                {"nk", o.nk},
-                {"degree", o.degree},
-                {"terms", static_cast<int>(r.model.terms.size())},
-                {"Ts", Ts}};
-    std::vector<std::string> terms;
-    for (std::size_t i = 0; i < r.model.terms.size(); ++i)
-      terms.push_back(
-          fmt::format("{} (ERR {:.4g})", r.model.TermName(r.model.terms[i]), r.model.err[i]));
-    m.notes.push_back(fmt::format("selected terms: {}", fmt::join(terms, ", ")));
-    m.notes.push_back(r.model.Equation());
-    m.notes.push_back(fmt::format("{}; one-step fit {:.2f} %, simulation fit {:.2f} %",
-                                  r.summary.message, r.one_step_fit_percent,
-                                  r.simulation_fit_percent));
-    for (const std::string& w : r.summary.warnings) m.notes.push_back(w);
-    m.termination = r.summary.termination;
+    SetNarxModel(EstimateNarx(u, y, Ts, o), &m);
   }
   if (m.input_map)
-    for (const MapGap& gap : FindMapGaps(*m.input_map, u))
+    for (const MapGap& gap : FindMapGaps(*m.input_map, u)) {
       m.notes.push_back("input map: " + gap.Describe());
+      m.input_map_undetermined.emplace_back(gap.u_lo, gap.u_hi);
+    }
   ScoreModel(data, request.input, request.output, &m);
   return m;
 }
@@ -473,6 +557,18 @@ std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, con
         "model{} was estimated on ({} of {} samples more than 5 % of that range outside): the "
         "map is held at its end values there, an extrapolation the data do not support",
         lo, hi, c1, cm, model.method.empty() ? "" : " '" + model.method + "'", outside, u.size()));
+  }
+  for (const auto& [a, b] : model.input_map_undetermined) {
+    const double margin = 0.01 * (b - a);
+    const Eigen::Index inside = (u.array() > a + margin && u.array() < b - margin).count();
+    if (inside == 0) continue;
+    w.push_back(fmt::format(
+        "the input visits ({:g}, {:g}) in {} of {} samples, where the data the model{} was "
+        "estimated on leave its input map undetermined (a steep change between two visited "
+        "levels, f = {:.4g} .. {:.4g}): the simulation there is a guess; an estimation "
+        "experiment with levels inside that interval would place it",
+        a, b, inside, u.size(), model.method.empty() ? "" : " '" + model.method + "'",
+        model.input_map->Evaluate(a), model.input_map->Evaluate(b)));
   }
   return w;
 }

@@ -26,6 +26,13 @@
 // theta follows by least squares on the chosen terms (the one-step-ahead
 // prediction error criterion, rows t = n0 .. N-1, n0 = max(ny, nk + nu - 1)).
 //
+// Focus (as the 'Focus' option of MATLAB's nlarx): kPrediction keeps theta
+// of the one-step least squares above; kSimulation refines theta over the
+// chosen terms by minimising the free-run simulation error from that start
+// (Levenberg-Marquardt, narx_simulation_fit.hpp), which on data the one-step
+// criterion fits but the free run does not (e.g. the cascaded tanks) gives a
+// model that simulates better; the terms are those FROLS chose.
+//
 // Simulation (free run, the simulation-error check of [1] sec. 3.9): yhat(t)
 // from the model with yhat in place of y; the first n0 outputs are taken from
 // the measured output (the model's past before it can predict).
@@ -52,6 +59,18 @@
 
 namespace pneumid {
 
+/// Criterion of the NARX coefficients (see above).
+enum class NarxFocus {
+  kPrediction,  ///< one-step prediction error (least squares), the default
+  kSimulation,  ///< free-run simulation error, refined from the least-squares start
+};
+
+/// "prediction" or "simulation".
+const char* ToString(NarxFocus focus);
+/// Inverse of ToString(NarxFocus).
+/// @throws InvalidArgument for another name (listing the valid ones).
+NarxFocus NarxFocusFromString(const std::string& name);
+
 /// Lags, degree and term-selection stop rule of the polynomial NARX estimate (FROLS).
 struct NarxOptions {
   int ny = 2;      ///< output lags (>= 0)
@@ -66,8 +85,13 @@ struct NarxOptions {
   int max_terms = 10;  ///< at most this many terms (>= 1)
   /// Normalise the signals (see above); false: u_offset = 0, scales 1.
   bool normalise = true;
-  /// True when ny >= 0, nu >= 1, nk >= 0, degree is 1..3, err_tolerance is in (0, 1) and
-  /// max_terms >= 1; otherwise false with the reason in *error (when error is not null).
+  /// Criterion of theta (see above); the terms are chosen by FROLS either way.
+  NarxFocus focus = NarxFocus::kPrediction;
+  /// kSimulation: most Levenberg-Marquardt iterations (>= 1).
+  int max_iterations = 100;
+  /// True when ny >= 0, nu >= 1, nk >= 0, degree is 1..3, err_tolerance is in (0, 1),
+  /// max_terms >= 1 and max_iterations >= 1; otherwise false with the reason in *error
+  /// (when error is not null).
   bool IsValid(std::string* error) const;
 };
 
@@ -80,8 +104,10 @@ struct NarxResult {
   /// Selected terms with their coefficients theta and ERR, the lags, Ts and the
   /// normalisation (u_offset, u_scale, y_scale).
   NarxModel model;
-  /// termination (kConvergence), num_parameters = terms chosen, loss = mean
-  /// squared one-step error, message naming the stopping rule.
+  /// termination (kConvergence; kSimulation: that of the refinement, see
+  /// narx_simulation_fit.hpp), num_parameters = terms chosen, loss = mean
+  /// squared one-step error (kSimulation: simulation error), message naming
+  /// the stopping rule (and the refinement).
   EstimationSummary summary;
   double one_step_fit_percent = 0.0;    ///< NRMSE fit of the one-step predictions
   double simulation_fit_percent = 0.0;  ///< NRMSE fit of the free-run simulation

@@ -111,7 +111,10 @@ struct StructureChoice {
 /// squares and simulated on the held-out part from its own first measured
 /// outputs; the best held-out simulation fit wins (the most parsimonious,
 /// fewest terms then shortest lags, within 0.1 point). The choice sets na =
-/// nb = lags, nk, and `terms` (StructureChoice::terms).
+/// nb = lags, nk, and `terms` (StructureChoice::terms). With options.narx.focus
+/// kSimulation each prefix is refined by its simulation error on the
+/// estimation part before it is scored, and IdentifyNonlinear then refines the
+/// chosen candidate (its terms and theta) on all the data.
 StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& data,
                                      const IdentifyRequest& request,
                                      const NonlinearOptions& options,
@@ -142,7 +145,10 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
 
 /// Warnings for simulating `model` on input column `input` of `data`: an
 /// input that leaves the input map's knot range by more than 5 % of it (the
-/// map is held there: an extrapolation the estimation data do not support).
+/// map is held there: an extrapolation the estimation data do not support),
+/// and an input inside an interval the estimation data left the map
+/// undetermined in (IdentifiedModel::input_map_undetermined), one warning
+/// per interval visited.
 std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, const Dataset& data,
                                                int input = 0);
 
