@@ -2,8 +2,9 @@
 """`pneumid commission` on IPA twin variants, measured on the targets' scenario.
 
 For each variant (valves +-30 %, dead volume +-20 %, supply 0.5 MPa, sensor
-filter 0 and 0.25 s, one sample of transport delay, the chamber-lag twin and
-the default twin) the script writes the variant's TOML from
+filter 0, 0.05, 0.1 and 0.25 s, one sample of transport delay, three twins
+with several changes at once, the chamber-lag twin and the default twin) the
+script writes the variant's TOML from
 config/ipa_default.toml, runs `pneumid commission --plant ipa --plant-config
 VARIANT -o DIR --json` (wall time measured), then runs the written
 controller.toml with `pneumid control --config` on a staircase across
@@ -43,6 +44,15 @@ VARIANTS = {
     "sensor filter 0.25 s": {"pressure_filter_time_constant": ("=", 0.25)},
     "delay 1 sample": {"transport_delay_samples": ("=", 1)},
     "chamber-lag twin": "config/ipa_chamber_lag.toml",
+    # several changes at once
+    "mixed A": {"inlet_conductance": 1.2, "exhaust_conductance": 0.85, "dead_volume_a": 0.9,
+                "pressure": ("=", 0.55e6), "pressure_filter_time_constant": ("=", 0.15),
+                "transport_delay_samples": ("=", 1)},
+    "mixed B": {"inlet_conductance": 0.75, "exhaust_conductance": 1.25, "dead_volume_a": 1.15,
+                "dead_volume_b": 1.15, "pressure": ("=", 0.58e6),
+                "pressure_filter_time_constant": ("=", 0.07)},
+    "mixed C": {"inlet_conductance": 1.3, "dead_volume_a": 0.8, "pressure": ("=", 0.52e6),
+                "pressure_filter_time_constant": ("=", 0.2), "transport_delay_samples": ("=", 1)},
 }
 
 
