@@ -906,11 +906,11 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   // rest, not by the default variance 1 (output units squared): on the IPA
   // (0.06 N) the default made the disturbance estimate slow, and a bias the
   // modulation leaves at one level (the valve's gap) carried into the next
-  // step as overshoot. Floor: (1e-4 of the range)^2, for a noise-free plant.
-  if (settings.controller == "mpc") {
-    const double floor = 1e-4 * (ex.range_max - ex.range_min);
-    settings.measurement_noise = std::max(ex.noise_std * ex.noise_std, floor * floor);
-  }
+  // step as overshoot. A plant whose noise lies below 1e-4 of the range (a
+  // noise-free model) keeps the default: a near-zero variance makes the
+  // filter deadbeat and the auto-tuner's closed-loop search very slow.
+  if (settings.controller == "mpc" && ex.noise_std >= 1e-4 * (ex.range_max - ex.range_min))
+    settings.measurement_noise = ex.noise_std * ex.noise_std;
   TransferFunction model;
   if (!ChooseModel(r, o, settings, Ts, &model)) return r;
   // Softer: half the aggressiveness and, since the fastest robust design's

@@ -23,7 +23,6 @@
 #include "pneumid/lti/model_file_scope.hpp"
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/lti/response.hpp"
-#include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/realtime/io_backend.hpp"
 #include "pneumid/realtime/realtime_config.hpp"
@@ -867,7 +866,7 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
   std::string plant_spec = "ipa";
   if (Get(b, "plant", plant_spec)) plant_spec = PlantSpec(plant_spec);
   double Ts = 0.01;
-  const bool Ts_given = Get(b, "Ts", Ts);
+  Get(b, "Ts", Ts);
   CommissionOptions o;
   if (b.contains("range") && !b["range"].is_null()) {
     const nlohmann::json& r = b["range"];
@@ -902,12 +901,6 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
   std::string error;
   PNEUMID_CHECK(o.IsValid(&error), "{}", error);
   std::unique_ptr<Plant> plant = MakePlant(plant_spec, Ts, po);
-  // An IPA's loop samples once per PWM period unless told otherwise (PwmLoopPeriod).
-  if (const auto* ipa = dynamic_cast<const IpaSimulator*>(plant.get()); ipa && !Ts_given) {
-    Ts = PwmLoopPeriod(ipa->parameters().pwm_frequency);
-    plant = MakePlant(plant_spec, Ts, po);
-    CheckWork(Ts, o.budget, 0, 0);
-  }
   SetInputGaps(o, *plant, gaps);
   std::string dir_field;
   fs::path dir;
