@@ -161,8 +161,8 @@ void Run(CommissionArgs& c) {
       o.overshoot = 2.0;  // docs/position.md's targets, unless --spec says otherwise
       o.settling = 1.0;
     }
-    if (ipa != nullptr && c.ts_option->count() == 0) {
-      c.Ts = PwmLoopPeriod(ipa->parameters().pwm_frequency);
+    if (c.ts_option->count() == 0 && DefaultLoopPeriod(*plant, c.Ts) != c.Ts) {
+      c.Ts = DefaultLoopPeriod(*plant, c.Ts);
       plant = MakePlant(c.plant, c.Ts, po);
     }
   } else {

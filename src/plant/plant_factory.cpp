@@ -10,6 +10,7 @@
 #include "pneumid/lti/model_io.hpp"
 #include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/linear_plant.hpp"
+#include "pneumid/plant/mapped_plant.hpp"
 
 namespace pneumid {
 
@@ -66,6 +67,14 @@ std::unique_ptr<Plant> MakePlant(const std::string& spec, double Ts, const Plant
         "unknown plant '{}': expected ipa, ipa-position, ipa:config=FILE.toml or a model ({})",
         spec, e.what()));
   }
+  // A model file's maps are part of the plant: what the model predicts on
+  // data (mapped_plant.hpp), not its linear part alone.
+  MappedPlant::Parts parts;
+  parts.input_map = ParseModelInputMap(spec);
+  parts.output_map = ParseModelOutputMap(spec);
+  if (parts.input_map || parts.output_map)
+    return std::make_unique<MappedPlant>(g, std::move(parts), Ts,
+                                         options.noise_sigma.value_or(0.0), options.seed, spec);
   return std::make_unique<LinearPlant>(g, Ts, options.noise_sigma.value_or(0.0), options.seed,
                                        spec);
 }
@@ -84,7 +93,9 @@ std::string PlantSpecHelp() {
   arx-paper                the paper's ARX(3,3,1) force model, Ts = 0.01 s (Eq. 5)
   arx-paper-ct, fopdt-paper, fopdt:K=1.6,tau=0.245,theta=0.001, sopdt:K=..,tau1=..,tau2=..,theta=..,
   tf:num=..,den=..[,Ts=..]  linear models (continuous ones discretized with zoh at --Ts)
-  MODEL.json[#method]      a model written by pneumid (identify --json)
+  MODEL.json[#method]      a model written by pneumid (identify --json), with its input and
+                           output maps, in deviations from its operating point (NARX models
+                           cannot be plants)
 )";
 }
 

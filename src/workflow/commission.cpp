@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <utility>
@@ -169,6 +170,7 @@ void Report(const CommissionOptions& o, const std::string& stage, double fractio
 struct Probe {
   double y_rest = 0.0, y_mid = 0.0, y_high = 0.0, noise = 0.0;
   double u_mid = 0.0;
+  std::size_t high_settled_from = 0;  // first sample of the sweep's settled tail
 };
 
 // Stages 1 and 2: the probe step and the sweep. Returns an empty string on
@@ -246,7 +248,8 @@ std::string ProbeAndSweep(Recorder& rec, const CommissionOptions& o, double u_lo
   const double settle = ex.dead_time + 6 * ex.time_constant;
   const std::size_t high_from = rec.size();
   rec.Hold(u_hi, std::max(settle, 0.5));
-  p.y_high = rec.MeanY(high_from + (rec.size() - high_from) * 9 / 10, rec.size());
+  p.high_settled_from = high_from + (rec.size() - high_from) * 9 / 10;
+  p.y_high = rec.MeanY(p.high_settled_from, rec.size());
   Report(o, "sweep", 1.0);
   ex.reachable_min = std::min(p.y_rest, p.y_high);
   ex.reachable_max = std::max(p.y_rest, p.y_high);
@@ -379,8 +382,12 @@ std::string PlanExcitation(const CommissionOptions& o, const Recorder& rec, doub
 }
 
 // Sample ranges of the excitation in the record.
+// The estimation record begins with the sweep's settled tail (a steady state
+// at the highest input), so that the models' simulations, which start from a
+// steady state, start where the plant is; the first level then shows the
+// step down from it instead of a transient the models cannot start in.
 struct ExcitationSamples {
-  std::size_t est_from = 0, est_to = 0, val_to = 0;
+  std::size_t lead_from = 0, est_from = 0, est_to = 0, val_to = 0;
 };
 
 // Stage 3: the shuffled levels over the inputs that cover the range
@@ -412,6 +419,7 @@ ExcitationSamples RunExcitation(Recorder& rec, const CommissionOptions& o, const
   Report(o, "excitation", 0.0);
   const double total = (n_est + n_val) * ex.dwell;
   ExcitationSamples x;
+  x.lead_from = p.high_settled_from;
   x.est_from = rec.size();
   for (double u : ex.estimation_levels) {
     rec.Hold(u, ex.dwell);
@@ -458,8 +466,6 @@ bool IdentifyAndSave(CommissionResult& r, const CommissionOptions& o, double Ts)
   return true;
 }
 
-// Stage 5: the best-ranked model a controller can be built from with
-// `settings`. False (with r.message) when there is none.
 // The settings a design runs with. A GPC has no tuning to specifications of
 // its own: it takes the horizons and move suppression the auto-tuner finds
 // for a DMC on the same model and specification, with the T filter A (the
@@ -481,16 +487,32 @@ ControllerSettings DesignSettings(const ControllerSettings& s, const TransferFun
   return g;
 }
 
+// A design: the settings it runs with and the controller built from them.
+struct Design {
+  ControllerSettings settings;
+  BuiltController built;
+};
+
+Design MakeDesign(const ControllerSettings& s, const TransferFunction& model, double Ts,
+                  const std::string& spec) {
+  Design d;
+  d.settings = DesignSettings(s, model, Ts, spec);
+  d.built = MakeController(model, Ts, WithModelInputMap(ToControllerSpec(d.settings), spec));
+  return d;
+}
+
+// Stage 5: the best-ranked model a controller can be built from with
+// `settings`; its design goes to `first`, the verification's first attempt.
+// False (with r.message) when there is none.
 bool ChooseModel(CommissionResult& r, const CommissionOptions& o,
-                 const ControllerSettings& settings, double Ts, TransferFunction* model) {
+                 const ControllerSettings& settings, double Ts, TransferFunction* model,
+                 std::optional<Design>* first) {
   std::vector<std::string> skipped;
   for (const IdentifiedModel& m : r.identification.models) {
     const std::string spec = r.model_file + "#" + m.method;
     try {
       *model = ParseControllerModel(spec);
-      (void)MakeController(
-          *model, Ts,
-          WithModelInputMap(ToControllerSpec(DesignSettings(settings, *model, Ts, spec)), spec));
+      *first = MakeDesign(settings, *model, Ts, spec);
       r.chosen_model = m.method;
       r.controller_model = spec;
       r.chosen_reason = fmt::format(
@@ -520,7 +542,8 @@ bool ChooseModel(CommissionResult& r, const CommissionOptions& o,
 // is softened too (the verification's staircase is one sample of the
 // set-points the loop will see), and kept if the softer one fails more.
 bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
-            ControllerSettings settings, const TransferFunction& model, double Ts,
+            ControllerSettings settings, std::optional<Design> first,
+            const TransferFunction& model, double Ts,
             const std::function<void(ControllerSettings&, const CommissionAttempt&)>& soften,
             double sse_share, double safe_input, bool retune_on_ripple, double margin) {
   const CommissionExperiment& ex = r.experiment;
@@ -548,9 +571,10 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     }
     CommissionAttempt a;
     a.aggressiveness = settings.aggressiveness;
-    const ControllerSettings design = DesignSettings(settings, model, Ts, r.controller_model);
-    BuiltController built =
-        MakeController(model, Ts, WithModelInputMap(ToControllerSpec(design), r.controller_model));
+    Design d = attempt == 0 && first ? std::move(*first)
+                                     : MakeDesign(settings, model, Ts, r.controller_model);
+    const ControllerSettings& design = d.settings;
+    BuiltController& built = d.built;
     a.design = built.Summary();
     a.settings = built.SettingsToJson();
     a.result = SimulateClosedLoop(*built.controller, plant, *setpoint, cl);
@@ -722,7 +746,7 @@ CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
   const auto soften = [Ki](ControllerSettings& s, const CommissionAttempt&) {
     SetIntegratingPd(s, Ki, 1.5 * s.response_time);
   };
-  if (!Verify(r, plant, o, settings, model, Ts, soften, 0.00125, 0.0, true, 1.0)) return r;
+  if (!Verify(r, plant, o, settings, std::nullopt, model, Ts, soften, 0.00125, 0.0, true, 1.0)) return r;
   const std::string pd = fmt::format("PD (Kc = {:.4g}, Td = {:.3g} s, velocity feed-forward)",
                                      r.settings.pid_kc, r.settings.pid_td);
   if (r.passed()) {
@@ -888,7 +912,7 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     return EndedEarly(std::move(r), e);
   }
   FinishData(rec, act, r);
-  ex.estimation = rec.Slice(x.est_from, x.est_to, act.input, act.output);
+  ex.estimation = rec.Slice(x.lead_from, x.est_to, act.input, act.output);
   ex.validation = rec.Slice(x.est_to, x.val_to, act.input, act.output);
 
   // Stages 4-6: models, design, verification.
@@ -912,7 +936,8 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   if (settings.controller == "mpc" && ex.noise_std >= 1e-4 * (ex.range_max - ex.range_min))
     settings.measurement_noise = ex.noise_std * ex.noise_std;
   TransferFunction model;
-  if (!ChooseModel(r, o, settings, Ts, &model)) return r;
+  std::optional<Design> first;
+  if (!ChooseModel(r, o, settings, Ts, &model, &first)) return r;
   // Softer: half the aggressiveness and, since the fastest robust design's
   // speed does not depend on it (auto_tuning.hpp), a rise time aimed 1.5
   // times the one the last verification's first step measured.
@@ -924,7 +949,7 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     else if (std::isfinite(rise) && rise > 0.0)
       s.response_time = 1.5 * rise;
   };
-  if (!Verify(r, plant, o, settings, model, Ts, soften, 0.005, u_lo, false, 0.8)) return r;
+  if (!Verify(r, plant, o, settings, std::move(first), model, Ts, soften, 0.005, u_lo, false, 0.8)) return r;
   if (r.passed()) {
     r.termination = Termination::kSuccess;
     r.message = fmt::format(
@@ -945,6 +970,11 @@ double PwmLoopPeriod(double pwm_frequency) {
                 "PWM frequency must be finite and positive, got {} Hz", pwm_frequency);
   const double T = 1.0 / pwm_frequency;
   return std::ceil(0.003 / T - 1e-9) * T;
+}
+
+double DefaultLoopPeriod(const Plant& plant, double fallback) {
+  const auto* ipa = dynamic_cast<const IpaSimulator*>(&plant);
+  return ipa != nullptr ? PwmLoopPeriod(ipa->parameters().pwm_frequency) : fallback;
 }
 
 void SetInputGaps(CommissionOptions& options, const Plant& plant, const std::string& text) {

@@ -116,6 +116,14 @@ replay wiener_mpc "['output-map']" --model "$TMP/models.json#wiener" --controlle
 replay narx_mpc "['narx-linearization']" --model "$TMP/models.json#affine-narx" --controller mpc
 replay narx_pid "['narx-linearization']" --model "$TMP/models.json#affine-narx" --controller pid
 
+# --with-plant writes a linear plant module: a model with a map is refused,
+# not written without it.
+if "$PNEUMID" codegen --model "$TMP/models.json#hammerstein" --controller mpc --Ts 0.01 \
+  --with-plant plant -o "$TMP/hplant" 2> "$TMP/hplant.err"; then
+  fail "--with-plant on a Hammerstein model wrote its linear part only"
+fi
+grep -q "has a static input map" "$TMP/hplant.err" || fail "--with-plant error: $(cat "$TMP/hplant.err")"
+
 # --rule auto is reported as such (its settings are the tuner's explicit ones).
 expect_ok "auto rule" codegen "${common[@]}" --controller mpc --plant ipa --rule auto --prefix ctrl \
   -o "$TMP/auto" --json

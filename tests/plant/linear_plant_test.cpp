@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -14,6 +16,7 @@
 #include "pneumid/lti/response.hpp"
 #include "pneumid/plant/experiment.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
+#include "pneumid/plant/mapped_plant.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
 
@@ -118,6 +121,48 @@ TEST(PlantFactoryTest, MakesEveryKindOfPlant) {
   auto fopdt = MakePlant("fopdt:K=1.6,tau=0.245,theta=0.001", 0.01);
   for (int k = 0; k < 500; ++k) fopdt->Advance(1.0);
   EXPECT_NEAR(fopdt->Measure(), 1.6, 1e-6);
+}
+
+// A model file's plant is what the model predicts: G f(u) behind an input
+// map, g(G u) with an output map (G: y_k = 0.5 y_{k-1} + 0.5 u_{k-1}, gain 1;
+// maps through (0, 0), (50, 10), (100, 40)), each step response in closed
+// form; a linear model runs in deviations from its operating point, as the
+// controllers designed on it do.
+TEST(PlantFactoryTest, AModelFilesPlantRunsItsMaps) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / "pneumid_mapped_plant_test.json";
+  const std::string g = R"("tf": {"num": [0, 0.5], "den": [1, -0.5], "Ts": 0.1, "delay": 0})";
+  const std::string map = R"({"u": [0, 50, 100], "y": [0, 10, 40]})";
+  std::ofstream(file) << "{\"models\": [{\"method\": \"arx\", " << g
+                      << R"(, "operating_point": {"u0": 2, "y0": 5}}, {"method": "hammerstein", )"
+                      << g << ", \"input_map\": " << map << "}, {\"method\": \"wiener\", " << g
+                      << ", \"output_map\": " << map << "}]}";
+  const auto step = [](Plant& plant, double u, int k) {
+    Eigen::VectorXd y(k + 1);
+    for (int i = 0; i < k; ++i) {
+      y[i] = plant.Measure();
+      plant.Advance(u);
+    }
+    y[k] = plant.Measure();
+    return y;
+  };
+  auto arx = MakePlant(file.string() + "#arx", 0.1);
+  ASSERT_NE(dynamic_cast<LinearPlant*>(arx.get()), nullptr);
+  Eigen::VectorXd y = step(*arx, 10.0, 3);  // 10 (1 - 0.5^k)
+  EXPECT_NEAR(y[3], 10.0 * 0.875, 1e-12);
+  auto hammerstein = MakePlant(file.string() + "#hammerstein", 0.1);
+  ASSERT_NE(dynamic_cast<MappedPlant*>(hammerstein.get()), nullptr);
+  EXPECT_THAT(hammerstein->Describe(), HasSubstr("behind its input map"));
+  y = step(*hammerstein, 75.0, 40);  // f(75) = 25
+  EXPECT_NEAR(y[1], 12.5, 1e-12);
+  EXPECT_NEAR(y[40], 25.0, 1e-9);
+  auto wiener = MakePlant(file.string() + "#wiener", 0.1);
+  y = step(*wiener, 75.0, 40);  // g(37.5) = 7.5, g(75) = 25
+  EXPECT_NEAR(y[1], 7.5, 1e-12);
+  EXPECT_NEAR(y[40], 25.0, 1e-9);
+  EXPECT_NEAR(wiener->Extras().at("x"), 75.0, 1e-9);
+  EXPECT_THAT(wiener->Describe(), HasSubstr("with its output map"));
+  std::filesystem::remove(file);
 }
 
 TEST(PlantFactoryTest, BadSpecsGiveClearErrors) {

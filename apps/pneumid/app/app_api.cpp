@@ -866,7 +866,7 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
   std::string plant_spec = "ipa";
   if (Get(b, "plant", plant_spec)) plant_spec = PlantSpec(plant_spec);
   double Ts = 0.01;
-  Get(b, "Ts", Ts);
+  const bool ts_given = Get(b, "Ts", Ts);
   CommissionOptions o;
   if (b.contains("range") && !b["range"].is_null()) {
     const nlohmann::json& r = b["range"];
@@ -901,6 +901,12 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
   std::string error;
   PNEUMID_CHECK(o.IsValid(&error), "{}", error);
   std::unique_ptr<Plant> plant = MakePlant(plant_spec, Ts, po);
+  // The command's loop period: one PWM period on the IPA, unless given.
+  if (!ts_given && DefaultLoopPeriod(*plant, Ts) != Ts) {
+    Ts = DefaultLoopPeriod(*plant, Ts);
+    plant = MakePlant(plant_spec, Ts, po);
+  }
+  CheckWork(Ts, o.budget, 0, 0);
   SetInputGaps(o, *plant, gaps);
   std::string dir_field;
   fs::path dir;

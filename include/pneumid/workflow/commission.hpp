@@ -238,4 +238,10 @@ void SetInputGaps(CommissionOptions& options, const Plant& plant, const std::str
 /// @throws InvalidArgument unless pwm_frequency is finite and positive.
 double PwmLoopPeriod(double pwm_frequency);
 
+/// The loop period commission runs a simulated `plant` at when none is given:
+/// PwmLoopPeriod of its PWM frequency on the IPA simulator, else `fallback`
+/// (0.01 s in `pneumid commission` and in the app). The command and the app
+/// both take it from here.
+double DefaultLoopPeriod(const Plant& plant, double fallback);
+
 }  // namespace pneumid
