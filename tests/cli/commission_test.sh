@@ -9,8 +9,8 @@ source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 
 "$PNEUMID" commission --plant ipa -o "$TMP/c" --json --report > "$TMP/c.json"
 rc=$?
-# 0: the specification is met; 4: a controller that misses it (stated).
-[ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission exited $rc"
+# 0: the specification is met (4 would be a controller that misses it).
+[ "$rc" -eq 0 ] || fail "commission on the default twin exited $rc: $(head -c 600 "$TMP/c.json")"
 for f in data.csv models.json controller.toml verification.csv experiment.png verification.png \
   c/pneumid_ctrl.c c/pneumid_ctrl.h report.html; do
   [ -s "$TMP/c/$f" ] || fail "commission did not write $f"
@@ -46,6 +46,17 @@ assert v["overshoot_percent"] <= 5.0, v["overshoot_percent"]
 assert len(j["attempts"]) == 1, [a["aggressiveness"] for a in j["attempts"]]
 # The MPC's measurement noise is the noise measured at rest.
 assert 0.03 < e["noise_std"] < 0.15, e["noise_std"]
+# The estimation record begins at the sweep's steady state (193 N at 100 %),
+# so the Hammerstein's map holds at the low end (before, its simulation
+# started at rest at the first level, and the map came out 11 N too high at
+# 1 % duty: a 0.58 N cycle at 10 N failed the verification).
+assert j["chosen_model"] == "hammerstein", j["chosen_model"]
+models = json.load(open(sys.argv[1].replace("c.json", "c/models.json")))["models"]
+ham = next(m for m in models if m["method"] == "hammerstein")
+assert abs(ham["input_map"]["y"][0]) < 2.0, ham["input_map"]
+# One steady output and ripple per excitation level.
+levels = len(e["estimation_levels"]) + len(e["validation_levels"])
+assert len(e["level_outputs"]) == len(e["level_ripples"]) == levels, levels
 PYEOF
 # One sample per PWM period (300 Hz), and the Kalman filter's measurement
 # variance in the configuration.
@@ -92,6 +103,21 @@ rc=$?
 [ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission on the variant exited $rc"
 $PY -c 'import json,sys; j=json.load(open(sys.argv[1])); assert j["verification"]["steps"], j' "$TMP/v.json" \
   || fail "variant JSON"
+
+# The chamber-lag twin: inside the inlet valve's gap (about 10 N) the
+# modulation alone ripples by 0.7-0.9 N in open loop, above twice the
+# sensor's noise; the verification allows 1.25 times what the experiment's
+# levels showed there, and judges the overshoot beyond half the ripple.
+"$PNEUMID" commission --plant ipa --plant-config "$SRC/config/ipa_chamber_lag.toml" -o "$TMP/cl" \
+  --json > "$TMP/cl.json" || fail "commission on the chamber-lag twin exited $?: $(head -c 600 "$TMP/cl.json")"
+$PY - "$TMP/cl.json" <<'PYEOF' || fail "chamber-lag JSON"
+import json, sys
+j = json.load(open(sys.argv[1]))
+e = j["experiment"]
+gap = [r for y, r in zip(e["level_outputs"], e["level_ripples"]) if 5 < y < 14]
+assert gap and max(gap) > 2 * e["noise_peak_to_peak"], (gap, e["noise_peak_to_peak"])
+assert any(s["to"] < 12 and s["time"] > 0 for s in j["verification"]["steps"]), j["verification"]
+PYEOF
 
 # A GPC has no tuning to specifications of its own: it runs the horizons and
 # move suppression of the DMC's auto design with the T filter A, written

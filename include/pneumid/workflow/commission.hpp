@@ -172,8 +172,18 @@ struct CommissionExperiment {
   double dwell = 0.0;                     ///< s per excitation level
   std::vector<double> estimation_levels;  ///< inputs of the estimation sequence
   std::vector<double> validation_levels;  ///< inputs of the held-out sequence
+  /// Steady output of each excitation level (the mean of the last quarter of
+  /// its hold), estimation then held-out levels, in the order held.
+  std::vector<double> level_outputs;
+  /// Ripple of each level (same order): the largest peak-to-peak of 4
+  /// consecutive samples of the last quarter of its hold, about its linear
+  /// trend. Inside a valve's gap the modulation ripples by itself; the
+  /// verification's ripple criterion allows 1.25 times the ripple of the
+  /// levels whose outputs bracket the set-point.
+  std::vector<double> level_ripples;
   /// {duration, samples, probe, sweep, range, noise_peak_to_peak, noise_std, dwell,
-  /// estimation_levels, validation_levels, estimation_samples, validation_samples}.
+  /// estimation_levels, validation_levels, estimation_samples, validation_samples,
+  /// level_outputs, level_ripples}.
   nlohmann::ordered_json ToJson() const;
 };
 
