@@ -20,21 +20,6 @@
 
 namespace pneumid::cli {
 
-namespace {
-
-RunSafetyOverrides SafetyFlags(const RunArgs& o) {
-  RunSafetyOverrides s;
-  s.u_min = o.u_min;
-  s.u_max = o.u_max;
-  s.rate_max = o.rate_max;
-  s.y_min = o.y_min;
-  s.y_max = o.y_max;
-  s.frozen_samples = o.frozen_samples;
-  return s;
-}
-
-}  // namespace
-
 RunWorkflowOptions ToWorkflowOptions(const RunArgs& o) {
   RunWorkflowOptions w;
   w.controller = o.controller;
@@ -44,16 +29,10 @@ RunWorkflowOptions ToWorkflowOptions(const RunArgs& o) {
   for (const std::string& l : o.load_steps) w.load_steps.push_back(ParseLoadStep("--load-step", l));
   w.offline = o.offline;
   w.plant_options = SimulatedPlantOptions(o.rt);
-  w.safety = SafetyFlags(o);
+  w.safety = o.safety;
   w.log = o.rt.log;
   w.live_status = StderrIsTerminal() && !o.rt.json;
   return w;
-}
-
-void ApplySafetyFlags(const RunArgs& o, RealtimeConfig& config) {
-  SafetyFlags(o).ApplyTo(config.safety);
-  std::string error;
-  PNEUMID_CHECK(config.safety.IsValid(&error), "invalid safety settings: {}", error);
 }
 
 namespace {
@@ -105,14 +84,16 @@ static Registrar reg(
       help.plant = "plant of the sim backend and of --offline (default ipa)";
       help.json = "print samples, overruns, jitter_p99_us, jitter_max_us, ... and metrics as JSON";
       AddRealtimeOptions(app, o->rt, help);
-      app.add_option("--u-min", o->u_min,
+      app.add_option("--u-min", o->safety.u_min,
                      "output clamp, lower (%; default: the plant's input range, IPA 0, position "
                      "twin -100)");
-      app.add_option("--u-max", o->u_max, "output clamp, upper (%; default: the plant's, 100)");
-      app.add_option("--rate-max", o->rate_max, "output rate limit (%/s; default none)");
-      app.add_option("--y-min", o->y_min, "measurement range, lower (N): outside is a fault");
-      app.add_option("--y-max", o->y_max, "measurement range, upper (N)");
-      app.add_option("--frozen-samples", o->frozen_samples,
+      app.add_option("--u-max", o->safety.u_max,
+                     "output clamp, upper (%; default: the plant's, 100)");
+      app.add_option("--rate-max", o->safety.rate_max, "output rate limit (%/s; default none)");
+      app.add_option("--y-min", o->safety.y_min,
+                     "measurement range, lower (N): outside is a fault");
+      app.add_option("--y-max", o->safety.y_max, "measurement range, upper (N)");
+      app.add_option("--frozen-samples", o->safety.frozen_samples,
                      "unchanged readings that count as a frozen sensor (0 = off)");
       app.add_option("--load-step", o->load_steps,
                      "load disturbance on the output at=T,size=D (repeatable): applied to the "

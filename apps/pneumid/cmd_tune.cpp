@@ -28,31 +28,11 @@
 
 namespace pneumid::cli {
 
-TuneWorkflowOptions ToWorkflowOptions(const TuneArgs& c) {
-  TuneWorkflowOptions o;
-  o.model = c.model;
-  o.Ts = c.Ts;
-  o.rule = c.rule;
-  o.M = c.M;
-  o.P = c.P;
-  o.lambda = c.lambda;
-  o.tau_digits = c.tau_digits;
-  o.controller = c.controller;
-  o.response_time = c.response_time;
-  o.measure = c.measure;
-  o.overshoot = c.overshoot;
-  o.aggressiveness = c.aggressiveness;
-  o.u_min = c.u_min;
-  o.u_max = c.u_max;
-  o.du_max = c.du_max;
-  o.plant = c.plant;
-  return o;
-}
 
 namespace {
 
 void Run(const TuneArgs& c) {
-  const TuneWorkflowResult result = RunTuneWorkflow(ToWorkflowOptions(c));
+  const TuneWorkflowResult result = RunTuneWorkflow(c.options);
   if (c.json) {
     std::cout << result.ToJson().dump(2) << "\n";
     return;
@@ -70,7 +50,7 @@ void Run(const TuneArgs& c) {
         "lambda_condition  {:.6g}  (lambda_max(A'A)/500, used{})\n"
         "lambda_formula    {:.6g}  ((M/500) K^2 (3.5 tau/Ts + 2 - (M-1)/2), tau = {:g} s)\n",
         r.fopdt.K, r.fopdt.tau, r.fopdt.theta, r.fopdt.method, r.lambda_condition,
-        std::isnan(c.lambda) ? "" : " unless --lambda", r.lambda_formula, r.tau_used);
+        std::isnan(c.options.lambda) ? "" : " unless --lambda", r.lambda_formula, r.tau_used);
   }
   std::cout << "formula: " << r.formula << "\n";
 }
@@ -78,7 +58,8 @@ void Run(const TuneArgs& c) {
 const Registrar reg(
     "tune", "Horizons and move suppression (P, M, lambda) of DMC/GPC from a model",
     [](CLI::App& app) {
-      auto c = std::make_shared<TuneArgs>();
+      auto args = std::make_shared<TuneArgs>();
+      TuneWorkflowOptions* c = &args->options;
       app.add_option("--model", c->model,
                      "Model spec: fopdt:K=..,tau=..,theta=.., arx-paper, tf:..., FILE.json")
           ->required();
@@ -113,8 +94,15 @@ const Registrar reg(
       app.add_option("--plant", c->plant,
                      "auto: plant whose physical input range (ipa: duty 0..100 %) sets the "
                      "limits --u-min/--u-max leave open, as control --plant does");
-      app.add_flag("--json", c->json, "Print a JSON object");
-      app.callback([c] { Run(*c); });
+      app.add_option("--measurement-noise", c->measurement_noise,
+                     "auto, mpc: the Kalman filter's measurement noise variance, output units "
+                     "squared, as control's (default 1)");
+      app.add_option("--state-noise", c->state_noise,
+                     "auto, mpc: process noise variance on each model state (default 0)");
+      app.add_option("--disturbance-noise", c->disturbance_noise,
+                     "auto, mpc: process noise variance on the disturbance (default 1)");
+      app.add_flag("--json", args->json, "Print a JSON object");
+      app.callback([args] { Run(*args); });
     });
 
 }  // namespace

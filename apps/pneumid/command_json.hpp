@@ -71,31 +71,10 @@ nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs);
 // ---------------------------------------------------------------- tune
 
 struct TuneArgs {
-  std::string model;
-  double Ts = 0.0;
-  std::string rule = "shridhar-cooper";
-  int M = 0;
-  int P = 0;
-  double lambda = std::numeric_limits<double>::quiet_NaN();
-  int tau_digits = 2;
+  TuneWorkflowOptions options;  // every flag but --json
   bool json = false;
-  // --rule auto
-  std::string controller;
-  double response_time = std::numeric_limits<double>::quiet_NaN();
-  std::string measure;
-  double overshoot = std::numeric_limits<double>::quiet_NaN();
-  double aggressiveness = std::numeric_limits<double>::quiet_NaN();
-  double u_min = -std::numeric_limits<double>::infinity();
-  double u_max = std::numeric_limits<double>::infinity();
-  double du_max = std::numeric_limits<double>::infinity();
-  /// Plant spec whose physical input range gives the limits --u-min/--u-max
-  /// leave open (as `control --plant` does); empty: none.
-  std::string plant;
 };
 
-/// The tuning of `tune`'s flags (workflow/tune_workflow.hpp: RunTuneWorkflow,
-/// whose ToJson is what `tune --json` prints).
-TuneWorkflowOptions ToWorkflowOptions(const TuneArgs& c);
 
 // ---------------------------------------------------------------- identify
 
@@ -126,8 +105,7 @@ struct RunArgs {
   std::string model = "fopdt-paper";
   std::string setpoint = "step:from=0,to=100,at=0.5";
   RealtimeOptions rt;  // --io, --config, --plant, --Ts, --duration, --log, --json, ...
-  std::optional<double> u_min, u_max, rate_max, y_min, y_max;
-  std::optional<int> frozen_samples;
+  RunSafetyOverrides safety;  // --u-min, --u-max, --rate-max, --y-min, --y-max, --frozen-samples
   bool offline = false;
   std::vector<std::string> load_steps;
   /// A model held in memory under the name `model` (the app's model objects:
@@ -141,9 +119,5 @@ struct RunArgs {
 /// @throws InvalidArgument for a bad --load-step.
 RunWorkflowOptions ToWorkflowOptions(const RunArgs& args);
 
-/// `run`'s safety settings: the configuration's with the flags applied
-/// (RunSafetyOverrides::ApplyTo).
-/// @throws InvalidArgument for invalid settings.
-void ApplySafetyFlags(const RunArgs& o, RealtimeConfig& config);
 
 }  // namespace pneumid::cli

@@ -43,6 +43,9 @@ AutoTuneResult Auto(const TuneWorkflowOptions& c, const TransferFunction& model)
   if (!c.plant.empty())
     ResolvePlantInputRange(MakePlant(c.plant, c.Ts)->actuator(), o.limits.u_min, o.limits.u_max);
   o.M = c.M;
+  o.measurement_noise = c.measurement_noise;
+  o.state_noise = c.state_noise;
+  o.disturbance_noise = c.disturbance_noise;
   return AutoTune(model, c.Ts, o);
 }
 
@@ -51,9 +54,10 @@ TuningResult Conventional(const TuneWorkflowOptions& c, const TransferFunction& 
   PNEUMID_CHECK(c.controller.empty() && std::isnan(c.response_time) && c.measure.empty() &&
                     std::isnan(c.overshoot) && std::isnan(c.aggressiveness) &&
                     std::isinf(c.u_min) && std::isinf(c.u_max) && std::isinf(c.du_max) &&
-                    c.plant.empty(),
+                    c.plant.empty() && std::isnan(c.measurement_noise) &&
+                    std::isnan(c.state_noise) && std::isnan(c.disturbance_noise),
                 "--controller, --response-time, --measure, --overshoot, --aggressiveness, "
-                "the input limits and --plant apply to --rule auto only");
+                "the input limits, --plant and the Kalman noises apply to --rule auto only");
   TuningOptions o;
   o.rule = TuningRuleFromString(c.rule);
   o.M = c.M;

@@ -54,6 +54,15 @@ check_json "auto pid gains" "j['Kc'] > 0 and j['Ti'] > 0 and j['Td'] == 0 and ab
 expect_ok "auto text" tune --rule auto --controller dmc --model fopdt-paper --Ts 0.01
 check_output "auto text review" "review:"
 check_output "auto text termination" "termination: converged"
+# The MPC's Kalman noises are part of the design: the sensor's variance
+# (0.003 N^2) gives a faster estimator and so another lambda than the default
+# 1, and tune evaluates what control --rule auto deploys with the same flags.
+expect_ok "auto noise" tune --rule auto --model fopdt-paper --Ts 0.01 --measurement-noise 0.003 --json
+check_json "auto noise lambda" "abs(j['lambda'] - 0.734941) < 1e-5"
+"$PNEUMID" control --controller mpc --rule auto --model fopdt-paper --Ts 0.01 --measurement-noise 0.003 \
+  --setpoint step:from=0,to=10,at=0.1 --duration 1 --json | $PY -c 'import json, sys; j = json.load(sys.stdin); s = j["settings"]; assert abs(s["lambda"] - 0.734941) < 1e-5, s' \
+  || fail "control deploys another lambda than tune evaluated"
+expect_error "noise without auto" "apply to --rule auto only" tune --model fopdt-paper --Ts 0.01 --measurement-noise 1
 # A spec that cannot be met is a review that says why, not a crash.
 expect_ok "auto impossible" tune --rule auto --model fopdt-paper --Ts 0.01 --response-time 0.001 --u-min 0 --u-max 100 --json
 check_json "auto impossible" "j['termination'] == 'spec_not_met' and any(r['check'] == 'specification' and r['status'] == 'fail' and 'input held at its limit' in r['message'] for r in j['review'])"

@@ -740,6 +740,9 @@ nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
     Get(b, "u_min", c.u_min);
     Get(b, "u_max", c.u_max);
     Get(b, "du_max", c.du_max);
+    Get(b, "measurement_noise", c.measurement_noise);
+    Get(b, "state_noise", c.state_noise);
+    Get(b, "disturbance_noise", c.disturbance_noise);
     // The loop's plant bounds the design as in /api/control: the review then
     // describes the controller that runs.
     if (Get(b, "plant", c.plant)) c.plant = PlantSpec(c.plant);
@@ -961,9 +964,9 @@ Response AppApi::RunStart(const nlohmann::json& b) {
   if (Get(b, "setpoint", o.setpoint)) o.setpoint = SignalSpec(o.setpoint);
   o.load_steps = LoadSteps(b);
   double u = 0.0;
-  if (Get(b, "u_min", u)) o.u_min = u;
-  if (Get(b, "u_max", u)) o.u_max = u;
-  if (Get(b, "rate_max", u)) o.rate_max = u;
+  if (Get(b, "u_min", u)) o.safety.u_min = u;
+  if (Get(b, "u_max", u)) o.safety.u_max = u;
+  if (Get(b, "rate_max", u)) o.safety.rate_max = u;
   RealtimeConfig config;
   if (Get(b, "io", config.io)) CheckIo(config.io);
   if (Get(b, "plant", config.plant)) config.plant = PlantSpec(config.plant);
@@ -981,7 +984,8 @@ Response AppApi::RunStart(const nlohmann::json& b) {
   config.loop.realtime = io.kind != IoKind::kSim;
   std::string error;
   PNEUMID_CHECK(config.loop.IsValid(&error), "{}", error);
-  cli::ApplySafetyFlags(o, config);
+  o.safety.ApplyTo(config.safety);
+  PNEUMID_CHECK(config.safety.IsValid(&error), "invalid safety settings: {}", error);
   // Errors in the settings answer here rather than in the run's status.
   ParseControllerModel(o.model);
   ParseSignal(o.setpoint);

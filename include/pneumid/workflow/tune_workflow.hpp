@@ -53,6 +53,12 @@ struct TuneWorkflowOptions {
   /// Plant spec whose physical input range gives the limits u_min/u_max leave
   /// open (as `control --plant` designs); empty = none.
   std::string plant;
+  /// mpc: the Kalman filter's noise variances the design is evaluated with
+  /// (AutoTuneOptions::measurement_noise, state_noise, disturbance_noise, as
+  /// `control --measurement-noise` ... deploy them); NaN = MpcOptions' defaults.
+  double measurement_noise = std::numeric_limits<double>::quiet_NaN();
+  double state_noise = std::numeric_limits<double>::quiet_NaN();  ///< mpc: see measurement_noise
+  double disturbance_noise = std::numeric_limits<double>::quiet_NaN();  ///< mpc: ditto
 
   /// False (with the reason) for a Ts that is not positive and finite.
   bool IsValid(std::string* error) const;
