@@ -204,6 +204,10 @@ ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen
     if (k1 - k0 >= 2 * tail) s.ripple = RippleHalfBand(y, k1 - tail, k1);
     s.settling_band =
         std::max(options.settling_threshold * step, std::isfinite(s.ripple) ? s.ripple : 0.0);
+    if (options.settling_band_floor) {
+      const double floor = options.settling_band_floor(s.to);
+      if (std::isfinite(floor)) s.settling_band = std::max(s.settling_band, floor);
+    }
     if (k1 - k0 >= 3) {
       StepInfoOptions o;
       // The band as a fraction of the step (a ripple wider than the step

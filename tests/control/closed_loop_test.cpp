@@ -48,6 +48,33 @@ TEST(ClosedLoopMetricsTest, FirstOrderResponseClosedForms) {
   ASSERT_EQ(m.steps.size(), 1u);
 }
 
+// A level held by modulation wanders slowly: y = 1 - exp(-t/tau) plus a
+// 0.06 sine of period 0.5 s after a unit step. Four consecutive samples
+// (1 ms apart) see almost none of it, so the band stays 2 % of the step and
+// the response never settles; with a floor of 0.07 at the set-point (what
+// commission passes from its open-loop levels) it settles when the
+// exponential has decayed below 0.07 - 0.06, near tau ln(1 / 0.01).
+TEST(ClosedLoopMetricsTest, ASettlingBandFloorWidensTheBandForASlowWander) {
+  const double tau = 0.1, Ts = 1e-3, a = 0.06;
+  const int n = 3000;
+  Eigen::VectorXd t(n), r = Eigen::VectorXd::Ones(n), y(n), u = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < n; ++k) {
+    t(k) = k * Ts;
+    y(k) = 1.0 - std::exp(-t(k) / tau) + a * std::sin(2.0 * M_PI * t(k) / 0.5);
+  }
+  ClosedLoopOptions o;
+  ClosedLoopMetrics m = ComputeClosedLoopMetrics(t, r, y, u, 0.0, 0.0, o);
+  ASSERT_EQ(m.steps.size(), 1u);
+  EXPECT_FALSE(m.steps[0].settled);
+  EXPECT_NEAR(m.steps[0].settling_band, 0.02, 1e-3);
+  o.settling_band_floor = [](double to) { return to == 1.0 ? 0.07 : 0.0; };
+  m = ComputeClosedLoopMetrics(t, r, y, u, 0.0, 0.0, o);
+  EXPECT_TRUE(m.steps[0].settled);
+  EXPECT_DOUBLE_EQ(m.steps[0].settling_band, 0.07);
+  EXPECT_GT(m.steps[0].settling_time, tau * std::log(1.0 / 0.07));
+  EXPECT_LT(m.steps[0].settling_time, tau * std::log(1.0 / 0.01) + 0.5);
+}
+
 TEST(ClosedLoopMetricsTest, LoadStepPeakAndRecovery) {
   // After a load of -1 at t = 1: deviation -exp(-(t-1)/0.1); band 2 % of 1:
   // recovery when exp(-s/0.1) = 0.02, s = 0.1 ln 50.

@@ -28,7 +28,8 @@
 //     first step (steps[0] holds all of the first step's metrics). All are
 //     NaN (settled false) when the set-point never changes;
 //   settling_band: the half-width of the band |y - r| <= band the settling
-//     time refers to, max(settling_threshold |step|, ripple), where the ripple
+//     time refers to, max(settling_threshold |step|, ripple) (and
+//     ClosedLoopOptions::settling_band_floor at the new set-point, if set), where the ripple
 //     is the measured ripple/noise band of the segment's last quarter (at
 //     least 8 samples): the largest peak-to-peak range max - min of 4
 //     consecutive samples there (so a ripple centred up to half its
@@ -52,6 +53,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -96,6 +98,12 @@ struct ClosedLoopOptions {
   double u0 = 0.0;  ///< input before t = 0
   /// Settling band as a fraction of the step (and rise 10-90 %).
   double settling_threshold = 0.02;
+  /// Least half-width of the settling band at a set-point (output units):
+  /// the band is then max(settling_threshold |step|, ripple, floor(to)).
+  /// For an actuator that cannot hold some outputs more steadily than a
+  /// known ripple (commission passes 1.25 x the ripple its experiment's
+  /// levels showed near `to`, workflow/commission.hpp). Empty: none.
+  std::function<double(double to)> settling_band_floor;
   /// Record the wall-clock time of every Update() call.
   bool time_updates = false;
   /// When set and true, the simulation throws Cancelled at the next sample

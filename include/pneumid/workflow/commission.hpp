@@ -175,11 +175,12 @@ struct CommissionExperiment {
   /// Steady output of each excitation level (the mean of the last quarter of
   /// its hold), estimation then held-out levels, in the order held.
   std::vector<double> level_outputs;
-  /// Ripple of each level (same order): the largest peak-to-peak of 4
-  /// consecutive samples of the last quarter of its hold, about its linear
-  /// trend. Inside a valve's gap the modulation ripples by itself; the
-  /// verification's ripple criterion allows 1.25 times the ripple of the
-  /// levels whose outputs bracket the set-point.
+  /// Ripple of each level (same order): the peak-to-peak of the last quarter
+  /// of its hold about its linear trend. Inside a valve's gap the modulation
+  /// ripples and wanders by itself; the verification allows 1.25 times the
+  /// larger ripple of the two levels whose outputs bracket the set-point, in
+  /// its ripple criterion and as the least half-width of its settling band
+  /// (ClosedLoopOptions::settling_band_floor).
   std::vector<double> level_ripples;
   /// {duration, samples, probe, sweep, range, noise_peak_to_peak, noise_std, dwell,
   /// estimation_levels, validation_levels, estimation_samples, validation_samples,
