@@ -112,6 +112,17 @@ TEST(Commission, ThePwmLoopPeriodIsAWholeNumberOfPwmPeriodsOfAtLeast3Ms) {
   EXPECT_THROW(PwmLoopPeriod(std::nan("")), InvalidArgument);
 }
 
+// The command and the app take the loop period from one place: the IPA
+// simulator's PWM period (300 Hz on the default twin, 50 Hz on the slow-valve
+// twin), any other plant the caller's fallback.
+TEST(Commission, TheDefaultLoopPeriodIsThePwmPeriodOnTheIpaOnly) {
+  EXPECT_DOUBLE_EQ(DefaultLoopPeriod(*MakePlant("ipa", 0.01), 0.01), 1.0 / 300.0);
+  const std::string slow = std::string(PNEUMID_SOURCE_DIR) + "/config/ipa_slow_valves.toml";
+  EXPECT_DOUBLE_EQ(DefaultLoopPeriod(*MakePlant("ipa:config=" + slow, 0.01), 0.01), 0.02);
+  EXPECT_DOUBLE_EQ(DefaultLoopPeriod(*MakePlant("fopdt-paper", 0.01), 0.01), 0.01);
+  EXPECT_DOUBLE_EQ(DefaultLoopPeriod(*MakePlant("fopdt-paper", 0.05), 0.05), 0.05);
+}
+
 TEST(Commission, APlantThatDoesNotRespondIsNamed) {
   TestPlant plant(0.0, false);
   const CommissionResult r = Commission(plant, Options("dead"));
