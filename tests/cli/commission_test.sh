@@ -54,6 +54,11 @@ assert j["chosen_model"] == "hammerstein", j["chosen_model"]
 models = json.load(open(sys.argv[1].replace("c.json", "c/models.json")))["models"]
 ham = next(m for m in models if m["method"] == "hammerstein")
 assert abs(ham["input_map"]["y"][0]) < 2.0, ham["input_map"]
+# Knots at the ends of the valves' gaps (0:15 and 85:100 %), the corners of
+# the actuator's map: f(85 %) within 5 N of the twin's 135 N.
+u, f = ham["input_map"]["u"], ham["input_map"]["y"]
+assert 15.0 in u and 85.0 in u, u
+assert abs(f[u.index(85.0)] - 135.0) < 5.0, (u, f)
 # One steady output and ripple per excitation level.
 levels = len(e["estimation_levels"]) + len(e["validation_levels"])
 assert len(e["level_outputs"]) == len(e["level_ripples"]) == levels, levels
