@@ -105,7 +105,7 @@ void ParseSpecification(const std::string& text, CommissionOptions& o) {
   }
 }
 
-void PrintSummary(const CommissionResult& r, const std::string& dir) {
+void PrintSummary(const CommissionResult& r, const std::string& dir, double spec_overshoot) {
   const auto& ex = r.experiment;
   std::cout << fmt::format("commission {}: {}\n", ToString(r.termination), r.message);
   std::cout << fmt::format(
@@ -124,10 +124,17 @@ void PrintSummary(const CommissionResult& r, const std::string& dir) {
   if (!r.chosen_model.empty()) std::cout << "chosen: " << r.chosen_reason << "\n";
   for (const CommissionAttempt& a : r.attempts) {
     const ClosedLoopMetrics& m = a.result.metrics;
+    // A peak above the specification that the ripple explains: say what was judged.
+    const std::string judged =
+        m.overshoot_percent > spec_overshoot &&
+                a.overshoot_judged_percent < m.overshoot_percent - 0.005
+            ? fmt::format(" ({:.2f} % beyond half the ripple)", a.overshoot_judged_percent)
+            : std::string();
     std::cout << fmt::format(
-        "verification (aggressiveness {:g}): worst overshoot {:.2f} %, worst settling {:.3f} s, "
+        "verification (aggressiveness {:g}): worst overshoot {:.2f} %{}, worst settling {:.3f} s, "
         "IAE {:.4g}: {}\n",
-        a.aggressiveness, m.overshoot_percent, m.settling_time, m.iae, a.passed ? "pass" : "fail");
+        a.aggressiveness, m.overshoot_percent, judged, m.settling_time, m.iae,
+        a.passed ? "pass" : "fail");
     for (const std::string& f : a.failures) std::cout << "  - " << f << "\n";
   }
   for (const std::string& l : r.limits) std::cout << "limit: " << l << "\n";
@@ -211,7 +218,7 @@ void Run(CommissionArgs& c) {
     j["c_module"] = c_module;
     std::cout << j.dump(2) << "\n";
   } else {
-    PrintSummary(r, c.directory);
+    PrintSummary(r, c.directory, o.overshoot);
     if (!c_module.empty()) std::cout << "C module: " << c_module << "\n";
   }
   if (r.termination == Termination::kStopped) throw ExitCode{130};

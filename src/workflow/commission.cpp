@@ -321,6 +321,17 @@ double JudgedOvershoot(const StepMetrics& s, const CommissionExperiment& ex) {
   return std::max(0.0, s.overshoot_percent - 100.0 * 0.5 * s.ripple / step);
 }
 
+// The largest judged overshoot of a verification run's steps (its start from
+// rest excluded); NaN when no step has an overshoot.
+double WorstJudgedOvershoot(const ClosedLoopMetrics& m, const CommissionExperiment& ex) {
+  double worst = std::numeric_limits<double>::quiet_NaN();
+  for (const StepMetrics& s : m.steps) {
+    const double o = s.time > 0.0 ? JudgedOvershoot(s, ex) : kNaN;
+    if (std::isfinite(o) && !(o <= worst)) worst = o;
+  }
+  return worst;
+}
+
 // The checks of the verification against the specification.
 std::vector<std::string> Judge(const ClosedLoopMetrics& m, const CommissionOptions& o, double range,
                                const CommissionExperiment& ex, double sse_share) {
@@ -684,6 +695,7 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     plant.Advance(safe_input);  // the safe state after the run
     r.plant_time += cl.duration;
     a.failures = Judge(a.result.metrics, o, range, ex, sse_share);
+    a.overshoot_judged_percent = WorstJudgedOvershoot(a.result.metrics, ex);
     a.passed = a.failures.empty();
     r.attempts.push_back(std::move(a));
     tried.push_back(design);
@@ -960,12 +972,14 @@ nlohmann::ordered_json CommissionResult::ToJson() const {
     v["passed"] = a.passed;
     v["failures"] = a.failures;
     v["duration"] = a.result.t.size() > 0 ? a.result.t(a.result.t.size() - 1) : 0.0;
+    v["overshoot_judged_percent"] = NullIfNaN(a.overshoot_judged_percent);
     j["verification"] = v;
     j["attempts"] = nlohmann::ordered_json::array();
     for (const CommissionAttempt& b : attempts) {
       j["attempts"].push_back({{"aggressiveness", b.aggressiveness},
                                {"passed", b.passed},
                                {"overshoot_percent", NullIfNaN(b.result.metrics.overshoot_percent)},
+                               {"overshoot_judged_percent", NullIfNaN(b.overshoot_judged_percent)},
                                {"settling_time", NullIfNaN(b.result.metrics.settling_time)},
                                {"iae", b.result.metrics.iae},
                                {"failures", b.failures}});

@@ -122,6 +122,8 @@ e = j["experiment"]
 gap = [r for y, r in zip(e["level_outputs"], e["level_ripples"]) if 5 < y < 14]
 assert gap and max(gap) > 2 * e["noise_peak_to_peak"], (gap, e["noise_peak_to_peak"])
 assert any(s["to"] < 12 and s["time"] > 0 for s in j["verification"]["steps"]), j["verification"]
+v = j["verification"]
+assert v["overshoot_judged_percent"] <= min(v["overshoot_percent"], 5.0), v["overshoot_judged_percent"]
 PYEOF
 
 # A GPC has no tuning to specifications of its own: it runs the horizons and

@@ -196,6 +196,11 @@ struct CommissionAttempt {
   ClosedLoopResult result;            ///< the verification run on the plant
   bool passed = false;                ///< every item of the specification met
   std::vector<std::string> failures;  ///< the specification items not met
+  /// The worst overshoot as the specification judges it, percent of the
+  /// step: the peak beyond half the step's steady ripple where that ripple is
+  /// within its limit (a level the modulation holds inside a valve's gap),
+  /// else the peak (docs/commission.md). At most the run's worst overshoot.
+  double overshoot_judged_percent = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// What Commission did and found (after Ceres' Solver::Summary).
