@@ -652,11 +652,19 @@ bool ChooseModel(CommissionResult& r, const CommissionOptions& o,
 // design that passes with an overshoot above `margin` times the specified one
 // is softened too (the verification's staircase is one sample of the
 // set-points the loop will see), and kept if the softer one fails more.
+// When it is kept so and the overshoot judged beyond the ripple lies within
+// the margin, the peak is the actuator's ripple, which a softer design does
+// not remove: with `tighten`, the design at aggressiveness 1 is tried once and
+// kept when it passes with an overshoot judged within the margin, a peak no
+// higher than the kept one's by more than 5 % of the specification, and an
+// IAE at least 5 % lower (on the chamber-lag twin: IAE 34.2 -> 27.4 on the
+// verification, peak 5.56 % both).
 bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
             ControllerSettings settings, std::optional<Design> first,
             const TransferFunction& model, double Ts,
             const std::function<void(ControllerSettings&, const CommissionAttempt&)>& soften,
-            double sse_share, double safe_input, bool retune_on_ripple, double margin) {
+            double sse_share, double safe_input, bool retune_on_ripple, double margin,
+            bool tighten) {
   const CommissionExperiment& ex = r.experiment;
   const double range = ex.range_max - ex.range_min;
   std::vector<double> levels;
@@ -676,30 +684,36 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
   // shows near the set-point in open loop (a modulated level wanders by it).
   cl.settling_band_floor = [&ex](double to) { return 1.25 * OpenLoopRipple(ex, to); };
   std::vector<ControllerSettings> tried;
-  for (int attempt = 0; attempt <= o.retunes; ++attempt) {
-    Report(o, "verify", static_cast<double>(attempt) / (o.retunes + 1));
+  const int planned = o.retunes + 1 + (tighten ? 1 : 0);
+  // One verification run of a design, appended to r.attempts; false when
+  // stopped on request before it.
+  const auto run = [&](Design d) {
+    Report(o, "verify", static_cast<double>(r.attempts.size()) / planned);
     if (o.stop != nullptr && o.stop->load()) {
       r.termination = Termination::kStopped;
       r.message = "stopped on request before the verification";
       return false;
     }
     CommissionAttempt a;
-    a.aggressiveness = settings.aggressiveness;
-    Design d = attempt == 0 && first ? std::move(*first)
-                                     : MakeDesign(settings, model, Ts, r.controller_model);
-    const ControllerSettings& design = d.settings;
-    BuiltController& built = d.built;
-    a.design = built.Summary();
-    a.settings = built.SettingsToJson();
-    a.result = SimulateClosedLoop(*built.controller, plant, *setpoint, cl);
+    a.aggressiveness = d.settings.aggressiveness;
+    a.design = d.built.Summary();
+    a.settings = d.built.SettingsToJson();
+    a.result = SimulateClosedLoop(*d.built.controller, plant, *setpoint, cl);
     plant.Advance(safe_input);  // the safe state after the run
     r.plant_time += cl.duration;
     a.failures = Judge(a.result.metrics, o, range, ex, sse_share);
     a.overshoot_judged_percent = WorstJudgedOvershoot(a.result.metrics, ex);
     a.passed = a.failures.empty();
     r.attempts.push_back(std::move(a));
-    tried.push_back(design);
-    r.settings = design;
+    tried.push_back(d.settings);
+    r.settings = d.settings;
+    return true;
+  };
+  const ControllerSettings given = settings;
+  for (int attempt = 0; attempt <= o.retunes; ++attempt) {
+    if (!run(attempt == 0 && first ? std::move(*first)
+                                   : MakeDesign(settings, model, Ts, r.controller_model)))
+      return false;
     const bool overshoot_failed = std::any_of(
         r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
         [&](const std::string& f) {
@@ -712,8 +726,16 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     if (!overshoot_failed && !thin_margin) break;
     soften(settings, r.attempts.back());
   }
-  // None passed: the final design is the one with the fewest failures (then
-  // the smallest worst overshoot), moved last.
+  // The final design is the last attempt when it passed; else the one with
+  // the fewest failures (then the smallest worst overshoot), moved last.
+  const auto keep_last = [&](std::size_t i) {
+    if (i + 1 == r.attempts.size()) return;
+    std::rotate(r.attempts.begin() + static_cast<std::ptrdiff_t>(i),
+                r.attempts.begin() + static_cast<std::ptrdiff_t>(i) + 1, r.attempts.end());
+    std::rotate(tried.begin() + static_cast<std::ptrdiff_t>(i),
+                tried.begin() + static_cast<std::ptrdiff_t>(i) + 1, tried.end());
+    r.settings = tried.back();
+  };
   if (!r.attempts.back().passed) {
     const auto worse = [&](std::size_t i, std::size_t j) {
       const CommissionAttempt &a = r.attempts[i], &b = r.attempts[j];
@@ -723,11 +745,27 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     std::size_t best = r.attempts.size() - 1;
     for (std::size_t i = 0; i + 1 < r.attempts.size(); ++i)
       if (worse(best, i)) best = i;
-    if (best + 1 != r.attempts.size()) {
-      std::rotate(r.attempts.begin() + static_cast<std::ptrdiff_t>(best),
-                  r.attempts.begin() + static_cast<std::ptrdiff_t>(best) + 1, r.attempts.end());
-      r.settings = tried[best];
-    }
+    keep_last(best);
+  }
+  // A passing design kept over its softer ones, whose peak is the ripple.
+  const CommissionAttempt& kept = r.attempts.back();
+  const bool softened_in_vain = r.attempts.size() > 1 && kept.passed &&
+                                kept.result.metrics.overshoot_percent > margin * o.overshoot &&
+                                kept.overshoot_judged_percent <= margin * o.overshoot;
+  const bool tried_fastest =
+      std::any_of(tried.begin(), tried.end(),
+                  [](const ControllerSettings& s) { return s.aggressiveness >= 1.0; });
+  if (tighten && softened_in_vain && !tried_fastest) {
+    const std::size_t k = r.attempts.size() - 1;
+    ControllerSettings fastest = given;
+    fastest.aggressiveness = 1.0;
+    if (!run(MakeDesign(fastest, model, Ts, r.controller_model))) return false;
+    const CommissionAttempt &t = r.attempts.back(), &b = r.attempts[k];
+    const bool better = t.passed && t.overshoot_judged_percent <= margin * o.overshoot &&
+                        t.result.metrics.overshoot_percent <=
+                            b.result.metrics.overshoot_percent + 0.05 * o.overshoot &&
+                        t.result.metrics.iae < 0.95 * b.result.metrics.iae;
+    if (!better) keep_last(k);
   }
   Report(o, "verify", 1.0);
   return true;
@@ -863,7 +901,9 @@ CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
   const auto soften = [Ki](ControllerSettings& s, const CommissionAttempt&) {
     SetIntegratingPd(s, Ki, 1.5 * s.response_time);
   };
-  if (!Verify(r, plant, o, settings, std::nullopt, model, Ts, soften, 0.00125, 0.0, true, 1.0)) return r;
+  if (!Verify(r, plant, o, settings, std::nullopt, model, Ts, soften, 0.00125, 0.0, true, 1.0,
+              false))
+    return r;
   const std::string pd = fmt::format("PD (Kc = {:.4g}, Td = {:.3g} s, velocity feed-forward)",
                                      r.settings.pid_kc, r.settings.pid_td);
   if (r.passed()) {
@@ -1070,7 +1110,9 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     else if (std::isfinite(rise) && rise > 0.0)
       s.response_time = 1.5 * rise;
   };
-  if (!Verify(r, plant, o, settings, std::move(first), model, Ts, soften, 0.005, u_lo, false, 0.8)) return r;
+  if (!Verify(r, plant, o, settings, std::move(first), model, Ts, soften, 0.005, u_lo, false, 0.8,
+              true))
+    return r;
   if (r.passed()) {
     r.termination = Termination::kSuccess;
     r.message = fmt::format(

@@ -124,7 +124,14 @@ assert gap and max(gap) > 2 * e["noise_peak_to_peak"], (gap, e["noise_peak_to_pe
 assert any(s["to"] < 12 and s["time"] > 0 for s in j["verification"]["steps"]), j["verification"]
 v = j["verification"]
 assert v["overshoot_judged_percent"] <= min(v["overshoot_percent"], 5.0), v["overshoot_judged_percent"]
+# Its softer designs fail and the peak of the one kept (aggressiveness 0.5)
+# is the ripple: the fastest design is tried, and kept for its lower IAE.
+a = j["attempts"]
+assert a[-1]["aggressiveness"] == 1.0 and a[-1]["passed"], [(b["aggressiveness"], b["passed"]) for b in a]
+half = [b for b in a if b["aggressiveness"] == 0.5]
+assert half and half[0]["passed"] and a[-1]["iae"] < 0.95 * half[0]["iae"], [(b["aggressiveness"], b["iae"]) for b in a]
 PYEOF
+grep -q '^aggressiveness = 1$' "$TMP/cl/controller.toml" || fail "chamber-lag controller.toml: not the fastest design"
 
 # A GPC has no tuning to specifications of its own: it runs the horizons and
 # move suppression of the DMC's auto design with the T filter A, written

@@ -43,7 +43,12 @@
 //                 |steady-state error| at most 0.5 % of the range at every
 //                 level. On an overshoot failure the design is repeated with a
 //                 less aggressive setting (up to `retunes` times; when none
-//                 passes, the one with the fewest failures is kept); what limits
+//                 passes, the one with the fewest failures is kept). A passing
+//                 design within 80 % of the specified overshoot is softened
+//                 too; when every softer one fails and the kept design's
+//                 overshoot beyond half the ripple is within that margin, the
+//                 design at aggressiveness 1 is tried once and kept if it
+//                 passes with no higher peak and a lower IAE. What limits
 //                 the loop (saturation, dead time, model error, ripple) is
 //                 stated with what to try.
 //
