@@ -100,11 +100,12 @@ void Execute(const CodegenArgs& c) {
     PNEUMID_CHECK(po.prefix != options.prefix, "--with-plant needs another name than --prefix ({})",
                   options.prefix);
     // The plant module is the linear part only: refuse rather than drop a map.
-    PNEUMID_CHECK(!ParseModelInputMap(c.model) && !ParseModelOutputMap(c.model),
+    const bool input_map = ParseModelInputMap(c.model).has_value();
+    PNEUMID_CHECK(!input_map && !ParseModelOutputMap(c.model),
                   "--with-plant writes a linear plant, and the model '{}' has a static {} map; "
                   "give a linear model for the plant, or simulate the loop with `pneumid "
                   "control --plant {}`",
-                  c.model, ParseModelInputMap(c.model) ? "input" : "output", c.model);
+                  c.model, input_map ? "input" : "output", c.model);
     CodegenResult plant = GenerateLinearPlantC(SampledStateSpace(model, c.Ts), po);
     plant.readme.clear();
     for (const std::string& p : WriteCodegenFiles(plant, c.output)) paths.push_back(p);

@@ -157,20 +157,19 @@ void Run(CommissionArgs& c) {
   const IoSpec io = ParseIoSpec(c.io);
   std::unique_ptr<Plant> plant;
   if (io.kind == IoKind::kSim) {
-    plant = MakePlant(c.plant, c.Ts, po);
-    PNEUMID_CHECK(c.plant_config.empty() || dynamic_cast<IpaSimulator*>(plant.get()),
-                  "--plant-config applies to the ipa plant only, not to '{}'", c.plant);
     // An IPA loop samples once per PWM period, the valves' fastest action
     // (docs/position.md, docs/commission.md): the duty modulation across the
     // valves' gaps then alternates per period, not per 10 ms.
+    CommissionPlant made = MakeCommissionPlant(
+        c.plant, c.ts_option->count() ? std::optional<double>(c.Ts) : std::nullopt, po, c.Ts);
+    plant = std::move(made.plant);
+    c.Ts = made.Ts;
+    PNEUMID_CHECK(c.plant_config.empty() || dynamic_cast<IpaSimulator*>(plant.get()),
+                  "--plant-config applies to the ipa plant only, not to '{}'", c.plant);
     const auto* ipa = dynamic_cast<IpaSimulator*>(plant.get());
     if (ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition) {
       o.overshoot = 2.0;  // docs/position.md's targets, unless --spec says otherwise
       o.settling = 1.0;
-    }
-    if (c.ts_option->count() == 0 && DefaultLoopPeriod(*plant, c.Ts) != c.Ts) {
-      c.Ts = DefaultLoopPeriod(*plant, c.Ts);
-      plant = MakePlant(c.plant, c.Ts, po);
     }
   } else {
     PNEUMID_CHECK(!c.fast || io.kind == IoKind::kUdp,

@@ -12,10 +12,8 @@ namespace pneumid {
 
 LinearPlant::LinearPlant(const TransferFunction& model, double Ts, double noise_sigma,
                          std::uint64_t seed, std::string name)
-    : Ts_(Ts), noise_sigma_(noise_sigma), seed_(seed), name_(std::move(name)) {
+    : Ts_(Ts), noise_(noise_sigma, seed), name_(std::move(name)) {
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "sample time must be positive, got Ts = {}", Ts);
-  PNEUMID_CHECK(noise_sigma >= 0.0 && std::isfinite(noise_sigma),
-                "output noise standard deviation must be >= 0, got {}", noise_sigma);
   if (model.IsContinuous()) {
     model_ = C2D(model, Ts, DiscretizationMethod::kZoh);
   } else {
@@ -37,16 +35,14 @@ LinearPlant::LinearPlant(const TransferFunction& model, double Ts, double noise_
 }
 
 void LinearPlant::Reset() {
-  rng_.seed(seed_);
-  normal_.reset();
+  noise_.Reset();
   k_ = 0;
   load_disturbance_ = 0.0;
   u_.assign(b_.size() + static_cast<std::size_t>(delay_) + 1, 0.0);
   y_.assign(a_.size() + 1, 0.0);
-  noise_ = noise_sigma_ > 0.0 ? noise_sigma_ * normal_(rng_) : 0.0;
 }
 
-double LinearPlant::Measure() { return y_.front() + load_disturbance_ + noise_; }
+double LinearPlant::Measure() { return y_.front() + load_disturbance_ + noise_.value(); }
 
 void LinearPlant::Advance(double u) {
   PNEUMID_CHECK(std::isfinite(u), "plant input must be finite, got {}", u);
@@ -62,7 +58,7 @@ void LinearPlant::Advance(double u) {
   y_.push_front(acc / a_[0]);
   y_.pop_back();
   ++k_;
-  noise_ = noise_sigma_ > 0.0 ? noise_sigma_ * normal_(rng_) : 0.0;
+  noise_.Next();
 }
 
 std::map<std::string, double> LinearPlant::Extras() const { return {{"y_true", y_.front()}}; }
@@ -71,7 +67,7 @@ std::string LinearPlant::Describe() const {
   return fmt::format(
       "{}linear model {} (Ts = {:g} s{})", name_.empty() ? "" : name_ + ": ", model_.ToString(5),
       Ts_,
-      noise_sigma_ > 0.0 ? fmt::format(", output noise sigma {:g}", noise_sigma_) : std::string());
+      noise_.sigma() > 0.0 ? fmt::format(", output noise sigma {:g}", noise_.sigma()) : std::string());
 }
 
 }  // namespace pneumid

@@ -15,11 +15,8 @@ MappedPlant::MappedPlant(const TransferFunction& linear, Parts parts, double Ts,
                          double noise_sigma, std::uint64_t seed, std::string name)
     : linear_(linear, Ts),
       parts_(std::move(parts)),
-      noise_sigma_(noise_sigma),
-      seed_(seed),
+      noise_(noise_sigma, seed),
       name_(std::move(name)) {
-  PNEUMID_CHECK(noise_sigma >= 0.0 && std::isfinite(noise_sigma),
-                "output noise standard deviation must be >= 0, got {}", noise_sigma);
   PNEUMID_CHECK(parts_.input_map || parts_.output_map,
                 "a mapped plant needs an input or an output map (else use LinearPlant)");
   Reset();
@@ -27,10 +24,8 @@ MappedPlant::MappedPlant(const TransferFunction& linear, Parts parts, double Ts,
 
 void MappedPlant::Reset() {
   linear_.Reset();
-  rng_.seed(seed_);
-  normal_.reset();
+  noise_.Reset();
   load_disturbance_ = 0.0;
-  noise_ = noise_sigma_ > 0.0 ? noise_sigma_ * normal_(rng_) : 0.0;
 }
 
 double MappedPlant::Output() const {
@@ -38,12 +33,12 @@ double MappedPlant::Output() const {
   return parts_.output_map ? parts_.output_map->Evaluate(x) : x;
 }
 
-double MappedPlant::Measure() { return Output() + load_disturbance_ + noise_; }
+double MappedPlant::Measure() { return Output() + load_disturbance_ + noise_.value(); }
 
 void MappedPlant::Advance(double u) {
   PNEUMID_CHECK(std::isfinite(u), "plant input must be finite, got {}", u);
   linear_.Advance(parts_.input_map ? parts_.input_map->Evaluate(u) : u);
-  noise_ = noise_sigma_ > 0.0 ? noise_sigma_ * normal_(rng_) : 0.0;
+  noise_.Next();
 }
 
 std::map<std::string, double> MappedPlant::Extras() const {
@@ -56,7 +51,7 @@ std::string MappedPlant::Describe() const {
   if (parts_.output_map) parts += ", with its output map";
   return fmt::format("{}{}{}{}", name_.empty() ? "" : name_ + ": ",
                      linear_.Describe(), parts,
-                     noise_sigma_ > 0.0 ? fmt::format(", output noise sigma {:g}", noise_sigma_)
+                     noise_.sigma() > 0.0 ? fmt::format(", output noise sigma {:g}", noise_.sigma())
                                         : std::string());
 }
 

@@ -1140,6 +1140,18 @@ double DefaultLoopPeriod(const Plant& plant, double fallback) {
   return ipa != nullptr ? PwmLoopPeriod(ipa->parameters().pwm_frequency) : fallback;
 }
 
+CommissionPlant MakeCommissionPlant(const std::string& spec, std::optional<double> Ts,
+                                    const PlantOptions& options, double fallback) {
+  const double given = Ts.value_or(fallback);
+  PNEUMID_CHECK(std::isfinite(given) && given > 0.0,
+                "commission: the loop period must be finite and positive, got {} s", given);
+  CommissionPlant c{MakePlant(spec, given, options), given};
+  if (Ts) return c;
+  c.Ts = DefaultLoopPeriod(*c.plant, fallback);
+  if (c.Ts != given) c.plant = MakePlant(spec, c.Ts, options);
+  return c;
+}
+
 void SetInputGaps(CommissionOptions& options, const Plant& plant, const std::string& text) {
   if (text == "plant") return;
   if (text == "none") {

@@ -123,6 +123,20 @@ TEST(Commission, TheDefaultLoopPeriodIsThePwmPeriodOnTheIpaOnly) {
   EXPECT_DOUBLE_EQ(DefaultLoopPeriod(*MakePlant("fopdt-paper", 0.05), 0.05), 0.05);
 }
 
+TEST(Commission, TheCommissionPlantRunsAtTheGivenOrTheDefaultPeriod) {
+  const CommissionPlant ipa = MakeCommissionPlant("ipa", std::nullopt, PlantOptions{});
+  EXPECT_DOUBLE_EQ(ipa.Ts, 1.0 / 300.0);
+  EXPECT_DOUBLE_EQ(ipa.plant->Ts(), 1.0 / 300.0);
+  const CommissionPlant given = MakeCommissionPlant("ipa", 0.01, PlantOptions{});
+  EXPECT_DOUBLE_EQ(given.Ts, 0.01);
+  EXPECT_DOUBLE_EQ(given.plant->Ts(), 0.01);
+  const CommissionPlant linear = MakeCommissionPlant("fopdt-paper", std::nullopt, PlantOptions{}, 0.05);
+  EXPECT_DOUBLE_EQ(linear.Ts, 0.05);
+  EXPECT_DOUBLE_EQ(linear.plant->Ts(), 0.05);
+  EXPECT_THROW(MakeCommissionPlant("ipa", -0.01, PlantOptions{}), InvalidArgument);
+  EXPECT_THROW(MakeCommissionPlant("ipa", std::nullopt, PlantOptions{}, 0.0), InvalidArgument);
+}
+
 TEST(Commission, APlantThatDoesNotRespondIsNamed) {
   TestPlant plant(0.0, false);
   const CommissionResult r = Commission(plant, Options("dead"));

@@ -903,12 +903,11 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
   Get(b, "input_gaps", gaps);
   std::string error;
   PNEUMID_CHECK(o.IsValid(&error), "{}", error);
-  std::unique_ptr<Plant> plant = MakePlant(plant_spec, Ts, po);
   // The command's loop period: one PWM period on the IPA, unless given.
-  if (!ts_given && DefaultLoopPeriod(*plant, Ts) != Ts) {
-    Ts = DefaultLoopPeriod(*plant, Ts);
-    plant = MakePlant(plant_spec, Ts, po);
-  }
+  CommissionPlant made =
+      MakeCommissionPlant(plant_spec, ts_given ? std::optional<double>(Ts) : std::nullopt, po, Ts);
+  std::unique_ptr<Plant> plant = std::move(made.plant);
+  Ts = made.Ts;
   CheckWork(Ts, o.budget, 0, 0);
   SetInputGaps(o, *plant, gaps);
   std::string dir_field;

@@ -15,12 +15,12 @@
 
 #include <cstdint>
 #include <deque>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "pneumid/lti/transfer_function.hpp"
 #include "pneumid/plant/plant.hpp"
+#include "pneumid/plant/seeded_noise.hpp"
 
 namespace pneumid {
 
@@ -50,17 +50,13 @@ class LinearPlant final : public Plant {
  private:
   TransferFunction model_;
   double Ts_;
-  double noise_sigma_;
-  std::uint64_t seed_;
+  SeededNoise noise_;  ///< the measurement noise, drawn per sample
   std::string name_;
   std::vector<double> b_, a_;  // ascending powers of z^-1, a_[0] != 0
   int delay_ = 0;
   std::deque<double> u_;  // u_[m] = u_{k-1-m}
   std::deque<double> y_;  // y_[m] = y_{k-m}
-  double noise_ = 0.0;
   long long k_ = 0;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
 };
 
 }  // namespace pneumid

@@ -18,11 +18,11 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <random>
 #include <string>
 
 #include "pneumid/lti/static_map.hpp"
 #include "pneumid/plant/linear_plant.hpp"
+#include "pneumid/plant/seeded_noise.hpp"
 
 namespace pneumid {
 
@@ -56,12 +56,8 @@ class MappedPlant final : public Plant {
 
   LinearPlant linear_;
   Parts parts_;
-  double noise_sigma_;
-  std::uint64_t seed_;
+  SeededNoise noise_;  ///< the measurement noise, drawn per sample
   std::string name_;
-  double noise_ = 0.0;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
 };
 
 }  // namespace pneumid

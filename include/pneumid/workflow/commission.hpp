@@ -85,6 +85,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -98,6 +99,7 @@
 #include "pneumid/identify/identify.hpp"
 #include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/plant.hpp"
+#include "pneumid/plant/plant_factory.hpp"
 
 namespace pneumid {
 
@@ -264,5 +266,19 @@ double PwmLoopPeriod(double pwm_frequency);
 /// (0.01 s in `pneumid commission` and in the app). The command and the app
 /// both take it from here.
 double DefaultLoopPeriod(const Plant& plant, double fallback);
+
+/// A simulated plant for commission and the loop period it runs at.
+struct CommissionPlant {
+  std::unique_ptr<Plant> plant;  ///< built by MakePlant at `Ts`
+  double Ts = 0.0;               ///< the given period, else DefaultLoopPeriod
+};
+
+/// MakePlant(spec, Ts, options) at the given period, or, when `Ts` is empty,
+/// at DefaultLoopPeriod(plant, fallback) (the command and the app build their
+/// simulated plant here).
+/// @throws InvalidArgument as MakePlant, or when a given Ts or the fallback
+/// is not finite and positive.
+CommissionPlant MakeCommissionPlant(const std::string& spec, std::optional<double> Ts,
+                                    const PlantOptions& options, double fallback = 0.01);
 
 }  // namespace pneumid
