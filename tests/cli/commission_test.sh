@@ -39,11 +39,15 @@ assert len(v["steps"]) >= 8, len(v["steps"])
 fits = {m["method"]: m["validation_fit_percent"] for m in j["models"]}
 assert fits[j["chosen_model"]] > 90.0, fits
 # Modulation across the valves' dead bands, behind the chord of the map
-# inside them: the first design meets the 5 % specification on the plant
-# (before the chord it overshot 5.3 % and commission fell back to half the
-# aggressiveness).
+# inside them: the loop meets the 5 % specification on the plant. The
+# verification's small steps (8-12 % of the range) show what its large ones
+# do not: the fastest design, whose overshoot on the model is at the
+# specification, overshoots there, and the softer one passes.
 assert v["overshoot_percent"] <= 5.0, v["overshoot_percent"]
-assert len(j["attempts"]) == 1, [a["aggressiveness"] for a in j["attempts"]]
+a = j["attempts"]
+assert len(a) == 2 and not a[0]["passed"] and a[1]["passed"], [(b["aggressiveness"], b["passed"]) for b in a]
+small = [f for f in a[0]["failures"] if f.startswith("overshoot") and ("-> 1" in f or "-> 4" in f)]
+assert small, a[0]["failures"]
 # The MPC's measurement noise is the noise measured at rest.
 assert 0.03 < e["noise_std"] < 0.15, e["noise_std"]
 # The estimation record begins at the sweep's steady state (193 N at 100 %),

@@ -32,7 +32,8 @@
 //                 the experiment and in the controller alike, so the models
 //                 see the actuator as the controller will drive it.
 //   6. verify     a staircase across the range in both directions (levels at
-//                 0, 25, 60, 85, 100, 70, 35, 10 and 0 % of the range, dwell
+//                 0, 25, 60, 85, 100, 88, 70, 78, 35, 10, 18 and 0 % of the
+//                 range (three small steps among the large ones), dwell
 //                 max(2 s, 4 x the settling specification)) and a load step
 //                 (-8 % of the range) half-way through the last level, closed
 //                 loop on the plant. Pass: the worst step's overshoot within
