@@ -405,6 +405,8 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
     b.fopdt = FopdtFromModel(model);
     b.pid_gains = a.pid;
     b.auto_summary = a.message;
+    b.auto_response_time = a.response_time_target;
+    b.auto_fastest = a.fastest;
     PidOptions o;
     o.gains = a.pid;
     o.setpoint_weight = a.setpoint_weight;
@@ -480,6 +482,8 @@ BuiltController BuildController(const PredictionModel& model, const ControllerSp
   if (qdmc_for_limits) spec.constrained = true;
   BuiltController b = internal::MakePredictiveController(model, spec);
   b.auto_summary = a.message;
+  b.auto_response_time = a.response_time_target;
+  b.auto_fastest = a.fastest;
   b.tuning = a.ToTuningResult();
   if (qdmc_for_limits)
     b.tuning.formula +=

@@ -659,17 +659,21 @@ bool ChooseModel(CommissionResult& r, const CommissionOptions& o,
 // higher than the kept one's by more than 5 % of the specification, and an
 // IAE at least 5 % lower (on the chamber-lag twin: IAE 40.9 -> 33.3 on the
 // verification, peaks 5.92 and 6.20 %, 1.40 and 1.21 % beyond the ripple).
+// With `small_steps` the staircase has three small steps among its large
+// ones (8-12 % of the range), where a model's local gain error shows.
 bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
             ControllerSettings settings, std::optional<Design> first,
             const TransferFunction& model, double Ts,
             const std::function<void(ControllerSettings&, const CommissionAttempt&)>& soften,
             double sse_share, double safe_input, bool retune_on_ripple, double margin,
-            bool tighten) {
+            bool tighten, bool small_steps) {
   const CommissionExperiment& ex = r.experiment;
   const double range = ex.range_max - ex.range_min;
   std::vector<double> levels;
-  for (double f : {0.0, 0.25, 0.6, 0.85, 1.0, 0.88, 0.7, 0.78, 0.35, 0.1, 0.18, 0.0})
-    levels.push_back(ex.range_min + f * range);
+  const std::vector<double> large{0.0, 0.25, 0.6, 0.85, 1.0, 0.7, 0.35, 0.1, 0.0};
+  const std::vector<double> with_small{0.0,  0.25, 0.6, 0.85, 1.0,  0.88,
+                                       0.7,  0.78, 0.35, 0.1, 0.18, 0.0};
+  for (double f : small_steps ? with_small : large) levels.push_back(ex.range_min + f * range);
   const double dwell =
       std::isnan(o.verification_dwell) ? std::max(2.0, 4 * o.settling) : o.verification_dwell;
   const double load = std::isnan(o.load_step) ? -0.08 * range : o.load_step;
@@ -902,7 +906,7 @@ CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
     SetIntegratingPd(s, Ki, 1.5 * s.response_time);
   };
   if (!Verify(r, plant, o, settings, std::nullopt, model, Ts, soften, 0.00125, 0.0, true, 1.0,
-              false))
+              false, false))
     return r;
   const std::string pd = fmt::format("PD (Kc = {:.4g}, Td = {:.3g} s, velocity feed-forward)",
                                      r.settings.pid_kc, r.settings.pid_td);
@@ -1099,6 +1103,15 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   TransferFunction model;
   std::optional<Design> first;
   if (!ChooseModel(r, o, settings, Ts, &model, &first)) return r;
+  // The fastest robust design has its overshoot on the model at the
+  // specification (auto_tuning.hpp); on the plant, the small steps near the
+  // valves' gaps, where the model's local gain is least accurate, overshoot
+  // it (docs/commission.md). The first design aims at 1.25 times its
+  // response time instead.
+  if (first && first->built.auto_fastest && std::isfinite(first->built.auto_response_time)) {
+    settings.response_time = 1.25 * first->built.auto_response_time;
+    first = MakeDesign(settings, model, Ts, r.controller_model);
+  }
   // Softer: half the aggressiveness and, since the fastest robust design's
   // speed does not depend on it (auto_tuning.hpp), a rise time aimed 1.5
   // times the one the last verification's first step measured.
@@ -1111,7 +1124,7 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
       s.response_time = 1.5 * rise;
   };
   if (!Verify(r, plant, o, settings, std::move(first), model, Ts, soften, 0.005, u_lo, false, 0.8,
-              true))
+              true, true))
     return r;
   if (r.passed()) {
     r.termination = Termination::kSuccess;

@@ -39,15 +39,17 @@ assert len(v["steps"]) >= 8, len(v["steps"])
 fits = {m["method"]: m["validation_fit_percent"] for m in j["models"]}
 assert fits[j["chosen_model"]] > 90.0, fits
 # Modulation across the valves' dead bands, behind the chord of the map
-# inside them: the loop meets the 5 % specification on the plant. The
-# verification's small steps (8-12 % of the range) show what its large ones
-# do not: the fastest design, whose overshoot on the model is at the
-# specification, overshoots there, and the softer one passes.
+# inside them: the loop meets the 5 % specification on the plant, small
+# steps included (8-12 % of the range), at the first design, which aims at
+# 1.25 times the fastest robust design's response time (that design, whose
+# overshoot on the model is at the specification, overshot 15.7 % on a
+# small step).
 assert v["overshoot_percent"] <= 5.0, v["overshoot_percent"]
 a = j["attempts"]
-assert len(a) == 2 and not a[0]["passed"] and a[1]["passed"], [(b["aggressiveness"], b["passed"]) for b in a]
-small = [f for f in a[0]["failures"] if f.startswith("overshoot") and ("-> 1" in f or "-> 4" in f)]
-assert small, a[0]["failures"]
+assert len(a) == 1 and a[0]["passed"], [(b["aggressiveness"], b["passed"]) for b in a]
+span = e["range"][1] - e["range"][0]
+small = [s for s in v["steps"] if s["time"] > 0 and abs(s["to"] - s["from"]) < 0.15 * span]
+assert len(small) >= 3, [(s["from"], s["to"]) for s in v["steps"]]
 # The MPC's measurement noise is the noise measured at rest.
 assert 0.03 < e["noise_std"] < 0.15, e["noise_std"]
 # The estimation record begins at the sweep's steady state (193 N at 100 %),
@@ -71,6 +73,7 @@ PYEOF
 # variance in the configuration.
 grep -q '^period = 0.00333333' "$TMP/c/controller.toml" || fail "controller.toml: period $(grep period "$TMP/c/controller.toml")"
 grep -q '^measurement_noise = 0.00' "$TMP/c/controller.toml" || fail "controller.toml: no measurement_noise"
+grep -q '^response_time = 0.0' "$TMP/c/controller.toml" || fail "controller.toml: no response_time (1.25 x the fastest design's)"
 
 # The configuration runs as written: control, codegen and run.
 "$PNEUMID" control --config "$TMP/c/controller.toml" --setpoint "staircase:levels=10 50 100 150 180 120 60 10,dwell=2" \

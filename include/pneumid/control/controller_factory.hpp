@@ -198,6 +198,12 @@ struct BuiltController {
   double pid_kff = 0.0;       ///< (pid) velocity feed-forward Kff (0: none)
   /// Rule "auto": the auto-tuner's message (what it met or why not).
   std::string auto_summary;
+  /// Rule "auto": t_r, the response time it aimed at (given, from the
+  /// model, or the fastest robust design's: AutoTuneResult::
+  /// response_time_target); NaN for other rules.
+  double auto_response_time = std::numeric_limits<double>::quiet_NaN();
+  /// Rule "auto": t_r is the fastest robust design's (no response time given).
+  bool auto_fastest = false;
 
   /// "pid" for a PID, "auto" for settings tuned to specifications, else the
   /// tuning rule's name (as in a comparison table).

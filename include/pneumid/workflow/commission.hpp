@@ -26,6 +26,9 @@
 //                 controller can be built from.
 //   5. design     the controller tuned to the specification (rule "auto",
 //                 auto_tuning.hpp), behind the model's input map when it has one.
+//                 An MPC or DMC aims at 1.25 times the response time of the
+//                 fastest robust design (whose overshoot on the model is at
+//                 the specification: on the plant's small steps it overshoots).
 //                 When the actuator has input gaps (a PWM valve's minimum
 //                 pulse: IPA duties in (0, 15) and (85, 100) %), the input is
 //                 sigma-delta modulated across them (duty_modulator.hpp), in
@@ -33,7 +36,7 @@
 //                 see the actuator as the controller will drive it.
 //   6. verify     a staircase across the range in both directions (levels at
 //                 0, 25, 60, 85, 100, 88, 70, 78, 35, 10, 18 and 0 % of the
-//                 range (three small steps among the large ones), dwell
+//                 range: three small steps among the large ones), dwell
 //                 max(2 s, 4 x the settling specification)) and a load step
 //                 (-8 % of the range) half-way through the last level, closed
 //                 loop on the plant. Pass: the worst step's overshoot within
@@ -72,7 +75,8 @@
 //                 tau = settling / 8, Kc Ki = 3 / tau and Kc Ki Td = 1
 //                 (docs/position.md); the range served is the output range of
 //                 the actuator less 10 % at each end, or the one asked for.
-//   4. verify     as above, with |steady-state error| at most 0.125 % of the
+//   4. verify     as above without the small steps (levels at 0, 25, 60, 85,
+//                 100, 70, 35, 10 and 0 %), with |steady-state error| at most 0.125 % of the
 //                 range (0.1 mm over 80 mm); a design that overshoots or
 //                 cycles is repeated with tau x 1.5.
 //
