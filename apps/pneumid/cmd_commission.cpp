@@ -189,6 +189,14 @@ void Run(CommissionArgs& c) {
   }
   if (!c.spec.empty()) ParseSpecification(c.spec, o);
   SetInputGaps(o, *plant, c.input_gaps);
+  // A plant behind a backend does not report its valves' gaps: without them
+  // the experiment and the loop hold inputs the valves cannot (docs/commission.md).
+  if (io.kind != IoKind::kSim && c.input_gaps == "plant" && o.actuator &&
+      o.actuator->input_gaps.empty())
+    std::cerr << "pneumid commission: warning: the plant behind " << c.io
+              << " reports no input gaps; a PWM valve's minimum pulse leaves some (the "
+                 "IPA's at 300 Hz: --input-gaps 0:15,85:100), which are then not modulated "
+                 "across\n";
   ProgressBar bar("commission", c.progress || StderrIsTerminal());
   o.progress = [&bar](const std::string& stage, double f) { bar(f, stage); };
   g_stop.store(false);

@@ -184,9 +184,10 @@ for _ in $(seq 50); do
 done
 [ -n "$PORT" ] || fail "plant-server did not start: $(cat "$TMP/server.txt")"
 "$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --fast --input-gaps 0:15,85:100 -o "$TMP/u" --json \
-  > "$TMP/u.json"
+  > "$TMP/u.json" 2> "$TMP/u.err"
 rc=$?
 [ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission over udp exited $rc"
+grep -q "reports no input gaps" "$TMP/u.err" && fail "udp with --input-gaps: warned $(cat "$TMP/u.err")"
 $PY - "$TMP/u.json" "$TMP/c.json" <<'PYEOF' || fail "commission over udp JSON"
 import json, sys
 u, s = (json.load(open(p)) for p in sys.argv[1:3])
@@ -196,6 +197,12 @@ assert abs(u["experiment"]["sweep"]["reachable_max"] - s["experiment"]["sweep"][
 assert u["verification"]["steps"], u
 PYEOF
 grep -q 'backend = "udp://127.0.0.1:' "$TMP/u/controller.toml" || fail "udp controller.toml: no backend"
+# Without --input-gaps the plant behind the backend reports none: a warning
+# names the IPA's.
+"$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --fast --budget 20 -o "$TMP/u0" > /dev/null \
+  2> "$TMP/u0.err"
+grep -q "reports no input gaps.*--input-gaps 0:15,85:100" "$TMP/u0.err" ||
+  fail "udp without --input-gaps: no warning: $(head -c 300 "$TMP/u0.err")"
 kill "$SERVER_PID"; wait "$SERVER_PID" 2>/dev/null; SERVER_PID=""
 
 # Ctrl-C in the middle of the experiment: exit 130, the plant at its lowest
