@@ -36,6 +36,7 @@ struct Element {
   std::uint64_t nbytes = 0;      ///< as claimed by the tag
   std::string_view data;         ///< the claimed bytes that are present
   std::size_t size_on_disk = 0;  ///< tag + data + padding to 8 bytes
+  bool small = false;            ///< small data element format (data in the tag)
 };
 
 class Scanner {
@@ -95,6 +96,7 @@ class Scanner {
                         Variable(), e.type, e.nbytes));
       e.data = s.substr(4, std::min<std::uint64_t>(e.nbytes, 4));
       e.size_on_disk = 8;
+      e.small = true;
       return e;
     }
     e.type = w0;
@@ -186,13 +188,16 @@ class Scanner {
                         Variable()));
       }
       const Element e = ReadTag(data.substr(at));
-      if (e.data.size() < e.nbytes) {
-        if (partial && data.size() < nbytes) return;
+      // What the element claims must fit in what its array claims, even
+      // where only the start of a compressed array was inflated.
+      const std::uint64_t room = nbytes > at + 8 ? nbytes - at - 8 : 0;
+      if (e.nbytes > room || (e.data.size() < e.nbytes && !(partial && data.size() < nbytes))) {
         Fail(
             fmt::format("{}: an element claims {} bytes, more than the {} bytes left in its "
                         "array: the file is corrupt",
-                        Variable(), e.nbytes, data.size() - at - 8));
+                        Variable(), e.nbytes, room));
       }
+      if (e.data.size() < e.nbytes) return;  // the rest was not inflated
       if (k == 0 && e.type == kMiUint32 && e.nbytes >= 4) {
         cls = U32(e.data, 0) & 0xFF;
       } else if (k == 1 && e.type != kMiInt32) {
@@ -203,6 +208,14 @@ class Scanner {
             fmt::format("{}: its dimensions element has type {}, not miINT32 (5): the file is "
                         "corrupt",
                         Variable(), e.type));
+      } else if (k == 1 && e.small) {
+        // Dimensions take at least 8 bytes (two int32), so never the small
+        // format; matio reads its data word as the byte count (4 bytes of
+        // data 0x26000000 made it ask for 2.5 GB).
+        Fail(
+            fmt::format("{}: its dimensions element is in the small data element format ({} "
+                        "bytes), too short for two dimensions: the file is corrupt",
+                        Variable(), e.nbytes));
       } else if (k == 1) {
         for (std::size_t d = 0; d + 4 <= e.data.size(); d += 4) {
           const auto n = static_cast<std::int32_t>(U32(e.data, d));

@@ -26,6 +26,7 @@ IoPlant::~IoPlant() {
 
 void IoPlant::Reset() {
   k_ = 0;
+  load_disturbance_ = 0.0;
   start_ = std::chrono::steady_clock::now();
 }
 
@@ -34,7 +35,7 @@ double IoPlant::Measure() {
   status_ = backend_->Read(&m);
   if (status_ == IoStatus::kError || status_ == IoStatus::kTimeout)
     return std::numeric_limits<double>::quiet_NaN();
-  return m.y;
+  return m.y + load_disturbance_;
 }
 
 void IoPlant::Advance(double u) {

@@ -304,8 +304,8 @@ double OpenLoopRipple(const CommissionExperiment& ex, double y) {
 // loop (inside a valve's gap the modulation ripples by itself: no loop holds
 // such a force more steadily than its actuator does).
 double RippleLimit(const StepMetrics& s, const CommissionExperiment& ex) {
-  return std::max({0.02 * std::abs(s.to), 2.0 * ex.noise_peak_to_peak,
-                   1.25 * OpenLoopRipple(ex, s.to)});
+  return std::max(
+      {0.02 * std::abs(s.to), 2.0 * ex.noise_peak_to_peak, 1.25 * OpenLoopRipple(ex, s.to)});
 }
 
 // The overshoot judged against the specification: the peak beyond half the
@@ -535,8 +535,8 @@ std::vector<double> MapKnotsWithGapEdges(const Eigen::VectorXd& u,
   if (edges.empty()) return knots;
   std::vector<double> merged = edges;
   for (double k : knots) {
-    const bool near_edge = std::any_of(edges.begin(), edges.end(),
-                                       [&](double e) { return std::abs(k - e) <= tol; });
+    const bool near_edge =
+        std::any_of(edges.begin(), edges.end(), [&](double e) { return std::abs(k - e) <= tol; });
     if (!near_edge || k == lo || k == hi) merged.push_back(k);
   }
   std::sort(merged.begin(), merged.end());
@@ -644,36 +644,51 @@ bool ChooseModel(CommissionResult& r, const CommissionOptions& o,
   return false;
 }
 
+// How Verify judges and redesigns: what differs between the force loop
+// (MPC/DMC/GPC behind a process model) and the position PD of an integrating
+// plant.
+struct VerifyPolicy {
+  /// Makes the next design less aggressive, given the last attempt.
+  std::function<void(ControllerSettings&, const CommissionAttempt&)> soften;
+  /// The steady-state error allowed, as a share of the range.
+  double sse_share = 0.005;
+  /// The input held between runs (the safe state).
+  double safe_input = 0.0;
+  /// A ripple failure triggers the softer design too.
+  bool retune_on_ripple = false;
+  /// A design that passes with an overshoot above `margin` times the
+  /// specified one is softened too (the verification's staircase is one
+  /// sample of the set-points the loop will see), and kept if the softer one
+  /// fails more.
+  double margin = 0.8;
+  /// When a design is kept so and the overshoot judged beyond the ripple lies
+  /// within the margin, the peak is the actuator's ripple, which a softer
+  /// design does not remove: the design at aggressiveness 1 is tried once and
+  /// kept when it passes with an overshoot judged within the margin and no
+  /// higher than the kept one's by more than 5 % of the specification, and an
+  /// IAE at least 5 % lower (on the chamber-lag twin: IAE 40.9 -> 33.3 on the
+  /// verification, peaks 5.92 and 6.20 %, 1.40 and 1.21 % beyond the ripple).
+  bool tighten = false;
+  /// Three small steps among the large ones (8-12 % of the range), where a
+  /// model's local gain error shows.
+  bool small_steps = false;
+};
+
 // Stage 6: the verification staircase and load step on the plant, the
-// design repeated at half the aggressiveness after an overshoot failure.
-// False when stopped on request (r.termination and r.message set).
-// `soften` makes the next design less aggressive, given the last attempt;
-// `sse_share` is the steady-state error allowed, as a share of the range. A
-// design that passes with an overshoot above `margin` times the specified one
-// is softened too (the verification's staircase is one sample of the
-// set-points the loop will see), and kept if the softer one fails more.
-// When it is kept so and the overshoot judged beyond the ripple lies within
-// the margin, the peak is the actuator's ripple, which a softer design does
-// not remove: with `tighten`, the design at aggressiveness 1 is tried once and
-// kept when it passes with an overshoot judged within the margin and no
-// higher than the kept one's by more than 5 % of the specification, and an
-// IAE at least 5 % lower (on the chamber-lag twin: IAE 40.9 -> 33.3 on the
-// verification, peaks 5.92 and 6.20 %, 1.40 and 1.21 % beyond the ripple).
-// With `small_steps` the staircase has three small steps among its large
-// ones (8-12 % of the range), where a model's local gain error shows.
+// design repeated softer after an overshoot failure (VerifyPolicy). False
+// when stopped on request (r.termination and r.message set).
 bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
-            ControllerSettings settings, std::optional<Design> first,
-            const TransferFunction& model, double Ts,
-            const std::function<void(ControllerSettings&, const CommissionAttempt&)>& soften,
-            double sse_share, double safe_input, bool retune_on_ripple, double margin,
-            bool tighten, bool small_steps) {
+            ControllerSettings settings, std::optional<Design> first, const TransferFunction& model,
+            double Ts, const VerifyPolicy& policy) {
+  const double margin = policy.margin;
   const CommissionExperiment& ex = r.experiment;
   const double range = ex.range_max - ex.range_min;
   std::vector<double> levels;
   const std::vector<double> large{0.0, 0.25, 0.6, 0.85, 1.0, 0.7, 0.35, 0.1, 0.0};
-  const std::vector<double> with_small{0.0,  0.25, 0.6, 0.85, 1.0,  0.88,
-                                       0.7,  0.78, 0.35, 0.1, 0.18, 0.0};
-  for (double f : small_steps ? with_small : large) levels.push_back(ex.range_min + f * range);
+  const std::vector<double> with_small{0.0, 0.25, 0.6,  0.85, 1.0,  0.88,
+                                       0.7, 0.78, 0.35, 0.1,  0.18, 0.0};
+  for (double f : policy.small_steps ? with_small : large)
+    levels.push_back(ex.range_min + f * range);
   const double dwell =
       std::isnan(o.verification_dwell) ? std::max(2.0, 4 * o.settling) : o.verification_dwell;
   const double load = std::isnan(o.load_step) ? -0.08 * range : o.load_step;
@@ -688,7 +703,7 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
   // shows near the set-point in open loop (a modulated level wanders by it).
   cl.settling_band_floor = [&ex](double to) { return 1.25 * OpenLoopRipple(ex, to); };
   std::vector<ControllerSettings> tried;
-  const int planned = o.retunes + 1 + (tighten ? 1 : 0);
+  const int planned = o.retunes + 1 + (policy.tighten ? 1 : 0);
   // One verification run of a design, appended to r.attempts; false when
   // stopped on request before it.
   const auto run = [&](Design d) {
@@ -703,9 +718,9 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     a.design = d.built.Summary();
     a.settings = d.built.SettingsToJson();
     a.result = SimulateClosedLoop(*d.built.controller, plant, *setpoint, cl);
-    plant.Advance(safe_input);  // the safe state after the run
+    plant.Advance(policy.safe_input);  // the safe state after the run
     r.plant_time += cl.duration;
-    a.failures = Judge(a.result.metrics, o, range, ex, sse_share);
+    a.failures = Judge(a.result.metrics, o, range, ex, policy.sse_share);
     a.overshoot_judged_percent = WorstJudgedOvershoot(a.result.metrics, ex);
     a.passed = a.failures.empty();
     r.attempts.push_back(std::move(a));
@@ -718,17 +733,18 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     if (!run(attempt == 0 && first ? std::move(*first)
                                    : MakeDesign(settings, model, Ts, r.controller_model)))
       return false;
-    const bool overshoot_failed = std::any_of(
-        r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
-        [&](const std::string& f) {
-          return f.rfind("overshoot", 0) == 0 || (retune_on_ripple && f.rfind("ripple", 0) == 0);
-        });
+    const bool overshoot_failed =
+        std::any_of(r.attempts.back().failures.begin(), r.attempts.back().failures.end(),
+                    [&](const std::string& f) {
+                      return f.rfind("overshoot", 0) == 0 ||
+                             (policy.retune_on_ripple && f.rfind("ripple", 0) == 0);
+                    });
     // The margin is judged on the peak itself: a design close to the
     // specification is softened even when the ripple explains part of it.
     const bool thin_margin =
         r.attempts.back().result.metrics.overshoot_percent > margin * o.overshoot;
     if (!overshoot_failed && !thin_margin) break;
-    soften(settings, r.attempts.back());
+    policy.soften(settings, r.attempts.back());
   }
   // The final design is the last attempt when it passed; else the one with
   // the fewest failures (then the smallest worst overshoot), moved last.
@@ -759,16 +775,16 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
   const bool tried_fastest =
       std::any_of(tried.begin(), tried.end(),
                   [](const ControllerSettings& s) { return s.aggressiveness >= 1.0; });
-  if (tighten && softened_in_vain && !tried_fastest) {
+  if (policy.tighten && softened_in_vain && !tried_fastest) {
     const std::size_t k = r.attempts.size() - 1;
     ControllerSettings fastest = given;
     fastest.aggressiveness = 1.0;
     if (!run(MakeDesign(fastest, model, Ts, r.controller_model))) return false;
     const CommissionAttempt &t = r.attempts.back(), &b = r.attempts[k];
-    const bool better = t.passed && t.overshoot_judged_percent <= margin * o.overshoot &&
-                        t.overshoot_judged_percent <=
-                            b.overshoot_judged_percent + 0.05 * o.overshoot &&
-                        t.result.metrics.iae < 0.95 * b.result.metrics.iae;
+    const bool better =
+        t.passed && t.overshoot_judged_percent <= margin * o.overshoot &&
+        t.overshoot_judged_percent <= b.overshoot_judged_percent + 0.05 * o.overshoot &&
+        t.result.metrics.iae < 0.95 * b.result.metrics.iae;
     if (!better) keep_last(k);
   }
   Report(o, "verify", 1.0);
@@ -905,9 +921,13 @@ CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
   const auto soften = [Ki](ControllerSettings& s, const CommissionAttempt&) {
     SetIntegratingPd(s, Ki, 1.5 * s.response_time);
   };
-  if (!Verify(r, plant, o, settings, std::nullopt, model, Ts, soften, 0.00125, 0.0, true, 1.0,
-              false, false))
-    return r;
+  VerifyPolicy policy;
+  policy.soften = soften;
+  policy.sse_share = 0.00125;
+  policy.safe_input = 0.0;
+  policy.retune_on_ripple = true;
+  policy.margin = 1.0;
+  if (!Verify(r, plant, o, settings, std::nullopt, model, Ts, policy)) return r;
   const std::string pd = fmt::format("PD (Kc = {:.4g}, Td = {:.3g} s, velocity feed-forward)",
                                      r.settings.pid_kc, r.settings.pid_td);
   if (r.passed()) {
@@ -1123,9 +1143,14 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     else if (std::isfinite(rise) && rise > 0.0)
       s.response_time = 1.5 * rise;
   };
-  if (!Verify(r, plant, o, settings, std::move(first), model, Ts, soften, 0.005, u_lo, false, 0.8,
-              true, true))
-    return r;
+  VerifyPolicy policy;
+  policy.soften = soften;
+  policy.sse_share = 0.005;
+  policy.safe_input = u_lo;
+  policy.margin = 0.8;
+  policy.tighten = true;
+  policy.small_steps = true;
+  if (!Verify(r, plant, o, settings, std::move(first), model, Ts, policy)) return r;
   if (r.passed()) {
     r.termination = Termination::kSuccess;
     r.message = fmt::format(

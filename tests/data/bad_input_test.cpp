@@ -325,6 +325,53 @@ TEST_F(BadInputTest, MatSmallElementClaimingMoreThanItsTagIsCorrupt) {
   }
 }
 
+TEST_F(BadInputTest, MatSmallFormatDimensionsAreCorrupt) {
+  // Found by mat_fuzz: in a compressed variable, a small-format dimensions
+  // element holding 4 bytes (0x26000000); matio took that word for the size of
+  // the dimensions and asked for 2.5 GB.
+  std::string flags, dims;
+  PutU32(&flags, 6);  // mxDOUBLE_CLASS
+  PutU32(&flags, 0);
+  PutU32(&dims, (4u << 16) | 5u);  // small element: 4 bytes of miINT32
+  PutU32(&dims, 0x26000000u);
+  const std::string bad =
+      Element(14, Element(6, flags) + dims + Element(1, "t") + Element(9, std::string(8, '\0')));
+  for (const auto& [name, body] :
+       {std::pair<std::string, std::string>{"small4.mat", bad}, {"zsmall4.mat", Compress(bad)}}) {
+    const std::string path = Write(name, MatHeader() + body);
+    EXPECT_THAT([&] { ReadMat(path); },
+                ThrowsMessage<DataError>(
+                    AllOf(HasSubstr("its dimensions element is in the small data element "
+                                    "format (4 bytes)"),
+                          HasSubstr("the file is corrupt"))))
+        << name;
+  }
+}
+
+TEST_F(BadInputTest, MatElementLargerThanItsCompressedArrayIsCorrupt) {
+  // Only the start of a compressed array is inflated; an element there that
+  // claims more than its array claims is corrupt even though its bytes are
+  // not all present.
+  std::string flags;
+  PutU32(&flags, 6);  // mxDOUBLE_CLASS
+  PutU32(&flags, 0);
+  std::string body = Element(6, flags);
+  PutU32(&body, 5);            // miINT32 dimensions
+  PutU32(&body, 0x4C000000u);  // claiming 1.3 GB
+  PutU32(&body, 2);
+  PutU32(&body, 2);
+  std::string matrix;
+  PutU32(&matrix, 14);
+  PutU32(&matrix, 200);  // the array claims 200 bytes; 32 follow
+  matrix += body;
+  const std::string path = Write("zroom.mat", MatHeader() + Compress(matrix));
+  EXPECT_THAT(
+      [&] { ReadMat(path); },
+      ThrowsMessage<DataError>(AllOf(HasSubstr("variable 1: an element claims 1275068416 bytes"),
+                                     HasSubstr("more than the 176 bytes left in its "
+                                               "array: the file is corrupt"))));
+}
+
 TEST_F(BadInputTest, MatEmptyVariableWithAHugeDimensionIsCorrupt) {
   // Found by mat_fuzz: a 22-byte Level 4 file whose variable claims 0 x
   // 1415643158 doubles; no data, but matio walked the columns for 11 s.

@@ -2,8 +2,10 @@
 // plants (experiments, closed loops, workflow/commission.hpp) drives a real
 // plant: a data acquisition card (comedi) or a plant server over UDP.
 //
-//   Measure()  -> backend.Read(): the measured output, NaN when the read
-//                 fails or times out (the caller's safety check stops then)
+//   Measure()  -> backend.Read(): the measured output plus the load
+//                 disturbance set by SetLoadDisturbance (an output
+//                 disturbance, as every simulated plant applies it), NaN when
+//                 the read fails or times out (the caller's safety check stops then)
 //   Advance(u) -> backend.Write(u), then, in real time, a wait until the
 //                 next period (absolute deadlines on the steady clock, so the
 //                 period does not drift); without real time the next sample
@@ -36,9 +38,10 @@ class IoPlant : public Plant {
   IoPlant(const IoPlant&) = delete;             ///< not copyable: owns the backend
   IoPlant& operator=(const IoPlant&) = delete;  ///< not copyable: owns the backend
 
-  /// Restarts the clock (a real plant keeps its state).
+  /// Restarts the clock and clears the load disturbance (a real plant keeps its state).
   void Reset() override;
-  /// backend.Read(): the output, NaN on a read that failed or timed out.
+  /// backend.Read(): the output plus the load disturbance, NaN on a read that
+  /// failed or timed out.
   double Measure() override;
   /// backend.Write(u), then the wait for the next period in real time.
   void Advance(double u) override;
