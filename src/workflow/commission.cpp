@@ -582,13 +582,18 @@ bool IdentifyAndSave(CommissionResult& r, const CommissionOptions& o, double Ts,
 // for a DMC on the same model and specification, with the T filter A (the
 // model's denominator, the DMC's disturbance model), and the verification
 // judges it as it runs. The other controllers run their settings as given.
+// `auto_design` receives the DMC's auto-tuning facts (response time, fastest
+// design), which the GPC's first design is placed from as the others' are.
 ControllerSettings DesignSettings(const ControllerSettings& s, const TransferFunction& model,
-                                  double Ts, const std::string& spec) {
+                                  double Ts, const std::string& spec,
+                                  BuiltController* auto_design) {
   if (s.controller != "gpc" || s.rule != "auto") return s;
   ControllerSettings dmc = s;
   dmc.controller = "dmc";
   const BuiltController b =
       MakeController(model, Ts, WithModelInputMap(ToControllerSpec(dmc), spec));
+  auto_design->auto_response_time = b.auto_response_time;
+  auto_design->auto_fastest = b.auto_fastest;
   ControllerSettings g = s;
   g.rule = "explicit";
   g.P = b.tuning.P;
@@ -607,8 +612,13 @@ struct Design {
 Design MakeDesign(const ControllerSettings& s, const TransferFunction& model, double Ts,
                   const std::string& spec) {
   Design d;
-  d.settings = DesignSettings(s, model, Ts, spec);
+  BuiltController dmc;
+  d.settings = DesignSettings(s, model, Ts, spec, &dmc);
   d.built = MakeController(model, Ts, WithModelInputMap(ToControllerSpec(d.settings), spec));
+  if (s.controller == "gpc" && s.rule == "auto") {
+    d.built.auto_response_time = dmc.auto_response_time;
+    d.built.auto_fastest = dmc.auto_fastest;
+  }
   return d;
 }
 
@@ -672,7 +682,22 @@ struct VerifyPolicy {
   /// Three small steps among the large ones (8-12 % of the range), where a
   /// model's local gain error shows.
   bool small_steps = false;
+  /// On a plant that cannot be reset (a real one behind a backend), hold the
+  /// safe input before each run, so that the run starts from rest as on the
+  /// simulator (the staircase starts at the range's low end, where the plant
+  /// rests): five times the probe's tau + theta, at most a dwell.
+  bool rest_before_run = false;
 };
+
+// Holds `u` on `plant` for `seconds` (to whole samples); the plant time spent.
+double HoldInput(Plant& plant, double u, double seconds) {
+  const auto n = static_cast<long>(std::ceil(seconds / plant.Ts() - 1e-9));
+  for (long k = 0; k < n; ++k) {
+    plant.Measure();
+    plant.Advance(u);
+  }
+  return static_cast<double>(n) * plant.Ts();
+}
 
 // Stage 6: the verification staircase and load step on the plant, the
 // design repeated softer after an overshoot failure (VerifyPolicy). False
@@ -712,6 +737,11 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
       r.termination = Termination::kStopped;
       r.message = "stopped on request before the verification";
       return false;
+    }
+    if (policy.rest_before_run && !plant.can_reset()) {
+      const double settle = 5.0 * (ex.time_constant + ex.dead_time);
+      r.plant_time += HoldInput(plant, policy.safe_input,
+                                std::isfinite(settle) ? std::min(settle, dwell) : dwell);
     }
     CommissionAttempt a;
     a.aggressiveness = d.settings.aggressiveness;
@@ -1150,6 +1180,7 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   policy.margin = 0.8;
   policy.tighten = true;
   policy.small_steps = true;
+  policy.rest_before_run = true;
   if (!Verify(r, plant, o, settings, std::move(first), model, Ts, policy)) return r;
   if (r.passed()) {
     r.termination = Termination::kSuccess;

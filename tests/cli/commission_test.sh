@@ -149,6 +149,15 @@ rc=$?
 for k in 'type = "gpc"' 'rule = "explicit"' 't_filter = "A"' '^P = ' '^lambda = '; do
   grep -q "$k" "$TMP/g/controller.toml" || fail "gpc controller.toml: no '$k'"
 done
+# Its first design aims at 1.25 x the DMC's fastest robust response time, as
+# the MPC's and DMC's do (from the DMC's fastest design itself: 13.8 %).
+$PY - "$TMP/g.json" <<'PYEOF' || fail "gpc first design"
+import json, sys
+j = json.load(open(sys.argv[1]))
+first = j["attempts"][0]
+assert first["passed"] and first["overshoot_percent"] < 10.0, first
+assert len(j["attempts"]) <= 2, [a["overshoot_percent"] for a in j["attempts"]]
+PYEOF
 "$PNEUMID" control --config "$TMP/g/controller.toml" --setpoint "staircase:levels=20 120 60,dwell=1.5" \
   --duration 4.5 --json > "$TMP/gctl.json" || fail "control --config (gpc)"
 $PY - "$TMP/gctl.json" <<'PYEOF' || fail "gpc control metrics"
@@ -170,11 +179,13 @@ out=$("$PNEUMID" commission --plant ipa --spec overshoot=x -o "$TMP/e3" 2>&1)
 echo "$out" | grep -q "overshoot" || fail "bad --spec message: $out"
 
 # Over UDP against a plant server (the same twin in another process), stepped
-# as fast as it answers: the same stages, the same kind of result.
+# as fast as it answers, at the simulator's loop period (one PWM period): the
+# same stages and the same verification within noise, the load step included
+# (an output disturbance over the backend too) and each run started from rest.
 SERVER_PID=""
 cleanup() { [ -n "$SERVER_PID" ] && kill "$SERVER_PID" 2>/dev/null; }
 : > "$TMP/server.txt"
-"$PNEUMID" plant-server --plant ipa --port 0 > "$TMP/server.txt" 2>&1 &
+"$PNEUMID" plant-server --plant ipa --port 0 --Ts 0.0033333333333 > "$TMP/server.txt" 2>&1 &
 SERVER_PID=$!
 PORT=""
 for _ in $(seq 50); do
@@ -183,7 +194,8 @@ for _ in $(seq 50); do
   sleep 0.1
 done
 [ -n "$PORT" ] || fail "plant-server did not start: $(cat "$TMP/server.txt")"
-"$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --fast --input-gaps 0:15,85:100 -o "$TMP/u" --json \
+"$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --Ts 0.0033333333333 --fast \
+  --input-gaps 0:15,85:100 -o "$TMP/u" --json \
   > "$TMP/u.json" 2> "$TMP/u.err"
 rc=$?
 [ "$rc" -eq 0 ] || [ "$rc" -eq 4 ] || fail "commission over udp exited $rc"
@@ -195,11 +207,17 @@ u, s = (json.load(open(p)) for p in sys.argv[1:3])
 assert abs(u["experiment"]["probe"]["time_constant"] - s["experiment"]["probe"]["time_constant"]) < 0.03
 assert abs(u["experiment"]["sweep"]["reachable_max"] - s["experiment"]["sweep"]["reachable_max"]) < 5
 assert u["verification"]["steps"], u
+uv, sv = u["verification"], s["verification"]
+assert abs(uv["overshoot_percent"] - sv["overshoot_percent"]) < 1.5, (uv["overshoot_percent"], sv["overshoot_percent"])
+assert abs(uv["iae"] / sv["iae"] - 1.0) < 0.15, (uv["iae"], sv["iae"])
+assert abs(uv["load_peak_deviation"] - sv["load_peak_deviation"]) < 1.5, (uv["load_peak_deviation"], sv["load_peak_deviation"])
+assert sv["load_peak_deviation"] < -10.0, sv["load_peak_deviation"]
 PYEOF
 grep -q 'backend = "udp://127.0.0.1:' "$TMP/u/controller.toml" || fail "udp controller.toml: no backend"
 # Without --input-gaps the plant behind the backend reports none: a warning
 # names the IPA's.
-"$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --fast --budget 20 -o "$TMP/u0" > /dev/null \
+"$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --Ts 0.0033333333333 --fast --budget 20 \
+  -o "$TMP/u0" > /dev/null \
   2> "$TMP/u0.err"
 grep -q "reports no input gaps.*--input-gaps 0:15,85:100" "$TMP/u0.err" ||
   fail "udp without --input-gaps: no warning: $(head -c 300 "$TMP/u0.err")"

@@ -31,6 +31,8 @@ TEST(IoPlant, MeasureIsTheBackendReadingPlusTheLoadDisturbance) {
   plant.SetLoadDisturbance(-0.25);
   EXPECT_NEAR(plant.Measure(), 1.0 - std::pow(0.9, 5) - 0.25, 1e-12);
   EXPECT_DOUBLE_EQ(plant.time(), 5 * Ts);
+  EXPECT_FALSE(plant.can_reset());
+  EXPECT_TRUE(reference.can_reset());
   plant.Reset();  // the clock and the load restart; the plant keeps its state
   EXPECT_DOUBLE_EQ(plant.time(), 0.0);
   EXPECT_NEAR(plant.Measure(), 1.0 - std::pow(0.9, 5), 1e-12);

@@ -24,6 +24,10 @@ class Plant {
 
   /// Back to the initial state (and the noise generators to their seed).
   virtual void Reset() = 0;
+  /// Whether Reset() returns the plant to its initial state: true for
+  /// simulated plants; false for a real one behind a backend, whose Reset()
+  /// only restarts the clock (realtime/io_plant.hpp).
+  virtual bool can_reset() const { return true; }
   /// Measured output at the current time (sensor model included: noise,
   /// quantization, transport delay).
   virtual double Measure() = 0;

@@ -40,6 +40,8 @@ class IoPlant : public Plant {
 
   /// Restarts the clock and clears the load disturbance (a real plant keeps its state).
   void Reset() override;
+  /// False: Reset() does not bring the plant back to rest.
+  bool can_reset() const override { return false; }
   /// backend.Read(): the output plus the load disturbance, NaN on a read that
   /// failed or timed out.
   double Measure() override;

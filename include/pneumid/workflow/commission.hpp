@@ -26,7 +26,7 @@
 //                 controller can be built from.
 //   5. design     the controller tuned to the specification (rule "auto",
 //                 auto_tuning.hpp), behind the model's input map when it has one.
-//                 An MPC or DMC aims at 1.25 times the response time of the
+//                 An MPC, DMC or GPC aims at 1.25 times the response time of the
 //                 fastest robust design (whose overshoot on the model is at
 //                 the specification: on the plant's small steps it overshoots).
 //                 When the actuator has input gaps (a PWM valve's minimum
