@@ -89,6 +89,7 @@ bool PlantServer::Handle(const std::uint8_t* data, std::size_t size, udp::Packet
   udp::Request req;
   const udp::DecodeResult dr = udp::DecodeRequest(data, size, &req);
   udp::Reply rep;
+  rep.Ts = plant_->Ts();
   if (dr != udp::DecodeResult::kOk) {
     ++stats_.bad_packets;
     if (dr != udp::DecodeResult::kBadVersion || size != udp::kPacketSize) return false;

@@ -111,6 +111,11 @@ void UdpBackend::Open(double period) {
               udp::DecodeResult::kOk ||
           rep.type != udp::PacketType::kHello || rep.sequence != req.sequence)
         continue;
+      if (rep.status == udp::PacketStatus::kBadTs && rep.Ts > 0.0)
+        throw DataError(fmt::format(
+            "udp://{}:{}: plant server refused the session: its plant runs at Ts = {:.17g} s, "
+            "not {:.17g} s: give that period (--Ts {:.17g}) or start the server with --Ts {:.17g}",
+            options_.host, options_.port, rep.Ts, period, rep.Ts, period));
       if (rep.status != udp::PacketStatus::kOk)
         throw DataError(
             fmt::format("udp://{}:{}: plant server refused the session: {} (period {} s)",

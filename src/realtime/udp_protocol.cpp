@@ -94,6 +94,7 @@ Packet Encode(const Reply& r) noexcept {
   Put(p, 32, r.plant_time);
   Put(p, 40, r.y);
   Put(p, 48, r.aux);
+  Put(p, 56, r.Ts);
   return p;
 }
 
@@ -122,6 +123,7 @@ DecodeResult DecodeReply(const std::uint8_t* d, std::size_t size, Reply* out) no
   out->plant_time = Get<double>(d, 32);
   out->y = Get<double>(d, 40);
   out->aux = Get<double>(d, 48);
+  out->Ts = Get<double>(d, 56);
   return DecodeResult::kOk;
 }
 

@@ -221,6 +221,11 @@ grep -q 'backend = "udp://127.0.0.1:' "$TMP/u/controller.toml" || fail "udp cont
   2> "$TMP/u0.err"
 grep -q "reports no input gaps.*--input-gaps 0:15,85:100" "$TMP/u0.err" ||
   fail "udp without --input-gaps: no warning: $(head -c 300 "$TMP/u0.err")"
+# Another period than the server's: the error names the server's.
+out=$("$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --fast -o "$TMP/u1" 2>&1)
+[ $? -eq 1 ] || fail "udp with another period: exit status"
+echo "$out" | grep -q "its plant runs at Ts = 0.0033333333333 s, not 0.01 s" ||
+  fail "udp with another period: $out"
 kill "$SERVER_PID"; wait "$SERVER_PID" 2>/dev/null; SERVER_PID=""
 
 # Ctrl-C in the middle of the experiment: exit 130, the plant at its lowest

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -68,13 +69,18 @@ TEST(UdpProtocol, ReplyRoundTripAndRejections) {
   r.server_time_ns = 123456789;
   r.plant_time = 2.5;
   r.y = -12.25;
+  r.Ts = 1.0 / 300.0;
   const udp::Packet p = udp::Encode(r);
+  double at56 = 0.0;
+  std::memcpy(&at56, p.data() + 56, 8);  // offset 56: the server plant's Ts
+  EXPECT_EQ(at56, 1.0 / 300.0);
   EXPECT_EQ(p[6], 0x81);  // Hello | reply bit
   udp::Reply back;
   ASSERT_EQ(udp::DecodeReply(p.data(), p.size(), &back), udp::DecodeResult::kOk);
   EXPECT_EQ(back.status, udp::PacketStatus::kBadTs);
   EXPECT_EQ(back.y, -12.25);
   EXPECT_TRUE(std::isnan(back.aux));
+  EXPECT_EQ(back.Ts, 1.0 / 300.0);
   udp::Request req;
   EXPECT_EQ(udp::DecodeRequest(p.data(), p.size(), &req), udp::DecodeResult::kNotRequest);
   EXPECT_EQ(udp::DecodeReply(p.data(), 63, &back), udp::DecodeResult::kWrongSize);
@@ -112,6 +118,7 @@ TEST(PlantServer, HandlesHelloStepRetransmissionAndBadPeriod) {
   ASSERT_TRUE(server.Handle(p.data(), p.size(), &out));
   udp::DecodeReply(out.data(), out.size(), &rep);
   EXPECT_EQ(rep.status, udp::PacketStatus::kBadTs);
+  EXPECT_EQ(rep.Ts, 0.01);  // the period the server's plant runs at
   hello.Ts = 0.01;
   p = udp::Encode(hello);
   ASSERT_TRUE(server.Handle(p.data(), p.size(), &out));
@@ -241,7 +248,8 @@ void ExpectLogReplaysTheLoop(const LoggedRun& run) {
       check(std::abs(run.y[k] - y_plant) <= 1e-6 * (1.0 + std::abs(y_plant)),
             fmt::format("sample {}: y = {}, the plant gives {}", k, run.y[k], y_plant));
     }
-    const double u = std::clamp(pi.Update(static_cast<std::int64_t>(k), 10.0, run.y[k]), 0.0, 100.0);
+    const double u =
+        std::clamp(pi.Update(static_cast<std::int64_t>(k), 10.0, run.y[k]), 0.0, 100.0);
     check(std::abs(run.u[k] - u) <= 1e-6 * (1.0 + std::abs(u)),
           fmt::format("sample {}: u = {}, the controller gives {}", k, run.u[k], u));
     plant.Advance(run.u[k]);

@@ -15,11 +15,12 @@
 //   32   8   Ts, s (Hello) (float64)         32   8   plant time, s (float64)
 //   40  24   reserved, zero                  40   8   y, measured output (float64)
 //                                            48   8   aux (pressure, Pa, or NaN)
-//                                            56   8   reserved, zero
+//                                            56   8   the server plant's Ts, s (float64;
+//                                                      0 from servers that do not say)
 //
 // Semantics (one exchange per period):
 //   Hello(Ts)  -> the server resets its plant and replies y_0 (status BadTs when the
-//                 plant's sample time differs from Ts).
+//                 plant's sample time differs from Ts; the reply's Ts says which it is).
 //   Step(u_k)  -> the server holds u_k for one period (Plant::Advance) and replies
 //                 y_(k+1); a repeated sequence number is answered again, not re-applied.
 //   Safe(s)    -> the server drives its plant's outputs to safe state s and replies.
@@ -73,6 +74,7 @@ struct Reply {
   double plant_time = 0.0;                  ///< plant time after the request, s
   double y = 0.0;                           ///< measured output (IPA: force N)
   double aux = std::numeric_limits<double>::quiet_NaN();  ///< chamber pressure, Pa, or NaN
+  double Ts = 0.0;  ///< the server plant's sample time, s (0: not told)
 };
 
 /// Result of decoding a datagram.
