@@ -198,7 +198,16 @@ class Scanner {
                         Variable(), e.nbytes, room));
       }
       if (e.data.size() < e.nbytes) return;  // the rest was not inflated
-      if (k == 0 && e.type == kMiUint32 && e.nbytes >= 4) {
+      if (k == 0 && (e.small || (e.type != kMiUint32 && e.type != kMiInt32) || e.nbytes != 8)) {
+        // matio reads the array flags as 8 bytes after their tag whatever the
+        // tag claims, and the dimensions right after: another size would put
+        // it on other bytes than this check (flags claiming 50 bytes hid a
+        // dimensions tag of type 10 before a 1.8 GB name: 11 s).
+        Fail(
+            fmt::format("{}: its array flags element has type {} and {} bytes, not miUINT32 (6) "
+                        "and 8 bytes: the file is corrupt",
+                        Variable(), e.type, e.nbytes));
+      } else if (k == 0) {
         cls = U32(e.data, 0) & 0xFF;
       } else if (k == 1 && e.type != kMiInt32) {
         // matio reads the dimensions as int32 whatever the tag says, so a

@@ -287,6 +287,37 @@ TEST_F(BadInputTest, MatDimensionsOfTheWrongTypeAreRejected) {
   EXPECT_THAT([&] { ReadMat(zpath); }, ThrowsMessage<DataError>(HasSubstr("not miINT32 (5)")));
 }
 
+TEST_F(BadInputTest, MatArrayFlagsOfAnotherSizeAreRejected) {
+  // Found by mat_fuzz: array flags claiming 50 bytes; matio reads 8 whatever
+  // the tag says, so it met a dimensions tag of type 10 and a name claiming
+  // 1.8 GB where this check saw valid dimensions (11 s for a 464-byte file).
+  std::string flags, dims;
+  PutU32(&flags, 1);  // mxCELL_CLASS
+  PutU32(&flags, 0);
+  std::string hidden = flags;
+  PutU32(&hidden, 10);  // what matio takes for the dimensions tag
+  PutU32(&hidden, 50);
+  PutU32(&hidden, 1);
+  PutU32(&hidden, 0x6e696cfeu);
+  hidden.resize(50, '\0');
+  PutU32(&dims, 1);
+  PutU32(&dims, 1);
+  const std::string bad = Element(14, Element(6, hidden) + Element(5, dims) + Element(1, "") +
+                                          Element(9, std::string(8, '\0')));
+  for (const auto& [name, body] :
+       {std::pair<std::string, std::string>{"flags.mat", bad}, {"zflags.mat", Compress(bad)}}) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::string path = Write(name, MatHeader() + body);
+    EXPECT_THAT([&] { ReadMat(path); },
+                ThrowsMessage<DataError>(AllOf(
+                    HasSubstr("its array flags element has type 6 and 50 bytes, not miUINT32 (6) "
+                              "and 8 bytes"),
+                    HasSubstr("the file is corrupt"))))
+        << name;
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2)) << name;
+  }
+}
+
 TEST_F(BadInputTest, MatFunctionClassDimensionsAreCheckedLikeNumericOnes) {
   // Found by mat_fuzz: a function-class (16) array claiming 1296629765x1
   // elements in 88 bytes; matio allocated 10 GB of doubles for it.
