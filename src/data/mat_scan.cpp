@@ -190,8 +190,10 @@ class Scanner {
       const Element e = ReadTag(data.substr(at));
       // What the element claims must fit in what its array claims, even
       // where only the start of a compressed array was inflated.
+      // (A small element's data lies inside its 8-byte tag.)
       const std::uint64_t room = nbytes > at + 8 ? nbytes - at - 8 : 0;
-      if (e.nbytes > room || (e.data.size() < e.nbytes && !(partial && data.size() < nbytes))) {
+      if ((!e.small && e.nbytes > room) || (e.small && at + 8 > nbytes) ||
+          (e.data.size() < e.nbytes && !(partial && data.size() < nbytes))) {
         Fail(
             fmt::format("{}: an element claims {} bytes, more than the {} bytes left in its "
                         "array: the file is corrupt",
@@ -225,6 +227,13 @@ class Scanner {
             fmt::format("{}: its dimensions element is in the small data element format ({} "
                         "bytes), too short for two dimensions: the file is corrupt",
                         Variable(), e.nbytes));
+      } else if (k == 1 && (e.nbytes % 4 != 0 || e.nbytes < 8)) {
+        // matio reads nbytes / 4 dimensions (and one more word for an odd
+        // count), so other sizes put its next read elsewhere than this check.
+        Fail(
+            fmt::format("{}: its dimensions element holds {} bytes, not two or more int32: the "
+                        "file is corrupt",
+                        Variable(), e.nbytes));
       } else if (k == 1) {
         for (std::size_t d = 0; d + 4 <= e.data.size(); d += 4) {
           const auto n = static_cast<std::int32_t>(U32(e.data, d));
@@ -233,11 +242,31 @@ class Scanner {
           elements *= static_cast<double>(n);
           dims += (d == 0 ? "" : "x") + std::to_string(n);
         }
-      } else if (k == 2 && e.type == kMiInt8 && depth == 0) {
+      } else if (k == 2 && e.type != kMiInt8) {
+        // matio skips only the tag of a name of another type and reads on
+        // from its data.
+        Fail(fmt::format("{}: its name element has type {}, not miINT8 (1): the file is corrupt",
+                         Variable(), e.type));
+      } else if (k == 2 && depth == 0) {
         name_ = Excerpt(e.data);
-      } else if (k == 3 && cls == kClassStruct && e.type == kMiInt32 && e.nbytes >= 4) {
+      } else if (k == 3 && cls == kClassStruct &&
+                 (!e.small || e.type != kMiInt32 || e.nbytes != 4)) {
+        // matio takes the word after the tag as the length, which only the
+        // small format (the length inside the tag) puts there.
+        Fail(
+            fmt::format("{}: its field name length is not a 4-byte miINT32 in the small data "
+                        "element format (type {}, {} bytes): the file is corrupt",
+                        Variable(), e.type, e.nbytes));
+      } else if (k == 3 && cls == kClassStruct) {
         field_name_length = U32(e.data, 0);
-      } else if (k == 4 && cls == kClassStruct && e.type == kMiInt8) {
+      } else if (k == 4 && cls == kClassStruct &&
+                 (e.type != kMiInt8 ||
+                  (field_name_length != 0 && e.nbytes % field_name_length != 0))) {
+        Fail(
+            fmt::format("{}: its field names element (type {}, {} bytes) is not miINT8 names "
+                        "of {} bytes each: the file is corrupt",
+                        Variable(), e.type, e.nbytes, field_name_length));
+      } else if (k == 4 && cls == kClassStruct) {
         fields = field_name_length == 0 ? 0.0 : static_cast<double>(e.nbytes / field_name_length);
       }
       if ((k == 2 && cls != kClassStruct) || (k == 4 && cls == kClassStruct)) {

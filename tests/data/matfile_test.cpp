@@ -231,5 +231,26 @@ TEST_F(MatFileTest, ReadsFileWrittenByScipy) {
   ExpectError(path, o, {"variable 'name'", "char"});
 }
 
+TEST_F(MatFileTest, ReadsScipyFileWithStructCellAndSmallElements) {
+  // tests/data/scipy_struct_cell.mat from gen_matfile.py: a struct, a cell,
+  // small data elements at the end of their arrays (int8 [1 2 3], single
+  // 2.5) and an empty array beside the signals; none of them is corrupt.
+  const std::string path = std::string(PNEUMID_SOURCE_DIR) + "/tests/data/scipy_struct_cell.mat";
+  const Dataset d = ReadMat(path);
+  ASSERT_EQ(d.size(), 5);
+  EXPECT_NEAR(d.time()[4], 0.4, 1e-15);
+  EXPECT_DOUBLE_EQ(d.u()[1], std::sin(0.1));
+  EXPECT_DOUBLE_EQ(d.y()[2], std::cos(0.2));
+  MatReadOptions o;
+  o.sample_time = 1.0;
+  o.input_variables = {"i8"};
+  o.output_variables = {"f"};
+  ExpectError(path, o, {"has 1 samples but 'i8' has 3"});
+  o.output_variables = {"i8"};
+  const Dataset small = ReadMat(path, o);
+  ASSERT_EQ(small.size(), 3);
+  EXPECT_DOUBLE_EQ(small.y()[2], 3.0);
+}
+
 }  // namespace
 }  // namespace pneumid
