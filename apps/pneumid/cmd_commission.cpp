@@ -177,6 +177,8 @@ void Run(CommissionArgs& c) {
                   "a comedi card runs in real time");
     RealtimeConfig config = c.config.empty() ? RealtimeConfig{} : LoadRealtimeConfig(c.config);
     config.loop.period = c.Ts;
+    // Without --Ts the loop runs at the plant server's period (a card takes any).
+    config.udp.adopt_server_period = !c.ts_option->count();
     if (c.fast) {
       // Not bound to the clock: wait for late replies (a loaded machine) rather
       // than count them as missed; a server silent for 100 periods is a fault.
@@ -184,13 +186,15 @@ void Run(CommissionArgs& c) {
       config.udp.max_missed = std::max(config.udp.max_missed, 100);
     }
     auto io_plant = std::make_unique<IoPlant>(MakeIoBackend(io, config, po), c.Ts, !c.fast);
+    c.Ts = io_plant->Ts();
     o.actuator = io_plant->actuator();
     plant = std::move(io_plant);
   }
   if (!c.spec.empty()) ParseSpecification(c.spec, o);
   SetInputGaps(o, *plant, c.input_gaps);
-  // A plant behind a backend does not report its valves' gaps: without them
-  // the experiment and the loop hold inputs the valves cannot (docs/commission.md).
+  // A plant behind a card (or a plant server older than the Info message)
+  // does not report its valves' gaps: without them the experiment and the
+  // loop hold inputs the valves cannot (docs/commission.md).
   if (io.kind != IoKind::kSim && c.input_gaps == "plant" && o.actuator &&
       o.actuator->input_gaps.empty())
     std::cerr << "pneumid commission: warning: the plant behind " << c.io
@@ -264,7 +268,8 @@ const Registrar reg(
       c->ts_option =
           AddSampleTimeOption(app, c->Ts,
                               "Sample period in s (default 0.01; an IPA: its PWM period, or the "
-                              "smallest multiple of it of at least 3 ms)");
+                              "smallest multiple of it of at least 3 ms; udp: the plant "
+                              "server's)");
       app.add_option("--range", c->range,
                      "Output range LO:HI the controller must serve (default: the reachable "
                      "range found by the sweep, less 5 % at each end)");

@@ -13,6 +13,7 @@ IoPlant::IoPlant(std::unique_ptr<IoBackend> backend, double Ts, bool realtime)
   PNEUMID_CHECK(backend_ != nullptr, "IoPlant: the backend is null");
   PNEUMID_CHECK(Ts > 0.0 && std::isfinite(Ts), "IoPlant: Ts must be positive, got {}", Ts);
   backend_->Open(Ts);
+  if (std::isfinite(backend_->adopted_period())) Ts_ = backend_->adopted_period();
   start_ = std::chrono::steady_clock::now();
 }
 

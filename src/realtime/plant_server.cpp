@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -48,6 +49,7 @@ PlantServer::PlantServer(std::unique_ptr<Plant> plant, PlantServerOptions option
   PNEUMID_CHECK(plant_ != nullptr, "plant server needs a plant, got null");
   std::string error;
   PNEUMID_CHECK(options_.IsValid(&error), "invalid plant-server options: {}", error);
+  input_gaps_ = PlantActuator(*plant_).input_gaps;
   sockaddr_storage ss{};
   socklen_t len = 0;
   in_addr a4;
@@ -140,6 +142,17 @@ bool PlantServer::Handle(const std::uint8_t* data, std::size_t size, udp::Packet
     case udp::PacketType::kBye:
       session_ = false;
       return false;
+    case udp::PacketType::kInfo: {
+      // The plant is not measured (that would draw its noise).
+      const std::size_t k = req.arg;
+      rep.plant_time = static_cast<double>(input_gaps_.size());
+      rep.y = k < input_gaps_.size() ? input_gaps_[k].lo : std::numeric_limits<double>::quiet_NaN();
+      rep.aux =
+          k < input_gaps_.size() ? input_gaps_[k].hi : std::numeric_limits<double>::quiet_NaN();
+      rep.server_time_ns = NowNs();
+      *out = udp::Encode(rep);
+      return true;
+    }
   }
   rep.server_time_ns = NowNs();
   rep.plant_time = plant_->time();

@@ -89,6 +89,8 @@ void UdpBackend::Open(double period) {
     throw DataError(fmt::format("udp://{}:{}: cannot open socket: {}", options_.host, options_.port,
                                 std::strerror(errno)));
   // Hello: reset the remote plant and get y_0.
+  adopted_period_ = std::numeric_limits<double>::quiet_NaN();
+  input_gaps_.clear();
   for (int attempt = 0; attempt < options_.hello_attempts; ++attempt) {
     udp::Request req;
     req.type = udp::PacketType::kHello;
@@ -97,38 +99,34 @@ void UdpBackend::Open(double period) {
     req.Ts = period;
     const udp::Packet p = udp::Encode(req);
     ::send(fd_, p.data(), p.size(), 0);  // failures show up as no answer
-    const std::int64_t until = NowNs() + static_cast<std::int64_t>(options_.hello_timeout * 1e9);
-    for (std::int64_t now = NowNs(); now < until; now = NowNs()) {
-      if (!WaitReadable(fd_, until - now)) break;
-      udp::Packet buf;
-      const ssize_t got = ::recv(fd_, buf.data(), buf.size(), 0);
-      udp::Reply rep;
-      if (got < 0) {
-        if (errno == ECONNREFUSED) break;  // nobody listening yet: next attempt
-        continue;
-      }
-      if (udp::DecodeReply(buf.data(), static_cast<std::size_t>(got), &rep) !=
-              udp::DecodeResult::kOk ||
-          rep.type != udp::PacketType::kHello || rep.sequence != req.sequence)
-        continue;
-      if (rep.status == udp::PacketStatus::kBadTs && rep.Ts > 0.0)
-        throw DataError(fmt::format(
-            "udp://{}:{}: plant server refused the session: its plant runs at Ts = {:.17g} s, "
-            "not {:.17g} s: give that period (--Ts {:.17g}) or start the server with --Ts {:.17g}",
-            options_.host, options_.port, rep.Ts, period, rep.Ts, period));
-      if (rep.status != udp::PacketStatus::kOk)
-        throw DataError(
-            fmt::format("udp://{}:{}: plant server refused the session: {} (period {} s)",
-                        options_.host, options_.port, udp::ToString(rep.status), period));
-      last_y_ = rep.y;
-      last_aux_ = rep.aux;
-      have_reply_ = true;
-      expect_seq_ = req.sequence;
-      missed_ = 0;
-      stale_total_ = 0;
-      return;
+    udp::Reply rep;
+    if (!AwaitReply(udp::PacketType::kHello, req.sequence, options_.hello_timeout, &rep)) {
+      if (attempt + 1 < options_.hello_attempts) ::usleep(100000);
+      continue;
     }
-    if (attempt + 1 < options_.hello_attempts) ::usleep(100000);
+    if (rep.status == udp::PacketStatus::kBadTs && rep.Ts > 0.0 && options_.adopt_server_period &&
+        !std::isfinite(adopted_period_)) {
+      // Ask again at the server's period (once; this attempt does not count).
+      period = period_ = adopted_period_ = rep.Ts;
+      --attempt;
+      continue;
+    }
+    if (rep.status == udp::PacketStatus::kBadTs && rep.Ts > 0.0)
+      throw DataError(fmt::format(
+          "udp://{}:{}: plant server refused the session: its plant runs at Ts = {:.17g} s, "
+          "not {:.17g} s: give that period (--Ts {:.17g}) or start the server with --Ts {:.17g}",
+          options_.host, options_.port, rep.Ts, period, rep.Ts, period));
+    if (rep.status != udp::PacketStatus::kOk)
+      throw DataError(fmt::format("udp://{}:{}: plant server refused the session: {} (period {} s)",
+                                  options_.host, options_.port, udp::ToString(rep.status), period));
+    last_y_ = rep.y;
+    last_aux_ = rep.aux;
+    input_gaps_ = AskInputGaps();
+    have_reply_ = true;
+    expect_seq_ = req.sequence;
+    missed_ = 0;
+    stale_total_ = 0;
+    return;
   }
   ::close(fd_);
   fd_ = -1;
@@ -137,6 +135,57 @@ void UdpBackend::Open(double period) {
       "plant-server --port {}` running?)",
       options_.host, options_.port, options_.hello_attempts, options_.hello_timeout,
       options_.port));
+}
+
+bool UdpBackend::AwaitReply(udp::PacketType type, std::uint32_t sequence, double timeout,
+                            udp::Reply* reply) {
+  const std::int64_t until = NowNs() + static_cast<std::int64_t>(timeout * 1e9);
+  for (std::int64_t now = NowNs(); now < until; now = NowNs()) {
+    if (!WaitReadable(fd_, until - now)) return false;
+    udp::Packet buf;
+    const ssize_t got = ::recv(fd_, buf.data(), buf.size(), 0);
+    if (got < 0) {
+      if (errno == ECONNREFUSED) return false;  // nobody listening (yet)
+      continue;
+    }
+    if (udp::DecodeReply(buf.data(), static_cast<std::size_t>(got), reply) ==
+            udp::DecodeResult::kOk &&
+        reply->type == type && reply->sequence == sequence)
+      return true;
+  }
+  return false;
+}
+
+std::vector<InputGap> UdpBackend::AskInputGaps() {
+  // A gap of the IPA's duty is a few % wide; a server telling more than a few
+  // gaps, or ends out of order, is not believed.
+  constexpr std::uint32_t kMaxGaps = 16;
+  std::vector<InputGap> gaps;
+  for (std::uint32_t k = 0; k < kMaxGaps; ++k) {
+    udp::Request req;
+    req.type = udp::PacketType::kInfo;
+    req.sequence = ++seq_;
+    req.arg = k;
+    req.client_time_ns = NowNs();
+    const udp::Packet p = udp::Encode(req);
+    ::send(fd_, p.data(), p.size(), 0);
+    udp::Reply rep;
+    if (!AwaitReply(udp::PacketType::kInfo, req.sequence, 0.2, &rep) ||
+        rep.status != udp::PacketStatus::kOk)
+      return {};  // a server before Info: no gaps told
+    const double n = rep.plant_time;
+    if (!(n >= 0.0 && n <= kMaxGaps) || n != std::floor(n)) return {};
+    if (k >= static_cast<std::uint32_t>(n)) break;
+    if (!(std::isfinite(rep.y) && std::isfinite(rep.aux) && rep.y < rep.aux)) return {};
+    gaps.push_back({rep.y, rep.aux});
+  }
+  return gaps;
+}
+
+Actuator UdpBackend::actuator() const {
+  Actuator a = IpaActuator();
+  a.input_gaps = input_gaps_;
+  return a;
 }
 
 bool UdpBackend::Collect(std::int64_t wait_ns) noexcept {

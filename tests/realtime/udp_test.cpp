@@ -16,6 +16,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "pneumid/plant/plant_factory.hpp"
+#include "pneumid/realtime/io_plant.hpp"
 #include "pneumid/realtime/plant_server.hpp"
 #include "pneumid/realtime/realtime_loop.hpp"
 #include "pneumid/realtime/udp_backend.hpp"
@@ -91,7 +93,7 @@ TEST(UdpProtocol, ReplyRoundTripAndRejections) {
   bad[4] = 2;
   EXPECT_EQ(udp::DecodeReply(bad.data(), bad.size(), &back), udp::DecodeResult::kBadVersion);
   bad = p;
-  bad[6] = 0x85;
+  bad[6] = 0x86;  // type 6: unknown (1..5 are Hello, Step, Safe, Bye, Info)
   EXPECT_EQ(udp::DecodeReply(bad.data(), bad.size(), &back), udp::DecodeResult::kBadType);
 }
 
@@ -380,6 +382,76 @@ TEST(UdpBackend, NoServerIsAClearErrorAtOpen) {
     EXPECT_THAT(e.what(), HasSubstr("no answer from a plant server"));
   }
   EXPECT_THROW(UdpBackend(UdpBackendOptions{"", 1}), InvalidArgument);
+}
+
+// Info(k) tells the server plant's input gaps (the IPA's from its valves'
+// minimum pulse at 300 Hz: 0..15 and 85..100 % duty; none for a linear
+// plant) without touching the plant.
+TEST(PlantServer, InfoTellsThePlantsInputGapsWithoutTouchingIt) {
+  PlantServerOptions o;
+  o.port = 0;
+  const auto info = [](PlantServer& server, std::uint32_t k) {
+    udp::Request req;
+    req.type = udp::PacketType::kInfo;
+    req.sequence = 7 + k;
+    req.arg = k;
+    const udp::Packet p = udp::Encode(req);
+    udp::Packet out;
+    EXPECT_TRUE(server.Handle(p.data(), p.size(), &out));
+    udp::Reply rep;
+    EXPECT_EQ(udp::DecodeReply(out.data(), out.size(), &rep), udp::DecodeResult::kOk);
+    EXPECT_EQ(rep.type, udp::PacketType::kInfo);
+    EXPECT_EQ(rep.sequence, 7 + k);
+    EXPECT_EQ(rep.status, udp::PacketStatus::kOk);
+    return rep;
+  };
+  PlantServer ipa(MakePlant("ipa", 1.0 / 300.0), o);
+  const std::vector<InputGap> gaps = PlantActuator(*MakePlant("ipa", 1.0 / 300.0)).input_gaps;
+  ASSERT_EQ(gaps.size(), 2u);
+  for (std::uint32_t k = 0; k < 2; ++k) {
+    const udp::Reply rep = info(ipa, k);
+    EXPECT_EQ(rep.plant_time, 2.0);
+    EXPECT_EQ(rep.y, gaps[k].lo);
+    EXPECT_EQ(rep.aux, gaps[k].hi);
+  }
+  EXPECT_TRUE(std::isnan(info(ipa, 2).y));
+  EXPECT_EQ(ipa.stats().steps, 0);
+
+  PlantServer linear(std::make_unique<FirstOrderPlant>(0.01, 0.5, 1.0), o);
+  const udp::Reply none = info(linear, 0);
+  EXPECT_EQ(none.plant_time, 0.0);
+  EXPECT_TRUE(std::isnan(none.y) && std::isnan(none.aux));
+}
+
+// A client whose period was not given takes the server's (the reply to a
+// Hello at another period says it); one that gave its period is refused
+// with the server's in the message. The IPA server's gaps reach the
+// client's actuator.
+TEST(UdpBackend, AdoptsTheServersPeriodWhenAskedAndLearnsItsGaps) {
+  PlantServerOptions so;
+  so.port = 0;
+  auto srv = std::make_unique<ServerThread>(so, MakePlant("ipa", 1.0 / 300.0));
+  UdpBackendOptions uo;
+  uo.port = srv->server.port();
+  {
+    UdpBackend strict(uo);
+    try {
+      strict.Open(0.01);
+      FAIL() << "Open at another period succeeded";
+    } catch (const DataError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("its plant runs at Ts = 0.0033333"));
+    }
+  }
+  uo.adopt_server_period = true;
+  auto backend = std::make_unique<UdpBackend>(uo);
+  UdpBackend* raw = backend.get();
+  IoPlant plant(std::move(backend), 0.01, false);
+  EXPECT_DOUBLE_EQ(plant.Ts(), 1.0 / 300.0);
+  EXPECT_DOUBLE_EQ(raw->adopted_period(), 1.0 / 300.0);
+  EXPECT_EQ(plant.actuator().input_gaps, PlantActuator(*MakePlant("ipa", 1.0 / 300.0)).input_gaps);
+  EXPECT_TRUE(std::isfinite(plant.Measure()));
+  plant.Advance(50.0);
+  EXPECT_TRUE(std::isfinite(plant.Measure()));
 }
 
 TEST(IoSpec, ParsesTheThreeBackends) {

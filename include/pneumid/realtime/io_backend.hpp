@@ -51,6 +51,10 @@ class IoBackend {
   /// The actuator behind the backend: channels, input range, safe-state names.
   /// Default: the generic description (Actuator{}).
   virtual Actuator actuator() const { return Actuator{}; }
+  /// The period Open() settled on when the device chose it instead of the one
+  /// asked for (a plant server's, UdpBackendOptions::adopt_server_period);
+  /// NaN (the default): the period given to Open().
+  virtual double adopted_period() const { return std::numeric_limits<double>::quiet_NaN(); }
 };
 
 /// Backend kinds selectable with --io.

@@ -10,8 +10,10 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pneumid/control/closed_loop.hpp"
+#include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/plant.hpp"
 #include "pneumid/realtime/safety.hpp"
 #include "pneumid/realtime/udp_protocol.hpp"
@@ -68,6 +70,7 @@ class PlantServer {
  private:
   std::unique_ptr<Plant> plant_;
   PlantServerOptions options_;
+  std::vector<InputGap> input_gaps_;  // of the plant's actuator, told by Info
   int fd_ = -1;
   int port_ = 0;
   bool session_ = false;

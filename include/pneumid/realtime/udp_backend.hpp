@@ -9,7 +9,9 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "pneumid/realtime/io_backend.hpp"
 #include "pneumid/realtime/udp_protocol.hpp"
@@ -24,6 +26,10 @@ struct UdpBackendOptions {
   double reply_wait = 0.25;        ///< fraction of the period Read() may wait for a late reply
   double hello_timeout = 1.0;      ///< s to wait for the server's answer to Hello (per attempt)
   int hello_attempts = 3;          ///< Hello requests sent before Open() gives up (>= 1)
+  /// When the server's plant runs at another period than the one Open() asks
+  /// for, take the server's (adopted_period()) instead of refusing: for a
+  /// command whose period was not given (the loop then runs at the plant's).
+  bool adopt_server_period = false;
   /// True for a non-empty host, port 1..65535, max_missed >= 1, reply_wait in [0, 0.9],
   /// hello_timeout in (0, 60] s and hello_attempts >= 1; otherwise false with the reason
   /// in *error (when not null).
@@ -36,18 +42,26 @@ class UdpBackend : public IoBackend {
   /// @throws InvalidArgument on invalid options.
   explicit UdpBackend(UdpBackendOptions options);
   ~UdpBackend() override;
-  /// Resolves the host, connects and sends Hello(period).
+  /// Resolves the host, connects and sends Hello(period) (again with the
+  /// server's period when it differs and adopt_server_period is set), then
+  /// asks the server for its plant's input gaps (Info; none from a server
+  /// that does not answer it within 0.2 s).
   /// @throws DataError when the host cannot be resolved, the server does not answer,
   /// or it rejects the period.
   void Open(double period) override;
+  /// The server's period when Open() adopted it, else NaN.
+  double adopted_period() const override { return adopted_period_; }
   IoStatus Read(Measurement* m) noexcept override;
   IoStatus Write(double u) noexcept override;
   /// Sends Safe(state) and waits up to one period (at least 20 ms) for the answer.
   IoStatus EnterSafeState(SafeState state) noexcept override;
   void Close() override;
   std::string Describe() const override;
-  /// The plant server's protocol carries the IPA's duty (%) and force (N): IpaActuator().
-  Actuator actuator() const override { return IpaActuator(); }
+  /// The plant server's protocol carries the IPA's duty (%) and force (N):
+  /// IpaActuator(), with the input gaps the server told at Open().
+  Actuator actuator() const override;
+  /// The input gaps the server told at Open() (empty: none, or not told).
+  const std::vector<InputGap>& input_gaps() const { return input_gaps_; }
 
   /// Periods whose reply had not arrived in time (last value repeated) since Open().
   std::int64_t stale_samples() const { return stale_total_; }
@@ -57,10 +71,16 @@ class UdpBackend : public IoBackend {
  private:
   // Receives pending replies; returns true when the one for `expect_seq_` arrived.
   bool Collect(std::int64_t wait_ns) noexcept;
+  // Info requests: the server plant's input gaps (empty when it does not say).
+  std::vector<InputGap> AskInputGaps();
+  // Waits up to `timeout` s for the reply of `type` to `sequence`; false on none.
+  bool AwaitReply(udp::PacketType type, std::uint32_t sequence, double timeout, udp::Reply* reply);
 
   UdpBackendOptions options_;
   int fd_ = -1;
   double period_ = 0.01;
+  double adopted_period_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<InputGap> input_gaps_;
   std::uint32_t seq_ = 0;
   std::uint32_t expect_seq_ = 0;
   bool have_reply_ = false;  // reply for expect_seq_ received

@@ -7,9 +7,11 @@
 //   off size field                          off size field
 //    0   4   magic 0x444D4E50 ("PNMD")       0   4   magic
 //    4   2   version = 1                      4   2   version
-//    6   2   type (Hello, Step, Safe, Bye)    6   2   type | 0x80
+//    6   2   type (Hello, Step, Safe, Bye,    6   2   type | 0x80
+//            Info)
 //    8   4   sequence                         8   4   sequence (echoed)
-//   12   4   arg (safe state for Safe)       12   4   status (PacketStatus)
+//   12   4   arg (safe state for Safe,       12   4   status (PacketStatus)
+//            gap index for Info)
 //   16   8   client time, ns (int64)         16   8   client time (echoed)
 //   24   8   u, duty % (float64)             24   8   server time, ns (int64, monotonic)
 //   32   8   Ts, s (Hello) (float64)         32   8   plant time, s (float64)
@@ -25,6 +27,13 @@
 //                 y_(k+1); a repeated sequence number is answered again, not re-applied.
 //   Safe(s)    -> the server drives its plant's outputs to safe state s and replies.
 //   Bye        -> the session ends (the server keeps serving new Hellos).
+//   Info(k)    -> the inputs the server plant's actuator cannot hold (its input
+//                 gaps, plant/actuator.hpp: a PWM valve's minimum pulse, IPA
+//                 duties 0..15 and 85..100 % at 300 Hz): the reply's plant time
+//                 field holds their number n, y and aux the low and high end of
+//                 gap k (NaN for k >= n). The plant is not touched, and no
+//                 session is needed. Servers older than this message do not
+//                 answer it (the client then knows no gaps).
 #pragma once
 
 #include <array>
@@ -39,7 +48,7 @@ inline constexpr std::size_t kPacketSize = 64;        ///< bytes of every datagr
 inline constexpr std::uint16_t kReplyBit = 0x80;      ///< set in the type field of a reply
 
 /// Kind of exchange (semantics above).
-enum class PacketType : std::uint16_t { kHello = 1, kStep = 2, kSafe = 3, kBye = 4 };
+enum class PacketType : std::uint16_t { kHello = 1, kStep = 2, kSafe = 3, kBye = 4, kInfo = 5 };
 /// Server's verdict on a request, in the reply.
 enum class PacketStatus : std::uint32_t {
   kOk = 0,
@@ -58,7 +67,7 @@ using Packet = std::array<std::uint8_t, kPacketSize>;
 struct Request {
   PacketType type = PacketType::kStep;  ///< Hello, Step, Safe or Bye
   std::uint32_t sequence = 0;           ///< request number; a repeated Step is not re-applied
-  std::uint32_t arg = 0;                ///< SafeState for Safe, else 0
+  std::uint32_t arg = 0;                ///< SafeState for Safe, gap index for Info, else 0
   std::int64_t client_time_ns = 0;      ///< client's monotonic clock at sending, ns (echoed)
   double u = 0.0;                       ///< input to hold for one period (Step), duty %
   double Ts = 0.0;                      ///< client's sample period (Hello), s
@@ -71,9 +80,10 @@ struct Reply {
   PacketStatus status = PacketStatus::kOk;  ///< kOk, or why the request was refused
   std::int64_t client_time_ns = 0;          ///< the request's client time (round-trip time)
   std::int64_t server_time_ns = 0;          ///< server's monotonic clock at replying, ns
-  double plant_time = 0.0;                  ///< plant time after the request, s
-  double y = 0.0;                           ///< measured output (IPA: force N)
-  double aux = std::numeric_limits<double>::quiet_NaN();  ///< chamber pressure, Pa, or NaN
+  double plant_time = 0.0;                  ///< plant time after the request, s (Info: gaps)
+  double y = 0.0;                           ///< measured output (IPA: force N; Info: gap's low end)
+  /// Chamber pressure, Pa, or NaN (Info: the gap's high end).
+  double aux = std::numeric_limits<double>::quiet_NaN();
   double Ts = 0.0;  ///< the server plant's sample time, s (0: not told)
 };
 
