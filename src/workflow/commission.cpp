@@ -34,6 +34,34 @@ struct ExperimentEnded {
   std::string message;
 };
 
+// One sample on the plant under the experiment's guards: a stop request, or
+// an output beyond the safety limits (or not finite), puts the plant at
+// u_safe and ends the experiment (ExperimentEnded); otherwise y is measured
+// and then u applied. `t` is the plant time, for the messages.
+double GuardedSample(Plant& plant, const CommissionOptions& o, double u, double u_safe, double t) {
+  if (o.stop != nullptr && o.stop->load()) {
+    plant.Advance(u_safe);
+    throw ExperimentEnded{Termination::kStopped,
+                          fmt::format("stopped on request after {:.2f} s of plant time; the "
+                                      "plant is at u = {:g}",
+                                      t, u_safe)};
+  }
+  const double y = plant.Measure();
+  if (!std::isfinite(y) || y < o.y_min || y > o.y_max) {
+    plant.Advance(u_safe);
+    throw ExperimentEnded{
+        Termination::kFailure,
+        fmt::format("output y = {:g} at t = {:.2f} s is outside the safety limits [{:g}, {:g}]; "
+                    "the plant is at u = {:g}",
+                    y, t, o.y_min, o.y_max, u_safe)};
+  }
+  plant.Advance(u);
+  return y;
+}
+
+// Samples in `seconds` of plant time (at least one).
+long HoldSamples(double seconds, double Ts) { return std::max<long>(1, std::lround(seconds / Ts)); }
+
 // Drives the plant sample by sample and records t, u, y (y measured before u
 // is applied, as RunExperiment does); counts plant time.
 class Recorder {
@@ -52,30 +80,15 @@ class Recorder {
 
   // Holds u for `seconds` (at least one sample).
   void Hold(double u, double seconds) {
-    const auto n = std::max<long>(1, std::lround(seconds / Ts_));
+    const long n = HoldSamples(seconds, Ts_);
     for (long k = 0; k < n; ++k) Step(u);
   }
 
   void Step(double u) {
-    if (o_.stop != nullptr && o_.stop->load()) {
-      Safe();
-      throw ExperimentEnded{Termination::kStopped,
-                            fmt::format("stopped on request after {:.2f} s of plant time; the "
-                                        "plant is at u = {:g}",
-                                        time(), u_safe_)};
-    }
-    const double y = plant_.Measure();
-    if (!std::isfinite(y) || y < o_.y_min || y > o_.y_max) {
-      Safe();
-      throw ExperimentEnded{
-          Termination::kFailure,
-          fmt::format("output y = {:g} at t = {:.2f} s is outside the safety limits [{:g}, {:g}]; "
-                      "the plant is at u = {:g}",
-                      y, time(), o_.y_min, o_.y_max, u_safe_)};
-    }
+    // u itself outside the gaps
+    const double y = GuardedSample(plant_, o_, modulator_.Next(u), u_safe_, time());
     u_.push_back(u);
     y_.push_back(y);
-    plant_.Advance(modulator_.Next(u));  // u itself outside the gaps
   }
 
   // Mean output of samples [from, to).
@@ -689,19 +702,21 @@ struct VerifyPolicy {
   bool rest_before_run = false;
 };
 
-// Holds `u` on `plant` for `seconds` (to whole samples); the plant time spent.
-double HoldInput(Plant& plant, double u, double seconds) {
-  const auto n = static_cast<long>(std::ceil(seconds / plant.Ts() - 1e-9));
-  for (long k = 0; k < n; ++k) {
-    plant.Measure();
-    plant.Advance(u);
-  }
+// Holds the safe input `u` on `plant` for `seconds` (whole samples, at least
+// one) under the experiment's guards (GuardedSample), without recording,
+// from plant time t0; the plant time spent.
+double HoldSafeInput(Plant& plant, const CommissionOptions& o, double u, double seconds,
+                     double t0) {
+  const long n = HoldSamples(seconds, plant.Ts());
+  for (long k = 0; k < n; ++k)
+    GuardedSample(plant, o, u, u, t0 + static_cast<double>(k) * plant.Ts());
   return static_cast<double>(n) * plant.Ts();
 }
 
 // Stage 6: the verification staircase and load step on the plant, the
 // design repeated softer after an overshoot failure (VerifyPolicy). False
-// when stopped on request (r.termination and r.message set).
+// when stopped on request, or by the output beyond its safety limits during
+// the rest before a run (r.termination and r.message set).
 bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
             ControllerSettings settings, std::optional<Design> first, const TransferFunction& model,
             double Ts, const VerifyPolicy& policy) {
@@ -740,8 +755,15 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     }
     if (policy.rest_before_run && !plant.can_reset()) {
       const double settle = 5.0 * (ex.time_constant + ex.dead_time);
-      r.plant_time += HoldInput(plant, policy.safe_input,
-                                std::isfinite(settle) ? std::min(settle, dwell) : dwell);
+      try {
+        r.plant_time +=
+            HoldSafeInput(plant, o, policy.safe_input,
+                          std::isfinite(settle) ? std::min(settle, dwell) : dwell, r.plant_time);
+      } catch (const ExperimentEnded& e) {
+        r.termination = e.termination;
+        r.message = "before a verification run: " + e.message;
+        return false;
+      }
     }
     CommissionAttempt a;
     a.aggressiveness = d.settings.aggressiveness;

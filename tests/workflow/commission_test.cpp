@@ -4,6 +4,7 @@
 // of reach, a budget too short) and a stop request.
 #include "pneumid/workflow/commission.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 
@@ -130,7 +131,8 @@ TEST(Commission, TheCommissionPlantRunsAtTheGivenOrTheDefaultPeriod) {
   const CommissionPlant given = MakeCommissionPlant("ipa", 0.01, PlantOptions{});
   EXPECT_DOUBLE_EQ(given.Ts, 0.01);
   EXPECT_DOUBLE_EQ(given.plant->Ts(), 0.01);
-  const CommissionPlant linear = MakeCommissionPlant("fopdt-paper", std::nullopt, PlantOptions{}, 0.05);
+  const CommissionPlant linear =
+      MakeCommissionPlant("fopdt-paper", std::nullopt, PlantOptions{}, 0.05);
   EXPECT_DOUBLE_EQ(linear.Ts, 0.05);
   EXPECT_DOUBLE_EQ(linear.plant->Ts(), 0.05);
   EXPECT_THROW(MakeCommissionPlant("ipa", -0.01, PlantOptions{}), InvalidArgument);
@@ -209,6 +211,59 @@ TEST(Commission, AStopRequestEndsAtTheSafeInputWithTheData) {
   EXPECT_EQ(r.termination, Termination::kStopped);
   EXPECT_GT(r.experiment.data.size(), 0);
   EXPECT_TRUE(r.attempts.empty());
+}
+
+// A plant that cannot be reset (as one behind an I/O backend) and raises a
+// stop flag at its first measurement once armed.
+class NoResetPlant : public Plant {
+ public:
+  NoResetPlant(std::unique_ptr<Plant> inner, std::atomic<bool>* stop)
+      : inner_(std::move(inner)), stop_(stop) {}
+  void Reset() override { inner_->Reset(); }
+  bool can_reset() const override { return false; }
+  double Measure() override {
+    if (armed) {
+      stop_->store(true);
+      ++measured_armed;
+    }
+    return inner_->Measure();
+  }
+  void Advance(double u) override {
+    inner_->Advance(u);
+    if (armed) last_u = u;
+  }
+  double Ts() const override { return inner_->Ts(); }
+  double time() const override { return inner_->time(); }
+  std::string Describe() const override { return "no-reset " + inner_->Describe(); }
+  bool armed = false;
+  int measured_armed = 0;
+  double last_u = std::nan("");
+
+ private:
+  std::unique_ptr<Plant> inner_;
+  std::atomic<bool>* stop_;
+};
+
+// Over a plant that cannot be reset, the rest before a verification run
+// (the safe input held, not recorded) honours a stop request at its next
+// sample, as the experiment does, and leaves the plant at the safe input.
+TEST(Commission, AStopRequestDuringTheRestBeforeAVerificationRunEndsThere) {
+  std::atomic<bool> stop{false};
+  NoResetPlant plant(MakePlant("fopdt:K=2,tau=0.5,theta=0.1", 0.01), &stop);
+  CommissionOptions o = Options("rest_stop");
+  o.range_min = 2.0;
+  o.range_max = 18.0;
+  o.settling = 2.0;
+  o.stop = &stop;
+  o.progress = [&](const std::string& stage, double) {
+    if (stage == "verify") plant.armed = true;
+  };
+  const CommissionResult r = Commission(plant, o);
+  EXPECT_EQ(r.termination, Termination::kStopped);
+  EXPECT_THAT(r.message, HasSubstr("before a verification run: stopped on request"));
+  EXPECT_TRUE(r.attempts.empty());
+  EXPECT_EQ(plant.measured_armed, 1);  // the hold's first sample; the second sees the stop
+  EXPECT_EQ(plant.last_u, 0.0);        // u_min: the safe input
 }
 
 TEST(Commission, InvalidOptionsNameTheField) {
