@@ -274,7 +274,7 @@ const Registrar reg(
                      "Output range LO:HI the controller must serve (default: the reachable "
                      "range found by the sweep, less 5 % at each end)");
       app.add_option("--budget", c->options.budget,
-                     "Plant time in s the identification experiment may take")
+                     "Plant time in s for the experiment and the first verification run")
           ->capture_default_str()
           ->check(Positive());
       app.add_option("--controller", c->options.controller, "Controller: mpc, dmc, gpc or pid")

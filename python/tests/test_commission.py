@@ -10,7 +10,7 @@ import pneumid
 
 def test_commission_of_a_fopdt_plant_measures_it_and_meets_the_specification(tmp_path):
     plant = pneumid.make_plant("fopdt:K=2,tau=0.5,theta=0.1", 0.01)
-    r = pneumid.commission(plant, str(tmp_path), range=(2.0, 18.0), budget=60.0,
+    r = pneumid.commission(plant, str(tmp_path), range=(2.0, 18.0), budget=160.0,
                            methods=["arx", "oe"], u_min=0.0, u_max=10.0,
                            settling=2.0)
     probe = r["experiment"]["probe"]
@@ -28,7 +28,7 @@ def test_commission_of_a_fopdt_plant_measures_it_and_meets_the_specification(tmp
 def test_commission_writes_the_files_of_the_command_with_a_plant_spec(tmp_path):
     spec = "fopdt:K=2,tau=0.5,theta=0.1"
     r = pneumid.commission(pneumid.make_plant(spec, 0.01), str(tmp_path), range=(2.0, 18.0),
-                           budget=60.0, methods=["arx", "oe"], u_min=0.0, u_max=10.0,
+                           budget=160.0, methods=["arx", "oe"], u_min=0.0, u_max=10.0,
                            settling=2.0, plant_spec=spec)
     toml = (tmp_path / "controller.toml").read_text()
     assert "[controller]" in toml and f'plant = "{spec}"' in toml

@@ -437,11 +437,37 @@ nlohmann::ordered_json NullIfNaN(double v) {
   return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json();
 }
 
+// The verification staircase (stage 6): its levels as fractions of the
+// range, from the low end up and back down, the three small steps among the
+// large ones with `small_steps`, and the dwell per level.
+struct VerificationStaircase {
+  std::vector<double> fractions;
+  double dwell = 0.0;
+  double duration() const { return static_cast<double>(fractions.size()) * dwell; }
+};
+
+VerificationStaircase PlanVerification(const CommissionOptions& o, bool small_steps) {
+  VerificationStaircase v;
+  v.fractions = small_steps ? std::vector<double>{0.0, 0.25, 0.6,  0.85, 1.0,  0.88,
+                                                  0.7, 0.78, 0.35, 0.1,  0.18, 0.0}
+                            : std::vector<double>{0.0, 0.25, 0.6, 0.85, 1.0, 0.7, 0.35, 0.1, 0.0};
+  v.dwell = std::isnan(o.verification_dwell) ? std::max(2.0, 4 * o.settling) : o.verification_dwell;
+  return v;
+}
+
+// The rest before a verification run on a plant that cannot be reset: five
+// times the probe's tau + theta, at most a dwell (0 on a plant that can be).
+double RestBeforeRun(const Plant& plant, const CommissionExperiment& ex, double dwell) {
+  if (plant.can_reset()) return 0.0;
+  const double settle = 5.0 * (ex.time_constant + ex.dead_time);
+  return std::isfinite(settle) ? std::min(settle, dwell) : dwell;
+}
+
 // Stage 3's preconditions: the range served (the one asked for, which must
 // be reachable, or the reachable one less 5 % at each end), the dwell per
 // level, and a budget that leaves room for 11 levels. "" or the reason.
 std::string PlanExcitation(const CommissionOptions& o, const Recorder& rec, double u_lo,
-                           double u_hi, CommissionExperiment& ex) {
+                           double u_hi, double verification, CommissionExperiment& ex) {
   const double Ts = rec.Ts();
   std::string error;
   if (std::isfinite(o.range_min)) {
@@ -461,14 +487,15 @@ std::string PlanExcitation(const CommissionOptions& o, const Recorder& rec, doub
   }
   ex.dwell = std::max(ex.dead_time + 4 * ex.time_constant, 10 * Ts);
   ex.dwell = std::ceil(ex.dwell / Ts - 1e-9) * Ts;
-  const double left = o.budget - rec.time();
+  const double left = o.budget - rec.time() - verification;
   if (error.empty() && left < 11 * ex.dwell) {
     error = fmt::format(
         "the budget of {:g} s is too short for the time scale found (tau = {:.3g} s, theta = "
-        "{:.3g} s: {:.3g} s per level): the probe and sweep took {:.1f} s and the excitation "
-        "needs at least {:.1f} s more (a budget of {:.0f} s or more)",
-        o.budget, ex.time_constant, ex.dead_time, ex.dwell, rec.time(), 11 * ex.dwell,
-        std::ceil(rec.time() + 11 * ex.dwell));
+        "{:.3g} s: {:.3g} s per level): the probe and sweep took {:.1f} s, the verification "
+        "run takes {:.1f} s and the excitation needs at least {:.1f} s more (a budget of {:.0f} "
+        "s or more)",
+        o.budget, ex.time_constant, ex.dead_time, ex.dwell, rec.time(), verification, 11 * ex.dwell,
+        std::ceil(rec.time() + verification + 11 * ex.dwell));
   }
   return error;
 }
@@ -486,9 +513,10 @@ struct ExcitationSamples {
 // (monotone interpolation through the three measured points; the whole input
 // range when they are not monotone), estimation then held-out.
 ExcitationSamples RunExcitation(Recorder& rec, const CommissionOptions& o, const Probe& p,
-                                double u_lo, double u_hi, CommissionExperiment& ex) {
+                                double u_lo, double u_hi, double verification,
+                                CommissionExperiment& ex) {
   const double Ts = rec.Ts();
-  const double left = o.budget - rec.time();
+  const double left = o.budget - rec.time() - verification;
   std::vector<std::pair<double, double>> map = {
       {p.y_rest, u_lo}, {p.y_mid, p.u_mid}, {p.y_high, u_hi}};
   std::sort(map.begin(), map.end());
@@ -723,14 +751,10 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
   const double margin = policy.margin;
   const CommissionExperiment& ex = r.experiment;
   const double range = ex.range_max - ex.range_min;
+  const VerificationStaircase staircase = PlanVerification(o, policy.small_steps);
   std::vector<double> levels;
-  const std::vector<double> large{0.0, 0.25, 0.6, 0.85, 1.0, 0.7, 0.35, 0.1, 0.0};
-  const std::vector<double> with_small{0.0, 0.25, 0.6,  0.85, 1.0,  0.88,
-                                       0.7, 0.78, 0.35, 0.1,  0.18, 0.0};
-  for (double f : policy.small_steps ? with_small : large)
-    levels.push_back(ex.range_min + f * range);
-  const double dwell =
-      std::isnan(o.verification_dwell) ? std::max(2.0, 4 * o.settling) : o.verification_dwell;
+  for (double f : staircase.fractions) levels.push_back(ex.range_min + f * range);
+  const double dwell = staircase.dwell;
   const double load = std::isnan(o.load_step) ? -0.08 * range : o.load_step;
   const auto setpoint =
       ParseSignal(fmt::format("staircase:levels={},dwell={:g}", LevelList(levels), dwell));
@@ -754,11 +778,9 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
       return false;
     }
     if (policy.rest_before_run && !plant.can_reset()) {
-      const double settle = 5.0 * (ex.time_constant + ex.dead_time);
       try {
-        r.plant_time +=
-            HoldSafeInput(plant, o, policy.safe_input,
-                          std::isfinite(settle) ? std::min(settle, dwell) : dwell, r.plant_time);
+        r.plant_time += HoldSafeInput(plant, o, policy.safe_input, RestBeforeRun(plant, ex, dwell),
+                                      r.plant_time);
       } catch (const ExperimentEnded& e) {
         r.termination = e.termination;
         r.message = "before a verification run: " + e.message;
@@ -1136,14 +1158,18 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   try {
     Probe p;
     error = ProbeAndSweep(rec, o, u_lo, u_hi, ex, p);
-    if (error.empty()) error = PlanExcitation(o, rec, u_lo, u_hi, ex);
+    // The budget holds the experiment and the first verification run (with
+    // the rest before it on a plant that cannot be reset).
+    const VerificationStaircase staircase = PlanVerification(o, true);
+    const double verification = staircase.duration() + RestBeforeRun(plant, ex, staircase.dwell);
+    if (error.empty()) error = PlanExcitation(o, rec, u_lo, u_hi, verification, ex);
     if (!error.empty()) {
       rec.Hold(u_lo, Ts);
       FinishData(rec, act, r);
       r.message = error;
       return r;
     }
-    x = RunExcitation(rec, o, p, u_lo, u_hi, ex);
+    x = RunExcitation(rec, o, p, u_lo, u_hi, verification, ex);
   } catch (const ExperimentEnded& e) {
     FinishData(rec, act, r);
     return EndedEarly(std::move(r), e);

@@ -29,7 +29,7 @@ CommissionOptions FopdtOptions(const std::string& dir) {
   o.directory = dir;
   o.u_min = 0.0;
   o.u_max = 10.0;
-  o.budget = 60.0;
+  o.budget = 160.0;  // the experiment, and a verification run of 12 levels of 8 s
   o.methods = {"arx", "oe"};
   o.settling = 2.0;
   return o;

@@ -64,6 +64,7 @@ TEST(Commission, TheProbeMeasuresAFirstOrderPlantWithDeadTime) {
   o.range_min = 2.0;
   o.range_max = 18.0;
   o.settling = 2.0;  // tau = 0.5 s, theta = 0.1 s: about 4 (tau + theta)
+  o.budget = 160.0;  // the experiment, and a verification run of 12 levels of 8 s
   const CommissionResult r = Commission(*plant, o);
   EXPECT_NEAR(r.experiment.gain, 2.0, 0.01);
   EXPECT_NEAR(r.experiment.time_constant, 0.5, 0.015);
@@ -73,10 +74,11 @@ TEST(Commission, TheProbeMeasuresAFirstOrderPlantWithDeadTime) {
   EXPECT_LE(r.experiment.duration, o.budget + 0.02);
   EXPECT_GT(r.experiment.estimation.size(), 0);
   EXPECT_GT(r.experiment.validation.size(), 0);
-  // A linear plant: the linear models fit the held-out part almost exactly,
-  // and the loop meets the specification.
+  // A linear plant: the linear models fit the held-out part almost exactly
+  // (up to its start, 4 tau + theta after the last estimation level's step:
+  // e^-4 = 1.8 % of that step is left), and the loop meets the specification.
   ASSERT_FALSE(r.identification.models.empty());
-  EXPECT_GT(r.identification.models.front().validation_fit_percent, 99.0);
+  EXPECT_GT(r.identification.models.front().validation_fit_percent, 98.5);
   ASSERT_FALSE(r.attempts.empty());
   EXPECT_EQ(r.termination, Termination::kSuccess) << r.message;
   EXPECT_LE(r.attempts.back().result.metrics.overshoot_percent, 5.0);
@@ -97,6 +99,7 @@ TEST(Commission, TheMpcWeighsTheMeasurementByTheNoiseMeasuredAtRest) {
   o.range_min = 2.0;
   o.range_max = 18.0;
   o.settling = 2.0;
+  o.budget = 160.0;  // the experiment, and a verification run of 12 levels of 8 s
   o.controller = "mpc";
   const CommissionResult r = Commission(*plant, o);
   EXPECT_NEAR(r.experiment.noise_std, 0.05, 0.015);
@@ -254,6 +257,7 @@ TEST(Commission, AStopRequestDuringTheRestBeforeAVerificationRunEndsThere) {
   o.range_min = 2.0;
   o.range_max = 18.0;
   o.settling = 2.0;
+  o.budget = 160.0;  // the experiment, and a verification run of 12 levels of 8 s
   o.stop = &stop;
   o.progress = [&](const std::string& stage, double) {
     if (stage == "verify") plant.armed = true;

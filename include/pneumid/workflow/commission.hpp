@@ -15,9 +15,11 @@
 //   3. excitation a multi-level sequence over the inputs that cover the asked
 //                 range (levels from the three measured points, shuffled, so the
 //                 output moves both ways by large and small steps), dwell
-//                 theta + 4 tau (at least 10 samples), filling what is left of
-//                 the budget; a second sequence on levels between the first's
-//                 (30 % of the time) is held out for validation.
+//                 theta + 4 tau (at least 10 samples), filling what the
+//                 budget leaves after one verification run (stage 6, with
+//                 the rest before it on a plant that cannot be reset); a
+//                 second sequence on levels between the first's (30 % of the
+//                 time) is held out for validation.
 //   4. identify   the candidate methods (linear and nonlinear) on the first
 //                 sequence, ranked by their simulation fit on the held-out one
 //                 (IdentifyModels; the polynomial models' input delay nk from
@@ -116,8 +118,9 @@ struct CommissionOptions {
   /// reachable range measured by the sweep, less 5 % at each end.
   double range_min = std::numeric_limits<double>::quiet_NaN();
   double range_max = std::numeric_limits<double>::quiet_NaN();  ///< upper end of that range
-  /// Plant time in s the identification experiment may take (probe, sweep
-  /// and excitation; verification comes on top).
+  /// Plant time in s the experiment (probe, sweep and excitation) and the
+  /// first verification run may take together; each further design's
+  /// verification run comes on top.
   double budget = 120.0;
   /// Input limits (input units); NaN = the plant's physical range (IPA 0..100 %).
   double u_min = std::numeric_limits<double>::quiet_NaN();
