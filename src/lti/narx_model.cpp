@@ -125,7 +125,7 @@ Eigen::VectorXd NarxModel::Simulate(const Eigen::VectorXd& u, const Eigen::Vecto
   for (Eigen::Index t = FirstSample(); t < y.size(); ++t) {
     double v = 0.0;
     for (std::size_t i = 0; i < terms.size(); ++i) v += theta[i] * TermValue(terms[i], t, s, u);
-    s[t] = y_scale * v;
+    s[t] = std::clamp(y_scale * v, y_min, y_max);  // NaN stays NaN
   }
   return s;
 }
@@ -133,10 +133,13 @@ Eigen::VectorXd NarxModel::Simulate(const Eigen::VectorXd& u, const Eigen::Vecto
 nlohmann::json ToJson(const NarxModel& m) {
   std::vector<std::string> names;
   for (const NarxTerm& t : m.terms) names.push_back(m.TermName(t));
-  return {{"ny", m.ny},           {"nu", m.nu},          {"nk", m.nk},
-          {"degree", m.degree},   {"Ts", m.Ts},          {"terms", names},
-          {"theta", m.theta},     {"err", m.err},        {"u_offset", m.u_offset},
-          {"u_scale", m.u_scale}, {"y_scale", m.y_scale}};
+  nlohmann::json j = {{"ny", m.ny},           {"nu", m.nu},          {"nk", m.nk},
+                      {"degree", m.degree},   {"Ts", m.Ts},          {"terms", names},
+                      {"theta", m.theta},     {"err", m.err},        {"u_offset", m.u_offset},
+                      {"u_scale", m.u_scale}, {"y_scale", m.y_scale}};
+  if (std::isfinite(m.y_min)) j["y_min"] = m.y_min;
+  if (std::isfinite(m.y_max)) j["y_max"] = m.y_max;
+  return j;
 }
 
 NarxModel NarxModelFromJson(const nlohmann::json& j) {
@@ -177,6 +180,15 @@ NarxModel NarxModelFromJson(const nlohmann::json& j) {
   PNEUMID_CHECK(m.u_scale != 0.0 && m.y_scale != 0.0,
                 "NARX model: u_scale and y_scale must not be 0, got {} and {}", m.u_scale,
                 m.y_scale);
+  for (auto [key, dst] : {std::pair{"y_min", &m.y_min}, {"y_max", &m.y_max}}) {
+    if (!j.contains(key)) continue;
+    PNEUMID_CHECK(j.at(key).is_number() && std::isfinite(j.at(key).get<double>()),
+                  "NARX model: '{}' must be a finite number, got {}", key,
+                  Excerpt(j.at(key).dump()));
+    *dst = j.at(key).get<double>();
+  }
+  PNEUMID_CHECK(m.y_min < m.y_max, "NARX model: y_min must lie below y_max, got {} and {}", m.y_min,
+                m.y_max);
   return m;
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 
@@ -99,6 +100,42 @@ TEST(NarxTest, RoundTripsThroughJson) {
   bad["terms"][1] = "x(t-1)";
   EXPECT_THAT([&] { NarxModelFromJson(bad); },
               ThrowsMessage<InvalidArgument>(HasSubstr("factor 'x(t-1)' is not y(t-K)")));
+  // Without a band (a file written before it): none; with one, kept.
+  EXPECT_FALSE(j.contains("y_min") || j.contains("y_max"));
+  m.y_min = -2.5;
+  m.y_max = 7.0;
+  const nlohmann::json banded = ToJson(m);
+  EXPECT_EQ(banded.at("y_min"), -2.5);
+  EXPECT_EQ(NarxModelFromJson(banded), m);
+  bad = banded;
+  bad["y_max"] = -3.0;
+  EXPECT_THAT(
+      [&] { NarxModelFromJson(bad); },
+      ThrowsMessage<InvalidArgument>(HasSubstr("y_min must lie below y_max, got -2.5 and -3")));
+  bad["y_max"] = "high";
+  EXPECT_THAT([&] { NarxModelFromJson(bad); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("'y_max' must be a finite number")));
+}
+
+// The free run is held within the band: y(t) = 2 y(t-1) + u(t-1) from y = 1
+// doubles each sample until it meets y_max, and stays there.
+TEST(NarxTest, TheFreeRunIsHeldWithinTheOutputBand) {
+  NarxModel m;
+  m.ny = 1;
+  m.nu = 1;
+  m.nk = 1;
+  m.degree = 1;
+  m.terms = {NarxTerm{0}, NarxTerm{1}};
+  m.theta = {2.0, 1.0};
+  m.y_max = 10.0;
+  m.y_min = -1.0;
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(8);
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(8);
+  y(0) = 1.0;
+  const Eigen::VectorXd s = m.Simulate(u, y);
+  const std::vector<double> expected{1, 2, 4, 8, 10, 10, 10, 10};
+  for (Eigen::Index t = 0; t < s.size(); ++t)
+    EXPECT_EQ(s(t), expected[static_cast<std::size_t>(t)]);
 }
 
 TEST(NarxTest, RejectsMoreCandidatesThanSamples) {
@@ -134,7 +171,18 @@ TEST(NarxTest, SimulationFitStartsFromADivergentModelAndRecoversTheSystem) {
   const auto y1 = std::find(m.terms.begin(), m.terms.end(), NarxTerm{0}) - m.terms.begin();
   ASSERT_LT(y1, 4);
   m.theta[static_cast<std::size_t>(y1)] = 1.5;
-  EXPECT_FALSE(m.Simulate(d.u(), d.y()).allFinite());
+  NarxModel unbanded = m;
+  unbanded.y_min = -std::numeric_limits<double>::infinity();
+  unbanded.y_max = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(unbanded.Simulate(d.u(), d.y()).allFinite());
+  // The model's output band (the estimation output's range widened by a
+  // quarter of it each way) holds the run at its edge instead.
+  const Eigen::VectorXd banded = m.Simulate(d.u(), d.y());
+  const double range = d.y().maxCoeff() - d.y().minCoeff();
+  EXPECT_DOUBLE_EQ(m.y_max, d.y().maxCoeff() + 0.25 * range);
+  EXPECT_DOUBLE_EQ(m.y_min, d.y().minCoeff() - 0.25 * range);
+  EXPECT_TRUE(banded.allFinite());
+  EXPECT_TRUE((banded.array() == m.y_max).any() || (banded.array() == m.y_min).any());
   const NarxSimulationFitResult r = FitNarxSimulation(&m, d.u(), d.y());
   EXPECT_EQ(r.summary.termination, Termination::kConvergence) << r.summary.message;
   EXPECT_FALSE(r.diverges);

@@ -12,16 +12,25 @@
 //
 // Simulation (free run): yhat(t) from the model with yhat in place of y; the
 // first FirstSample() outputs are taken from the measured output (the model's
-// past before it can predict).
+// past before it can predict). yhat is held within [y_min, y_max], the
+// output band the model was estimated for: a polynomial fitted on a range
+// of outputs runs away outside it (the cascaded tanks' free run below the
+// estimation record's lowest level went to -1e30 within 40 samples), where
+// the band keeps the run at its edge; the estimator sets it to the
+// estimation output's range widened by a quarter of it each way (the band of
+// the simulation-focus fit, narx_simulation_fit.hpp). Infinite: no band.
 //
 // JSON form: {"ny": 2, "nu": 2, "nk": 1, "degree": 2, "Ts": 0.01,
 //   "terms": ["1", "y(t-1)", "y(t-2)^2", "u(t-1)*y(t-1)"], "theta": [...], "err": [...],
-//   "u_offset": 50, "u_scale": 50, "y_scale": 193}  (the last three optional: 0, 1, 1).
+//   "u_offset": 50, "u_scale": 50, "y_scale": 193, "y_min": -48, "y_max": 241}
+//   (the last five optional: 0, 1, 1, no band; files before the band load
+//   without it).
 //
 // [1] S. A. Billings, Nonlinear System Identification: NARMAX Methods in the
 //     Time, Frequency, and Spatio-Temporal Domains, Wiley, 2013.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -42,12 +51,15 @@ struct NarxModel {
       degree = 2;   ///< largest number of regressors multiplied in one term
   double Ts = 1.0;  ///< sample time, s
   // Normalisation (see above): u enters as (u - u_offset) / u_scale, y as y / y_scale.
-  double u_offset = 0.0,        ///< subtracted from the input before u_scale (input units)
-      u_scale = 1.0,            ///< divisor of the input after u_offset (input units)
-      y_scale = 1.0;            ///< divisor of the output; the model output is multiplied by it
-  std::vector<NarxTerm> terms;  ///< selected monomials, one per theta
-  std::vector<double> theta;    ///< one per term
-  std::vector<double> err;      ///< ERR of each term when it was selected (fraction of y'y)
+  double u_offset = 0.0,  ///< subtracted from the input before u_scale (input units)
+      u_scale = 1.0,      ///< divisor of the input after u_offset (input units)
+      y_scale = 1.0;      ///< divisor of the output; the model output is multiplied by it
+  /// Output band of the free run (output units, see above); infinite = none.
+  double y_min = -std::numeric_limits<double>::infinity();
+  double y_max = std::numeric_limits<double>::infinity();  ///< upper end of the band
+  std::vector<NarxTerm> terms;                             ///< selected monomials, one per theta
+  std::vector<double> theta;                               ///< one per term
+  std::vector<double> err;  ///< ERR of each term when it was selected (fraction of y'y)
   /// First sample with a complete regressor, max(ny, nk + nu - 1).
   int FirstSample() const;
   /// "1", "y(t-1)", "y(t-2)^2", "u(t-1)*y(t-2)".
@@ -59,7 +71,8 @@ struct NarxModel {
   /// before); y and u of equal length.
   /// @throws InvalidArgument for lengths that differ.
   Eigen::VectorXd Predict(const Eigen::VectorXd& y, const Eigen::VectorXd& u) const;
-  /// Free-run simulation (see above); y supplies the first FirstSample() outputs.
+  /// Free-run simulation (see above), held within [y_min, y_max]; y supplies
+  /// the first FirstSample() outputs.
   /// @throws InvalidArgument for lengths that differ or fewer samples than FirstSample().
   Eigen::VectorXd Simulate(const Eigen::VectorXd& u, const Eigen::VectorXd& y) const;
   /// Value of regressor r (see NarxTerm) at time t, normalised.

@@ -132,6 +132,15 @@ NarxResult EstimateNarx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, doub
     m.y_scale = y.cwiseAbs().maxCoeff();
     PNEUMID_CHECK(m.y_scale > 0.0, "NARX: the output is zero throughout");
   }
+  // The free run's band (narx_model.hpp): the outputs estimated on, widened
+  // as the simulation-focus fit's clip band.
+  {
+    const double band = NarxSimulationFitOptions{}.band;
+    const double lo = y.minCoeff(), hi = y.maxCoeff();
+    const double range = std::max(hi - lo, 1e-12 * std::max(1.0, std::abs(hi)));
+    m.y_min = lo - band * range;
+    m.y_max = hi + band * range;
+  }
   const std::vector<NarxTerm> cand = NarxCandidates(o.ny, o.nu, o.degree);
   const Eigen::Index n0 = m.FirstSample();
   const Eigen::Index rows = std::max<Eigen::Index>(0, y.size() - n0);
