@@ -465,9 +465,13 @@ double RestBeforeRun(const Plant& plant, const CommissionExperiment& ex, double 
 
 // Stage 3's preconditions: the range served (the one asked for, which must
 // be reachable, or the reachable one less 5 % at each end), the dwell per
-// level, and a budget that leaves room for 11 levels. "" or the reason.
+// level, and a budget that leaves room for 11 levels. "" or the reason. The
+// excitation's time, *excitation, is what the budget leaves after the
+// verification run of `verification` s, and at least the 11 levels (the
+// verification then comes on top of a budget too short for both).
 std::string PlanExcitation(const CommissionOptions& o, const Recorder& rec, double u_lo,
-                           double u_hi, double verification, CommissionExperiment& ex) {
+                           double u_hi, double verification, CommissionExperiment& ex,
+                           double* excitation) {
   const double Ts = rec.Ts();
   std::string error;
   if (std::isfinite(o.range_min)) {
@@ -487,16 +491,18 @@ std::string PlanExcitation(const CommissionOptions& o, const Recorder& rec, doub
   }
   ex.dwell = std::max(ex.dead_time + 4 * ex.time_constant, 10 * Ts);
   ex.dwell = std::ceil(ex.dwell / Ts - 1e-9) * Ts;
-  const double left = o.budget - rec.time() - verification;
+  const double left = o.budget - rec.time();
   if (error.empty() && left < 11 * ex.dwell) {
     error = fmt::format(
         "the budget of {:g} s is too short for the time scale found (tau = {:.3g} s, theta = "
-        "{:.3g} s: {:.3g} s per level): the probe and sweep took {:.1f} s, the verification "
-        "run takes {:.1f} s and the excitation needs at least {:.1f} s more (a budget of {:.0f} "
-        "s or more)",
-        o.budget, ex.time_constant, ex.dead_time, ex.dwell, rec.time(), verification, 11 * ex.dwell,
-        std::ceil(rec.time() + verification + 11 * ex.dwell));
+        "{:.3g} s: {:.3g} s per level): the probe and sweep took {:.1f} s and the excitation "
+        "needs at least {:.1f} s more (a budget of {:.0f} s or more; {:.0f} s to hold the "
+        "verification run too)",
+        o.budget, ex.time_constant, ex.dead_time, ex.dwell, rec.time(), 11 * ex.dwell,
+        std::ceil(rec.time() + 11 * ex.dwell),
+        std::ceil(rec.time() + 11 * ex.dwell + verification));
   }
+  *excitation = std::max(left - verification, 11 * ex.dwell);
   return error;
 }
 
@@ -513,10 +519,8 @@ struct ExcitationSamples {
 // (monotone interpolation through the three measured points; the whole input
 // range when they are not monotone), estimation then held-out.
 ExcitationSamples RunExcitation(Recorder& rec, const CommissionOptions& o, const Probe& p,
-                                double u_lo, double u_hi, double verification,
-                                CommissionExperiment& ex) {
+                                double u_lo, double u_hi, double left, CommissionExperiment& ex) {
   const double Ts = rec.Ts();
-  const double left = o.budget - rec.time() - verification;
   std::vector<std::pair<double, double>> map = {
       {p.y_rest, u_lo}, {p.y_mid, p.u_mid}, {p.y_high, u_hi}};
   std::sort(map.begin(), map.end());
@@ -1159,17 +1163,18 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     Probe p;
     error = ProbeAndSweep(rec, o, u_lo, u_hi, ex, p);
     // The budget holds the experiment and the first verification run (with
-    // the rest before it on a plant that cannot be reset).
+    // the rest before it on a plant that cannot be reset) when it can.
     const VerificationStaircase staircase = PlanVerification(o, true);
     const double verification = staircase.duration() + RestBeforeRun(plant, ex, staircase.dwell);
-    if (error.empty()) error = PlanExcitation(o, rec, u_lo, u_hi, verification, ex);
+    double excitation = 0.0;
+    if (error.empty()) error = PlanExcitation(o, rec, u_lo, u_hi, verification, ex, &excitation);
     if (!error.empty()) {
       rec.Hold(u_lo, Ts);
       FinishData(rec, act, r);
       r.message = error;
       return r;
     }
-    x = RunExcitation(rec, o, p, u_lo, u_hi, verification, ex);
+    x = RunExcitation(rec, o, p, u_lo, u_hi, excitation, ex);
   } catch (const ExperimentEnded& e) {
     FinishData(rec, act, r);
     return EndedEarly(std::move(r), e);

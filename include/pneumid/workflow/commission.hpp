@@ -17,7 +17,9 @@
 //                 output moves both ways by large and small steps), dwell
 //                 theta + 4 tau (at least 10 samples), filling what the
 //                 budget leaves after one verification run (stage 6, with
-//                 the rest before it on a plant that cannot be reset); a
+//                 the rest before it on a plant that cannot be reset), and
+//                 at least 11 levels (a budget too short for them is an
+//                 error that says what the time scale needs); a
 //                 second sequence on levels between the first's (30 % of the
 //                 time) is held out for validation.
 //   4. identify   the candidate methods (linear and nonlinear) on the first
@@ -120,7 +122,8 @@ struct CommissionOptions {
   double range_max = std::numeric_limits<double>::quiet_NaN();  ///< upper end of that range
   /// Plant time in s the experiment (probe, sweep and excitation) and the
   /// first verification run may take together; each further design's
-  /// verification run comes on top.
+  /// verification run comes on top. A budget that cannot hold both keeps the
+  /// excitation's 11 levels, and the verification comes on top of it.
   double budget = 120.0;
   /// Input limits (input units); NaN = the plant's physical range (IPA 0..100 %).
   double u_min = std::numeric_limits<double>::quiet_NaN();
