@@ -8,6 +8,7 @@
 #include <optional>
 #include <random>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include <fmt/format.h>
@@ -622,30 +623,35 @@ bool IdentifyAndSave(CommissionResult& r, const CommissionOptions& o, double Ts,
   return true;
 }
 
-// The settings a design runs with. A GPC has no tuning to specifications of
-// its own: it takes the horizons and move suppression the auto-tuner finds
-// for a DMC on the same model and specification, with the T filter A (the
-// model's denominator, the DMC's disturbance model), and the verification
-// judges it as it runs. The other controllers run their settings as given.
-// `auto_design` receives the DMC's auto-tuning facts (response time, fastest
-// design), which the GPC's first design is placed from as the others' are.
-ControllerSettings DesignSettings(const ControllerSettings& s, const TransferFunction& model,
-                                  double Ts, const std::string& spec,
-                                  BuiltController* auto_design) {
-  if (s.controller != "gpc" || s.rule != "auto") return s;
+// The settings a design runs with, and the auto-tuner's facts about the
+// design they came from when they are another controller's.
+struct DesignSettingsResult {
+  ControllerSettings settings;
+  /// The DMC design's response time and whether it is the fastest robust
+  /// one (BuiltController::auto_response_time, auto_fastest): a GPC's.
+  std::optional<std::pair<double, bool>> taken_from_dmc;
+};
+
+// A GPC has no tuning to specifications of its own: it takes the horizons
+// and move suppression the auto-tuner finds for a DMC on the same model and
+// specification, with the T filter A (the model's denominator, the DMC's
+// disturbance model), and the verification judges it as it runs; the DMC's
+// facts go with it, so that the GPC's first design is placed as the others'
+// are. The other controllers run their settings as given.
+DesignSettingsResult DesignSettings(const ControllerSettings& s, const TransferFunction& model,
+                                    double Ts, const std::string& spec) {
+  if (s.controller != "gpc" || s.rule != "auto") return {s, std::nullopt};
   ControllerSettings dmc = s;
   dmc.controller = "dmc";
   const BuiltController b =
       MakeController(model, Ts, WithModelInputMap(ToControllerSpec(dmc), spec));
-  auto_design->auto_response_time = b.auto_response_time;
-  auto_design->auto_fastest = b.auto_fastest;
   ControllerSettings g = s;
   g.rule = "explicit";
   g.P = b.tuning.P;
   g.M = b.tuning.M;
   g.lambda = b.tuning.lambda;
   g.t_filter = "A";
-  return g;
+  return {g, std::pair{b.auto_response_time, b.auto_fastest}};
 }
 
 // A design: the settings it runs with and the controller built from them.
@@ -656,14 +662,12 @@ struct Design {
 
 Design MakeDesign(const ControllerSettings& s, const TransferFunction& model, double Ts,
                   const std::string& spec) {
+  DesignSettingsResult ds = DesignSettings(s, model, Ts, spec);
   Design d;
-  BuiltController dmc;
-  d.settings = DesignSettings(s, model, Ts, spec, &dmc);
+  d.settings = std::move(ds.settings);
   d.built = MakeController(model, Ts, WithModelInputMap(ToControllerSpec(d.settings), spec));
-  if (s.controller == "gpc" && s.rule == "auto") {
-    d.built.auto_response_time = dmc.auto_response_time;
-    d.built.auto_fastest = dmc.auto_fastest;
-  }
+  if (ds.taken_from_dmc)
+    std::tie(d.built.auto_response_time, d.built.auto_fastest) = *ds.taken_from_dmc;
   return d;
 }
 
