@@ -738,6 +738,39 @@ struct VerifyPolicy {
   bool rest_before_run = false;
 };
 
+// The verification policy of a plant with a steady state (the force loop),
+// safe at `u_safe`.
+VerifyPolicy SteadyStatePolicy(double u_safe) {
+  VerifyPolicy policy;
+  // Softer: half the aggressiveness and, since the fastest robust design's
+  // speed does not depend on it (auto_tuning.hpp), a rise time aimed 1.5
+  // times the one the last verification's first step measured.
+  policy.soften = [](ControllerSettings& s, const CommissionAttempt& last) {
+    s.aggressiveness *= 0.5;
+    const double rise = last.result.metrics.rise_time;
+    if (std::isfinite(s.response_time))
+      s.response_time *= 1.5;
+    else if (std::isfinite(rise) && rise > 0.0)
+      s.response_time = 1.5 * rise;
+  };
+  policy.sse_share = 0.005;
+  policy.safe_input = u_safe;
+  policy.margin = 0.8;
+  policy.tighten = true;
+  policy.small_steps = true;
+  policy.rest_before_run = true;
+  return policy;
+}
+
+// Plant time of one verification run under `policy`: its staircase, and the
+// rest before it on a plant that cannot be reset.
+double VerificationRunTime(const CommissionOptions& o, const VerifyPolicy& policy,
+                           const Plant& plant, const CommissionExperiment& ex) {
+  const VerificationStaircase staircase = PlanVerification(o, policy.small_steps);
+  return staircase.duration() +
+         (policy.rest_before_run ? RestBeforeRun(plant, ex, staircase.dwell) : 0.0);
+}
+
 // Holds the safe input `u` on `plant` for `seconds` (whole samples, at least
 // one) under the experiment's guards (GuardedSample), without recording,
 // from plant time t0; the plant time spent.
@@ -1161,6 +1194,8 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   Recorder rec(plant, o, u_lo, u_lo, u_hi, gaps);
   const double Ts = rec.Ts();
 
+  const VerifyPolicy policy = SteadyStatePolicy(u_lo);
+
   // Stages 1-3: the experiment.
   ExcitationSamples x;
   try {
@@ -1168,8 +1203,7 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     error = ProbeAndSweep(rec, o, u_lo, u_hi, ex, p);
     // The budget holds the experiment and the first verification run (with
     // the rest before it on a plant that cannot be reset) when it can.
-    const VerificationStaircase staircase = PlanVerification(o, true);
-    const double verification = staircase.duration() + RestBeforeRun(plant, ex, staircase.dwell);
+    const double verification = VerificationRunTime(o, policy, plant, ex);
     double excitation = 0.0;
     if (error.empty()) error = PlanExcitation(o, rec, u_lo, u_hi, verification, ex, &excitation);
     if (!error.empty()) {
@@ -1219,25 +1253,6 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
     settings.response_time = 1.25 * first->built.auto_response_time;
     first = MakeDesign(settings, model, Ts, r.controller_model);
   }
-  // Softer: half the aggressiveness and, since the fastest robust design's
-  // speed does not depend on it (auto_tuning.hpp), a rise time aimed 1.5
-  // times the one the last verification's first step measured.
-  const auto soften = [](ControllerSettings& s, const CommissionAttempt& last) {
-    s.aggressiveness *= 0.5;
-    const double rise = last.result.metrics.rise_time;
-    if (std::isfinite(s.response_time))
-      s.response_time *= 1.5;
-    else if (std::isfinite(rise) && rise > 0.0)
-      s.response_time = 1.5 * rise;
-  };
-  VerifyPolicy policy;
-  policy.soften = soften;
-  policy.sse_share = 0.005;
-  policy.safe_input = u_lo;
-  policy.margin = 0.8;
-  policy.tighten = true;
-  policy.small_steps = true;
-  policy.rest_before_run = true;
   if (!Verify(r, plant, o, settings, std::move(first), model, Ts, policy)) return r;
   if (r.passed()) {
     r.termination = Termination::kSuccess;

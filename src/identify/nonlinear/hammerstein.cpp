@@ -10,8 +10,8 @@
 
 #include "../ceres_logging.hpp"
 #include "pneumid/common/check.hpp"
-#include "pneumid/identify/parametric/arx.hpp"
 #include "pneumid/identify/nonlinear/static_map_fit.hpp"
+#include "pneumid/identify/parametric/arx.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace pneumid {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <fmt/format.h>
@@ -134,13 +135,7 @@ NarxResult EstimateNarx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, doub
   }
   // The free run's band (narx_model.hpp): the outputs estimated on, widened
   // as the simulation-focus fit's clip band.
-  {
-    const double band = NarxSimulationFitOptions{}.band;
-    const double lo = y.minCoeff(), hi = y.maxCoeff();
-    const double range = std::max(hi - lo, 1e-12 * std::max(1.0, std::abs(hi)));
-    m.y_min = lo - band * range;
-    m.y_max = hi + band * range;
-  }
+  std::tie(m.y_min, m.y_max) = NarxDataBand(y, NarxSimulationFitOptions{}.band);
   const std::vector<NarxTerm> cand = NarxCandidates(o.ny, o.nu, o.degree);
   const Eigen::Index n0 = m.FirstSample();
   const Eigen::Index rows = std::max<Eigen::Index>(0, y.size() - n0);

@@ -118,6 +118,12 @@ bool NarxSimulationFitOptions::IsValid(std::string* error) const {
   return true;
 }
 
+std::pair<double, double> NarxDataBand(const Eigen::VectorXd& y, double band) {
+  const double ymin = y.minCoeff(), ymax = y.maxCoeff();
+  const double range = std::max(ymax - ymin, 1e-12 * std::max(1.0, std::abs(ymax)));
+  return {ymin - band * range, ymax + band * range};
+}
+
 NarxSimulationFitResult FitNarxSimulation(NarxModel* m, const Eigen::VectorXd& u,
                                           const Eigen::VectorXd& y,
                                           const NarxSimulationFitOptions& o) {
@@ -132,9 +138,8 @@ NarxSimulationFitResult FitNarxSimulation(NarxModel* m, const Eigen::VectorXd& u
   const Eigen::Index N = y.size(), n0 = m->FirstSample();
   PNEUMID_CHECK(N > n0, "NARX simulation fit: {} samples, the free run starts at sample {}", N, n0);
   const auto K = static_cast<int>(m->terms.size());
-  const double ymin = y.minCoeff(), ymax = y.maxCoeff();
-  const double range = std::max(ymax - ymin, 1e-12 * std::max(1.0, std::abs(ymax)));
-  const double lo = (ymin - o.band * range) / m->y_scale, hi = (ymax + o.band * range) / m->y_scale;
+  const auto [band_lo, band_hi] = NarxDataBand(y, o.band);
+  const double lo = band_lo / m->y_scale, hi = band_hi / m->y_scale;
   const double inf = std::numeric_limits<double>::infinity();
   const NarxRun run(*m, u, y);
   const double scale2 = m->y_scale * m->y_scale / static_cast<double>(N - n0);

@@ -13,15 +13,18 @@
 //
 // A polynomial free run can leave any bound for a trial theta and overflow;
 // to keep V finite the run is clipped to a band around the data,
-// [min y - band * range, max y + band * range] (range = max y - min y), and a
-// clipped sample does not depend on theta. The model itself has no clip: the
-// result states whether its unclipped run on the data stays inside the band
-// (`clipped`, `diverges`), the summary warns when it does not, and when the
+// [min y - band * range, max y + band * range] (range = max y - min y,
+// NarxDataBand), and a clipped sample does not depend on theta. The result
+// states whether the model's unclipped run on the data stays inside the band
+// (`clipped`, `diverges`; the model's own output band, NarxModel::y_min and
+// y_max, which the estimator sets to this band, is not applied there), the
+// summary warns when it does not, and when the
 // refined model diverges without the band while the start did not, the start
 // is kept (termination kNoConvergence, with a warning).
 #pragma once
 
 #include <string>
+#include <utility>
 
 #include <Eigen/Core>
 
@@ -40,6 +43,11 @@ struct NarxSimulationFitOptions {
   /// the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
+
+/// The band around the outputs y (above): [min y - band * range, max y +
+/// band * range] in output units, range = max y - min y (at least 1e-12 of
+/// max(1, |max y|)). y must not be empty.
+std::pair<double, double> NarxDataBand(const Eigen::VectorXd& y, double band);
 
 /// Outcome of FitNarxSimulation.
 struct NarxSimulationFitResult {
