@@ -12,9 +12,9 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
+#include "pneumid/identify/evaluation/validation.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/identify/parametric/parametric.hpp"
-#include "pneumid/identify/evaluation/validation.hpp"
 
 namespace pneumid {
 
@@ -149,15 +149,21 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
   }
 
   // The estimation part, and the held-out samples [score_from, N) of `scored`.
-  std::optional<Dataset> head;
+  std::optional<Dataset> head, rest;
   const Dataset* scored = validation;
   Eigen::Index score_from = 0;
   if (options.split > 0.0) {
     auto parts = SplitDataset(data, options.split);
     head.emplace(std::move(parts.first));
+    rest.emplace(std::move(parts.second));
+    rest->set_source(fmt::format("the last {:.0f} % of {}", 100.0 * (1.0 - options.split),
+                                 data.source().empty() ? "the data" : data.source()));
     scored = &data;
     score_from = head->size();
   }
+  // The held-out record of the nonlinear methods' structure search: the
+  // validation data, or the split's rest (the same part that scores them).
+  const Dataset* held_out = validation != nullptr ? validation : (rest ? &*rest : nullptr);
   const Dataset& estimation = head ? *head : data;
   if (scored != nullptr) {
     const Eigen::VectorXd y = scored->y(request.output).tail(scored->size() - score_from);
@@ -185,13 +191,13 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
         progress(started++, n, methods[i]);
       }
       try {
-        // A structure search of the nonlinear methods uses the held-out file
-        // when there is one (a split's rest is not separate data: it searches
-        // on its own split of the estimation part).
+        // A structure search of the nonlinear methods chooses on the held-out
+        // part when there is one (--validation or --split); without one it
+        // splits the estimation data itself (NonlinearOptions::structure_split).
         IdentifiedModel m;
-        if (IsNonlinearMethod(methods[i]) && validation != nullptr) {
+        if (IsNonlinearMethod(methods[i]) && held_out != nullptr) {
           estimation.RequireNumericScale();
-          m = IdentifyNonlinear(methods[i], estimation, request, options.nonlinear, validation);
+          m = IdentifyNonlinear(methods[i], estimation, request, options.nonlinear, held_out);
         } else {
           m = Identify(methods[i], estimation, request, options);
         }
@@ -231,7 +237,7 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
       s.failures.emplace_back(methods[i], errors[i]);
     }
   }
-  RankModels(&s.models);
+  RankModels(&s.models, options.quality);
   if (s.models.empty()) {
     s.termination = Termination::kFailure;
     s.message = fmt::format("no method produced a model ({} failed)", n);

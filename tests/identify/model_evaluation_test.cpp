@@ -10,9 +10,10 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
-#include "pneumid/identify/identify.hpp"
 #include "pneumid/identify/evaluation/residual_analysis.hpp"
 #include "pneumid/identify/evaluation/validation.hpp"
+#include "pneumid/identify/identify.hpp"
+#include "pneumid/lti/static_map.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {
@@ -90,7 +91,8 @@ TEST(ModelEvaluationTest, EstimatedInitialStateExplainsARecordThatStartsMoving) 
 }
 
 TEST(ModelEvaluationTest, DiscreteModelNeedsTheDataSampleTime) {
-  const Dataset d = Dataset::FromUniform(0.01, Eigen::VectorXd::Ones(10), Eigen::VectorXd::Ones(10));
+  const Dataset d =
+      Dataset::FromUniform(0.01, Eigen::VectorXd::Ones(10), Eigen::VectorXd::Ones(10));
   const IdentifiedModel m = Discrete(Eigen::Vector2d(0, 0.1), Eigen::Vector2d(1, -0.9), 0.02);
   EXPECT_THAT([&] { SimulateModel(m, d); },
               ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("sample time 0.02 s")));
@@ -122,11 +124,13 @@ TEST(ModelEvaluationTest, FlagsPolesNearMinusOneAndOutsideTheUnitCircle) {
   o.nyquist_distance = 0.03;
   EXPECT_FALSE(HasFlag(AssessModel(nyq, d, 0, 0, o), ModelFlag::kNyquistPole));
 
-  const IdentifiedModel unstable = Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -1.05), 0.1);
+  const IdentifiedModel unstable =
+      Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -1.05), 0.1);
   flags = AssessModel(unstable, d);
   EXPECT_TRUE(HasFlag(flags, ModelFlag::kUnstable));
   // An integrator (pole at z = 1) is not unstable in this sense.
-  const IdentifiedModel integrator = Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -1.0), 0.1);
+  const IdentifiedModel integrator =
+      Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -1.0), 0.1);
   EXPECT_FALSE(HasFlag(AssessModel(integrator, d), ModelFlag::kUnstable));
 }
 
@@ -134,8 +138,10 @@ TEST(ModelEvaluationTest, ResidualWhitenessSeparatesTheTrueModelFromAWrongOne) {
   const Dataset d = ArxData(2000, 0.2, 7);
   IdentifiedModel truth = Discrete(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -0.9), 0.1);
   truth.structure = "ARX";
-  truth.params = {{"a", std::vector<double>{1, -0.9}}, {"b", std::vector<double>{0, 0.5}},
-                  {"nk", 1}, {"Ts", 0.1}};
+  truth.params = {{"a", std::vector<double>{1, -0.9}},
+                  {"b", std::vector<double>{0, 0.5}},
+                  {"nk", 1},
+                  {"Ts", 0.1}};
   // The test runs on simulation errors for every class: the true ARX model's
   // are coloured by 1 / A (equation noise), its one-step errors are white,
   // and the note says so.
@@ -144,8 +150,10 @@ TEST(ModelEvaluationTest, ResidualWhitenessSeparatesTheTrueModelFromAWrongOne) {
   EXPECT_THAT(truth_flags.back().reason, HasSubstr("simulation errors not white"));
   EXPECT_THAT(truth_flags.back().reason, HasSubstr("one-step prediction errors white"));
   IdentifiedModel wrong = truth;
-  wrong.params = {{"a", std::vector<double>{1, -0.5}}, {"b", std::vector<double>{0, 0.5}},
-                  {"nk", 1}, {"Ts", 0.1}};
+  wrong.params = {{"a", std::vector<double>{1, -0.5}},
+                  {"b", std::vector<double>{0, 0.5}},
+                  {"nk", 1},
+                  {"Ts", 0.1}};
   wrong.tf = TransferFunction(Eigen::Vector2d(0, 0.5), Eigen::Vector2d(1, -0.5), 0.1);
   wrong.discrete = wrong.tf;
   const auto flags = AssessModel(wrong, d);
@@ -203,6 +211,71 @@ TEST(ModelEvaluationTest, RanksByEvidenceAndMovesOnlyUntrustedSimulationsBack) {
   EXPECT_EQ(RankReason(v[1]), "held-out simulation fit 70.00 %");
 }
 
+TEST(ModelEvaluationTest, CountsTheParametersAnEstimatorChose) {
+  // ARX(2, 2, 1): a1 a2 b1 b2 (the leading zero of B is the delay).
+  IdentifiedModel arx = Discrete(Eigen::Vector3d(0, 0.1, 0.2), Eigen::Vector3d(1, -0.5, 0.1), 0.01);
+  EXPECT_EQ(ParameterCount(arx), 4);
+  // K exp(-theta s) / (tau s + 1): K, tau and theta.
+  IdentifiedModel p1d;
+  p1d.tf = TransferFunction::Fopdt(1.6, 0.245, 0.01);
+  EXPECT_EQ(ParameterCount(p1d), 3);
+  // Hammerstein: a1, b1 and the values of a 5-knot input map; Hammerstein-
+  // Wiener adds a 4-knot output map.
+  IdentifiedModel h = Discrete(Eigen::Vector2d(0, 0.045), Eigen::Vector2d(1, -0.955), 0.01);
+  h.input_map = StaticMap({0, 25, 50, 75, 100}, {0, 20, 60, 120, 190});
+  EXPECT_EQ(ParameterCount(h), 7);
+  IdentifiedModel hw = h;
+  hw.output_map = StaticMap({0, 60, 120, 190}, {0, 61, 119, 190});
+  EXPECT_EQ(ParameterCount(hw), 11);
+}
+
+TEST(ModelEvaluationTest, ParsimonyPrefersTheSimplestModelTheEvidenceCannotTellFromTheBest) {
+  IdentifiedModel h = Discrete(Eigen::Vector2d(0, 0.045), Eigen::Vector2d(1, -0.955), 0.01);
+  h.method = "hammerstein";
+  h.input_map = StaticMap({0, 25, 50, 75, 100}, {0, 20, 60, 120, 190});
+  IdentifiedModel hw = h;
+  hw.method = "hw";
+  hw.output_map = StaticMap({0, 60, 120, 190}, {0, 61, 119, 190});
+  IdentifiedModel arx = Discrete(Eigen::Vector3d(0, 0.1, 0.2), Eigen::Vector3d(1, -0.5, 0.1), 0.01);
+  arx.method = "arx";
+  // Simulation errors (100 - fit): hw 2.87, hammerstein 2.93 (2 % more),
+  // arx 4.0 (39 % more than hw's).
+  hw.validation_fit_percent = 97.13;
+  h.validation_fit_percent = 97.07;
+  arx.validation_fit_percent = 96.0;
+  std::vector<IdentifiedModel> ms = {hw, arx, h};
+  RankModels(&ms);
+  ASSERT_EQ(ms.size(), 3u);
+  EXPECT_EQ(ms[0].method, "hammerstein");
+  EXPECT_EQ(ms[1].method, "hw");
+  EXPECT_EQ(ms[2].method, "arx");
+  EXPECT_EQ(RankReason(ms[0]),
+            "held-out simulation fit 97.07 %; preferred to hw (97.13 %, 11 parameters) for "
+            "fewer parameters (7): simulation errors within 5 % of each other");
+  EXPECT_EQ(RankReason(ms[1]), "held-out simulation fit 97.13 %");
+
+  // Just outside the tolerance (hammerstein's error 5.2 % above hw's) the
+  // score decides; so it does with the tolerance 0.
+  ms = {hw, h};
+  ms[1].validation_fit_percent = 100.0 - 2.87 * 1.052;
+  RankModels(&ms);
+  EXPECT_EQ(ms[0].method, "hw");
+  EXPECT_TRUE(ms[0].rank_note.empty());
+  ms = {hw, h};
+  ModelQualityOptions by_score;
+  by_score.parsimony_tolerance = 0.0;
+  RankModels(&ms, by_score);
+  EXPECT_EQ(ms[0].method, "hw");
+  // A simpler model in a later group (a pole at z = -1) is not preferred.
+  ms = {hw, h};
+  ms[1].flags.push_back({ModelFlag::kNyquistPole, ""});
+  RankModels(&ms);
+  EXPECT_EQ(ms[0].method, "hw");
+
+  by_score.parsimony_tolerance = 1.0;
+  EXPECT_THROW(RankModels(&ms, by_score), InvalidArgument);
+}
+
 TEST(IdentifyModelsTest, AFailingMethodDoesNotStopTheOthers) {
   // A PRBS record has no single step: the step-response methods fail, ARX works.
   const Dataset d = ArxData(400, 0.05, 3);
@@ -231,8 +304,7 @@ TEST(IdentifyModelsTest, SplitScoresTheTailOfOneSimulation) {
   const IdentifiedModel& m = s.models.front();
   EXPECT_DOUBLE_EQ(m.validation_fit_percent, EvaluateModel(m, d, 0, 0, 700).fit_percent);
   // Estimated on the first 70 % only.
-  EXPECT_DOUBLE_EQ(m.fit_percent,
-                   Identify("arx", SliceDataset(d, 0, 700)).fit_percent);
+  EXPECT_DOUBLE_EQ(m.fit_percent, Identify("arx", SliceDataset(d, 0, 700)).fit_percent);
 }
 
 TEST(IdentifyModelsTest, ThreadsDoNotChangeTheResult) {

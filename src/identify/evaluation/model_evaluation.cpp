@@ -11,9 +11,9 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/evaluation/initial_state.hpp"
+#include "pneumid/identify/evaluation/residual_analysis.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/identify/parametric/parametric_model.hpp"
-#include "pneumid/identify/evaluation/residual_analysis.hpp"
 #include "pneumid/lti/conversion.hpp"
 #include "pneumid/lti/response.hpp"
 
@@ -209,6 +209,9 @@ bool ModelQualityOptions::IsValid(std::string* error) const {
         fmt::format("ModelQualityOptions::confidence must be in (0, 1), got {}", confidence));
   if (max_lag < 1)
     return fail(fmt::format("ModelQualityOptions::max_lag must be >= 1, got {}", max_lag));
+  if (!(parsimony_tolerance >= 0.0 && parsimony_tolerance < 1.0))
+    return fail(fmt::format("ModelQualityOptions::parsimony_tolerance must be in [0, 1), got {}",
+                            parsimony_tolerance));
   return true;
 }
 
@@ -269,8 +272,7 @@ std::vector<ModelFlagNote> AssessModel(const IdentifiedModel& model, const Datas
       std::string one_step;
       if (noise_model) {
         try {
-          const PolynomialModel poly =
-              PolynomialModelFromParams(model.params, model.structure);
+          const PolynomialModel poly = PolynomialModelFromParams(model.params, model.structure);
           // The polynomial acts on the deviations from the operating point.
           const Eigen::VectorXd dy = (data.y(output).array() - model.y0).matrix();
           const Eigen::VectorXd du = (data.u(input).array() - model.u0).matrix();
@@ -324,17 +326,82 @@ std::string RankReason(const IdentifiedModel& model) {
                                              : "a ripple at the Nyquist frequency");
   if (!soft.empty())
     why += fmt::format("; flagged {}, ranked by its fit all the same", fmt::join(soft, ", "));
+  if (!model.rank_note.empty()) why += "; " + model.rank_note;
   return why;
 }
 
-void RankModels(std::vector<IdentifiedModel>* models) {
+namespace {
+
+// Coefficients of a transfer function that an estimator chose: the
+// denominator after its leading coefficient, the numerator from its first
+// nonzero coefficient (leading zeros are the delay), and the dead time of a
+// continuous model (a discrete one delays by whole samples, its structure).
+int TransferFunctionParameters(const TransferFunction& g) {
+  const Eigen::VectorXd& num = g.num();
+  Eigen::Index first = 0;
+  while (first < num.size() && num[first] == 0.0) ++first;
+  const auto den = static_cast<int>(std::max<Eigen::Index>(g.den().size() - 1, 0));
+  return den + static_cast<int>(num.size() - first) + (g.IsContinuous() && g.delay() > 0.0 ? 1 : 0);
+}
+
+}  // namespace
+
+int ParameterCount(const IdentifiedModel& model) {
+  int n = 0;
+  if (model.narx) {
+    n += static_cast<int>(model.narx->theta.size());
+  } else {
+    n += TransferFunctionParameters(model.discrete ? *model.discrete : model.tf);
+  }
+  if (model.input_map) n += static_cast<int>(model.input_map->size());
+  if (model.output_map) n += static_cast<int>(model.output_map->size());
+  return n;
+}
+
+void RankModels(std::vector<IdentifiedModel>* models, const ModelQualityOptions& options) {
   PNEUMID_CHECK(models != nullptr, "RankModels: models must not be null");
+  std::string why;
+  PNEUMID_CHECK(options.IsValid(&why), "{}", why);
   std::stable_sort(models->begin(), models->end(),
                    [](const IdentifiedModel& a, const IdentifiedModel& b) {
                      const int ga = RankGroup(a), gb = RankGroup(b);
                      if (ga != gb) return ga < gb;
                      return RankScore(a) > RankScore(b);
                    });
+  for (IdentifiedModel& m : *models) m.rank_note.clear();
+  if (options.parsimony_tolerance <= 0.0) return;
+  // Each place in turn goes to the simplest model the evidence cannot tell
+  // from the best remaining one (same group, error within the tolerance).
+  for (std::size_t i = 0; i < models->size(); ++i) {
+    const IdentifiedModel& lead = (*models)[i];
+    const double score = RankScore(lead);
+    if (!std::isfinite(score)) continue;
+    const double limit = (100.0 - score) * (1.0 + options.parsimony_tolerance);
+    std::size_t pick = i;
+    int fewest = ParameterCount(lead);
+    for (std::size_t j = i + 1; j < models->size(); ++j) {
+      const IdentifiedModel& m = (*models)[j];
+      if (RankGroup(m) != RankGroup(lead)) break;
+      if (!(100.0 - RankScore(m) <= limit)) break;  // sorted: the rest score lower
+      const int count = ParameterCount(m);
+      if (count < fewest) {
+        fewest = count;
+        pick = j;
+      }
+    }
+    if (pick == i) continue;
+    std::vector<std::string> better;
+    for (std::size_t j = i; j < pick; ++j)
+      better.push_back(fmt::format("{} ({:.2f} %, {} parameters)", (*models)[j].method,
+                                   RankScore((*models)[j]), ParameterCount((*models)[j])));
+    std::rotate(models->begin() + static_cast<std::ptrdiff_t>(i),
+                models->begin() + static_cast<std::ptrdiff_t>(pick),
+                models->begin() + static_cast<std::ptrdiff_t>(pick) + 1);
+    (*models)[i].rank_note = fmt::format(
+        "preferred to {} for fewer parameters ({}): simulation errors within {:g} % of each "
+        "other",
+        fmt::join(better, ", "), fewest, 100.0 * options.parsimony_tolerance);
+  }
 }
 
 }  // namespace pneumid

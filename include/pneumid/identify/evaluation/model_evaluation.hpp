@@ -110,7 +110,17 @@ struct ModelQualityOptions {
   double confidence = 0.99;
   /// Largest lag M of the whiteness test (MATLAB's default 25), >= 1.
   int max_lag = 25;
-  /// True when nyquist_distance is in [0, 1), confidence in (0, 1) and max_lag >= 1;
+  /// Parsimony of the ranking (RankModels): models of one group whose
+  /// simulation errors (100 - RankScore, the normalised RMSE in %) lie within
+  /// this fraction of the best remaining model's count as tied, and the one
+  /// with the fewest parameters (ParameterCount) ranks first, as the
+  /// one-standard-error rule of cross-validation prefers the simplest model
+  /// the evidence cannot tell from the best (Hastie, Tibshirani and Friedman,
+  /// "The Elements of Statistical Learning", 2nd ed., 2009, sec. 7.10).
+  /// Default 0.05 (errors within 5 %); 0 ranks by the score alone. In [0, 1).
+  double parsimony_tolerance = 0.05;
+  /// True when nyquist_distance is in [0, 1), confidence in (0, 1), max_lag >= 1
+  /// and parsimony_tolerance in [0, 1);
   /// otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
 };
@@ -138,10 +148,25 @@ int RankGroup(const IdentifiedModel& model);
 double RankScore(const IdentifiedModel& model);
 
 /// One line on why the model stands where it does, e.g. "held-out simulation
-/// fit 97.01 %; flagged no_convergence, ranked by its fit all the same".
+/// fit 97.01 %; flagged no_convergence, ranked by its fit all the same", with
+/// the model's rank_note when parsimony placed it (RankModels).
 std::string RankReason(const IdentifiedModel& model);
 
-/// Sorts best first by (RankGroup, -RankScore); stable for ties.
-void RankModels(std::vector<IdentifiedModel>* models);
+/// The free parameters of a model: the coefficients of its linear part (the
+/// discrete form when it has one: denominator after its leading 1, numerator
+/// from its first nonzero coefficient; plus 1 for the dead time of a
+/// continuous model),
+/// the knot values of its input and output maps, and the terms of its NARX
+/// part (whose linear part is a placeholder and does not count).
+int ParameterCount(const IdentifiedModel& model);
+
+/// Sorts best first by (RankGroup, -RankScore), then, with
+/// options.parsimony_tolerance > 0, takes each place in turn for the model
+/// with the fewest parameters among those of the group whose simulation
+/// error lies within the tolerance of the best remaining one's (ties by the
+/// score); such a model's rank_note names the better-scoring models it was
+/// preferred to. Stable for equal scores.
+/// @throws InvalidArgument for a null list or invalid options.
+void RankModels(std::vector<IdentifiedModel>* models, const ModelQualityOptions& options = {});
 
 }  // namespace pneumid
