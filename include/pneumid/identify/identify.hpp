@@ -107,7 +107,10 @@ using IdentifyProgress =
 /// still run. Each model is flagged (AssessModel on the estimation data),
 /// scored on the held-out data when given (`validation`, scored from its first
 /// sample, simulated from options.validation_initial; or the split's rest), and
-/// the list is ranked (RankModels).
+/// the list is ranked (RankModels with options.quality). The nonlinear
+/// methods' structure search (NonlinearOptions::choose_structure) chooses on
+/// the same held-out part: `validation`, or the split's rest, named "the last
+/// 30 % of FILE" in its note.
 /// @throws InvalidArgument for an empty method list, an unknown method, invalid
 ///         request/options, a split together with a validation dataset, or a
 ///         validation dataset whose channels differ from the data's.
