@@ -25,7 +25,7 @@
 #include "pneumid/control/gpc.hpp"
 #include "pneumid/control/inverse_map_controller.hpp"
 #include "pneumid/control/mpc.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 
 namespace {

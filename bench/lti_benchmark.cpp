@@ -4,7 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include "pneumid/lti/conversion.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/lti/response.hpp"
 
 namespace {

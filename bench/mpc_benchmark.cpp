@@ -29,7 +29,7 @@
 #include <benchmark/benchmark.h>
 
 #include "pneumid/control/mpc.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 
 namespace {

@@ -23,7 +23,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/control/mpc.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "validators.hpp"
 

@@ -18,7 +18,7 @@
 #include "model_options.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/conversion.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid::cli {
 namespace {

@@ -20,7 +20,7 @@
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/identify/parametric/parametric_model.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/report/plot.hpp"
 #include "validators.hpp"
 

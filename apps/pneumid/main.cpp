@@ -15,7 +15,7 @@
 #include "command.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/version.hpp"
-#include "pneumid/lti/model_file_scope.hpp"
+#include "pneumid/models/model_file_scope.hpp"
 
 namespace pneumid::cli {
 

@@ -10,7 +10,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/spec.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "validators.hpp"
 
 namespace pneumid::cli {

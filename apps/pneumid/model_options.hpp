@@ -1,7 +1,7 @@
 // Command-line options that select a linear model, shared by every command
 // that takes one (convert, step, bode, tune, simulate, ...):
 //
-//   --model SPEC      a model spec (pneumid/lti/model_io.hpp): arx-paper,
+//   --model SPEC      a model spec (pneumid/models/model_file.hpp): arx-paper,
 //                     arx-paper-ct, fopdt-paper, fopdt:K=..,tau=..,theta=..,
 //                     sopdt:..., tf:num=..,den=..[,Ts=..][,delay=..], FILE.json[#method]
 //   --num B0,B1,...   numerator coefficients, comma-separated: descending powers

@@ -7,7 +7,7 @@
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/lti/conversion.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/lti/state_space.hpp"
 #include "pneumid/lti/transfer_function.hpp"

@@ -1,4 +1,4 @@
-// Bindings of the nonlinear identification: StaticMap (lti/static_map.hpp),
+// Bindings of the nonlinear identification: StaticMap (models/static_map.hpp),
 // fit_static_map, the nonlinear method names and the nonlinear parts of an
 // IdentifiedModel (identify(method, data, ...) runs the methods themselves).
 #include <pybind11/eigen.h>
@@ -9,7 +9,7 @@
 #include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/identify/nonlinear/static_map_fit.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 
 namespace py = pybind11;
 using namespace py::literals;

@@ -16,7 +16,7 @@
 #include "pneumid/control/gpc.hpp"
 #include "pneumid/control/inverse_map_controller.hpp"
 #include "pneumid/control/mpc.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "predictive_controller_design.hpp"
 
 namespace pneumid {

@@ -10,7 +10,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/preprocess_io.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid {
 

@@ -7,7 +7,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/spec.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/mapped_plant.hpp"

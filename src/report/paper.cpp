@@ -16,7 +16,7 @@
 #include "pneumid/data/preprocess.hpp"
 #include "pneumid/identify/identify.hpp"
 #include "pneumid/lti/conversion.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/linear_plant.hpp"

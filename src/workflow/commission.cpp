@@ -18,7 +18,7 @@
 #include "pneumid/control/duty_modulator.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/nonlinear/static_map_fit.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/actuator.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/signal.hpp"

@@ -10,7 +10,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/controller.hpp"
-#include "pneumid/lti/model_file_scope.hpp"
+#include "pneumid/models/model_file_scope.hpp"
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/realtime/controller_adapter.hpp"
 #include "pneumid/realtime/io_factory.hpp"

@@ -7,7 +7,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/controller.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/workflow/control_scenario.hpp"
 

@@ -37,7 +37,7 @@
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
 #include "pneumid/control/prediction_model.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
 

@@ -13,8 +13,8 @@
 #include "pneumid/control/gpc.hpp"
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/pid.hpp"
-#include "pneumid/lti/model_io.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/model_file.hpp"
+#include "pneumid/models/static_map.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};

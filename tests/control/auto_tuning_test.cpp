@@ -19,7 +19,7 @@
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/controller_factory.hpp"
 #include "pneumid/lti/frequency.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
 

@@ -2,8 +2,8 @@
 // NARX linearization (control) and of its generated C (codegen).
 #pragma once
 
-#include "pneumid/lti/narx_model.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/narx_model.hpp"
+#include "pneumid/models/static_map.hpp"
 
 namespace pneumid::testing_models {
 

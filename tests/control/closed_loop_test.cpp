@@ -11,7 +11,7 @@
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/gpc.hpp"
 #include "pneumid/control/pid.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"

@@ -16,7 +16,7 @@
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/narx_linearizing_controller.hpp"
 #include "pneumid/control/pid.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid {
 namespace {

@@ -11,7 +11,7 @@
 
 #include "pneumid/control/closed_loop.hpp"
 #include "pneumid/control/dmc.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"
 

@@ -12,7 +12,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/mpc.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/plant/signal.hpp"

@@ -20,7 +20,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/controller_factory.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/control/closed_loop.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/signal.hpp"
 

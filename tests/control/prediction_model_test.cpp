@@ -19,7 +19,7 @@
 #include "pneumid/control/mpc.hpp"
 #include "pneumid/control/tuning.hpp"
 #include "pneumid/lti/conversion.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid {
 namespace {

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid {
 namespace {

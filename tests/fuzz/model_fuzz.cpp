@@ -1,8 +1,8 @@
-// Model specs (lti/model_io): the input is an inline spec ("tf:num=...",
+// Model specs (models/model_file): the input is an inline spec ("tf:num=...",
 // "fopdt:K=..."), or, when it starts with '{' or '[', the content of a model
 // JSON file.
 #include "fuzz_support.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace pneumid;

@@ -13,7 +13,7 @@
 #include "pneumid/identify/step/tangent.hpp"
 #include "pneumid/identify/step/two_point.hpp"
 #include "pneumid/lti/conversion.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {

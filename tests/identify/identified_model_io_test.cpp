@@ -11,7 +11,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {

@@ -13,7 +13,7 @@
 #include "pneumid/identify/evaluation/residual_analysis.hpp"
 #include "pneumid/identify/evaluation/validation.hpp"
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {

@@ -32,9 +32,9 @@
 #include "pneumid/data/preprocess_io.hpp"
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
-#include "pneumid/lti/model_io.hpp"
-#include "pneumid/lti/narx_model.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/model_file.hpp"
+#include "pneumid/models/narx_model.hpp"
+#include "pneumid/models/static_map.hpp"
 
 namespace pneumid {
 namespace {

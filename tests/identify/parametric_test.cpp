@@ -10,7 +10,7 @@
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid {
 namespace {

@@ -8,7 +8,7 @@
 #include <Eigen/Core>
 
 #include "pneumid/identify/parametric/parametric_model.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid::testing {
 

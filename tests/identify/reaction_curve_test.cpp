@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {

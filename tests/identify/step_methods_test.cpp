@@ -16,7 +16,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/lti/conversion.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 
 namespace pneumid {
 namespace {

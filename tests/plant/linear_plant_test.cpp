@@ -12,7 +12,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/load.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/lti/response.hpp"
 #include "pneumid/plant/experiment.hpp"
 #include "pneumid/plant/ipa_simulator.hpp"

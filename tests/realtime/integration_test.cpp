@@ -7,7 +7,7 @@
 
 #include "pneumid/control/dmc.hpp"
 #include "pneumid/control/pid.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/realtime/controller_adapter.hpp"
 #include "pneumid/realtime/realtime_session.hpp"

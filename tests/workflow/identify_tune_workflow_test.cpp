@@ -9,7 +9,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/load.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/workflow/identify_workflow.hpp"
 #include "pneumid/workflow/tune_workflow.hpp"
 

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "pneumid/common/check.hpp"
-#include "pneumid/lti/model_io.hpp"
+#include "pneumid/models/model_file.hpp"
 #include "pneumid/workflow/run_workflow.hpp"
 
 namespace pneumid {

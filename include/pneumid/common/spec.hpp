@@ -1,5 +1,5 @@
 // One parser for the `kind:key=value,key=value` specs of every area: model
-// specs (lti/model_io.hpp), signals (plant/signal.hpp), plants
+// specs (lti/model_io.hpp, models/model_file.hpp), signals (plant/signal.hpp), plants
 // (plant/plant_factory.hpp) and command-line values such as --load-step.
 //
 // Grammar:

@@ -44,7 +44,7 @@
 #include "pneumid/control/pid.hpp"
 #include "pneumid/control/prediction_model.hpp"
 #include "pneumid/control/tuning.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
@@ -146,7 +146,7 @@ struct ControllerSettings {
   double response_time = std::numeric_limits<double>::quiet_NaN();
   double overshoot = 5.0;       ///< rule "auto": maximum overshoot, percent (default 5)
   double aggressiveness = 0.5;  ///< rule "auto": 0 robust .. 1 aggressive (default 0.5)
-  /// A file with the actuator's static map (lti/model_io.hpp ReadStaticMap:
+  /// A file with the actuator's static map (models/model_file.hpp ReadStaticMap:
   /// a static-map or Hammerstein model file, or {"u", "y"}); empty = none,
   /// or the model file's own input map (WithModelInputMap).
   std::string input_map;
@@ -172,9 +172,9 @@ TuningRule InferTuningRule(const std::string& rule, int P, int M, double lambda)
 /// @throws DataError naming the file of an input map that cannot be read.
 ControllerSpec ToControllerSpec(const ControllerSettings& settings);
 /// `spec` with the input map of the model file `model_spec` (a Hammerstein
-/// model's, lti/model_io.hpp ParseModelInputMap) when it has none yet, its
+/// model's, models/model_file.hpp ParseModelInputMap) when it has none yet, its
 /// output map (a Wiener model's, ParseModelOutputMap), or its NARX model
-/// (narx_model, lti/model_io.hpp ParseModelNarx).
+/// (narx_model, models/model_file.hpp ParseModelNarx).
 /// @throws InvalidArgument for a NARX model together with an input map, or a
 /// NARX model a controller cannot use (InputAffineNarx).
 ControllerSpec WithModelInputMap(ControllerSpec spec, const std::string& model_spec);

@@ -2,7 +2,7 @@
 // linearizing input transformation of a Hammerstein plant [1, sec. 2.3; 2].
 //
 // Plant (Hammerstein): y = G(q) v with v = f(u), f the static map of the
-// actuator (lti/static_map.hpp; for the IPA the steady force in N at duty u
+// actuator (models/static_map.hpp; for the IPA the steady force in N at duty u
 // in %), G the linear dynamics (unit static gain when f is the steady-state
 // map). The inner controller is designed on G: its input is v, in f's output
 // units. At every sample
@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "pneumid/control/controller.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 #include "pneumid/plant/actuator.hpp"
 
 namespace pneumid {

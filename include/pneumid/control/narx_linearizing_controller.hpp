@@ -2,7 +2,7 @@
 // input-affine NARX model (identify/affine_narx.hpp): the nonlinear-model
 // controller of the actuator across its whole range.
 //
-// Model (lti/narx_model.hpp, with its input map f; without one f(u) = u):
+// Model (models/narx_model.hpp, with its input map f; without one f(u) = u):
 //   y(t+1) = F(y(t)) + G(y(t)) v(t),   v = f(u),
 // F and G polynomials in y read off the NARX terms (ny = nu = nk = 1, each
 // term with at most one input factor; InputAffineNarx). The loop is shaped
@@ -40,8 +40,8 @@
 #include <string>
 
 #include "pneumid/control/controller.hpp"
-#include "pneumid/lti/narx_model.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/narx_model.hpp"
+#include "pneumid/models/static_map.hpp"
 
 namespace pneumid {
 

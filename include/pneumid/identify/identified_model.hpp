@@ -23,7 +23,7 @@
 #include "pneumid/data/preprocess.hpp"
 #include "pneumid/identify/nonlinear/narx.hpp"
 #include "pneumid/identify/parametric/subspace.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {

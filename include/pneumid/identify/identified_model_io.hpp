@@ -10,14 +10,14 @@
 //    "covariance": {"names": ["a1", "b1"], "matrix": [[...], [...]]}
 //                                              (only when known; model_uncertainty.hpp)
 //    "input_map": {"u": [...], "y": [...], "extrapolation": "clamp"}
-//                                              (static-map, hammerstein; lti/static_map.hpp)
+//                                              (static-map, hammerstein; models/static_map.hpp)
 //    "output_map": {...}                       (wiener)
 //    "narx": {"ny", "nu", "nk", "degree", "Ts", "terms", "theta", "err"}
 //                                              (narx; identify/narx.hpp)}
 // The nonlinear keys are optional: files without them read as before.
 //
 // The keys are a file format read back by `pneumid step/bode/control --model
-// FILE` (lti/model_io.hpp reads "tf") and `pneumid validate` (the polynomial
+// FILE` (models/model_file.hpp reads "tf") and `pneumid validate` (the polynomial
 // "params"); keep them. Parameters map to JSON numbers (integers stay
 // integers), arrays and arrays of arrays, in the order of their names.
 #pragma once

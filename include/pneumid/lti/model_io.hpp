@@ -1,4 +1,5 @@
-// Model specifications shared by every command and binding:
+// Linear model specifications (the built-in names and inline specs every
+// command and binding accepts) and the JSON form of a transfer function:
 //   * built-in names:   arx-paper     the paper's ARX(3,3,1) force model, Ts = 0.01 (Eq. 5)
 //                       arx-paper-ct  its zoh d2c continuous equivalent (Eq. 6)
 //                       fopdt-paper   1.6 exp(-0.001 s) / (0.245 s + 1) (Eq. 2)
@@ -7,11 +8,8 @@
 //                       tf:num=1 2,den=1 3 2[,Ts=0.01][,delay=0]   (coefficients separated
 //                       by spaces, ';' or ',': tf:num=1,den=1,-1 is den = [1, -1]; as in
 //                       TransferFunction, delay in seconds; syntax in common/spec.hpp)
-//   * a model JSON file written by pneumid (`pneumid identify --json`, a single
-//     model object, or an object {"num","den","Ts","delay"}); for a list of
-//     models the first (best) one is taken, or `FILE.json#method` selects one;
-//     a model with a static input map (Hammerstein, static map) gives its
-//     linear part here and its map by ParseModelInputMap.
+// Model files written by pneumid (and every spec above) are read by
+// models/model_file.hpp (ParseModelSpec), the layer above this one.
 // JSON form of a transfer function: {"num": [...], "den": [...], "Ts": x, "delay": s}.
 #pragma once
 
@@ -20,57 +18,15 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pneumid/lti/narx_model.hpp"
-#include "pneumid/lti/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
 
-/// Parses a model spec (see above). Throws InvalidArgument naming the spec and
-/// the offending key, or DataError naming the file for an unreadable file,
-/// a directory or invalid JSON.
-TransferFunction ParseModelSpec(const std::string& spec);
-
-/// The static input map of a model file spec: the "input_map" of the selected
-/// model (a static-map or Hammerstein model written by `pneumid identify`),
-/// or the file itself when it is a static map {"u": [...], "y": [...]}
-/// (StaticMapFromJson). std::nullopt for built-in and inline specs, for
-/// models without an input map and for NARX models (whose map feeds the NARX:
-/// ParseModelNarx).
-/// @throws DataError naming the file for an unreadable file or an invalid map.
-std::optional<StaticMap> ParseModelInputMap(const std::string& spec);
-/// The static output map of a model file spec: the "output_map" of the
-/// selected model (a Wiener or Hammerstein-Wiener model); std::nullopt
-/// otherwise (built-in and inline specs, models without one).
-/// @throws DataError naming the file for an unreadable file or an invalid map.
-std::optional<StaticMap> ParseModelOutputMap(const std::string& spec);
-/// ParseModelInputMap, required: @throws DataError naming the file when it
-/// holds no static map.
-StaticMap ReadStaticMap(const std::string& spec);
-
-/// A NARX model of a model file with its input map (affine-narx models carry
-/// one; lti/narx_model.hpp).
-struct NarxWithMap {
-  NarxModel narx;  ///< the polynomial NARX, driven by the mapped input v = f(u) with a map
-  /// Static input map v = f(u) run before the NARX (affine-narx); std::nullopt without one.
-  std::optional<StaticMap> input_map;
-};
-/// The NARX model of a model file spec (the "narx" of the selected model,
-/// with its "input_map" when present); std::nullopt for built-in and inline
-/// specs and models without one.
-/// @throws DataError naming the file for an unreadable file or an invalid model.
-std::optional<NarxWithMap> ParseModelNarx(const std::string& spec);
-
-/// The JSON object of the model a file spec `FILE[#method]` names: the file's
-/// model, or the entry of its "models" list that `#method` selects (the first
-/// without one), as every reader of this header selects it; `path` (may be
-/// null) receives FILE. Read through the current ModelFileScope (once per
-/// scope). std::nullopt when the spec names no regular file (built-in and
-/// inline specs). The one reader of model files: the identify area reads its
-/// models through it (identified_model_io.hpp, LoadIdentifiedModel).
-/// @throws DataError naming the file for an unreadable file, invalid JSON or
-///         a selection that names no model.
-std::optional<nlohmann::json> ReadModelEntry(const std::string& spec, std::string* path = nullptr);
+/// The transfer function of a built-in name or an inline spec (see above);
+/// std::nullopt for any other text (a file name, for models/model_file.hpp).
+/// @throws InvalidArgument naming the spec and the offending key for an
+///         inline spec that is malformed, and for an empty spec.
+std::optional<TransferFunction> ParseLinearSpec(const std::string& spec);
 
 /// {"num", "den", "Ts", "delay"} with a monic denominator.
 nlohmann::json ToJson(const TransferFunction& g);

@@ -3,7 +3,7 @@
 // Hammerstein-Wiener model as it predicts on data, not its linear part alone.
 //
 // With the linear part G (a LinearPlant without noise) and the optional input
-// map f and output map g (StaticMap, lti/static_map.hpp):
+// map f and output map g (StaticMap, models/static_map.hpp):
 //   v_k = f(u_k) with an input map (Hammerstein, static map, HW), else u_k;
 //   x   = G v,   y_k = g(x_k) with an output map (Wiener, HW), else x_k;
 //   y_meas,k = y_k + load disturbance + e_k,   e_k ~ N(0, sigma^2),
@@ -20,7 +20,7 @@
 #include <optional>
 #include <string>
 
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 #include "pneumid/plant/linear_plant.hpp"
 #include "pneumid/plant/seeded_noise.hpp"
 

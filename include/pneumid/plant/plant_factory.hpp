@@ -5,7 +5,7 @@
 //                               command -100..100 %), output m
 //   ipa:config=FILE.toml[,mode=force|position][,pwm=switching|averaged]
 //                               parameters from a TOML file (config/ipa_default.toml)
-//   anything ParseModelSpec accepts (pneumid/lti/model_io.hpp): arx-paper,
+//   anything ParseModelSpec accepts (pneumid/models/model_file.hpp): arx-paper,
 //   arx-paper-ct, fopdt-paper, fopdt:K=1.6,tau=0.245,theta=0.001, sopdt:..., tf:...,
 //   a model JSON file written by pneumid   -> LinearPlant
 // Input of the IPA: PWM duty in percent; of a linear model: its own input unit.

@@ -33,7 +33,7 @@
 
 #include "pneumid/data/dataset.hpp"
 #include "pneumid/identify/step/step_methods.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 #include "pneumid/report/plot.hpp"
 

@@ -6,7 +6,7 @@
 // so that the same model and settings give the same numbers everywhere.
 //
 //   TuneWorkflowOptions o;
-//   o.model = "fopdt-paper";   // model spec (lti/model_io.hpp)
+//   o.model = "fopdt-paper";   // model spec (models/model_file.hpp)
 //   o.Ts = 0.01;
 //   o.rule = "auto";           // or shridhar-cooper, paper-modified, explicit
 //   o.controller = "pid";      // auto only: mpc (default), dmc, pid

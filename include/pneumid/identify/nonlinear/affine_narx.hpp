@@ -45,7 +45,7 @@
 
 #include "pneumid/identify/nonlinear/narx.hpp"
 #include "pneumid/identify/parametric/parametric_model.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 
 namespace pneumid {
 

@@ -6,7 +6,7 @@
 //   Wiener:              x(t) = G(q) u(t),  y(t) = f(x(t)) + e(t)
 //   Hammerstein-Wiener:  x(t) = G(q) f(u(t)),  y(t) = g(x(t)) + e(t)
 //
-// with f a piecewise-linear StaticMap (lti/static_map.hpp) through knots
+// with f a piecewise-linear StaticMap (models/static_map.hpp) through knots
 // c_1 < ... < c_m (given, or placed where the data are: PlaceMapKnots) and
 //   G(q) = B(q) / A(q) = (b_1 q^-nk + ... + b_nb q^-(nk+nb-1)) / (1 + a_1 q^-1 + ... + a_na q^-na).
 //
@@ -72,7 +72,7 @@
 #include <Eigen/Core>
 
 #include "pneumid/identify/parametric/parametric_model.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {

@@ -1,4 +1,4 @@
-// Polynomial NARX models (lti/narx_model.hpp) with term selection by forward regression with
+// Polynomial NARX models (models/narx_model.hpp) with term selection by forward regression with
 // orthogonal least squares (FROLS) and the error reduction ratio (ERR),
 // method `narx` of `pneumid identify` (Billings [1] ch. 3, Chen, Billings and
 // Luo [2]).
@@ -55,7 +55,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pneumid/identify/parametric/parametric_model.hpp"
-#include "pneumid/lti/narx_model.hpp"
+#include "pneumid/models/narx_model.hpp"
 
 namespace pneumid {
 

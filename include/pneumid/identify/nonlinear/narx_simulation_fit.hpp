@@ -29,7 +29,7 @@
 #include <Eigen/Core>
 
 #include "pneumid/identify/parametric/parametric_model.hpp"
-#include "pneumid/lti/narx_model.hpp"
+#include "pneumid/models/narx_model.hpp"
 
 namespace pneumid {
 

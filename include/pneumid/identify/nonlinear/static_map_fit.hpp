@@ -1,6 +1,6 @@
 // The steady-state input-output map of a plant from a staircase (or a slow
 // ramp) experiment, as a monotone piecewise-linear StaticMap
-// (lti/static_map.hpp). Method `static-map` of `pneumid identify`.
+// (models/static_map.hpp). Method `static-map` of `pneumid identify`.
 //
 // Staircase ([1] sec. 13.2, static gain from steady states):
 //   1. segments of constant input: runs of samples whose input differs from
@@ -37,7 +37,7 @@
 
 #include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 
 namespace pneumid {
 

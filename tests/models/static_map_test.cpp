@@ -1,7 +1,7 @@
 // Piecewise-linear static maps: evaluation, inverse with dead zone and
 // saturation, descriptions, JSON and bad input. Golden values from numpy
 // (gen_static_map_cases.py beside this file).
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 
 #include <cmath>
 #include <limits>

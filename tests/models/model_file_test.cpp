@@ -1,6 +1,6 @@
 // Model specs and the JSON form of a transfer function.
-#include "pneumid/lti/model_io.hpp"
-#include "pneumid/lti/model_file_scope.hpp"
+#include "pneumid/models/model_file.hpp"
+#include "pneumid/models/model_file_scope.hpp"
 
 #include <cstdio>
 #include <fstream>

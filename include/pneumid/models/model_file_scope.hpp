@@ -1,5 +1,5 @@
 // Reading a model file once per command (docs/models.md): the model specs of
-// lti/model_io.hpp name files that a command consults several times (the
+// models/model_file.hpp name files that a command consults several times (the
 // linear part, the NARX part, the input and output maps, each controller of
 // a comparison).
 #pragma once
@@ -12,7 +12,7 @@ namespace pneumid {
 
 /// While an object of this class lives, the model files read on its thread
 /// (ParseModelSpec, ParseModelInputMap, ParseModelOutputMap, ParseModelNarx,
-/// ReadStaticMap of lti/model_io.hpp and the controllers built from them) are
+/// ReadStaticMap of models/model_file.hpp and the controllers built from them) are
 /// opened and parsed once each. A file changed on disk since (its size,
 /// modification or change time, or inode) is read again. Scopes nest; the
 /// outermost keeps the files. Without a scope every call reads the file.

@@ -1,4 +1,4 @@
-#include "pneumid/lti/static_map.hpp"
+#include "pneumid/models/static_map.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pneumid/lti/narx_model.hpp"
+#include "pneumid/models/narx_model.hpp"
 
 #include <algorithm>
 #include <cmath>
