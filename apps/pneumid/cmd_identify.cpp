@@ -156,7 +156,7 @@ void Run(const IdentifyArgs& args) {
   const bool held_out = summary.validation_samples > 0;
   const std::optional<Dataset>& validation = validation_raw;
   const nlohmann::json j = outcome.ToJson();
-  if (!args.output.empty()) WriteJsonFile(j, args.output);
+  if (!args.output.empty()) SaveModelFile(args.output, j);
   if (!args.plot.empty()) WritePlot(args.plot, data, args.request, models);
 
   if (args.json && !args.output.empty()) {

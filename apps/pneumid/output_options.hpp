@@ -23,8 +23,4 @@ nlohmann::json JsonNumber(double v);
 /// The numbers of `v` as a JSON array (null where not finite).
 nlohmann::json JsonNumbers(const Eigen::VectorXd& v);
 
-/// Writes `j` (indented) to `path`. @throws DataError when it cannot be written.
-void WriteJsonFile(const nlohmann::json& j, const std::string& path);
-void WriteJsonFile(const nlohmann::ordered_json& j, const std::string& path);
-
 }  // namespace pneumid::cli

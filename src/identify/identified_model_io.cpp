@@ -1,5 +1,7 @@
 #include "pneumid/identify/identified_model_io.hpp"
 
+#include <fstream>
+
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -213,13 +215,16 @@ IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j) {
   if (j.contains("narx")) m.narx = NarxModelFromJson(j.at("narx"));
   if (j.contains("input_map_undetermined")) {
     const nlohmann::json& gaps = j.at("input_map_undetermined");
-    PNEUMID_CHECK(gaps.is_array(), "model key 'input_map_undetermined' must be a list of "
-                       "[lo, hi] pairs, got {}", gaps.dump());
+    PNEUMID_CHECK(gaps.is_array(),
+                  "model key 'input_map_undetermined' must be a list of "
+                  "[lo, hi] pairs, got {}",
+                  gaps.dump());
     for (const nlohmann::json& g : gaps) {
       PNEUMID_CHECK(g.is_array() && g.size() == 2 && g[0].is_number() && g[1].is_number() &&
-                             g[0].get<double>() < g[1].get<double>(),
-                         "model key 'input_map_undetermined': each entry must be [lo, hi] with "
-                         "lo < hi, got {}", g.dump());
+                        g[0].get<double>() < g[1].get<double>(),
+                    "model key 'input_map_undetermined': each entry must be [lo, hi] with "
+                    "lo < hi, got {}",
+                    g.dump());
       m.input_map_undetermined.emplace_back(g[0].get<double>(), g[1].get<double>());
     }
   }
@@ -241,6 +246,20 @@ std::optional<IdentifiedModel> LoadIdentifiedModel(const std::string& spec) {
   } catch (const InvalidArgument& e) {
     throw DataError(fmt::format("{}: {}", path, e.what()));
   }
+}
+
+nlohmann::json ModelFileDocument(const std::vector<IdentifiedModel>& models) {
+  nlohmann::json j;
+  j["models"] = nlohmann::json::array();
+  for (const IdentifiedModel& m : models) j["models"].push_back(ToJson(m));
+  return j;
+}
+
+void SaveModelFile(const std::string& path, const nlohmann::json& document) {
+  std::ofstream f(path);
+  if (!f) throw DataError(fmt::format("{}: cannot open for writing", path));
+  f << document.dump(2) << "\n";
+  if (!f) throw DataError(fmt::format("{}: write failed", path));
 }
 
 }  // namespace pneumid

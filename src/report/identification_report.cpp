@@ -358,16 +358,12 @@ void AddReproduceSection(HtmlDocument& doc, const std::vector<std::string>& comm
 
 // models.json: the data's source, every model and the methods that failed.
 void WriteModelsJson(const ReportSummary& summary, const std::string& source) {
-  nlohmann::json j;
+  nlohmann::json j = ModelFileDocument(summary.models);
   j["data"] = source;
-  j["models"] = nlohmann::json::array();
-  for (const auto& model : summary.models) j["models"].push_back(ToJson(model));
   j["failures"] = nlohmann::json::array();
   for (const auto& [method, failure] : summary.failures)
     j["failures"].push_back({{"method", method}, {"error", failure}});
-  std::ofstream f(summary.models_path);
-  if (!f) throw DataError(summary.models_path + ": cannot open the file for writing");
-  f << j.dump(2) << "\n";
+  SaveModelFile(summary.models_path, j);
 }
 
 void SetTermination(ReportSummary& summary, std::size_t num_methods) {

@@ -612,14 +612,10 @@ bool IdentifyAndSave(CommissionResult& r, const CommissionOptions& o, double Ts,
     return false;
   }
   r.model_file = (std::filesystem::path(o.directory) / "models.json").string();
-  nlohmann::json file;
-  file["models"] = nlohmann::json::array();
-  for (const IdentifiedModel& m : r.identification.models) file["models"].push_back(ToJson(m));
+  nlohmann::json file = ModelFileDocument(r.identification.models);
   file["best"] = r.identification.models.front().method;
   file["ranked_by"] = "validation_fit_percent";
-  std::ofstream out(r.model_file);
-  out << file.dump(2) << "\n";
-  if (!out) throw DataError(fmt::format("{}: cannot write", r.model_file));
+  SaveModelFile(r.model_file, file);
   return true;
 }
 

@@ -52,12 +52,9 @@ nlohmann::json IdentifyWorkflowResult::ToJson() const {
   const std::vector<IdentifiedModel>& models = summary.models;
   if (models.empty()) return nullptr;
   const bool held_out = summary.validation_samples > 0;
-  nlohmann::json j;
-  j["models"] = nlohmann::json::array();
-  for (const IdentifiedModel& m : models) {
-    j["models"].push_back(pneumid::ToJson(m));
-    j["models"].back()["rank_reason"] = RankReason(m);
-  }
+  nlohmann::json j = ModelFileDocument(models);
+  for (std::size_t i = 0; i < models.size(); ++i)
+    j["models"][i]["rank_reason"] = RankReason(models[i]);
   j["best"] = models.front().method;
   j["ranked_by"] = held_out ? "validation_fit_percent" : "fit_percent";
   j["estimation_samples"] = summary.estimation_samples;

@@ -122,7 +122,8 @@ TEST(IdentifiedModelIoTest, ModelFilesOfIdentifyStayReadableAsModelSpecs) {
   for (const char* key : {"K", "tau", "theta", "t63"}) {
     EXPECT_TRUE(j["models"][1]["params"][key].is_number_float()) << key;
   }
-  for (const char* key : {"a", "b", "nk", "Ts"}) EXPECT_TRUE(j["models"][0]["params"].contains(key));
+  for (const char* key : {"a", "b", "nk", "Ts"})
+    EXPECT_TRUE(j["models"][0]["params"].contains(key));
   EXPECT_TRUE(j["models"][0]["params"]["nk"].is_number_integer());
   const auto path = std::filesystem::temp_directory_path() / "pneumid_identified_model_io.json";
   std::ofstream(path) << j.dump(2);
@@ -144,10 +145,16 @@ TEST(IdentifiedModelIoTest, ModelFilesOfIdentifyStayReadableAsModelSpecs) {
 }
 
 TEST(IdentifiedModelIoTest, ErrorsNameTheKey) {
-  EXPECT_THAT([] { ModelParamsFromJson(nlohmann::json{{"K", "big"}}); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("parameter 'K'")));
-  EXPECT_THAT([] { ModelParamsFromJson(nlohmann::json{{"a", {1.0, "x"}}}); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("parameter 'a'")));
+  EXPECT_THAT(
+      [] {
+        ModelParamsFromJson(nlohmann::json{{"K", "big"}});
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("parameter 'K'")));
+  EXPECT_THAT(
+      [] {
+        ModelParamsFromJson(nlohmann::json{{"a", {1.0, "x"}}});
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("parameter 'a'")));
   nlohmann::json no_tf = nlohmann::json::parse(kWritten);
   no_tf.erase("tf");
   EXPECT_THAT([&] { IdentifiedModelFromJson(no_tf); },
@@ -168,8 +175,9 @@ TEST(IdentifiedModelIoTest, LoadIdentifiedModelSelectsAsEveryReaderDoes) {
   ASSERT_TRUE(LoadIdentifiedModel(file).has_value());
   EXPECT_EQ(LoadIdentifiedModel(file)->method, "n4sid");  // the first without #method
   EXPECT_DOUBLE_EQ(LoadIdentifiedModel(file + "#arx")->params.Scalar("K"), 2.5);
-  EXPECT_THAT([&] { LoadIdentifiedModel(file + "#oe"); },
-              ThrowsMessage<DataError>(HasSubstr("no model with method 'oe' (available: n4sid, arx)")));
+  EXPECT_THAT(
+      [&] { LoadIdentifiedModel(file + "#oe"); },
+      ThrowsMessage<DataError>(HasSubstr("no model with method 'oe' (available: n4sid, arx)")));
   const std::string plain = (dir / "tf.json").string();
   std::ofstream(plain) << R"({"num": [1], "den": [1, 1], "Ts": 0, "delay": 0})";
   EXPECT_FALSE(LoadIdentifiedModel(plain).has_value());
@@ -183,6 +191,31 @@ TEST(IdentifiedModelIoTest, LoadIdentifiedModelSelectsAsEveryReaderDoes) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(IdentifiedModelIoTest, SaveModelFileWritesWhatLoadIdentifiedModelReads) {
+  const auto dir = std::filesystem::temp_directory_path() / "pneumid_save_model_file";
+  std::filesystem::create_directories(dir);
+  IdentifiedModel first = IdentifiedModelFromJson(nlohmann::json::parse(kWritten));
+  IdentifiedModel second = first;
+  second.method = "arx";
+  second.params = ModelParamsFromJson({{"K", 2.5}});
+  nlohmann::json doc = ModelFileDocument({first, second});
+  ASSERT_EQ(doc.at("models").size(), 2u);
+  EXPECT_EQ(doc.at("models")[0], ToJson(first));
+  doc["best"] = "n4sid";
+  const std::string file = (dir / "models.json").string();
+  SaveModelFile(file, doc);
+  EXPECT_EQ(LoadIdentifiedModel(file)->method, "n4sid");
+  EXPECT_DOUBLE_EQ(LoadIdentifiedModel(file + "#arx")->params.Scalar("K"), 2.5);
+  EXPECT_EQ(ParseModelSpec(file + "#arx").ToString(6), second.tf.ToString(6));
+  std::ifstream in(file);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, doc.dump(2) + "\n");
+  const std::string nowhere = (dir / "no" / "such" / "dir.json").string();
+  EXPECT_THAT([&] { SaveModelFile(nowhere, doc); },
+              ThrowsMessage<DataError>(HasSubstr("dir.json: cannot open for writing")));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ModelParamsTest, TypedAccessors) {
   ModelParams p{{"K", 2.0}, {"n", 3}, {"a", std::vector<double>{1.0, 0.5}}};
   EXPECT_DOUBLE_EQ(p.Scalar("K"), 2.0);
@@ -190,8 +223,8 @@ TEST(ModelParamsTest, TypedAccessors) {
   EXPECT_FALSE(p.FindScalar("a").has_value());
   EXPECT_FALSE(p.FindScalar("y0").has_value());
   EXPECT_EQ(p.Vector("a").size(), 2u);
-  EXPECT_THAT([&] { p.Scalar("tau"); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("no parameter 'tau' (parameters: K, a, n)")));
+  EXPECT_THAT([&] { p.Scalar("tau"); }, ThrowsMessage<InvalidArgument>(
+                                            HasSubstr("no parameter 'tau' (parameters: K, a, n)")));
   EXPECT_THAT([&] { p.Vector("K"); },
               ThrowsMessage<InvalidArgument>(HasSubstr("'K' is not a coefficient vector")));
 }

@@ -24,6 +24,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -49,11 +50,24 @@ IdentifiedModel IdentifiedModelFromJson(const nlohmann::json& j);
 
 /// The identified model a file spec `FILE.json[#method]` names (written by
 /// `pneumid identify -o` or `--json`; the first model without `#method`), read
-/// through lti's model file reader (ReadModelEntry: once per ModelFileScope).
-/// std::nullopt when the spec is no JSON file name (built-in and inline
-/// specs) or the entry is a plain transfer function {"num", "den", ...}.
+/// through the model file reader of models/model_file.hpp (ReadModelEntry: once per
+/// ModelFileScope). std::nullopt when the spec is no JSON file name (built-in and inline specs) or
+/// the entry is a plain transfer function {"num", "den", ...}.
 /// @throws DataError naming the file for a missing or unreadable file,
 ///         invalid JSON, a selection that names no model or an invalid model.
 std::optional<IdentifiedModel> LoadIdentifiedModel(const std::string& spec);
+
+/// The document of a model file: {"models": [ToJson(m), ...]} with `models`
+/// in their order (best first). Its writers add their own keys: `pneumid
+/// identify -o` "best" and "ranked_by" and each model's "rank_reason",
+/// `pneumid commission` "best" and "ranked_by", `pneumid report` "data" and
+/// "failures".
+nlohmann::json ModelFileDocument(const std::vector<IdentifiedModel>& models);
+
+/// Writes a model file document (ModelFileDocument) to `path`, indented by 2
+/// with a final newline: the file LoadIdentifiedModel and every model spec
+/// `path#method` read back.
+/// @throws DataError naming the path when it cannot be opened or written.
+void SaveModelFile(const std::string& path, const nlohmann::json& document);
 
 }  // namespace pneumid
