@@ -253,6 +253,13 @@ TEST(ModelEvaluationTest, ParsimonyPrefersTheSimplestModelTheEvidenceCannotTellF
             "held-out simulation fit 97.07 %; preferred to hw (97.13 %, 11 parameters) for "
             "fewer parameters (7): simulation errors within 5 % of each other");
   EXPECT_EQ(RankReason(ms[1]), "held-out simulation fit 97.13 %");
+  // A structure chosen on the held-out data is said to be.
+  ms[1].notes = {"structure chosen on held-out data: na = 1, nb = 1, nk = 2 (...)"};
+  EXPECT_EQ(RankReason(ms[1]),
+            "held-out simulation fit 97.13 %; its structure was chosen on the same held-out data");
+  ms[1].validation_fit_percent = std::numeric_limits<double>::quiet_NaN();
+  ms[1].fit_percent = 98.0;
+  EXPECT_EQ(RankReason(ms[1]), "estimation fit 98.00 % (no held-out data)");
 
   // Just outside the tolerance (hammerstein's error 5.2 % above hw's) the
   // score decides; so it does with the tolerance 0.

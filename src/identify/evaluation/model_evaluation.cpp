@@ -326,6 +326,12 @@ std::string RankReason(const IdentifiedModel& model) {
                                              : "a ripple at the Nyquist frequency");
   if (!soft.empty())
     why += fmt::format("; flagged {}, ranked by its fit all the same", fmt::join(soft, ", "));
+  // A structure search scores its candidates on the held-out data that rank
+  // the model (IdentifyModels): the fit includes that choice.
+  if (held_out && std::any_of(model.notes.begin(), model.notes.end(), [](const std::string& n) {
+        return n.rfind("structure chosen on held-out data", 0) == 0;
+      }))
+    why += "; its structure was chosen on the same held-out data";
   if (!model.rank_note.empty()) why += "; " + model.rank_note;
   return why;
 }

@@ -149,7 +149,9 @@ double RankScore(const IdentifiedModel& model);
 
 /// One line on why the model stands where it does, e.g. "held-out simulation
 /// fit 97.01 %; flagged no_convergence, ranked by its fit all the same", with
-/// the model's rank_note when parsimony placed it (RankModels).
+/// "its structure was chosen on the same held-out data" for a model whose
+/// structure search scored on them (its fit includes that choice) and the
+/// model's rank_note when parsimony placed it (RankModels).
 std::string RankReason(const IdentifiedModel& model);
 
 /// The free parameters of a model: the coefficients of its linear part (the
