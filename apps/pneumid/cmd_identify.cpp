@@ -148,6 +148,8 @@ void Run(const IdentifyArgs& args) {
   }
   for (const auto& [method, reason] : outcome.summary.failures)
     std::cerr << fmt::format("pneumid identify: {} failed: {}\n", method, reason);
+  for (const std::string& w : outcome.summary.warnings)
+    std::cerr << fmt::format("pneumid identify: warning: {}\n", w);
   if (outcome.summary.models.empty()) throw DataError(outcome.summary.message);
   const Dataset& data = outcome.data;
   const PreprocessRecord& record = outcome.record;
@@ -176,6 +178,7 @@ void Run(const IdentifyArgs& args) {
     brief["best"] = models.front().method;
     brief["failures"] = j["failures"];
     brief["termination"] = j["termination"];
+    brief["warnings"] = j["warnings"];
     if (!args.plot.empty()) brief["plot"] = args.plot;
     std::cout << brief.dump(2) << "\n";
     return;

@@ -169,6 +169,10 @@ void BindIdentify(py::module_& m) {
                     "Input intervals [(lo, hi), ...] between neighbouring levels of the "
                     "estimation data across which the input map changes steeply with no "
                     "sample inside: the data leave the map undetermined there.")
+      .def_readonly("structure_chosen_on", &IdentifiedModel::structure_chosen_on,
+                    "The held-out record a structure search chose the orders, delay, degree "
+                    "or terms on (e.g. 'the last 30 % of est.csv'); '' when they were given "
+                    "or chosen on a split of the estimation data.")
       .def_property_readonly(
           "narx",
           [](const IdentifiedModel& r) -> py::object {
@@ -258,7 +262,8 @@ void BindIdentify(py::module_& m) {
         return py::dict("models"_a = s.models, "failures"_a = failures,
                         "best"_a = s.models.empty() ? py::object(py::none())
                                                     : py::cast(s.models.front().method),
-                        "termination"_a = ToString(s.termination), "message"_a = s.message);
+                        "termination"_a = ToString(s.termination), "message"_a = s.message,
+                        "warnings"_a = s.warnings);
       },
       "methods"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3, "nb"_a = 3,
       "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3, "split"_a = 0.0, "validation"_a = py::none(),
@@ -267,7 +272,8 @@ void BindIdentify(py::module_& m) {
       "Runs several methods as `pneumid identify -m` does: each fails alone, models are "
       "flagged and ranked (unflagged first; by validation fit with `split` or `validation` "
       "data). Returns {'models': [IdentifiedModel, best first], 'failures': [{'method', "
-      "'reason'}], 'best', 'termination', 'message'}.");
+      "'reason'}], 'best', 'termination', 'message', 'warnings': [what the held-out part cannot "
+      "tell, e.g. a constant input]}.");
   m.def(
       "identify_json",
       [](const Dataset& data, const std::variant<std::string, std::vector<std::string>>& methods,

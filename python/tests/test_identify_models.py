@@ -45,6 +45,19 @@ def test_split_ranks_by_the_held_out_fit():
         assert math.isfinite(m.validation_fit_percent)
     fits = [m.validation_fit_percent for m in r["models"] if not m.flags]
     assert fits == sorted(fits, reverse=True)
+    assert r["warnings"] == []
+    assert all(m.structure_chosen_on == "" for m in r["models"])
+
+
+def test_a_held_out_part_on_one_level_is_warned_of():
+    d = prbs_record(2)
+    n = len(d)
+    u = d.u(0).copy()
+    u[int(0.7 * n) - 5:] = u[int(0.7 * n) - 5]
+    flat = pneumid.Dataset(d.time, u.reshape(-1, 1), d.y(0).reshape(-1, 1))
+    r = pneumid.identify_models(["arx"], flat, split=0.7)
+    assert len(r["warnings"]) == 1
+    assert "holds a constant input" in r["warnings"][0]
 
 
 def test_preprocess_matches_numpy():

@@ -177,6 +177,20 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
                   validation ? "give a validation record that excites the plant"
                              : "choose another --split or give --validation data");
   }
+  std::vector<std::string> warnings;
+  if (held_out != nullptr) {
+    // A held-out part on one input level scores each model's steady state
+    // there, not its dynamics: a ranking (and a structure search) on it says
+    // little. Models are still scored; the nonlinear structure search refuses.
+    const Eigen::VectorXd u = held_out->u(request.input);
+    if (u.size() > 0 && !(u.maxCoeff() > u.minCoeff()))
+      warnings.push_back(fmt::format(
+          "{} holds a constant input (u = {:g} over {} samples): its fit scores each model's "
+          "steady state at one level, not its dynamics, and the ranking rests on it; {}",
+          held_out->source().empty() ? "the held-out data" : held_out->source(), u[0], u.size(),
+          validation ? "give a validation record whose input moves"
+                     : "choose another --split or give --validation data"));
+  }
 
   const std::size_t n = methods.size();
   std::vector<std::optional<IdentifiedModel>> results(n);
@@ -228,6 +242,7 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
   if (progress) progress(n, n, "");
 
   IdentificationSummary s;
+  s.warnings = std::move(warnings);
   s.estimation_samples = estimation.size();
   s.validation_samples = scored == nullptr ? 0 : scored->size() - score_from;
   for (std::size_t i = 0; i < n; ++i) {

@@ -64,6 +64,7 @@ nlohmann::json IdentifyWorkflowResult::ToJson() const {
     j["failures"].push_back({{"method", method}, {"reason", reason}});
   j["termination"] = ToString(summary.termination);
   j["message"] = summary.message;
+  j["warnings"] = summary.warnings;
   return j;
 }
 

@@ -165,6 +165,8 @@ TEST(GeneralizationTest, ASplitChoosesTheStructureOnItsRestAndRanksTheSimplestFi
   ASSERT_FALSE(best.notes.empty());
   EXPECT_THAT(best.notes[0], HasSubstr("na = 1, nb = 1, nk = 2"));
   EXPECT_THAT(best.notes[0], HasSubstr("on the last 25 % of"));
+  EXPECT_THAT(best.structure_chosen_on, HasSubstr("the last 25 % of"));
+  EXPECT_TRUE(s.warnings.empty());
   EXPECT_THAT(RankReason(best), HasSubstr("preferred to hw"));
   EXPECT_LT(ParameterCount(best), ParameterCount(s.models[1]));
   // Estimated on three quarters of the record: the 95 % on other designs.
@@ -193,13 +195,31 @@ TEST(GeneralizationTest, StructureSearchErrorsAreClear) {
               ThrowsMessage<InvalidArgument>(HasSubstr("too few to choose the structure")));
   // The last 30 % of the first 4 s is one level: nothing to choose on.
   EXPECT_THAT([&] { ChooseBlockStructure("hammerstein", SliceDataset(est, 0, 330), {}, o); },
-              ThrowsMessage<InvalidArgument>(HasSubstr("hold a constant input")));
+              ThrowsMessage<InvalidArgument>(HasSubstr("holds a constant input")));
   // Identify falls back on the request's orders and says why.
   IdentifyOptions io;
   io.nonlinear.choose_structure = true;
   const IdentifiedModel m = Identify("hammerstein", SliceDataset(est, 0, 330), {}, io);
   EXPECT_THAT(m.notes[0], HasSubstr("warning: structure not chosen on held-out data"));
   EXPECT_THAT(m.notes[0], HasSubstr("na = 3, nb = 3, nk = 1 are used"));
+  EXPECT_TRUE(m.structure_chosen_on.empty());
+  // A split whose rest holds one level: the models are scored and ranked with
+  // a warning, and the structure search refuses that rest.
+  IdentifyOptions level;
+  level.split = 0.7;
+  level.num_threads = 1;
+  level.nonlinear.choose_structure = true;
+  const IdentificationSummary on_level =
+      IdentifyModels({"hammerstein", "arx"}, SliceDataset(est, 0, 330), {}, level);
+  ASSERT_EQ(on_level.models.size(), 2u);
+  ASSERT_EQ(on_level.warnings.size(), 1u);
+  EXPECT_THAT(on_level.warnings[0], HasSubstr("holds a constant input"));
+  EXPECT_THAT(on_level.warnings[0], HasSubstr("over 99 samples"));
+  for (const IdentifiedModel& x : on_level.models) {
+    EXPECT_TRUE(x.structure_chosen_on.empty()) << x.method;
+    if (x.method == "hammerstein")
+      EXPECT_THAT(x.notes[0], HasSubstr("the held-out part, the last 30 % of"));
+  }
   // A held-out part with a constant output cannot score any model.
   IdentifyOptions split;
   split.split = 0.5;

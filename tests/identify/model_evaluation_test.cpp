@@ -253,8 +253,11 @@ TEST(ModelEvaluationTest, ParsimonyPrefersTheSimplestModelTheEvidenceCannotTellF
             "held-out simulation fit 97.07 %; preferred to hw (97.13 %, 11 parameters) for "
             "fewer parameters (7): simulation errors within 5 % of each other");
   EXPECT_EQ(RankReason(ms[1]), "held-out simulation fit 97.13 %");
-  // A structure chosen on the held-out data is said to be.
+  // A structure chosen on the held-out data is said to be: the typed field
+  // decides, not a note's text.
   ms[1].notes = {"structure chosen on held-out data: na = 1, nb = 1, nk = 2 (...)"};
+  EXPECT_EQ(RankReason(ms[1]), "held-out simulation fit 97.13 %");
+  ms[1].structure_chosen_on = "the last 30 % of est.csv";
   EXPECT_EQ(RankReason(ms[1]),
             "held-out simulation fit 97.13 %; its structure was chosen on the same held-out data");
   ms[1].validation_fit_percent = std::numeric_limits<double>::quiet_NaN();

@@ -23,8 +23,8 @@
 #include "pneumid/data/preprocess.hpp"
 #include "pneumid/identify/nonlinear/narx.hpp"
 #include "pneumid/identify/parametric/subspace.hpp"
-#include "pneumid/models/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
+#include "pneumid/models/static_map.hpp"
 
 namespace pneumid {
 
@@ -170,6 +170,12 @@ struct IdentifiedModel {
   /// (97.13 %, 28 parameters) for fewer parameters (17): simulation errors
   /// within 5 % of each other"; empty otherwise. Not written to model files.
   std::string rank_note;
+  /// The held-out record a structure search scored this model's candidate
+  /// orders, delay, degree or terms on (IdentifyNonlinear's `held_out`, e.g.
+  /// "the last 30 % of est.csv"); empty when the structure was given, or chosen
+  /// on a split of the estimation data itself. A held-out fit on that record
+  /// includes the choice, and RankReason says so. Not written to model files.
+  std::string structure_chosen_on;
 };
 
 /// The operating point (u0, y0) the polynomial and state-space methods (arx,

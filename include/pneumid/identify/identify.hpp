@@ -24,8 +24,8 @@
 
 #include "pneumid/common/termination.hpp"
 #include "pneumid/data/dataset.hpp"
-#include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
+#include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/identify/step/step_methods.hpp"
 
@@ -94,6 +94,11 @@ struct IdentificationSummary {
   /// kSuccess: every method gave a model; kPartial: some failed; kFailure: none gave one.
   Termination termination = Termination::kFailure;
   std::string message;  ///< e.g. "all 22 methods produced a model", "2 of 22 methods failed"
+  /// What the held-out part cannot tell, e.g. "the last 40 % of two.csv holds a
+  /// constant input (u = 60 over 240 samples): ..." (its fit scores one steady
+  /// state, not the dynamics, yet the ranking and the structure search rest on
+  /// it). The CLI prints them on stderr and as "warnings" in --json.
+  std::vector<std::string> warnings;
   /// One line: "identify success: 22 model(s), 0 failed, best fit-p2d (99.1 %)".
   std::string BriefReport() const;
 };

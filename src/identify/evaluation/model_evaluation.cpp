@@ -328,9 +328,7 @@ std::string RankReason(const IdentifiedModel& model) {
     why += fmt::format("; flagged {}, ranked by its fit all the same", fmt::join(soft, ", "));
   // A structure search scores its candidates on the held-out data that rank
   // the model (IdentifyModels): the fit includes that choice.
-  if (held_out && std::any_of(model.notes.begin(), model.notes.end(), [](const std::string& n) {
-        return n.rfind("structure chosen on held-out data", 0) == 0;
-      }))
+  if (held_out && !model.structure_chosen_on.empty())
     why += "; its structure was chosen on the same held-out data";
   if (!model.rank_note.empty()) why += "; " + model.rank_note;
   return why;

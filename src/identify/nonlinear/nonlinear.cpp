@@ -330,12 +330,6 @@ StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& d
                   "(--na, --nb, --nk) or more data",
                   method, data.size(), options.structure_split, parts.first.size(),
                   parts.second.size());
-    const auto range = [](const Eigen::VectorXd& v) { return v.maxCoeff() - v.minCoeff(); };
-    PNEUMID_CHECK(range(parts.second.u(request.input)) > 0.0,
-                  "{}: the held-out last {:.0f} % of the data hold a constant input (no "
-                  "excitation to choose the structure on); give the orders (--na, --nb, --nk), "
-                  "another --split or --validation data",
-                  method, 100.0 * (1.0 - options.structure_split));
     head.emplace(std::move(parts.first));
     scored = &data;
     score_from = head->size();
@@ -344,6 +338,15 @@ StructureChoice ChooseBlockStructure(const std::string& method, const Dataset& d
   } else {
     out.held_out = held_out->source().empty() ? "the validation data" : held_out->source();
   }
+  // Candidates that differ in their dynamics only tell apart on an input
+  // that moves; on one level every stable candidate scores its steady state.
+  const Eigen::VectorXd u_held =
+      held_out ? held_out->u(request.input) : data.u(request.input).tail(data.size() - score_from);
+  PNEUMID_CHECK(u_held.size() > 0 && u_held.maxCoeff() > u_held.minCoeff(),
+                "{}: the held-out part, {}, holds a constant input (u = {:g} over {} samples: "
+                "no excitation to choose the structure on); give the orders (--na, --nb, --nk), "
+                "another --split or --validation data",
+                method, out.held_out, u_held.size() ? u_held[0] : 0.0, u_held.size());
   const Dataset& estimation = head ? *head : data;
   if (method == "narx")
     return ChooseNarxStructure(estimation,
@@ -457,6 +460,7 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
       }
     }
     m.notes.insert(m.notes.begin(), "structure chosen on held-out data: " + c.Describe());
+    if (held_out != nullptr) m.structure_chosen_on = c.held_out;
     return m;
   }
   std::string why;
