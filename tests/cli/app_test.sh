@@ -309,6 +309,25 @@ if expect(s, a, 200, "identify nonlinear"):
     got = sorted(m["method"] for m in a["models"])
     if got != ["affine-narx", "hammerstein"] or any(m["fit_percent"] < 90 for m in a["models"]):
         fail(f"identify nonlinear: {[(m['method'], m['fit_percent']) for m in a['models']]}")
+# a validation record whose input holds one level: still ranked, with the
+# command line's warning in "warnings"
+flat = []
+for line in demo.decode().splitlines():
+    cells = line.split(",")
+    if line.startswith("#") or not cells[0][:1].isdigit():
+        flat.append(line)
+    else:
+        cells[1] = "50"
+        flat.append(",".join(cells))
+s, a = call("POST", "/api/data/upload?name=flat.csv", ("\n".join(flat) + "\n").encode(),
+            headers={"Content-Type": "application/octet-stream"})
+if expect(s, a, 200, "upload a record at one input level"):
+    s, a = call("POST", "/api/identify", {"data": data_id, "methods": ["arx", "fit-p1d"],
+                                          "validation": a["id"], "detrend": "none"})
+    if expect(s, a, 200, "identify with a validation record at one input level"):
+        w = a.get("warnings", [])
+        if len(w) != 1 or "holds a constant input (u = 50 over 401 samples)" not in w[0]:
+            fail(f"identify on a one-level validation record: warnings {w}")
 
 # --- views of a model: step, Bode, the fit and residual correlations on data
 s, a = call("POST", "/api/model/views", {"model": arx, "data": data_id, "validation": data_id})

@@ -92,6 +92,8 @@ export interface IdentifyResult {
   models: ModelSummary[];
   best?: string;
   failures?: unknown[];
+  /** What the held-out part cannot tell (e.g. a constant input), one sentence each. */
+  warnings?: string[];
   responses?: Record<string, number[]>;
   model_file?: { models: ModelEntry[]; best?: string; [key: string]: unknown };
 }

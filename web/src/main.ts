@@ -371,7 +371,15 @@ async function identify(): Promise<void> {
       li.append(b, ' ' + (f.message ?? f.reason ?? f.error ?? (f.method ? '' : JSON.stringify(f))));
       warn.appendChild(li);
     }
-    warn.hidden = nfail === 0;
+    const warnings = Array.isArray(res.warnings) ? res.warnings : [];
+    for (const w of warnings) {
+      const li = document.createElement('li');
+      const b = document.createElement('strong');
+      b.textContent = 'warning:';
+      li.append(b, ' ' + w);
+      warn.appendChild(li);
+    }
+    warn.hidden = nfail === 0 && warnings.length === 0;
     clearStale(IDENTIFY_RESULTS);
     showIdentify(res);
   } catch (e) {
