@@ -229,6 +229,14 @@ std::string ProbeAndSweep(Recorder& rec, const CommissionOptions& o, double u_lo
   const double cap = 0.25 * o.budget;
   double previous = kNaN, current = kNaN, before = kNaN;
   bool settled = false;
+  // Divergence: the change per chunk grows by the same ratio above 1, chunk
+  // after chunk, as exp(a t) does. A stable response grows only up to its
+  // inflection, its ratios falling all the while (a PTn's by the factor
+  // 1 - 1/(k-1)^2 to the power n-1 at chunk k: a PT3 of T = 8 chunks gives
+  // 3.5, 2.0, 1.57, 1.38, ..., each more than 1 % below the one before while
+  // it exceeds 1.1), so it is not mistaken for one.
+  int growing = 0;
+  double last_ratio = kNaN, moved_at = kNaN;
   while (rec.time() - rest_end * Ts < cap) {
     const std::size_t from = rec.size();
     rec.Hold(p.u_mid, chunk);
@@ -237,10 +245,33 @@ std::string ProbeAndSweep(Recorder& rec, const CommissionOptions& o, double u_lo
     current = rec.MeanY(from + (rec.size() - from) / 2, rec.size());
     Report(o, "probe", (rec.time() - rest_end * Ts) / cap);
     const double change = current - p.y_rest;
+    if (std::isnan(moved_at) && std::abs(change) > 5 * p.noise) moved_at = rec.time() - chunk;
     if (std::isfinite(previous) && std::abs(current - previous) <= 0.005 * std::abs(change) &&
         std::abs(change) > 5 * p.noise) {
       settled = true;
       break;
+    }
+    const double ratio = (current - previous) / (previous - before);
+    const bool grows = std::isfinite(ratio) && ratio > 1.1 &&
+                       std::abs(current - previous) > 5 * p.noise && std::isfinite(last_ratio) &&
+                       ratio >= 0.99 * last_ratio;
+    growing = grows ? growing + 1 : 0;
+    last_ratio = std::isfinite(ratio) && ratio > 1.1 ? ratio : kNaN;
+    // ln(ratio) / chunk is the growth rate r of the output's slope; a PTn
+    // step response t^(n-1) exp(-t / T) has r = (n - 1) / t - 1 / T, so a
+    // rate held up to r t >= 8, t from the output's first move (past any dead
+    // time), would take an order above 9 to explain. (Checked on PT1..PT12
+    // with T = 0.2..40 s and dead times 0..10 s: none is called divergent;
+    // exp(a t) is for a >= 0.3 / s, within 30 s.)
+    const double elapsed = rec.time() - rest_end * Ts;
+    if (std::isinf(current) ||
+        (growing >= 4 && std::log(ratio) / chunk * (rec.time() - moved_at) >= 8.0)) {
+      return fmt::format(
+          "the output diverges after an input step from {:g} to {:g}: it moved by {:.3g} in "
+          "{:.1f} s, its change per {:g} s growing {:.3g}-fold each time, as an unstable plant's "
+          "does; the probe stopped and the input is back at {:g}. Stabilise the plant first (an "
+          "inner loop), then commission the loop around it",
+          u_lo, p.u_mid, current - p.y_rest, elapsed, chunk, ratio, u_lo);
     }
   }
   const double dy = current - p.y_rest;

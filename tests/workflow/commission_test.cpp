@@ -7,6 +7,8 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <tuple>
+#include <vector>
 
 #include <fmt/format.h>
 #include <gmock/gmock.h>
@@ -19,6 +21,7 @@ namespace pneumid {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::string TempDir(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() / ("pneumid_commission_" + name);
@@ -156,6 +159,70 @@ TEST(Commission, AnIntegratingPlantDoesNotSettle) {
   EXPECT_EQ(r.termination, Termination::kFailure);
   EXPECT_THAT(r.message, HasSubstr("did not settle"));
   EXPECT_LE(r.plant_time, 0.25 * 60.0 + 2.0);
+}
+
+// x(k+1) = a x(k) + b u(k): unstable for a > 1; or n first-order lags of
+// time constant T in series (exact discretisation, stable for any n) behind
+// a dead time.
+class LagChainPlant : public Plant {
+ public:
+  LagChainPlant(double a, double b) : n_(1), a_(a), b_(b), delay_(0) {}
+  LagChainPlant(int n, double T, double dead_time)
+      : n_(n),
+        a_(std::exp(-0.01 / T)),
+        b_(1.0 - a_),
+        delay_(static_cast<std::size_t>(std::lround(dead_time / 0.01))) {}
+  void Reset() override { x_.assign(n_, 0.0), u_.clear(), t_ = 0.0; }
+  double Measure() override { return x_.empty() ? 0.0 : x_.back(); }
+  void Advance(double u) override {
+    if (x_.empty()) Reset();
+    u_.push_back(u);
+    double in = u_.size() > delay_ ? u_[u_.size() - 1 - delay_] : 0.0;
+    for (double& x : x_) in = x = a_ * x + b_ * in;
+    t_ += Ts();
+  }
+  double Ts() const override { return 0.01; }
+  double time() const override { return t_; }
+  std::string Describe() const override { return "lag chain"; }
+
+ private:
+  int n_;
+  double a_, b_;
+  std::size_t delay_;
+  std::vector<double> x_, u_;
+  double t_ = 0.0;
+};
+
+TEST(Commission, AnUnstablePlantIsStoppedWhenItsOutputDiverges) {
+  // exp(2 t): the probe sees the change per 0.5 s grow 2.7-fold again and
+  // again and stops within seconds, not at the cap (15 s of a 60 s budget).
+  LagChainPlant plant(std::exp(0.02), 0.01);
+  const CommissionResult r = Commission(plant, Options("unstable"));
+  EXPECT_EQ(r.termination, Termination::kFailure);
+  EXPECT_THAT(r.message, HasSubstr("the output diverges after an input step from 0 to 5"));
+  EXPECT_THAT(r.message, HasSubstr("2.72-fold"));
+  EXPECT_LE(r.plant_time, 6.0);
+  ASSERT_GT(r.experiment.data.size(), 0);             // the data so far are kept
+  EXPECT_EQ(r.experiment.data.u(0).tail(1)[0], 0.0);  // the plant is left at the lowest input
+  // Slower divergence, exp(0.5 t): 16 s after the step, before the cap of a 120 s budget.
+  LagChainPlant slower(std::exp(0.005), 0.01);
+  CommissionOptions o = Options("unstable-slow");
+  o.budget = 120.0;
+  const CommissionResult s = Commission(slower, o);
+  EXPECT_THAT(s.message, HasSubstr("the output diverges"));
+  EXPECT_LE(s.plant_time, 20.0);
+}
+
+TEST(Commission, SlowHighOrderPlantsAreNotMistakenForUnstableOnes) {
+  // PT8 of T = 4 s behind 5 s of dead time, PT12 of T = 2 s: their slopes
+  // grow for a long time after the step, at ratios that keep falling.
+  for (const auto& [n, T, dead] :
+       {std::tuple{8, 4.0, 5.0}, std::tuple{12, 2.0, 0.0}, std::tuple{3, 10.0, 10.0}}) {
+    LagChainPlant plant(n, T, dead);
+    const CommissionResult r = Commission(plant, Options("slow-pt" + std::to_string(n)));
+    EXPECT_EQ(r.termination, Termination::kFailure);
+    EXPECT_THAT(r.message, Not(HasSubstr("diverges"))) << "PT" << n << ": " << r.message;
+  }
 }
 
 // The IPA's position twin integrates its input: the pulses measure its
