@@ -12,6 +12,7 @@
 // controller as C99, as `pneumid codegen --config DIR/controller.toml`).
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <iostream>
@@ -108,12 +109,18 @@ void ParseSpecification(const std::string& text, CommissionOptions& o) {
 void PrintSummary(const CommissionResult& r, const std::string& dir, double spec_overshoot) {
   const auto& ex = r.experiment;
   std::cout << fmt::format("commission {}: {}\n", ToString(r.termination), r.message);
-  std::cout << fmt::format(
-      "experiment: {:.1f} s of plant time; probe K = {:.4g}, tau = {:.3g} s, theta = {:.3g} s; "
-      "reachable {:.4g}..{:.4g}, range {:.4g}..{:.4g}; {} + {} levels of {:.3g} s\n",
-      ex.duration, ex.gain, ex.time_constant, ex.dead_time, ex.reachable_min, ex.reachable_max,
-      ex.range_min, ex.range_max, ex.estimation_levels.size(), ex.validation_levels.size(),
-      ex.dwell);
+  if (!std::isfinite(ex.gain)) {
+    // Stopped during the probe step: nothing was measured yet.
+    std::cout << fmt::format("experiment: {:.1f} s of plant time; stopped in the probe step\n",
+                             ex.duration);
+  } else {
+    std::cout << fmt::format(
+        "experiment: {:.1f} s of plant time; probe K = {:.4g}, tau = {:.3g} s, theta = {:.3g} "
+        "s; reachable {:.4g}..{:.4g}, range {:.4g}..{:.4g}; {} + {} levels of {:.3g} s\n",
+        ex.duration, ex.gain, ex.time_constant, ex.dead_time, ex.reachable_min, ex.reachable_max,
+        ex.range_min, ex.range_max, ex.estimation_levels.size(), ex.validation_levels.size(),
+        ex.dwell);
+  }
   if (!r.identification.models.empty()) {
     std::cout << "models (ranked on the held-out part):\n";
     for (const IdentifiedModel& m : r.identification.models)

@@ -174,6 +174,17 @@ echo "$out" | grep -q "cannot be reached: the output reaches" || fail "unreachab
 out=$("$PNEUMID" commission --plant ipa --budget 5 -o "$TMP/e2" 2>&1)
 [ $? -eq 1 ] || fail "short budget: exit status"
 echo "$out" | grep -q "too short" || fail "short budget: $out"
+# An unstable plant: stopped within seconds of the probe step, the reason on
+# stderr, no probe figures of NaN on stdout, the input back at its lowest.
+out=$("$PNEUMID" commission --plant "tf:num=0.1,den=1 -1.05,Ts=0.01" --u-min 0 --u-max 10 \
+  -o "$TMP/e4" 2>"$TMP/e4.err")
+[ $? -eq 1 ] || fail "unstable plant: exit status"
+grep -q "the output diverges after an input step from 0 to 5" "$TMP/e4.err" ||
+  fail "unstable plant: $(cat "$TMP/e4.err")"
+echo "$out" | grep -q "stopped in the probe step" || fail "unstable plant: stdout $out"
+echo "$out" | grep -qi "nan" && fail "unstable plant: NaN on stdout: $out"
+tail -1 "$TMP/e4/data.csv" | awk -F, '$1 <= 6 && $2 == 0 { ok = 1 } END { exit !ok }' ||
+  fail "unstable plant: data end $(tail -1 "$TMP/e4/data.csv") (not at u = 0 within 6 s)"
 out=$("$PNEUMID" commission --plant ipa --spec overshoot=x -o "$TMP/e3" 2>&1)
 [ $? -ne 0 ] || fail "bad --spec accepted"
 echo "$out" | grep -q "overshoot" || fail "bad --spec message: $out"
