@@ -181,7 +181,8 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
   if (held_out != nullptr) {
     // A held-out part on one input level scores each model's steady state
     // there, not its dynamics: a ranking (and a structure search) on it says
-    // little. Models are still scored; the nonlinear structure search refuses.
+    // little. Models are still scored; the nonlinear structure search does not
+    // choose on it (IdentifyNonlinear falls back on the request's orders).
     const Eigen::VectorXd u = held_out->u(request.input);
     if (u.size() > 0 && !(u.maxCoeff() > u.minCoeff()))
       warnings.push_back(fmt::format(
