@@ -344,6 +344,11 @@ static Registrar reg(
                    "Draw the progress bar even when stderr is not a terminal");
       app.callback([args, na, nb, nk, max_terms] {
         args->nonlinear.choose_structure = na->count() == 0 && nb->count() == 0 && nk->count() == 0;
+        if ((na->count() > 0 || nb->count() > 0) &&
+            ("," + args->methods + ",").find(",affine-narx,") != std::string::npos)
+          std::cerr << "pneumid identify: warning: affine-narx is first order (y(t-1) and "
+                       "f(u(t-nk))): --na and --nb do not change it; --nk, --degree and --knots "
+                       "do\n";
         if (max_terms->count() > 0) args->nonlinear.max_narx_terms = args->nonlinear.narx.max_terms;
         Run(*args);
       });

@@ -125,4 +125,19 @@ expect_ok "fit-p1d to file" identify "$DATA/fopdt.csv" -m fit-p1d -o "$TMP/p1d.j
 fit=$($PY -c "import json; print('%.2f' % json.load(open('$TMP/p1d.json'))['models'][0]['fit_percent'])")
 expect_ok "validate p1d" validate "$TMP/p1d.json" "$DATA/fopdt.csv"
 check_output "same fit" "simulation fit: $fit %"
+
+# A split whose rest holds one input level: ranked on it with a warning, on
+# stderr and in --json; orders that do not apply to a method are said to.
+expect_ok "one-level step" simulate --plant arx-paper --input step:from=0,to=50,at=1 --duration 4 \
+  -o "$TMP/onestep.csv"
+expect_ok "split at one level" identify "$TMP/onestep.csv" -m arx,fit-p1d --split 0.6
+check_output "one-level warning" "warning: the last 40 % of $TMP/onestep.csv holds a constant input (u = 50 over" "$TMP/err"
+expect_ok "split at one level, json" identify "$TMP/onestep.csv" -m arx,fit-p1d --split 0.6 --json
+check_json "warnings key" 'len(j["warnings"]) == 1 and "holds a constant input" in j["warnings"][0]'
+expect_ok "no warnings" identify "$TMP/prbs.csv" -m arx --split 0.7 --json
+check_json "empty warnings" 'j["warnings"] == []'
+expect_ok "stairs" simulate --plant ipa --input "staircase:levels=10 40 70 25 55 85,dwell=1" --duration 6 \
+  -o "$TMP/stairs.csv"
+expect_ok "affine-narx --na" identify "$TMP/stairs.csv" -m affine-narx --na 2
+check_output "affine-narx order warning" "affine-narx is first order" "$TMP/err"
 finish
