@@ -344,8 +344,9 @@ static Registrar reg(
                    "Draw the progress bar even when stderr is not a terminal");
       app.callback([args, na, nb, nk, max_terms] {
         args->nonlinear.choose_structure = na->count() == 0 && nb->count() == 0 && nk->count() == 0;
+        const std::vector<std::string> methods = ParseMethodList(args->methods);
         if ((na->count() > 0 || nb->count() > 0) &&
-            ("," + args->methods + ",").find(",affine-narx,") != std::string::npos)
+            std::find(methods.begin(), methods.end(), "affine-narx") != methods.end())
           std::cerr << "pneumid identify: warning: affine-narx is first order (y(t-1) and "
                        "f(u(t-nk))): --na and --nb do not change it; --nk, --degree and --knots "
                        "do\n";

@@ -243,7 +243,8 @@ std::string ProbeAndSweep(Recorder& rec, const CommissionOptions& o, double u_lo
     before = previous;
     previous = current;
     current = rec.MeanY(from + (rec.size() - from) / 2, rec.size());
-    Report(o, "probe", (rec.time() - rest_end * Ts) / cap);
+    const double elapsed = rec.time() - rest_end * Ts;  // since the step
+    Report(o, "probe", elapsed / cap);
     const double change = current - p.y_rest;
     if (std::isnan(moved_at) && std::abs(change) > 5 * p.noise) moved_at = rec.time() - chunk;
     if (std::isfinite(previous) && std::abs(current - previous) <= 0.005 * std::abs(change) &&
@@ -263,7 +264,6 @@ std::string ProbeAndSweep(Recorder& rec, const CommissionOptions& o, double u_lo
     // time), would take an order above 9 to explain. (Checked on PT1..PT12
     // with T = 0.2..40 s and dead times 0..10 s: none is called divergent;
     // exp(a t) is for a >= 0.3 / s, within 30 s.)
-    const double elapsed = rec.time() - rest_end * Ts;
     if (std::isinf(current) ||
         (growing >= 4 && std::log(ratio) / chunk * (rec.time() - moved_at) >= 8.0)) {
       return fmt::format(

@@ -4,6 +4,7 @@
 // of reach, a budget too short) and a stop request.
 #include "pneumid/workflow/commission.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -39,14 +40,24 @@ CommissionOptions Options(const std::string& name) {
   return o;
 }
 
-// y = c (constant sensor), or an integrator y += k u Ts.
+// x(k+1) = a x(k) + b u(k), y = x: a constant sensor (a = 1, b = 0), an
+// integrator (a = 1, b = k Ts), unstable for a > 1; or n first-order lags of
+// time constant T in series (exact discretisation, stable for any n) behind
+// a dead time.
 class TestPlant : public Plant {
  public:
-  TestPlant(double gain, bool integrating) : gain_(gain), integrating_(integrating) {}
-  void Reset() override { y_ = 0.0, t_ = 0.0; }
-  double Measure() override { return y_; }
+  TestPlant(double a, double b) : a_(a), b_(b), delay_(0), x_(1, 0.0) {}
+  TestPlant(int n, double T, double dead_time)
+      : a_(std::exp(-0.01 / T)),
+        b_(1.0 - a_),
+        delay_(static_cast<std::size_t>(std::lround(dead_time / 0.01))),
+        x_(static_cast<std::size_t>(n), 0.0) {}
+  void Reset() override { std::fill(x_.begin(), x_.end(), 0.0), u_.clear(), t_ = 0.0; }
+  double Measure() override { return x_.back(); }
   void Advance(double u) override {
-    if (integrating_) y_ += gain_ * u * Ts();
+    u_.push_back(u);
+    double in = u_.size() > delay_ ? u_[u_.size() - 1 - delay_] : 0.0;
+    for (double& x : x_) in = x = a_ * x + b_ * in;
     t_ += Ts();
   }
   double Ts() const override { return 0.01; }
@@ -54,9 +65,10 @@ class TestPlant : public Plant {
   std::string Describe() const override { return "test plant"; }
 
  private:
-  double gain_;
-  bool integrating_;
-  double y_ = 0.0, t_ = 0.0;
+  double a_, b_;
+  std::size_t delay_;
+  std::vector<double> x_, u_;
+  double t_ = 0.0;
 };
 
 TEST(Commission, TheProbeMeasuresAFirstOrderPlantWithDeadTime) {
@@ -146,7 +158,7 @@ TEST(Commission, TheCommissionPlantRunsAtTheGivenOrTheDefaultPeriod) {
 }
 
 TEST(Commission, APlantThatDoesNotRespondIsNamed) {
-  TestPlant plant(0.0, false);
+  TestPlant plant(1.0, 0.0);
   const CommissionResult r = Commission(plant, Options("dead"));
   EXPECT_EQ(r.termination, Termination::kFailure);
   EXPECT_THAT(r.message, HasSubstr("does not respond"));
@@ -154,49 +166,17 @@ TEST(Commission, APlantThatDoesNotRespondIsNamed) {
 }
 
 TEST(Commission, AnIntegratingPlantDoesNotSettle) {
-  TestPlant plant(1.0, true);
+  TestPlant plant(1.0, 0.01);  // y += u Ts
   const CommissionResult r = Commission(plant, Options("integrating"));
   EXPECT_EQ(r.termination, Termination::kFailure);
   EXPECT_THAT(r.message, HasSubstr("did not settle"));
   EXPECT_LE(r.plant_time, 0.25 * 60.0 + 2.0);
 }
 
-// x(k+1) = a x(k) + b u(k): unstable for a > 1; or n first-order lags of
-// time constant T in series (exact discretisation, stable for any n) behind
-// a dead time.
-class LagChainPlant : public Plant {
- public:
-  LagChainPlant(double a, double b) : n_(1), a_(a), b_(b), delay_(0) {}
-  LagChainPlant(int n, double T, double dead_time)
-      : n_(n),
-        a_(std::exp(-0.01 / T)),
-        b_(1.0 - a_),
-        delay_(static_cast<std::size_t>(std::lround(dead_time / 0.01))) {}
-  void Reset() override { x_.assign(n_, 0.0), u_.clear(), t_ = 0.0; }
-  double Measure() override { return x_.empty() ? 0.0 : x_.back(); }
-  void Advance(double u) override {
-    if (x_.empty()) Reset();
-    u_.push_back(u);
-    double in = u_.size() > delay_ ? u_[u_.size() - 1 - delay_] : 0.0;
-    for (double& x : x_) in = x = a_ * x + b_ * in;
-    t_ += Ts();
-  }
-  double Ts() const override { return 0.01; }
-  double time() const override { return t_; }
-  std::string Describe() const override { return "lag chain"; }
-
- private:
-  int n_;
-  double a_, b_;
-  std::size_t delay_;
-  std::vector<double> x_, u_;
-  double t_ = 0.0;
-};
-
 TEST(Commission, AnUnstablePlantIsStoppedWhenItsOutputDiverges) {
   // exp(2 t): the probe sees the change per 0.5 s grow 2.7-fold again and
   // again and stops within seconds, not at the cap (15 s of a 60 s budget).
-  LagChainPlant plant(std::exp(0.02), 0.01);
+  TestPlant plant(std::exp(0.02), 0.01);
   const CommissionResult r = Commission(plant, Options("unstable"));
   EXPECT_EQ(r.termination, Termination::kFailure);
   EXPECT_THAT(r.message, HasSubstr("the output diverges after an input step from 0 to 5"));
@@ -205,7 +185,7 @@ TEST(Commission, AnUnstablePlantIsStoppedWhenItsOutputDiverges) {
   ASSERT_GT(r.experiment.data.size(), 0);             // the data so far are kept
   EXPECT_EQ(r.experiment.data.u(0).tail(1)[0], 0.0);  // the plant is left at the lowest input
   // Slower divergence, exp(0.5 t): 16 s after the step, before the cap of a 120 s budget.
-  LagChainPlant slower(std::exp(0.005), 0.01);
+  TestPlant slower(std::exp(0.005), 0.01);
   CommissionOptions o = Options("unstable-slow");
   o.budget = 120.0;
   const CommissionResult s = Commission(slower, o);
@@ -218,7 +198,7 @@ TEST(Commission, SlowHighOrderPlantsAreNotMistakenForUnstableOnes) {
   // grow for a long time after the step, at ratios that keep falling.
   for (const auto& [n, T, dead] :
        {std::tuple{8, 4.0, 5.0}, std::tuple{12, 2.0, 0.0}, std::tuple{3, 10.0, 10.0}}) {
-    LagChainPlant plant(n, T, dead);
+    TestPlant plant(n, T, dead);
     const CommissionResult r = Commission(plant, Options("slow-pt" + std::to_string(n)));
     EXPECT_EQ(r.termination, Termination::kFailure);
     EXPECT_THAT(r.message, Not(HasSubstr("diverges"))) << "PT" << n << ": " << r.message;
