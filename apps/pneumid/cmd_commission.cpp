@@ -173,11 +173,6 @@ void Run(CommissionArgs& c) {
     c.Ts = made.Ts;
     PNEUMID_CHECK(c.plant_config.empty() || dynamic_cast<IpaSimulator*>(plant.get()),
                   "--plant-config applies to the ipa plant only, not to '{}'", c.plant);
-    const auto* ipa = dynamic_cast<IpaSimulator*>(plant.get());
-    if (ipa != nullptr && ipa->parameters().mode == IpaMode::kPosition) {
-      o.overshoot = 2.0;  // docs/position.md's targets, unless --spec says otherwise
-      o.settling = 1.0;
-    }
   } else {
     PNEUMID_CHECK(!c.fast || io.kind == IoKind::kUdp,
                   "--fast needs --io sim or udp://HOST:PORT (a plant server steps on request); "
@@ -197,6 +192,9 @@ void Run(CommissionArgs& c) {
     o.actuator = io_plant->actuator();
     plant = std::move(io_plant);
   }
+  // The plant's default specification (a positioning drive's is 2 % and 1 s),
+  // unless --spec says otherwise.
+  SetDefaultSpecification(o, o.actuator ? *o.actuator : PlantActuator(*plant));
   if (!c.spec.empty()) ParseSpecification(c.spec, o);
   SetInputGaps(o, *plant, c.input_gaps);
   // A plant behind a card (or a plant server older than the Info message)
@@ -289,7 +287,8 @@ const Registrar reg(
           ->check(CLI::IsMember({"mpc", "dmc", "gpc", "pid"}));
       app.add_option("--spec", c->spec,
                      "Specification: overshoot=PERCENT,settling=SECONDS (default "
-                     "overshoot=5,settling=0.5; an IPA in position mode: overshoot=2,settling=1)");
+                     "overshoot=5,settling=0.5; an integrating plant, such as the IPA in position "
+                     "mode: overshoot=2,settling=1)");
       app.add_option("--aggressiveness", c->options.aggressiveness,
                      "First design's aggressiveness, 0 robust .. 1 aggressive")
           ->capture_default_str();

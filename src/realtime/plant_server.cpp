@@ -44,12 +44,40 @@ bool PlantServerOptions::IsValid(std::string* error) const {
   return true;
 }
 
+namespace {
+
+// The fields of a Describe(k) reply (udp_protocol.hpp) for actuator `a`.
+void DescribeActuator(const Actuator& a, std::uint32_t k, udp::Reply* rep) {
+  const auto is_ipa = [&a](IpaMode mode) {
+    const Actuator ipa = IpaActuator(mode);
+    return a.hold_name == ipa.hold_name && a.output.unit == ipa.output.unit &&
+           a.integrating == ipa.integrating;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (k == 0) {
+    const udp::ActuatorKind kind = is_ipa(IpaMode::kForce)      ? udp::ActuatorKind::kIpaForce
+                                   : is_ipa(IpaMode::kPosition) ? udp::ActuatorKind::kIpaPosition
+                                                                : udp::ActuatorKind::kOther;
+    rep->plant_time = static_cast<double>(kind);
+    rep->y = a.u_min;
+    rep->aux = a.u_max;
+  } else if (k == 1) {
+    rep->plant_time = a.integrating ? 1.0 : 0.0;
+    rep->y = a.y_min;
+    rep->aux = a.y_max;
+  } else {
+    rep->plant_time = rep->y = rep->aux = nan;
+  }
+}
+
+}  // namespace
+
 PlantServer::PlantServer(std::unique_ptr<Plant> plant, PlantServerOptions options)
     : plant_(std::move(plant)), options_(std::move(options)) {
   PNEUMID_CHECK(plant_ != nullptr, "plant server needs a plant, got null");
   std::string error;
   PNEUMID_CHECK(options_.IsValid(&error), "invalid plant-server options: {}", error);
-  input_gaps_ = PlantActuator(*plant_).input_gaps;
+  actuator_ = PlantActuator(*plant_);
   sockaddr_storage ss{};
   socklen_t len = 0;
   in_addr a4;
@@ -144,15 +172,21 @@ bool PlantServer::Handle(const std::uint8_t* data, std::size_t size, udp::Packet
       return false;
     case udp::PacketType::kInfo: {
       // The plant is not measured (that would draw its noise).
+      const std::vector<InputGap>& gaps = actuator_.input_gaps;
       const std::size_t k = req.arg;
-      rep.plant_time = static_cast<double>(input_gaps_.size());
-      rep.y = k < input_gaps_.size() ? input_gaps_[k].lo : std::numeric_limits<double>::quiet_NaN();
-      rep.aux =
-          k < input_gaps_.size() ? input_gaps_[k].hi : std::numeric_limits<double>::quiet_NaN();
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      rep.plant_time = static_cast<double>(gaps.size());
+      rep.y = k < gaps.size() ? gaps[k].lo : nan;
+      rep.aux = k < gaps.size() ? gaps[k].hi : nan;
       rep.server_time_ns = NowNs();
       *out = udp::Encode(rep);
       return true;
     }
+    case udp::PacketType::kDescribe:
+      DescribeActuator(actuator_, req.arg, &rep);
+      rep.server_time_ns = NowNs();
+      *out = udp::Encode(rep);
+      return true;
   }
   rep.server_time_ns = NowNs();
   rep.plant_time = plant_->time();

@@ -91,6 +91,7 @@ void UdpBackend::Open(double period) {
   // Hello: reset the remote plant and get y_0.
   adopted_period_ = std::numeric_limits<double>::quiet_NaN();
   input_gaps_.clear();
+  described_.reset();
   for (int attempt = 0; attempt < options_.hello_attempts; ++attempt) {
     udp::Request req;
     req.type = udp::PacketType::kHello;
@@ -122,6 +123,7 @@ void UdpBackend::Open(double period) {
     last_y_ = rep.y;
     last_aux_ = rep.aux;
     input_gaps_ = AskInputGaps();
+    described_ = AskActuator();
     have_reply_ = true;
     expect_seq_ = req.sequence;
     missed_ = 0;
@@ -182,8 +184,42 @@ std::vector<InputGap> UdpBackend::AskInputGaps() {
   return gaps;
 }
 
+std::optional<Actuator> UdpBackend::AskActuator() {
+  udp::Reply field[2];
+  for (std::uint32_t k = 0; k < 2; ++k) {
+    udp::Request req;
+    req.type = udp::PacketType::kDescribe;
+    req.sequence = ++seq_;
+    req.arg = k;
+    req.client_time_ns = NowNs();
+    const udp::Packet p = udp::Encode(req);
+    ::send(fd_, p.data(), p.size(), 0);
+    if (!AwaitReply(udp::PacketType::kDescribe, req.sequence, 0.2, &field[k]) ||
+        field[k].status != udp::PacketStatus::kOk)
+      return std::nullopt;  // a server before Describe
+  }
+  const double kind = field[0].plant_time, integrating = field[1].plant_time;
+  Actuator a;
+  if (kind == static_cast<double>(udp::ActuatorKind::kIpaForce))
+    a = IpaActuator(IpaMode::kForce);
+  else if (kind == static_cast<double>(udp::ActuatorKind::kIpaPosition))
+    a = IpaActuator(IpaMode::kPosition);
+  else if (kind != static_cast<double>(udp::ActuatorKind::kOther))
+    return std::nullopt;
+  // Ranges: ordered, not NaN (infinite ends are unbounded).
+  const auto range = [](const udp::Reply& r) { return r.y < r.aux; };
+  if (!range(field[0]) || !range(field[1]) || !(integrating == 0.0 || integrating == 1.0))
+    return std::nullopt;
+  a.u_min = field[0].y;
+  a.u_max = field[0].aux;
+  a.y_min = field[1].y;
+  a.y_max = field[1].aux;
+  a.integrating = integrating == 1.0;
+  return a;
+}
+
 Actuator UdpBackend::actuator() const {
-  Actuator a = IpaActuator();
+  Actuator a = described_ ? *described_ : IpaActuator();
   a.input_gaps = input_gaps_;
   return a;
 }

@@ -27,7 +27,7 @@ T Get(const std::uint8_t* d, std::size_t off) noexcept {
   return v;
 }
 
-bool KnownType(std::uint16_t t) noexcept { return t >= 1 && t <= 5; }
+bool KnownType(std::uint16_t t) noexcept { return t >= 1 && t <= 6; }
 
 DecodeResult Header(const std::uint8_t* d, std::size_t size, bool reply,
                     PacketType* type) noexcept {

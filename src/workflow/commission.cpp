@@ -1320,6 +1320,12 @@ CommissionPlant MakeCommissionPlant(const std::string& spec, std::optional<doubl
   return c;
 }
 
+void SetDefaultSpecification(CommissionOptions& options, const Actuator& actuator) {
+  const CommissionOptions defaults;
+  options.overshoot = actuator.integrating ? 2.0 : defaults.overshoot;
+  options.settling = actuator.integrating ? 1.0 : defaults.settling;
+}
+
 void SetInputGaps(CommissionOptions& options, const Plant& plant, const std::string& text) {
   if (text == "plant") return;
   if (text == "none") {

@@ -195,16 +195,19 @@ echo "$out" | grep -q "overshoot" || fail "bad --spec message: $out"
 # (an output disturbance over the backend too) and each run started from rest.
 SERVER_PID=""
 cleanup() { [ -n "$SERVER_PID" ] && kill "$SERVER_PID" 2>/dev/null; }
-: > "$TMP/server.txt"
-"$PNEUMID" plant-server --plant ipa --port 0 --Ts 0.0033333333333 > "$TMP/server.txt" 2>&1 &
-SERVER_PID=$!
-PORT=""
-for _ in $(seq 50); do
-  PORT=$(sed -n 's/.*udp:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$TMP/server.txt")
-  [ -n "$PORT" ] && break
-  sleep 0.1
-done
-[ -n "$PORT" ] || fail "plant-server did not start: $(cat "$TMP/server.txt")"
+start_server() {  # start_server PLANT: serves it at one PWM period; sets SERVER_PID and PORT
+  : > "$TMP/server.txt"
+  "$PNEUMID" plant-server --plant "$1" --port 0 --Ts 0.0033333333333 > "$TMP/server.txt" 2>&1 &
+  SERVER_PID=$!
+  PORT=""
+  for _ in $(seq 50); do
+    PORT=$(sed -n 's/.*udp:\/\/127\.0\.0\.1:\([0-9]*\).*/\1/p' "$TMP/server.txt")
+    [ -n "$PORT" ] && break
+    sleep 0.1
+  done
+  [ -n "$PORT" ] || fail "plant-server did not start: $(cat "$TMP/server.txt")"
+}
+start_server ipa
 # Neither --Ts nor --input-gaps: the server's period and gaps are taken.
 "$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --fast -o "$TMP/u" --json \
   > "$TMP/u.json" 2> "$TMP/u.err"
@@ -234,6 +237,26 @@ out=$("$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --Ts 0.01 --fast -o "$T
 [ $? -eq 1 ] || fail "udp with another period: exit status"
 echo "$out" | grep -q "its plant runs at Ts = 0.0033333333333 s, not 0.01 s" ||
   fail "udp with another period: $out"
+kill "$SERVER_PID"; wait "$SERVER_PID" 2>/dev/null; SERVER_PID=""
+
+# A positioning drive behind the server: the server describes its actuator
+# (a signed command, the stroke, integrating), so commission takes the
+# integrating plant's route over UDP as on the simulator.
+start_server ipa-position
+"$PNEUMID" commission --io "udp://127.0.0.1:$PORT" --fast -o "$TMP/up" --json \
+  > "$TMP/up.json" 2> "$TMP/up.err" || fail "commission of a positioning drive over udp: $(cat "$TMP/up.err")"
+$PY - "$TMP/up.json" <<'PYEOF' || fail "commission of a positioning drive over udp JSON"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["chosen_model"] == "integrator", j["chosen_model"]
+assert "overshoot <= 2 %, settling <= 1 s" in j["message"], j["message"]  # a drive's targets
+assert j["controller"]["type"] == "pid", j["controller"]
+v = j["verification"]
+assert v["passed"] and v["u_min"] < -50.0, (v["passed"], v["u_min"])  # it retracts
+assert abs(v["steady_state_error"]) <= 1e-4, v["steady_state_error"]
+PYEOF
+grep -q '^input_gaps = "-100:-91,-9:0,0:9,91:100"' "$TMP/up/controller.toml" ||
+  fail "udp position: not the server's gaps: $(grep input_gaps "$TMP/up/controller.toml")"
 kill "$SERVER_PID"; wait "$SERVER_PID" 2>/dev/null; SERVER_PID=""
 
 # Ctrl-C in the middle of the experiment: exit 130, the plant at its lowest

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -93,7 +94,7 @@ TEST(UdpProtocol, ReplyRoundTripAndRejections) {
   bad[4] = 2;
   EXPECT_EQ(udp::DecodeReply(bad.data(), bad.size(), &back), udp::DecodeResult::kBadVersion);
   bad = p;
-  bad[6] = 0x86;  // type 6: unknown (1..5 are Hello, Step, Safe, Bye, Info)
+  bad[6] = 0x87;  // type 7: unknown (1..6 are Hello, Step, Safe, Bye, Info, Describe)
   EXPECT_EQ(udp::DecodeReply(bad.data(), bad.size(), &back), udp::DecodeResult::kBadType);
 }
 
@@ -359,7 +360,9 @@ TEST(UdpBackend, SilentServerIsATimeoutWithinMaxMissedPeriods) {
   // 50 steps answered (samples 0..50 fresh), then 3 missing replies: fault at sample 53.
   EXPECT_EQ(s.samples, 54);
   EXPECT_THAT(s.message, HasSubstr("timeout"));
-  EXPECT_THAT(s.message, HasSubstr("exhaust-open"));
+  // The served plant is a first-order one: its release state has the
+  // generic name (an IPA server's is "exhaust-open").
+  EXPECT_THAT(s.message, HasSubstr("outputs set to release"));
 }
 
 TEST(UdpBackend, NoServerIsAClearErrorAtOpen) {
@@ -421,6 +424,92 @@ TEST(PlantServer, InfoTellsThePlantsInputGapsWithoutTouchingIt) {
   const udp::Reply none = info(linear, 0);
   EXPECT_EQ(none.plant_time, 0.0);
   EXPECT_TRUE(std::isnan(none.y) && std::isnan(none.aux));
+}
+
+// Describe(k) tells the server plant's actuator: the IPA in force mode (duty
+// 0..100 %, force unbounded), in position mode (command -100..100 %, the
+// stroke, integrating) and a generic plant (unbounded), without a step.
+TEST(PlantServer, DescribeTellsThePlantsActuatorWithoutTouchingIt) {
+  PlantServerOptions o;
+  o.port = 0;
+  const auto describe = [](PlantServer& server, std::uint32_t k) {
+    udp::Request req;
+    req.type = udp::PacketType::kDescribe;
+    req.sequence = 40 + k;
+    req.arg = k;
+    const udp::Packet p = udp::Encode(req);
+    udp::Packet out;
+    EXPECT_TRUE(server.Handle(p.data(), p.size(), &out));
+    udp::Reply rep;
+    EXPECT_EQ(udp::DecodeReply(out.data(), out.size(), &rep), udp::DecodeResult::kOk);
+    EXPECT_EQ(rep.type, udp::PacketType::kDescribe);
+    EXPECT_EQ(rep.sequence, 40 + k);
+    EXPECT_EQ(rep.status, udp::PacketStatus::kOk);
+    return rep;
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  PlantServer force(MakePlant("ipa", 1.0 / 300.0), o);
+  udp::Reply r = describe(force, 0);
+  EXPECT_EQ(r.plant_time, static_cast<double>(udp::ActuatorKind::kIpaForce));
+  EXPECT_EQ(r.y, 0.0);
+  EXPECT_EQ(r.aux, 100.0);
+  r = describe(force, 1);
+  EXPECT_EQ(r.plant_time, 0.0);
+  EXPECT_EQ(r.y, -inf);
+  EXPECT_EQ(r.aux, inf);
+  EXPECT_TRUE(std::isnan(describe(force, 2).y));
+  EXPECT_EQ(force.stats().steps, 0);
+
+  const double stroke = PlantActuator(*MakePlant("ipa-position", 1.0 / 300.0)).y_max;
+  ASSERT_GT(stroke, 0.0);
+  PlantServer position(MakePlant("ipa-position", 1.0 / 300.0), o);
+  r = describe(position, 0);
+  EXPECT_EQ(r.plant_time, static_cast<double>(udp::ActuatorKind::kIpaPosition));
+  EXPECT_EQ(r.y, -100.0);
+  EXPECT_EQ(r.aux, 100.0);
+  r = describe(position, 1);
+  EXPECT_EQ(r.plant_time, 1.0);
+  EXPECT_EQ(r.y, 0.0);
+  EXPECT_EQ(r.aux, stroke);
+
+  PlantServer linear(std::make_unique<FirstOrderPlant>(0.01, 0.5, 1.0), o);
+  r = describe(linear, 0);
+  EXPECT_EQ(r.plant_time, static_cast<double>(udp::ActuatorKind::kOther));
+  EXPECT_EQ(r.y, -inf);
+  EXPECT_EQ(r.aux, inf);
+}
+
+// A client of a positioning drive's server gets that actuator: a signed
+// command, the stroke as output range, integrating, the four gaps; a
+// client of a linear plant's server gets the generic one, not the IPA's.
+TEST(UdpBackend, LearnsThePositioningDrivesActuatorFromItsServer) {
+  PlantServerOptions so;
+  so.port = 0;
+  const Actuator want = PlantActuator(*MakePlant("ipa-position", 1.0 / 300.0));
+  auto srv = std::make_unique<ServerThread>(so, MakePlant("ipa-position", 1.0 / 300.0));
+  UdpBackendOptions uo;
+  uo.port = srv->server.port();
+  IoPlant plant(std::make_unique<UdpBackend>(uo), 1.0 / 300.0, false);
+  const Actuator a = plant.actuator();
+  EXPECT_TRUE(a.integrating);
+  EXPECT_EQ(a.u_min, -100.0);
+  EXPECT_EQ(a.u_max, 100.0);
+  EXPECT_EQ(a.y_min, 0.0);
+  EXPECT_EQ(a.y_max, want.y_max);
+  EXPECT_EQ(a.output.unit, "m");
+  EXPECT_EQ(a.output_label, "position");
+  EXPECT_EQ(a.hold_name, want.hold_name);
+  EXPECT_EQ(a.input_gaps, want.input_gaps);
+
+  auto lin = std::make_unique<ServerThread>(so, std::make_unique<FirstOrderPlant>(0.01, 0.5, 1.0));
+  uo.port = lin->server.port();
+  IoPlant generic(std::make_unique<UdpBackend>(uo), 0.01, false);
+  const Actuator g = generic.actuator();
+  EXPECT_FALSE(g.integrating);
+  EXPECT_EQ(g.output.unit, "");
+  EXPECT_EQ(g.hold_name, "hold");
+  EXPECT_FALSE(std::isfinite(g.u_min));
+  EXPECT_TRUE(g.input_gaps.empty());
 }
 
 // A client whose period was not given takes the server's (the reply to a

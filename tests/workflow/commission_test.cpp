@@ -205,6 +205,23 @@ TEST(Commission, SlowHighOrderPlantsAreNotMistakenForUnstableOnes) {
   }
 }
 
+// The default specification follows the actuator: the force loop's 5 % and
+// 0.5 s, a positioning drive's 2 % and 1 s (docs/position.md), whichever it
+// was before.
+TEST(Commission, TheDefaultSpecificationFollowsTheActuator) {
+  CommissionOptions o;
+  SetDefaultSpecification(o, PlantActuator(*MakePlant("ipa-position", 1.0 / 300.0)));
+  EXPECT_EQ(o.overshoot, 2.0);
+  EXPECT_EQ(o.settling, 1.0);
+  SetDefaultSpecification(o, PlantActuator(*MakePlant("ipa", 1.0 / 300.0)));
+  EXPECT_EQ(o.overshoot, 5.0);
+  EXPECT_EQ(o.settling, 0.5);
+  Actuator integrator;  // a generic one that integrates
+  integrator.integrating = true;
+  SetDefaultSpecification(o, integrator);
+  EXPECT_EQ(o.overshoot, 2.0);
+}
+
 // The IPA's position twin integrates its input: the pulses measure its
 // velocity gain (the rig's nominal 0.004 m/s per %, within the coasting
 // after each pulse), the PD follows the design rule Kc Ki = 3 / tau, Kc Ki Td

@@ -20,9 +20,9 @@
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/lti/frequency.hpp"
-#include "pneumid/models/model_file_scope.hpp"
-#include "pneumid/models/model_file.hpp"
 #include "pneumid/lti/response.hpp"
+#include "pneumid/models/model_file.hpp"
+#include "pneumid/models/model_file_scope.hpp"
 #include "pneumid/plant/signal.hpp"
 #include "pneumid/realtime/io_backend.hpp"
 #include "pneumid/realtime/realtime_config.hpp"
@@ -886,8 +886,6 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
                                      kMaxCommissionBudget, o.budget));
   CheckWork(Ts, o.budget, 0, 0);
   Get(b, "controller", o.controller);
-  Get(b, "overshoot", o.overshoot);
-  Get(b, "settling", o.settling);
   Get(b, "aggressiveness", o.aggressiveness);
   Get(b, "methods", o.methods);
   double limit = 0.0;
@@ -910,6 +908,12 @@ nlohmann::ordered_json AppApi::Commission(const nlohmann::json& b,
   Ts = made.Ts;
   CheckWork(Ts, o.budget, 0, 0);
   SetInputGaps(o, *plant, gaps);
+  // The plant's default specification (a positioning drive's: 2 % and 1 s),
+  // unless the request gives one.
+  SetDefaultSpecification(o, PlantActuator(*plant));
+  Get(b, "overshoot", o.overshoot);
+  Get(b, "settling", o.settling);
+  PNEUMID_CHECK(o.IsValid(&error), "{}", error);
   std::string dir_field;
   fs::path dir;
   if (Get(b, "dir", dir_field) && !dir_field.empty()) {

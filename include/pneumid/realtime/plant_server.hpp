@@ -70,7 +70,7 @@ class PlantServer {
  private:
   std::unique_ptr<Plant> plant_;
   PlantServerOptions options_;
-  std::vector<InputGap> input_gaps_;  // of the plant's actuator, told by Info
+  Actuator actuator_;  // the plant's, told by Info (its gaps) and Describe
   int fd_ = -1;
   int port_ = 0;
   bool session_ = false;

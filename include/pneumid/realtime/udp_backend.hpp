@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,7 +46,8 @@ class UdpBackend : public IoBackend {
   /// Resolves the host, connects and sends Hello(period) (again with the
   /// server's period when it differs and adopt_server_period is set), then
   /// asks the server for its plant's input gaps (Info; none from a server
-  /// that does not answer it within 0.2 s).
+  /// that does not answer it within 0.2 s) and its actuator (Describe: input
+  /// and output ranges, whether it integrates, the IPA's mode).
   /// @throws DataError when the host cannot be resolved, the server does not answer,
   /// or it rejects the period.
   void Open(double period) override;
@@ -57,8 +59,10 @@ class UdpBackend : public IoBackend {
   IoStatus EnterSafeState(SafeState state) noexcept override;
   void Close() override;
   std::string Describe() const override;
-  /// The plant server's protocol carries the IPA's duty (%) and force (N):
-  /// IpaActuator(), with the input gaps the server told at Open().
+  /// The actuator the server described at Open() (Describe: the IPA in force
+  /// or position mode, or a generic plant with its input and output ranges),
+  /// with the input gaps it told; IpaActuator() in force mode from a server
+  /// that does not describe it (one older than Describe).
   Actuator actuator() const override;
   /// The input gaps the server told at Open() (empty: none, or not told).
   const std::vector<InputGap>& input_gaps() const { return input_gaps_; }
@@ -73,6 +77,9 @@ class UdpBackend : public IoBackend {
   bool Collect(std::int64_t wait_ns) noexcept;
   // Info requests: the server plant's input gaps (empty when it does not say).
   std::vector<InputGap> AskInputGaps();
+  // Describe requests: the server plant's actuator, without its gaps (nullopt
+  // when it does not say or says something inconsistent).
+  std::optional<Actuator> AskActuator();
   // Waits up to `timeout` s for the reply of `type` to `sequence`; false on none.
   bool AwaitReply(udp::PacketType type, std::uint32_t sequence, double timeout, udp::Reply* reply);
 
@@ -81,6 +88,7 @@ class UdpBackend : public IoBackend {
   double period_ = 0.01;
   double adopted_period_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<InputGap> input_gaps_;
+  std::optional<Actuator> described_;  // by Describe at Open()
   std::uint32_t seq_ = 0;
   std::uint32_t expect_seq_ = 0;
   bool have_reply_ = false;  // reply for expect_seq_ received

@@ -8,10 +8,11 @@
 //    0   4   magic 0x444D4E50 ("PNMD")       0   4   magic
 //    4   2   version = 1                      4   2   version
 //    6   2   type (Hello, Step, Safe, Bye,    6   2   type | 0x80
-//            Info)
+//            Info, Describe)
 //    8   4   sequence                         8   4   sequence (echoed)
 //   12   4   arg (safe state for Safe,       12   4   status (PacketStatus)
-//            gap index for Info)
+//            gap index for Info, field
+//            index for Describe)
 //   16   8   client time, ns (int64)         16   8   client time (echoed)
 //   24   8   u, duty % (float64)             24   8   server time, ns (int64, monotonic)
 //   32   8   Ts, s (Hello) (float64)         32   8   plant time, s (float64)
@@ -34,6 +35,14 @@
 //                 gap k (NaN for k >= n). The plant is not touched, and no
 //                 session is needed. Servers older than this message do not
 //                 answer it (the client then knows no gaps).
+//   Describe(k) -> the server plant's actuator (plant/actuator.hpp), without
+//                 touching the plant: k = 0: plant time = its kind
+//                 (ActuatorKind), y and aux = the input range u_min, u_max;
+//                 k = 1: plant time = 1 when the output integrates the input
+//                 (a positioning drive), else 0, y and aux = the output range
+//                 y_min, y_max (infinite = unbounded); k >= 2: NaN. Servers
+//                 older than this message do not answer it (the client then
+//                 takes the IPA in force mode, as before).
 #pragma once
 
 #include <array>
@@ -48,7 +57,17 @@ inline constexpr std::size_t kPacketSize = 64;        ///< bytes of every datagr
 inline constexpr std::uint16_t kReplyBit = 0x80;      ///< set in the type field of a reply
 
 /// Kind of exchange (semantics above).
-enum class PacketType : std::uint16_t { kHello = 1, kStep = 2, kSafe = 3, kBye = 4, kInfo = 5 };
+enum class PacketType : std::uint16_t {
+  kHello = 1,
+  kStep = 2,
+  kSafe = 3,
+  kBye = 4,
+  kInfo = 5,
+  kDescribe = 6
+};
+/// What a Describe(0) reply names the server plant's actuator: the words and
+/// safe states of IpaActuator(mode) for the IPA, the generic ones otherwise.
+enum class ActuatorKind : std::uint32_t { kOther = 0, kIpaForce = 1, kIpaPosition = 2 };
 /// Server's verdict on a request, in the reply.
 enum class PacketStatus : std::uint32_t {
   kOk = 0,
@@ -65,12 +84,12 @@ using Packet = std::array<std::uint8_t, kPacketSize>;
 
 /// A client -> server datagram, decoded.
 struct Request {
-  PacketType type = PacketType::kStep;  ///< Hello, Step, Safe or Bye
+  PacketType type = PacketType::kStep;  ///< Hello, Step, Safe, Bye, Info or Describe
   std::uint32_t sequence = 0;           ///< request number; a repeated Step is not re-applied
-  std::uint32_t arg = 0;                ///< SafeState for Safe, gap index for Info, else 0
-  std::int64_t client_time_ns = 0;      ///< client's monotonic clock at sending, ns (echoed)
-  double u = 0.0;                       ///< input to hold for one period (Step), duty %
-  double Ts = 0.0;                      ///< client's sample period (Hello), s
+  std::uint32_t arg = 0;  ///< SafeState for Safe, gap index for Info, field for Describe, else 0
+  std::int64_t client_time_ns = 0;  ///< client's monotonic clock at sending, ns (echoed)
+  double u = 0.0;                   ///< input to hold for one period (Step), duty %
+  double Ts = 0.0;                  ///< client's sample period (Hello), s
 };
 
 /// A server -> client datagram, decoded.
@@ -80,8 +99,8 @@ struct Reply {
   PacketStatus status = PacketStatus::kOk;  ///< kOk, or why the request was refused
   std::int64_t client_time_ns = 0;          ///< the request's client time (round-trip time)
   std::int64_t server_time_ns = 0;          ///< server's monotonic clock at replying, ns
-  double plant_time = 0.0;                  ///< plant time after the request, s (Info: gaps)
-  double y = 0.0;                           ///< measured output (IPA: force N; Info: gap's low end)
+  double plant_time = 0.0;  ///< plant time after the request, s (Info: gaps; Describe: above)
+  double y = 0.0;           ///< measured output (IPA: force N; Info: gap's low end)
   /// Chamber pressure, Pa, or NaN (Info: the gap's high end).
   double aux = std::numeric_limits<double>::quiet_NaN();
   double Ts = 0.0;  ///< the server plant's sample time, s (0: not told)
