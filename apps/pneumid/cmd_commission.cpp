@@ -194,7 +194,7 @@ void Run(CommissionArgs& c) {
   }
   // The plant's default specification (a positioning drive's is 2 % and 1 s),
   // unless --spec says otherwise.
-  SetDefaultSpecification(o, o.actuator ? *o.actuator : PlantActuator(*plant));
+  SetDefaultSpecification(o, PlantActuator(*plant));
   if (!c.spec.empty()) ParseSpecification(c.spec, o);
   SetInputGaps(o, *plant, c.input_gaps);
   // A plant behind a card (or a plant server older than the Info message)

@@ -158,23 +158,25 @@ bool UdpBackend::AwaitReply(udp::PacketType type, std::uint32_t sequence, double
   return false;
 }
 
+bool UdpBackend::AskServer(udp::PacketType type, std::uint32_t arg, udp::Reply* reply) {
+  udp::Request req;
+  req.type = type;
+  req.sequence = ++seq_;
+  req.arg = arg;
+  req.client_time_ns = NowNs();
+  const udp::Packet p = udp::Encode(req);
+  ::send(fd_, p.data(), p.size(), 0);
+  return AwaitReply(type, req.sequence, 0.2, reply) && reply->status == udp::PacketStatus::kOk;
+}
+
 std::vector<InputGap> UdpBackend::AskInputGaps() {
   // A gap of the IPA's duty is a few % wide; a server telling more than a few
   // gaps, or ends out of order, is not believed.
   constexpr std::uint32_t kMaxGaps = 16;
   std::vector<InputGap> gaps;
   for (std::uint32_t k = 0; k < kMaxGaps; ++k) {
-    udp::Request req;
-    req.type = udp::PacketType::kInfo;
-    req.sequence = ++seq_;
-    req.arg = k;
-    req.client_time_ns = NowNs();
-    const udp::Packet p = udp::Encode(req);
-    ::send(fd_, p.data(), p.size(), 0);
     udp::Reply rep;
-    if (!AwaitReply(udp::PacketType::kInfo, req.sequence, 0.2, &rep) ||
-        rep.status != udp::PacketStatus::kOk)
-      return {};  // a server before Info: no gaps told
+    if (!AskServer(udp::PacketType::kInfo, k, &rep)) return {};  // a server before Info
     const double n = rep.plant_time;
     if (!(n >= 0.0 && n <= kMaxGaps) || n != std::floor(n)) return {};
     if (k >= static_cast<std::uint32_t>(n)) break;
@@ -186,18 +188,9 @@ std::vector<InputGap> UdpBackend::AskInputGaps() {
 
 std::optional<Actuator> UdpBackend::AskActuator() {
   udp::Reply field[2];
-  for (std::uint32_t k = 0; k < 2; ++k) {
-    udp::Request req;
-    req.type = udp::PacketType::kDescribe;
-    req.sequence = ++seq_;
-    req.arg = k;
-    req.client_time_ns = NowNs();
-    const udp::Packet p = udp::Encode(req);
-    ::send(fd_, p.data(), p.size(), 0);
-    if (!AwaitReply(udp::PacketType::kDescribe, req.sequence, 0.2, &field[k]) ||
-        field[k].status != udp::PacketStatus::kOk)
+  for (std::uint32_t k = 0; k < 2; ++k)
+    if (!AskServer(udp::PacketType::kDescribe, k, &field[k]))
       return std::nullopt;  // a server before Describe
-  }
   const double kind = field[0].plant_time, integrating = field[1].plant_time;
   Actuator a;
   if (kind == static_cast<double>(udp::ActuatorKind::kIpaForce))

@@ -387,6 +387,24 @@ TEST(UdpBackend, NoServerIsAClearErrorAtOpen) {
   EXPECT_THROW(UdpBackend(UdpBackendOptions{"", 1}), InvalidArgument);
 }
 
+// A request about the plant (Info or Describe) of argument k, handled by
+// `server`; the reply, checked to answer it with status ok.
+udp::Reply AskPlantServer(PlantServer& server, udp::PacketType type, std::uint32_t k) {
+  udp::Request req;
+  req.type = type;
+  req.sequence = 7 + k;
+  req.arg = k;
+  const udp::Packet p = udp::Encode(req);
+  udp::Packet out;
+  EXPECT_TRUE(server.Handle(p.data(), p.size(), &out));
+  udp::Reply rep;
+  EXPECT_EQ(udp::DecodeReply(out.data(), out.size(), &rep), udp::DecodeResult::kOk);
+  EXPECT_EQ(rep.type, type);
+  EXPECT_EQ(rep.sequence, 7 + k);
+  EXPECT_EQ(rep.status, udp::PacketStatus::kOk);
+  return rep;
+}
+
 // Info(k) tells the server plant's input gaps (the IPA's from its valves'
 // minimum pulse at 300 Hz: 0..15 and 85..100 % duty; none for a linear
 // plant) without touching the plant.
@@ -394,19 +412,7 @@ TEST(PlantServer, InfoTellsThePlantsInputGapsWithoutTouchingIt) {
   PlantServerOptions o;
   o.port = 0;
   const auto info = [](PlantServer& server, std::uint32_t k) {
-    udp::Request req;
-    req.type = udp::PacketType::kInfo;
-    req.sequence = 7 + k;
-    req.arg = k;
-    const udp::Packet p = udp::Encode(req);
-    udp::Packet out;
-    EXPECT_TRUE(server.Handle(p.data(), p.size(), &out));
-    udp::Reply rep;
-    EXPECT_EQ(udp::DecodeReply(out.data(), out.size(), &rep), udp::DecodeResult::kOk);
-    EXPECT_EQ(rep.type, udp::PacketType::kInfo);
-    EXPECT_EQ(rep.sequence, 7 + k);
-    EXPECT_EQ(rep.status, udp::PacketStatus::kOk);
-    return rep;
+    return AskPlantServer(server, udp::PacketType::kInfo, k);
   };
   PlantServer ipa(MakePlant("ipa", 1.0 / 300.0), o);
   const std::vector<InputGap> gaps = PlantActuator(*MakePlant("ipa", 1.0 / 300.0)).input_gaps;
@@ -433,19 +439,7 @@ TEST(PlantServer, DescribeTellsThePlantsActuatorWithoutTouchingIt) {
   PlantServerOptions o;
   o.port = 0;
   const auto describe = [](PlantServer& server, std::uint32_t k) {
-    udp::Request req;
-    req.type = udp::PacketType::kDescribe;
-    req.sequence = 40 + k;
-    req.arg = k;
-    const udp::Packet p = udp::Encode(req);
-    udp::Packet out;
-    EXPECT_TRUE(server.Handle(p.data(), p.size(), &out));
-    udp::Reply rep;
-    EXPECT_EQ(udp::DecodeReply(out.data(), out.size(), &rep), udp::DecodeResult::kOk);
-    EXPECT_EQ(rep.type, udp::PacketType::kDescribe);
-    EXPECT_EQ(rep.sequence, 40 + k);
-    EXPECT_EQ(rep.status, udp::PacketStatus::kOk);
-    return rep;
+    return AskPlantServer(server, udp::PacketType::kDescribe, k);
   };
   const double inf = std::numeric_limits<double>::infinity();
   PlantServer force(MakePlant("ipa", 1.0 / 300.0), o);

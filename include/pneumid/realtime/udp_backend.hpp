@@ -75,6 +75,9 @@ class UdpBackend : public IoBackend {
  private:
   // Receives pending replies; returns true when the one for `expect_seq_` arrived.
   bool Collect(std::int64_t wait_ns) noexcept;
+  // One request about the server's plant (Info, Describe), answered within
+  // 0.2 s with status ok; false otherwise (a server older than it).
+  bool AskServer(udp::PacketType type, std::uint32_t arg, udp::Reply* reply);
   // Info requests: the server plant's input gaps (empty when it does not say).
   std::vector<InputGap> AskInputGaps();
   // Describe requests: the server plant's actuator, without its gaps (nullopt

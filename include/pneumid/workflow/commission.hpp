@@ -258,12 +258,10 @@ struct CommissionResult {
 CommissionResult Commission(Plant& plant, const CommissionOptions& options);
 
 /// Sets the specification of `options` to the default of the plant whose
-/// actuator is `actuator` (options.actuator, else PlantActuator(plant), as
-/// `pneumid commission` and the app take it before `--spec` or the request's
-/// values): overshoot 5 % and settling 0.5 s (the force loop's targets), and
-/// for an integrating plant (a positioning drive: the IPA in position mode,
-/// on the simulator or behind a plant server that describes it) 2 % and 1 s
-/// (docs/position.md).
+/// actuator is `actuator` (`pneumid commission` and the app call it before
+/// `--spec` or the request's values): overshoot 5 % and settling 0.5 s (the force loop's targets),
+/// and for an integrating plant (a positioning drive: the IPA in position mode, on the simulator or
+/// behind a plant server that describes it) 2 % and 1 s (docs/position.md).
 void SetDefaultSpecification(CommissionOptions& options, const Actuator& actuator);
 
 /// Sets the input gaps of `options` from text, as `--input-gaps` and the
