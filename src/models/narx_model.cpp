@@ -130,6 +130,24 @@ Eigen::VectorXd NarxModel::Simulate(const Eigen::VectorXd& u, const Eigen::Vecto
   return s;
 }
 
+bool NarxModel::ForgetsItsStart(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double shift,
+                                const Eigen::VectorXd* run) const {
+  const Eigen::VectorXd nominal = run != nullptr ? *run : Simulate(u, y);
+  PNEUMID_CHECK(nominal.size() == y.size(), "NARX: the run has {} samples, the output {}",
+                nominal.size(), y.size());
+  const Eigen::Index n0 = FirstSample(), half = (y.size() - n0) / 2;
+  if (!(shift > 0.0) || half < 2) return true;
+  for (const double sign : {-1.0, 1.0}) {
+    Eigen::VectorXd shifted = y;
+    shifted.head(n0).array() += sign * shift;
+    const Eigen::VectorXd r = Simulate(u, shifted);
+    if (!r.tail(half).allFinite() ||
+        !((r.tail(half) - nominal.tail(half)).cwiseAbs().maxCoeff() <= 0.2 * shift))
+      return false;
+  }
+  return true;
+}
+
 nlohmann::json ToJson(const NarxModel& m) {
   std::vector<std::string> names;
   for (const NarxTerm& t : m.terms) names.push_back(m.TermName(t));

@@ -8,7 +8,9 @@ simulation-focus test (narx_test.cpp, NarxTest.SimulationFocus*).
 integrated with RK4 (20 steps per sample, zero-order-hold input), Ts = 5 s.
 Input: random levels in [0.5, 5] held 8 .. 40 samples, one record per seed.
 Estimation starts at rest at its first input; validation starts away from rest
-(h1 = 1, h2 = 6). Writes data/two_tanks_est.csv and data/two_tanks_val.csv.
+(h1 = 1, h2 = 6). Writes data/two_tanks_est.csv and data/two_tanks_val.csv
+(seeds 11, 12) and data/two_tanks_41_est.csv and data/two_tanks_41_val.csv
+(seeds 41, 42).
 
 Run: python3 gen_two_tanks.py (numpy).
 """
@@ -56,7 +58,10 @@ def write(path, title, u, y, y_true):
 
 def main():
     here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
-    for name, seed, start in (("est", 11, None), ("val", 12, (1.0, 6.0))):
+    # Records 11/12 (two_tanks_*.csv) and 41/42 (two_tanks41_*.csv), the second
+    # pair's validation visiting outputs below the estimation record's.
+    for name, seed, start in (("est", 11, None), ("val", 12, (1.0, 6.0)),
+                              ("41_est", 41, None), ("41_val", 42, (1.0, 6.0))):
         rng = np.random.default_rng(seed)
         u = levels(rng)
         if start is None:  # at rest at u(0): KP u = K1 sqrt(h1) = K2 sqrt(h2)

@@ -15,6 +15,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/load.hpp"
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/evaluation/validation.hpp"
 #include "pneumid/identify/nonlinear/narx_simulation_fit.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 
@@ -136,6 +137,46 @@ TEST(NarxTest, TheFreeRunIsHeldWithinTheOutputBand) {
   const std::vector<double> expected{1, 2, 4, 8, 10, 10, 10, 10};
   for (Eigen::Index t = 0; t < s.size(); ++t)
     EXPECT_EQ(s(t), expected[static_cast<std::size_t>(t)]);
+}
+
+// ForgetsItsStart against its definition: runs from the first outputs
+// shifted by -+shift must come within shift / 5 of the nominal run over the
+// second half of the samples.
+TEST(NarxTest, ForgetsItsStartAsTheRunOfAStablePlantDoes) {
+  const auto model = [](std::vector<NarxTerm> terms, std::vector<double> theta) {
+    NarxModel m;
+    m.degree = 3;
+    m.terms = std::move(terms);
+    m.theta = std::move(theta);
+    return m;
+  };
+  const Eigen::VectorXd u = Eigen::VectorXd::Ones(41);
+  // y(t) = 0.5 y(t-1) + u(t-1): the shift halves every sample.
+  const NarxModel stable = model({NarxTerm{0}, NarxTerm{1}}, {0.5, 1.0});
+  EXPECT_TRUE(stable.ForgetsItsStart(u, Eigen::VectorXd::Constant(41, 2.0), 1.0));
+  // An integrator keeps the shift for ever; no shift is always forgotten.
+  const NarxModel integrator = model({NarxTerm{0}, NarxTerm{1}}, {1.0, 0.1});
+  EXPECT_FALSE(integrator.ForgetsItsStart(u, Eigen::VectorXd::Zero(41), 1.0));
+  EXPECT_TRUE(integrator.ForgetsItsStart(u, Eigen::VectorXd::Zero(41), 0.0));
+  // y(t) = 1.5 y(t-1) - 0.5 y(t-1)^3 rests at +-1 (0 is unstable): from 1
+  // shifted by 0.2 it returns to 1, shifted by 1.2 (to -0.2) it runs to -1.
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(41), one = Eigen::VectorXd::Ones(41);
+  const NarxModel bistable = model({NarxTerm{0}, NarxTerm{0, 0, 0}}, {1.5, -0.5});
+  EXPECT_TRUE(bistable.ForgetsItsStart(zero, one, 0.2));
+  EXPECT_FALSE(bistable.ForgetsItsStart(zero, one, 1.2));
+  // y(t) = 0.99 y(t-1) from 0: a shift s is 0.99^t s at t, above s / 5 until
+  // t = 161. 51 samples: the second half starts at t = 26 (0.77 s), not
+  // forgotten; 401 samples: at t = 201 (0.133 s), forgotten.
+  const NarxModel slow = model({NarxTerm{0}, NarxTerm{1}}, {0.99, 0.0});
+  EXPECT_FALSE(slow.ForgetsItsStart(Eigen::VectorXd::Zero(51), Eigen::VectorXd::Zero(51), 1.0));
+  EXPECT_TRUE(slow.ForgetsItsStart(Eigen::VectorXd::Zero(401), Eigen::VectorXd::Zero(401), 1.0));
+  // y(t) = 2 y(t-1) without an output band: a shifted run overflows.
+  const NarxModel unstable = model({NarxTerm{0}, NarxTerm{1}}, {2.0, 0.0});
+  EXPECT_FALSE(
+      unstable.ForgetsItsStart(Eigen::VectorXd::Zero(2001), Eigen::VectorXd::Zero(2001), 1.0));
+  // The nominal run, when given, must match the record.
+  const Eigen::VectorXd short_run = Eigen::VectorXd::Zero(5);
+  EXPECT_THROW(stable.ForgetsItsStart(u, one, 1.0, &short_run), InvalidArgument);
 }
 
 TEST(NarxTest, RejectsMoreCandidatesThanSamples) {
@@ -267,6 +308,40 @@ TEST(NarxTest, SimulationFocusStructureSearchOnTwoTanks) {
   const double fit_p =
       sp.allFinite() ? NrmseFit(val.y().tail(np).eval(), sp.tail(np).eval()) : -1e9;
   EXPECT_GT(fit, fit_p + 10.0);  // 86 % against 69 %
+}
+
+// Two tanks whose validation record starts away from rest and visits
+// outputs below the estimation record's (gen_two_tanks.py, seeds 41/42).
+// The simulation-focus search on the last 30 % chooses a 7-lag, 40-term
+// candidate (held-out fit 96 %); refined once more on the estimation part,
+// its free run no longer forgets its start and validated by -326 %. The
+// candidate as the search scored it is kept instead: 83 %.
+TEST(NarxTest, TheRefinedChoiceMustStillForgetItsStart) {
+#ifdef PNEUMID_SANITIZED_BUILD
+  GTEST_SKIP() << "a 4 s structure search in a release build";
+#endif
+  const Dataset data = Recorded("y", "two_tanks_41_est.csv");
+  const Dataset val = Recorded("y", "two_tanks_41_val.csv");
+  const auto [head, tail] = SplitDataset(data, 0.7);
+  IdentifyRequest request;
+  NonlinearOptions o;
+  o.choose_structure = true;
+  o.narx.degree = 3;
+  o.narx.focus = NarxFocus::kSimulation;
+  o.max_narx_lag = 7;
+  o.max_narx_terms = 40;
+  const IdentifiedModel m = IdentifyNonlinear("narx", head, request, o, &tail);
+  ASSERT_TRUE(m.narx.has_value());
+  ASSERT_GE(m.notes.size(), 4u);
+  EXPECT_THAT(m.notes[0], HasSubstr("ny = nu = 7, nk = 1, 40 terms"));
+  EXPECT_THAT(m.notes[3], HasSubstr("no longer forgets its start"));
+  EXPECT_EQ(m.termination, Termination::kConvergence);
+  const Eigen::VectorXd yh = head.y();
+  EXPECT_TRUE(m.narx->ForgetsItsStart(tail.u(), tail.y(), 0.25 * (yh.maxCoeff() - yh.minCoeff())));
+  const Eigen::Index n0 = m.narx->FirstSample(), n = val.size() - n0;
+  const double fit =
+      NrmseFit(val.y().tail(n).eval(), m.narx->Simulate(val.u(), val.y()).tail(n).eval());
+  EXPECT_GT(fit, 60.0) << m.notes[0];
 }
 
 TEST(NarxTest, FocusNamesRoundTrip) {

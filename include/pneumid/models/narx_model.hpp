@@ -75,6 +75,17 @@ struct NarxModel {
   /// the first FirstSample() outputs.
   /// @throws InvalidArgument for lengths that differ or fewer samples than FirstSample().
   Eigen::VectorXd Simulate(const Eigen::VectorXd& u, const Eigen::VectorXd& y) const;
+  /// Whether the free run forgets its initial outputs, as the run of a
+  /// model of a stable plant fades its initial state: the runs from y's
+  /// first FirstSample() outputs shifted by -shift and +shift stay within
+  /// shift / 5 of the run from y's own (`run`, computed when null) over the
+  /// second half of the samples after FirstSample(). False when a shifted run
+  /// is not finite; true for shift <= 0 or fewer than two such samples.
+  /// (A polynomial NARX can fit a record from its measured start and run off
+  /// to its output band's edge from a start nearby.)
+  /// @throws InvalidArgument as Simulate.
+  bool ForgetsItsStart(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double shift,
+                       const Eigen::VectorXd* run = nullptr) const;
   /// Value of regressor r (see NarxTerm) at time t, normalised.
   double Regressor(int r, Eigen::Index t, const Eigen::VectorXd& y, const Eigen::VectorXd& u) const;
   /// Value of the monomial `term` at time t (1 for the constant).

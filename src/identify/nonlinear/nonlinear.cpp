@@ -176,6 +176,7 @@ StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& ta
   const Eigen::VectorXd uv = tail.u(request.input), yv = tail.y(request.output);
   const double Ts = estimation.SampleTime();
   const double inf = std::numeric_limits<double>::infinity();
+  const double shift = 0.25 * (ye.maxCoeff() - ye.minCoeff());
   for (int nk = 0; nk <= std::min(1, options.max_delay); ++nk) {
     for (int lag = 1; lag <= options.max_narx_lag; ++lag) {
       NarxOptions no = options.narx;
@@ -193,7 +194,8 @@ StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& ta
           double fit = -inf;
           if (sim.allFinite()) fit = NrmseFit(yv.tail(nv).eval(), sim.tail(nv).eval());
           if (!std::isfinite(fit)) fit = -inf;
-          out.candidates.push_back({lag, lag, nk, k, fit, -inf, ""});
+          const bool forgets = std::isfinite(fit) && pm.ForgetsItsStart(uv, yv, shift, &sim);
+          out.candidates.push_back({lag, lag, nk, k, fit, -inf, "", forgets});
           return true;
         });
       } catch (const std::exception& e) {
@@ -201,13 +203,17 @@ StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& ta
       }
     }
   }
+  // Only candidates that forget their start, unless none does.
+  const bool any_forgets = std::any_of(out.candidates.begin(), out.candidates.end(),
+                                       [](const StructureCandidate& c) { return c.forgets_start; });
   double best = -inf;
-  for (const StructureCandidate& c : out.candidates) best = std::max(best, c.fit_percent);
+  for (const StructureCandidate& c : out.candidates)
+    if (c.forgets_start || !any_forgets) best = std::max(best, c.fit_percent);
   PNEUMID_CHECK(std::isfinite(best), "narx: no structure could be estimated ({})",
                 out.candidates.front().error);
   const StructureCandidate* pick = nullptr;
   for (const StructureCandidate& c : out.candidates) {
-    if (!(c.fit_percent >= best - 0.1)) continue;
+    if (!(c.fit_percent >= best - 0.1) || (any_forgets && !c.forgets_start)) continue;
     if (pick == nullptr || c.terms < pick->terms || (c.terms == pick->terms && c.na < pick->na))
       pick = &c;
   }
@@ -275,6 +281,21 @@ IdentifiedModel NarxFromChoice(const Dataset& data, const IdentifyRequest& reque
       "the chosen candidate ({} terms, FROLS on the estimation part) refined on all the data: "
       "{} ({} iterations, mean squared simulation error {:.4g}, from {:.4g})",
       c.terms, f.summary.message, f.summary.iterations, f.summary.loss, f.summary.initial_loss);
+  // The refinement must not undo what chose the candidate: a free run on the
+  // held-out part that forgets its start (ChooseNarxStructure).
+  const Dataset tail = held_out ? *held_out : SliceDataset(data, estimation.size(), data.size());
+  const Eigen::VectorXd ye = estimation.y(request.output);
+  const double shift = 0.25 * (ye.maxCoeff() - ye.minCoeff());
+  const Eigen::VectorXd ut = tail.u(request.input), yt = tail.y(request.output);
+  if (yt.size() > chosen->FirstSample() + 2 && chosen->ForgetsItsStart(ut, yt, shift) &&
+      !r.model.ForgetsItsStart(ut, yt, shift)) {
+    r.model = *chosen;
+    r.summary.termination = Termination::kConvergence;  // the candidate's own refinement
+    r.summary.message = fmt::format(
+        "the chosen candidate ({} terms) as estimated on the estimation part: refined on all the "
+        "data ({}), its free run on the held-out part no longer forgets its start",
+        c.terms, f.summary.message);
+  }
   const Eigen::Index n0 = r.model.FirstSample(), rows = y.size() - n0;
   r.one_step_fit_percent = NrmseFit(y.tail(rows).eval(), r.model.Predict(y, u).tail(rows).eval());
   r.simulation_fit_percent = NarxSimulationFit(r.model, u, y, rows, &r.summary.warnings);
@@ -290,13 +311,23 @@ IdentifiedModel NarxFromChoice(const Dataset& data, const IdentifyRequest& reque
 std::string StructureChoice::Describe() const {
   if (terms > 0) {
     std::vector<std::string> tried;
-    for (const StructureCandidate& c : candidates)
-      if (std::isfinite(c.fit_percent))
-        tried.push_back(fmt::format("{} {} {}: {:.2f}", c.na, c.nk, c.terms, c.fit_percent));
+    std::size_t kept = 0;
+    for (const StructureCandidate& c : candidates) {
+      if (!std::isfinite(c.fit_percent)) continue;
+      kept += c.forgets_start ? 1 : 0;
+      tried.push_back(fmt::format("{} {} {}: {:.2f}{}", c.na, c.nk, c.terms, c.fit_percent,
+                                  c.forgets_start ? "" : "*"));
+    }
+    const std::string starred =
+        kept == tried.size() ? ""
+        : kept == 0
+            ? "; * none forgets its start (all considered)"
+            : "; * does not forget its start (a run from outputs shifted by 25 % of their span "
+              "does not rejoin it): not chosen";
     return fmt::format(
         "ny = nu = {}, nk = {}, {} terms (held-out simulation fit {:.2f} % on {}); tried (lags nk "
-        "terms: held-out fit %): {}",
-        na, nk, terms, fit_percent, held_out, fmt::join(tried, ", "));
+        "terms: held-out fit %): {}{}",
+        na, nk, terms, fit_percent, held_out, fmt::join(tried, ", "), starred);
   }
   std::vector<std::string> tried;
   for (const StructureCandidate& c : candidates)

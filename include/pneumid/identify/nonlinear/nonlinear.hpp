@@ -27,9 +27,9 @@
 #include <Eigen/Core>
 
 #include "pneumid/data/dataset.hpp"
+#include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/nonlinear/affine_narx.hpp"
 #include "pneumid/identify/nonlinear/hammerstein.hpp"
-#include "pneumid/identify/identified_model.hpp"
 #include "pneumid/identify/nonlinear/narx.hpp"
 #include "pneumid/identify/nonlinear/static_map_fit.hpp"
 
@@ -75,6 +75,10 @@ struct StructureCandidate {
   /// Simulation fit on the estimation part; -inf when the estimate failed.
   double record_fit_percent = 0.0;
   std::string error;  ///< why it failed, else empty
+  /// narx: the free run on the held-out part forgets its initial outputs
+  /// (see ChooseBlockStructure); false candidates are not chosen while any
+  /// other is true.
+  bool forgets_start = true;
 };
 
 /// The orders of a block-oriented model (hammerstein, wiener, hw) chosen by
@@ -94,8 +98,8 @@ struct StructureChoice {
   int na = 1, nb = 1, nk = 1;  ///< chosen input delay in samples
   /// @var nb
   /// Chosen number of B coefficients (narx: the lags, na = nb).
-  int terms = 0;  ///< narx: terms chosen (0 for the block models)
-  double fit_percent = 0.0;  ///< held-out simulation fit of the choice, NRMSE %
+  int terms = 0;                               ///< narx: terms chosen (0 for the block models)
+  double fit_percent = 0.0;                    ///< held-out simulation fit of the choice, NRMSE %
   std::string held_out;                        ///< "the last 30 % of the data" or the file
   std::vector<StructureCandidate> candidates;  ///< in the order tried
   /// "na = 1, nb = 1, nk = 2 (held-out fit 98.7 % on ...); tried: ...".
@@ -110,7 +114,15 @@ struct StructureChoice {
 /// estimation part; every prefix of 1, 2, .., 10, 15, 20, .. terms is refitted by least
 /// squares and simulated on the held-out part from its own first measured
 /// outputs; the best held-out simulation fit wins (the most parsimonious,
-/// fewest terms then shortest lags, within 0.1 point). The choice sets na =
+/// fewest terms then shortest lags, within 0.1 point) among the candidates
+/// that forget their start: the held-out run is repeated from its first
+/// outputs shifted by -+25 % of the estimation output's span, and over the
+/// second half of the held-out part both runs must stay within a fifth of
+/// that shift (5 % of the span) of the nominal one, as the free run of a model of a
+/// stable plant fades its initial state. A polynomial that fits the
+/// held-out part from its measured start but runs off from a nearby one
+/// (to the output band's edge) is a model a record started elsewhere breaks;
+/// only when no candidate forgets its start are they all considered. The choice sets na =
 /// nb = lags, nk, and `terms` (StructureChoice::terms). With options.narx.focus
 /// kSimulation each prefix is refined by its simulation error on the
 /// estimation part before it is scored, and IdentifyNonlinear then refines the
