@@ -9,7 +9,8 @@ integrated with RK4 (20 steps per sample, zero-order-hold input), Ts = 5 s.
 Input: random levels in [0.5, 5] held 8 .. 40 samples, one record per seed.
 Estimation starts at rest at its first input; validation starts away from rest
 (h1 = 1, h2 = 6). Writes data/two_tanks_est.csv and data/two_tanks_val.csv
-(seeds 11, 12) and data/two_tanks_41_est.csv and data/two_tanks_41_val.csv
+(seeds 11, 12), data/two_tanks_31_est.csv and data/two_tanks_31_val.csv
+(seeds 31, 32) and data/two_tanks_41_est.csv and data/two_tanks_41_val.csv
 (seeds 41, 42).
 
 Run: python3 gen_two_tanks.py (numpy).
@@ -58,9 +59,11 @@ def write(path, title, u, y, y_true):
 
 def main():
     here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
-    # Records 11/12 (two_tanks_*.csv) and 41/42 (two_tanks41_*.csv), the second
-    # pair's validation visiting outputs below the estimation record's.
+    # Records 11/12 (two_tanks_*.csv), 31/32 and 41/42 (two_tanks_31_*.csv,
+    # two_tanks_41_*.csv), the 41/42 validation visiting outputs below the
+    # estimation record's.
     for name, seed, start in (("est", 11, None), ("val", 12, (1.0, 6.0)),
+                              ("31_est", 31, None), ("31_val", 32, (1.0, 6.0)),
                               ("41_est", 41, None), ("41_val", 42, (1.0, 6.0))):
         rng = np.random.default_rng(seed)
         u = levels(rng)
