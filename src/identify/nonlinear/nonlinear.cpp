@@ -167,6 +167,11 @@ void ForEachNarxPrefix(const Eigen::VectorXd& ue, const Eigen::VectorXd& ye, dou
   }
 }
 
+// The shift of the first outputs with which a NARX candidate's held-out run
+// must forget its start (NarxModel::ForgetsItsStart): 25 % of the span of
+// the estimation output `ye`.
+double StartShift(const Eigen::VectorXd& ye) { return 0.25 * (ye.maxCoeff() - ye.minCoeff()); }
+
 // The NARX part of ChooseBlockStructure (see nonlinear.hpp): `tail` is the
 // held-out record, simulated from its own first outputs.
 StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& tail,
@@ -176,7 +181,7 @@ StructureChoice ChooseNarxStructure(const Dataset& estimation, const Dataset& ta
   const Eigen::VectorXd uv = tail.u(request.input), yv = tail.y(request.output);
   const double Ts = estimation.SampleTime();
   const double inf = std::numeric_limits<double>::infinity();
-  const double shift = 0.25 * (ye.maxCoeff() - ye.minCoeff());
+  const double shift = StartShift(ye);
   for (int nk = 0; nk <= std::min(1, options.max_delay); ++nk) {
     for (int lag = 1; lag <= options.max_narx_lag; ++lag) {
       NarxOptions no = options.narx;
@@ -282,13 +287,16 @@ IdentifiedModel NarxFromChoice(const Dataset& data, const IdentifyRequest& reque
       "{} ({} iterations, mean squared simulation error {:.4g}, from {:.4g})",
       c.terms, f.summary.message, f.summary.iterations, f.summary.loss, f.summary.initial_loss);
   // The refinement must not undo what chose the candidate: a free run on the
-  // held-out part that forgets its start (ChooseNarxStructure).
+  // held-out part that forgets its start, as the search found for it
+  // (ChooseNarxStructure; `chosen` is the candidate it scored on that part).
+  const auto scored =
+      std::find_if(c.candidates.begin(), c.candidates.end(), [&](const StructureCandidate& k) {
+        return k.na == c.na && k.nk == c.nk && k.terms == c.terms;
+      });
   const Dataset tail = held_out ? *held_out : SliceDataset(data, estimation.size(), data.size());
-  const Eigen::VectorXd ye = estimation.y(request.output);
-  const double shift = 0.25 * (ye.maxCoeff() - ye.minCoeff());
-  const Eigen::VectorXd ut = tail.u(request.input), yt = tail.y(request.output);
-  if (yt.size() > chosen->FirstSample() + 2 && chosen->ForgetsItsStart(ut, yt, shift) &&
-      !r.model.ForgetsItsStart(ut, yt, shift)) {
+  if (scored != c.candidates.end() && scored->forgets_start &&
+      !r.model.ForgetsItsStart(tail.u(request.input), tail.y(request.output),
+                               StartShift(estimation.y(request.output)))) {
     r.model = *chosen;
     r.summary.termination = Termination::kConvergence;  // the candidate's own refinement
     r.summary.message = fmt::format(
