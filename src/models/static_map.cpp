@@ -128,6 +128,20 @@ double StaticMap::Inverse(double y) const {
   return u_[i - 1] + (u_[i] - u_[i - 1]) * (v - y0) / (y1 - y0);
 }
 
+std::optional<double> StaticMap::NearestPreimage(double y, double u_near) const {
+  PNEUMID_CHECK(!std::isnan(y) && !std::isnan(u_near),
+                "StaticMap::NearestPreimage: NaN output value ({}) or input ({})", y, u_near);
+  std::optional<double> best;
+  for (std::size_t i = 0; i + 1 < u_.size(); ++i) {
+    const double y0 = y_[i], y1 = y_[i + 1];
+    if (std::min(y0, y1) > y || std::max(y0, y1) < y) continue;
+    const double u = y0 == y1 ? std::clamp(u_near, u_[i], u_[i + 1])
+                              : u_[i] + (u_[i + 1] - u_[i]) * (y - y0) / (y1 - y0);
+    if (!best || std::abs(u - u_near) < std::abs(*best - u_near)) best = u;
+  }
+  return best;
+}
+
 std::optional<FlatSegment> StaticMap::DeadZone(double tolerance) const {
   PNEUMID_CHECK(tolerance >= 0.0, "the flat-segment tolerance must be >= 0, got {}", tolerance);
   std::size_t k = 0;

@@ -106,6 +106,28 @@ TEST(WienerTest, RecoversAKnownSystemWithinTwoPercent) {
   ExpectRecovered(r, 0.02);
 }
 
+// Placed output-map knots end at the range of the final x = G u on the
+// estimation data (not at the start's wider range, where an end value rests
+// on a few samples at a tent's far edge). The map is unchanged where x goes:
+// the trimmed model's simulation error is the refinement's loss.
+TEST(WienerTest, PlacedOutputMapKnotsEndAtTheRangeOfTheFinalLinearOutput) {
+  const Dataset d = Recorded("wiener");
+  BlockModelOptions o = TrueStructure();
+  o.knots.clear();
+  const BlockModelResult r = EstimateWiener(d.u(), d.y(), d.SampleTime(), o);
+  const TransferFunction g = r.linear.ToTransferFunction();
+  const StaticMap identity({-1e6, 1e6}, {-1e6, 1e6});
+  const Eigen::VectorXd x = SimulateWiener(g, identity, d.u());
+  EXPECT_GE(r.map.u_min(), x.minCoeff() - 1e-9);
+  EXPECT_LE(r.map.u_max(), x.maxCoeff() + 1e-9);
+  // The map reaches the range's ends (it is defined wherever x goes).
+  EXPECT_NEAR(r.map.u_min(), x.minCoeff(), 1e-6 * (1.0 + std::abs(x.minCoeff())));
+  EXPECT_NEAR(r.map.u_max(), x.maxCoeff(), 1e-6 * (1.0 + std::abs(x.maxCoeff())));
+  const Eigen::VectorXd yhat = SimulateWiener(g, r.map, d.u());
+  const double mse = (d.y() - yhat).squaredNorm() / static_cast<double>(d.size());
+  EXPECT_NEAR(mse, r.summary.loss, 1e-9 * r.summary.loss);
+}
+
 // The Hammerstein-Wiener system of gen_nonlinear_systems.py (hw.csv): the
 // same G, input map through kKnots (end values = end knots, as normalised).
 const std::vector<double> kHwIn = {0, 6, 24, 55, 85, 100};

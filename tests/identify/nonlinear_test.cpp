@@ -4,6 +4,7 @@
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -11,9 +12,9 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/data/load.hpp"
+#include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/identify.hpp"
-#include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "step_test_util.hpp"
 
 namespace pneumid {
@@ -68,9 +69,9 @@ TEST(NonlinearMethodsTest, ModelsRoundTripThroughTheModelFile) {
   EXPECT_THAT(ham.notes[0], HasSubstr("input map f(u): monotone increasing, 6 knots"));
   // The estimated initial state is the least-squares best one, so it fits at
   // least as well as the start at rest at u(0).
-  EXPECT_GE(ScoreSimulation(h, 0, SimulateModel(ham, h, 0, 0, InitialCondition::kEstimate))
-                .fit_percent,
-            ham.fit_percent - 1e-9);
+  EXPECT_GE(
+      ScoreSimulation(h, 0, SimulateModel(ham, h, 0, 0, InitialCondition::kEstimate)).fit_percent,
+      ham.fit_percent - 1e-9);
   const IdentifiedModel hw = Identify("hw", Recorded("hw"), r, o);
   EXPECT_EQ(hw.structure, "Hammerstein-Wiener");
   ASSERT_TRUE(hw.input_map.has_value() && hw.output_map.has_value());
@@ -79,6 +80,33 @@ TEST(NonlinearMethodsTest, ModelsRoundTripThroughTheModelFile) {
   EXPECT_THAT(hw.notes[1], HasSubstr("output map g(x): monotone increasing, 6 knots"));
   const IdentifiedModel narx = Identify("narx", Recorded("narx"), r, o);
   EXPECT_THAT(narx.notes[0], HasSubstr("selected terms: "));
+}
+
+// A Wiener model whose output map turns (end knots that the data barely
+// visit) starts at rest at the first measured output all the same: the
+// preimage of y(0) nearest the rest at the first input. Closed form: G(z) =
+// 0.2 z^-1 / (1 - 0.8 z^-1) (gain 1) from rest at x = 10 with u = 40 gives
+// x(t) = 10 + 30 (1 - 0.8^t), and f(x) = x on [0, 100]; f also reaches 10
+// at x = -3.33, farther from the rest at the first input (x = 40).
+TEST(NonlinearMethodsTest, AWienerModelWhoseOutputMapTurnsStartsAtTheFirstMeasuredOutput) {
+  const double Ts = 0.01;
+  IdentifiedModel w;
+  w.method = "wiener";
+  w.discrete = TransferFunction(Eigen::Vector2d(0.0, 0.2), Eigen::Vector2d(1.0, -0.8), Ts);
+  w.output_map = StaticMap({-10, 0, 50, 100, 120}, {30, 0, 50, 100, 80});
+  ASSERT_FALSE(w.output_map->IsMonotone());
+  const Eigen::Index n = 60;
+  const Eigen::VectorXd u = Eigen::VectorXd::Constant(n, 40.0);
+  Eigen::VectorXd y(n);
+  for (Eigen::Index t = 0; t < n; ++t)
+    y[t] = 10.0 + 30.0 * (1.0 - std::pow(0.8, static_cast<double>(t)));
+  const Eigen::VectorXd yhat = SimulateNonlinear(w, Dataset::FromUniform(Ts, u, y), 0, 0);
+  ASSERT_EQ(yhat.size(), n);
+  EXPECT_LT((yhat - y).cwiseAbs().maxCoeff(), 1e-9);
+  // A first output the map never reaches (150): at rest at the first input,
+  // f(40) = 40.
+  const Dataset beyond = Dataset::FromUniform(Ts, u, Eigen::VectorXd::Constant(n, 150.0));
+  EXPECT_NEAR(SimulateNonlinear(w, beyond, 0, 0)[0], 40.0, 1e-9);
 }
 
 TEST(NonlinearMethodsTest, StaticMapOfAStaircaseAndErrorsOnAStepTest) {

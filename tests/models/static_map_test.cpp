@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -120,6 +122,34 @@ TEST(StaticMapTest, RejectsBadKnotsAndNonMonotoneInverse) {
   const StaticMap flat({0, 1}, {5, 5});
   EXPECT_THAT([&] { flat.Inverse(5.0); },
               ThrowsMessage<InvalidArgument>(HasSubstr("constant static map (y = 5")));
+}
+
+// NearestPreimage by its definition: every input of [u_0, u_n-1] where f
+// takes the value, the nearest to u_near chosen.
+TEST(StaticMapTest, NearestPreimageIsTheClosestInputWithThatOutput) {
+  // Turns at u = 1 and u = 2: y = 1.5 is reached at u = 0.75, 1.5 and 2.25.
+  const StaticMap bump({0, 1, 2, 3}, {0, 2, 1, 3});
+  for (const auto& [u_near, want] :
+       std::vector<std::pair<double, double>>{{-5, 0.75}, {1.0, 0.75}, {1.2, 1.5}, {1.9, 2.25}}) {
+    const std::optional<double> u = bump.NearestPreimage(1.5, u_near);
+    ASSERT_TRUE(u.has_value()) << "u_near = " << u_near;
+    EXPECT_DOUBLE_EQ(*u, want) << "u_near = " << u_near;
+    EXPECT_DOUBLE_EQ(bump.Evaluate(*u), 1.5);
+  }
+  // Outside the knot values' range there is none; at its ends the knot.
+  EXPECT_FALSE(bump.NearestPreimage(3.5, 1.0).has_value());
+  EXPECT_FALSE(bump.NearestPreimage(-0.1, 1.0).has_value());
+  EXPECT_DOUBLE_EQ(*bump.NearestPreimage(3.0, 0.0), 3.0);
+  // A monotone map has one preimage: Inverse's.
+  const StaticMap ramp({0, 10, 20}, {-4, 6, 26});
+  for (const double y : {-4.0, 0.0, 6.0, 17.0, 26.0})
+    EXPECT_DOUBLE_EQ(*ramp.NearestPreimage(y, 100.0), ramp.Inverse(y)) << "y = " << y;
+  // On a flat segment at y, u_near clamped to it.
+  const StaticMap dead({0, 1, 2, 4}, {0, 0, 0, 2});
+  EXPECT_DOUBLE_EQ(*dead.NearestPreimage(0.0, 1.4), 1.4);
+  EXPECT_DOUBLE_EQ(*dead.NearestPreimage(0.0, 7.0), 2.0);
+  EXPECT_THAT([&] { bump.NearestPreimage(std::nan(""), 0.0); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("NaN")));
 }
 
 }  // namespace

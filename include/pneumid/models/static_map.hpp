@@ -107,6 +107,14 @@ class StaticMap {
   /// @throws InvalidArgument for a map that is not monotone (naming the knots
   ///         where it turns) or constant, or a NaN y.
   double Inverse(double y) const;
+  /// The input nearest to u_near among those in [u_min(), u_max()] at which
+  /// f takes the value y: on a segment from (u_i, y_i) to (u_i+1, y_i+1) with
+  /// y between y_i and y_i+1, u = u_i + (u_i+1 - u_i) (y - y_i) / (y_i+1 - y_i)
+  /// (on a flat segment at y, u_near clamped to it). Defined for every map,
+  /// monotone or not (a map that turns can reach y on several segments);
+  /// std::nullopt when y lies outside [min y_i, max y_i].
+  /// @throws InvalidArgument for a NaN y or u_near.
+  std::optional<double> NearestPreimage(double y, double u_near) const;
 
   /// The flat run at the low-input end (the knots whose values differ from
   /// y_0 by at most `tolerance`, output units, >= 0), when it spans at least

@@ -286,6 +286,36 @@ StaticMap MapOf(const std::vector<double>& knots, const Eigen::VectorXd& theta,
                    StaticMapExtrapolation::kClamp);
 }
 
+// The output map f on the range [lo, hi] of the final linear part's output x
+// over the estimation data: end knots beyond it (placed over the starting
+// model's x, which reached farther, or simply not reached) are moved to lo
+// and hi with f's values there. f is unchanged on [lo, hi], and so is every
+// simulated output on the estimation data; beyond, the map is held at its
+// values at the range's ends instead of at end values that a few samples
+// near the tent's far edge set (an end value 133 N for a map that starts at
+// 0 N, say), which a later record reaching there would follow.
+StaticMap TrimToRange(const StaticMap& f, double lo, double hi) {
+  if (!(std::isfinite(lo) && std::isfinite(hi) && lo < hi)) return f;
+  std::vector<double> u, y;
+  if (lo > f.u_min()) {
+    u.push_back(lo);
+    y.push_back(f.Evaluate(lo));
+  }
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const double k = f.u()[i];
+    if ((k > lo || (k == lo && lo <= f.u_min())) && (k < hi || (k == hi && hi >= f.u_max()))) {
+      u.push_back(k);
+      y.push_back(f.y()[i]);
+    }
+  }
+  if (hi < f.u_max()) {
+    u.push_back(hi);
+    y.push_back(f.Evaluate(hi));
+  }
+  if (u.size() < 2) return f;
+  return StaticMap(std::move(u), std::move(y), f.extrapolation());
+}
+
 BlockModelResult Finish(const Eigen::VectorXd& theta, const Layout& l, double Ts, StaticMap map,
                         EstimationSummary s) {
   BlockModelResult r;
@@ -492,7 +522,14 @@ BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd&
   RefineOutputError(std::make_unique<WienerError>(WienerError{l, &y, &u, knots}), u.size(), o,
                     &theta, &s);
   s.num_rows = u.size();
-  return Finish(theta, l, Ts, MapOf(knots, theta, l.map_offset()), std::move(s));
+  StaticMap f = MapOf(knots, theta, l.map_offset());
+  if (o.knots.empty()) {  // placed here, not given
+    std::vector<double> xf;
+    SimulateUnitGain(theta.data(), l, std::vector<double>(u.data(), u.data() + u.size()), &xf);
+    const auto [xlo, xhi] = std::minmax_element(xf.begin(), xf.end());
+    f = TrimToRange(f, *xlo, *xhi);
+  }
+  return Finish(theta, l, Ts, std::move(f), std::move(s));
 }
 
 BlockModelResult EstimateHammersteinWiener(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
@@ -540,14 +577,16 @@ BlockModelResult EstimateHammersteinWiener(const Eigen::VectorXd& u, const Eigen
   const Layout lj{o.na, o.nb, o.nk, m - 2 + static_cast<int>(out_knots.size())};
 
   // Joint output-error refinement of G and both maps.
-  RefineOutputError(
-      std::make_unique<HwError>(HwError{lj, &y, std::move(tents), in_knots, out_knots}), u.size(),
-      o, &theta, &s);
+  RefineOutputError(std::make_unique<HwError>(HwError{lj, &y, tents, in_knots, out_knots}),
+                    u.size(), o, &theta, &s);
   s.num_rows = u.size();
   Eigen::VectorXd fv(m);
   fv << c1, theta.segment(lj.map_offset(), m - 2), cm;
   BlockModelResult r = Finish(theta, lj, Ts, MapOf(in_knots, fv, 0), std::move(s));
-  r.output_map = MapOf(out_knots, theta, lj.map_offset() + m - 2);
+  std::vector<double> xf;
+  SimulateUnitGain(theta.data(), lj, MapThroughTents(fv.data(), tents), &xf);
+  const auto [xlo, xhi] = std::minmax_element(xf.begin(), xf.end());
+  r.output_map = TrimToRange(MapOf(out_knots, theta, lj.map_offset() + m - 2), *xlo, *xhi);
   return r;
 }
 

@@ -661,11 +661,17 @@ Eigen::VectorXd SimulateNonlinear(const IdentifiedModel& model, const Dataset& d
   if (model.output_map) {
     const StaticMap& out = *model.output_map;
     double v_rest = v[0];
-    if (y_first && gain &&
-        (out.Direction() == Monotonicity::kIncreasing ||
-         out.Direction() == Monotonicity::kDecreasing)) {
+    if (y_first && gain) {
       const auto [lo, hi] = std::minmax_element(out.y().begin(), out.y().end());
-      if (*y_first > *lo && *y_first < *hi) v_rest = out.Inverse(*y_first) / dc;
+      if (*y_first > *lo && *y_first < *hi) {
+        if (out.IsMonotone()) {
+          v_rest = out.Inverse(*y_first) / dc;
+        } else if (const std::optional<double> x = out.NearestPreimage(*y_first, dc * v[0])) {
+          // A map that turns reaches y_first on several segments: the state
+          // nearest the rest at the first input.
+          v_rest = *x / dc;
+        }
+      }
     }
     return out.Evaluate(linear(v_rest));
   }

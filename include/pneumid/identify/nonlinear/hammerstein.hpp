@@ -37,14 +37,19 @@
 //      Levenberg-Marquardt (Ceres, automatic derivatives through the
 //      simulation), from the estimate of step 1.
 // Wiener estimation: an ARX model (orders na, nb, nk) scaled to G(1) = 1
-// gives x; f is the least-squares piecewise-linear fit of y on x (knots over
-// the input range); then the same output-error refinement over a, b and the
-// values of f.
+// gives x; f is the least-squares piecewise-linear fit of y on x (knots where
+// the input dwells, widened to the range of x); then the same output-error
+// refinement over a, b and the values of f. Placed knots (not given ones)
+// end at the range of the final x on the estimation data: an end knot
+// beyond it (from the start's wider x) moves to the range's end with f's
+// value there, so f is unchanged where the data put x and flat beyond,
+// not held at an end value that a few samples at a tent's far edge set.
 //
 // Hammerstein-Wiener: f (the input map, knots as above) and g (the output
 // map, as many knots spread evenly over the range of x = G f(u) at the start,
-// empty ones dropped) leave, besides the scale of G, an affine transformation
-// of the intermediate signal free (x -> s x + d with f -> s f + d and
+// empty ones dropped, ending at the final x's range as the Wiener map)
+// leave, besides the scale of G, an affine transformation of the
+// intermediate signal free (x -> s x + d with f -> s f + d and
 // g(x) -> g((x - d) / s) give the same model). It is fixed by
 //   G(1) = 1,  f(c_1) = c_1,  f(c_m) = c_m,
 // i.e. the input map's end values equal its end knots, so x has the units of
@@ -72,8 +77,8 @@
 #include <Eigen/Core>
 
 #include "pneumid/identify/parametric/parametric_model.hpp"
-#include "pneumid/models/static_map.hpp"
 #include "pneumid/lti/transfer_function.hpp"
+#include "pneumid/models/static_map.hpp"
 
 namespace pneumid {
 
@@ -97,8 +102,8 @@ struct BlockModelOptions {
   bool monotone_map = false;
   /// Output-error refinement with Ceres after the initial estimate.
   bool refine = true;
-  int max_iterations = 100;           ///< Levenberg-Marquardt iterations (>= 1)
-  double function_tolerance = 1e-10;  ///< Ceres' relative cost change to stop
+  int max_iterations = 100;            ///< Levenberg-Marquardt iterations (>= 1)
+  double function_tolerance = 1e-10;   ///< Ceres' relative cost change to stop
   double gradient_tolerance = 1e-12;   ///< Ceres' gradient tolerance to stop (> 0)
   double parameter_tolerance = 1e-10;  ///< Ceres' relative parameter step to stop (> 0)
   /// True when na >= 0, nb >= 1, nk >= 0, num_knots is 0 or >= 2, given knots are >= 2,

@@ -169,9 +169,11 @@ std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, con
 /// G(1): Hammerstein / static map y = G(1) v_r + G (v - v_r), Wiener and
 /// Hammerstein-Wiener y = g(G(1) v_r + G (v - v_r)), the linear part at rest
 /// with input v_r: the rest that gives the first measured output y(0) of
-/// column `output` (v_r = y(0) / G(1), through the inverse output map when it
-/// is monotone and y(0) within its range), otherwise v(0) (at rest at the
-/// first input); a record that starts at rest anywhere then starts right.
+/// column `output` (v_r = y(0) / G(1), through the output map's inverse when
+/// y(0) lies within its range: for a map that turns, the preimage nearest the
+/// rest at the first input, StaticMap::NearestPreimage), otherwise v(0) (at
+/// rest at the first input; so with `output` < 0, no measured output); a
+/// record that starts at rest anywhere then starts right.
 /// NARX: free run with its first max-lag outputs from output column `output`.
 /// @throws InvalidArgument for a model without nonlinear part, bad columns,
 ///         or a sample time that differs from the model's.
