@@ -1209,7 +1209,9 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   const double u_lo = std::isfinite(o.u_min) ? o.u_min : act.u_min;
   const double u_hi = std::isfinite(o.u_max) ? o.u_max : act.u_max;
   PNEUMID_CHECK(std::isfinite(u_lo) && std::isfinite(u_hi) && u_lo < u_hi,
-                "commission: the input range must be finite (give u_min and u_max), got [{}, {}]",
+                "commission: the input range must be finite with its low end below its high "
+                "end, got [{}, {}]; give it where the plant declares none (--u-min and --u-max "
+                "on the command line, CommissionOptions u_min and u_max)",
                 u_lo, u_hi);
   // A positioning drive integrates its input: it has no steady state to probe
   // and its model no static gain to design on (docs/position.md).

@@ -185,6 +185,10 @@ echo "$out" | grep -q "stopped in the probe step" || fail "unstable plant: stdou
 echo "$out" | grep -qi "nan" && fail "unstable plant: NaN on stdout: $out"
 tail -1 "$TMP/e4/data.csv" | awk -F, '$1 <= 6 && $2 == 0 { ok = 1 } END { exit !ok }' ||
   fail "unstable plant: data end $(tail -1 "$TMP/e4/data.csv") (not at u = 0 within 6 s)"
+# A plant that declares no input range (a linear model) needs one: the
+# message names the flags.
+expect_error "no input range" "give it where the plant declares none (--u-min and --u-max" \
+  commission --plant "tf:num=1,den=1 1" -o "$TMP"
 out=$("$PNEUMID" commission --plant ipa --spec overshoot=x -o "$TMP/e3" 2>&1)
 [ $? -ne 0 ] || fail "bad --spec accepted"
 echo "$out" | grep -q "overshoot" || fail "bad --spec message: $out"
