@@ -112,6 +112,38 @@ std::string ChannelNames(const std::vector<Channel>& c) {
   return fmt::format("[{}]", fmt::join(names, ", "));
 }
 
+// The held-out fit from the other start than the ranking's (`ranked`), as a
+// note when the two differ by more than one point of fit: a model whose fit
+// rests on an estimated initial state (its slow modes absorbing an error of
+// the whole record), or one that cannot start at rest where the record does,
+// shows it. `validate` starts at rest unless told otherwise.
+std::optional<std::string> OtherStartNote(const IdentifiedModel& m, const Dataset& scored,
+                                          const IdentifyRequest& request, InitialCondition ranked,
+                                          Eigen::Index score_from) {
+  const InitialCondition other =
+      ranked == InitialCondition::kEstimate ? InitialCondition::kZero : InitialCondition::kEstimate;
+  double fit = 0.0;
+  try {
+    fit =
+        ScoreSimulation(scored, request.output,
+                        SimulateModel(m, scored, request.input, request.output, other), score_from)
+            .fit_percent;
+  } catch (const std::exception&) {
+    return std::nullopt;  // no such start for this model (e.g. no state-space form)
+  }
+  const double at = m.validation_fit_percent;
+  if (!std::isfinite(at) || (std::isfinite(fit) && std::abs(fit - at) <= 1.0)) return std::nullopt;
+  const auto name = [](InitialCondition c) {
+    return c == InitialCondition::kZero ? std::string("rest (--initial-state zero)")
+                                        : std::string(
+                                              "the estimated initial state "
+                                              "(--initial-state estimate)");
+  };
+  return fmt::format(
+      "held-out fit {:.2f} % from {}, the start it is ranked by; {} from {}", at, name(ranked),
+      std::isfinite(fit) ? fmt::format("{:.2f} %", fit) : std::string("not finite"), name(other));
+}
+
 }  // namespace
 
 IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, const Dataset& data,
@@ -223,6 +255,9 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
               SimulateModel(m, *scored, request.input, request.output, options.validation_initial),
               score_from);
           m.validation_fit_percent = f.fit_percent;
+          if (std::optional<std::string> note =
+                  OtherStartNote(m, *scored, request, options.validation_initial, score_from))
+            m.notes.push_back(std::move(*note));
         }
         results[i] = std::move(m);
       } catch (const std::exception& e) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -19,7 +20,9 @@
 namespace pneumid {
 namespace {
 
+using ::testing::Contains;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 IdentifiedModel Discrete(const Eigen::VectorXd& num, const Eigen::VectorXd& den, double Ts) {
   IdentifiedModel m;
@@ -315,6 +318,47 @@ TEST(IdentifyModelsTest, SplitScoresTheTailOfOneSimulation) {
   EXPECT_DOUBLE_EQ(m.validation_fit_percent, EvaluateModel(m, d, 0, 0, 700).fit_percent);
   // Estimated on the first 70 % only.
   EXPECT_DOUBLE_EQ(m.fit_percent, Identify("arx", SliceDataset(d, 0, 700)).fit_percent);
+}
+
+// The held-out fit from the other start is noted when it differs by more
+// than a point: on a validation record that starts far from rest (y = 20,
+// the system at rest at 0) the ARX model ranks by its fit from the estimated
+// initial state, and the note gives the fit from rest, as `validate` scores
+// it by default. A record that starts at rest gets no such note.
+TEST(IdentifyModelsTest, NotesTheHeldOutFitFromTheOtherStartWhenItDiffers) {
+  const Dataset d = ArxData(600, 0.05, 7);
+  std::mt19937 gen(8);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const int N = 120;
+  Eigen::VectorXd u(N), y(N);
+  double prev_y = 20.0, prev_u = 0.0;
+  for (int k = 0; k < N; ++k) {
+    u[k] = n(gen) > 0 ? 1.0 : -1.0;
+    y[k] = 0.9 * prev_y + 0.5 * prev_u + 0.05 * n(gen);
+    prev_y = y[k];
+    prev_u = u[k];
+  }
+  const Dataset away = Dataset::FromUniform(0.1, u, y);
+  IdentifyOptions o;
+  o.num_threads = 1;
+  const IdentificationSummary s = IdentifyModels({"arx"}, d, {}, o, &away);
+  ASSERT_EQ(s.models.size(), 1u);
+  const IdentifiedModel& m = s.models.front();
+  const double at_rest =
+      ScoreSimulation(away, 0, SimulateModel(m, away, 0, 0, InitialCondition::kZero)).fit_percent;
+  EXPECT_GT(m.validation_fit_percent, 95.0);
+  EXPECT_LT(at_rest, m.validation_fit_percent - 10.0);
+  EXPECT_THAT(m.notes,
+              Contains(fmt::format(
+                  "held-out fit {:.2f} % from the estimated initial state (--initial-state "
+                  "estimate), the start it is ranked by; {:.2f} % from rest "
+                  "(--initial-state zero)",
+                  m.validation_fit_percent, at_rest)));
+
+  const Dataset at_rest_record = ArxData(120, 0.05, 9);
+  const IdentificationSummary r = IdentifyModels({"arx"}, d, {}, o, &at_rest_record);
+  ASSERT_EQ(r.models.size(), 1u);
+  EXPECT_THAT(r.models.front().notes, Not(Contains(HasSubstr("the start it is ranked by"))));
 }
 
 TEST(IdentifyModelsTest, ThreadsDoNotChangeTheResult) {
