@@ -286,33 +286,28 @@ StaticMap MapOf(const std::vector<double>& knots, const Eigen::VectorXd& theta,
                    StaticMapExtrapolation::kClamp);
 }
 
-// The output map f on the range [lo, hi] of the final linear part's output x
-// over the estimation data: end knots beyond it (placed over the starting
-// model's x, which reached farther, or simply not reached) are moved to lo
-// and hi with f's values there. f is unchanged on [lo, hi], and so is every
-// simulated output on the estimation data; beyond, the map is held at its
-// values at the range's ends instead of at end values that a few samples
-// near the tent's far edge set (an end value 133 N for a map that starts at
-// 0 N, say), which a later record reaching there would follow.
-StaticMap TrimToRange(const StaticMap& f, double lo, double hi) {
-  if (!(std::isfinite(lo) && std::isfinite(hi) && lo < hi)) return f;
-  std::vector<double> u, y;
-  if (lo > f.u_min()) {
-    u.push_back(lo);
-    y.push_back(f.Evaluate(lo));
-  }
+// The output map f on the range [lo, hi] of x, the final linear part's
+// output over the estimation data: end knots beyond it (placed over the
+// starting model's x, which reached farther, or simply not reached) are
+// moved to lo and hi with f's values there. f is unchanged on [lo, hi], and
+// so is every simulated output on the estimation data; beyond, the map is
+// held at its values at the range's ends instead of at end values that a few
+// samples near the tent's far edge set (an end value 133 N for a map that
+// starts at 0 N, say), which a later record reaching there would follow.
+StaticMap TrimToRange(const StaticMap& f, const std::vector<double>& x) {
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  if (lo == x.end() || !std::isfinite(*lo) || !std::isfinite(*hi)) return f;
+  const double a = std::max(*lo, f.u_min()), b = std::min(*hi, f.u_max());
+  if (!(a < b)) return f;
+  std::vector<double> u = {a}, y = {f.Evaluate(a)};
   for (std::size_t i = 0; i < f.size(); ++i) {
-    const double k = f.u()[i];
-    if ((k > lo || (k == lo && lo <= f.u_min())) && (k < hi || (k == hi && hi >= f.u_max()))) {
-      u.push_back(k);
+    if (f.u()[i] > a && f.u()[i] < b) {
+      u.push_back(f.u()[i]);
       y.push_back(f.y()[i]);
     }
   }
-  if (hi < f.u_max()) {
-    u.push_back(hi);
-    y.push_back(f.Evaluate(hi));
-  }
-  if (u.size() < 2) return f;
+  u.push_back(b);
+  y.push_back(f.Evaluate(b));
   return StaticMap(std::move(u), std::move(y), f.extrapolation());
 }
 
@@ -489,11 +484,9 @@ BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd&
   const Eigen::VectorXd b = arx.model.b[0].segment(o.nk, o.nb);
   const Layout l0{o.na, o.nb, o.nk, 0};
   Eigen::VectorXd theta = Normalised(a, b, Eigen::VectorXd(), l0, true, &s.warnings);
+  const std::vector<double> v(u.data(), u.data() + u.size());
   std::vector<double> x;
-  {
-    std::vector<double> v(u.data(), u.data() + u.size());
-    SimulateUnitGain(theta.data(), l0, v, &x);
-  }
+  SimulateUnitGain(theta.data(), l0, v, &x);
   const Eigen::VectorXd xv = Eigen::Map<const Eigen::VectorXd>(x.data(), u.size());
   const bool x_finite = xv.allFinite() && xv.maxCoeff() > xv.minCoeff();
   if (!x_finite)
@@ -524,10 +517,9 @@ BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd&
   s.num_rows = u.size();
   StaticMap f = MapOf(knots, theta, l.map_offset());
   if (o.knots.empty()) {  // placed here, not given
-    std::vector<double> xf;
-    SimulateUnitGain(theta.data(), l, std::vector<double>(u.data(), u.data() + u.size()), &xf);
-    const auto [xlo, xhi] = std::minmax_element(xf.begin(), xf.end());
-    f = TrimToRange(f, *xlo, *xhi);
+    std::vector<double> final_x;
+    SimulateUnitGain(theta.data(), l, v, &final_x);
+    f = TrimToRange(f, final_x);
   }
   return Finish(theta, l, Ts, std::move(f), std::move(s));
 }
@@ -583,10 +575,9 @@ BlockModelResult EstimateHammersteinWiener(const Eigen::VectorXd& u, const Eigen
   Eigen::VectorXd fv(m);
   fv << c1, theta.segment(lj.map_offset(), m - 2), cm;
   BlockModelResult r = Finish(theta, lj, Ts, MapOf(in_knots, fv, 0), std::move(s));
-  std::vector<double> xf;
-  SimulateUnitGain(theta.data(), lj, MapThroughTents(fv.data(), tents), &xf);
-  const auto [xlo, xhi] = std::minmax_element(xf.begin(), xf.end());
-  r.output_map = TrimToRange(MapOf(out_knots, theta, lj.map_offset() + m - 2), *xlo, *xhi);
+  std::vector<double> final_x;
+  SimulateUnitGain(theta.data(), lj, MapThroughTents(fv.data(), tents), &final_x);
+  r.output_map = TrimToRange(MapOf(out_knots, theta, lj.map_offset() + m - 2), final_x);
   return r;
 }
 
