@@ -10,8 +10,10 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <matio.h>
 
 #include "column_spec.hpp"
@@ -255,6 +257,19 @@ class MatReader {
   const Eigen::MatrixXd& Read(const VarInfo& v, const std::string& role) {
     auto it = cache_.find(v.name);
     if (it != cache_.end()) return it->second;
+    // matio reads a variable by name, i.e. the first one of that name: a file
+    // that repeats a name (no MATLAB save does) cannot say which one is meant,
+    // and the size checked below would be another variable's.
+    std::vector<std::size_t> same;
+    for (std::size_t i = 0; i < vars_.size(); ++i) {
+      if (vars_[i].name == v.name) same.push_back(i + 1);
+    }
+    if (same.size() > 1) {
+      throw DataError(fmt::format(
+          "{}: variable name '{}' appears {} times in the file (variables {}): it cannot say "
+          "which one is the {} data; the file is corrupt or was not written by a MAT writer",
+          path_, v.label, same.size(), fmt::join(same, ", "), role));
+    }
     if (!IsNumericClass(v.class_type) || v.complex) {
       throw DataError(fmt::format("{}: variable '{}' ({}): {} data must be a real numeric array",
                                   path_, v.label,

@@ -415,6 +415,46 @@ TEST_F(BadInputTest, MatEmptyVariableWithAHugeDimensionIsCorrupt) {
                   AllOf(HasSubstr("0x1415643158"), HasSubstr("more than the file can hold"))));
 }
 
+TEST_F(BadInputTest, MatRepeatedVariableNameIsRejected) {
+  // Level-4 header: type 0 (little-endian double), rows, columns, real, name length.
+  auto v4 = [](const std::string& name, const std::vector<double>& values) {
+    std::string s;
+    for (std::uint32_t h : {0u, static_cast<std::uint32_t>(values.size()), 1u, 0u,
+                            static_cast<std::uint32_t>(name.size() + 1)}) {
+      PutU32(&s, h);
+    }
+    s += name;
+    s += '\0';
+    s.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+    return s;
+  };
+  MatReadOptions o;
+  o.input_variables = {};
+  o.output_variables = {"y"};
+  o.sample_time = 0.1;
+  const std::string ok = Write("y4.mat", v4("y", {0, 1, 2}) + v4("z", {5, 6}));
+  EXPECT_EQ(ReadMat(ok, o).size(), 3);
+  // matio reads the first 'y'; which one the user meant, the file cannot say.
+  const std::string twice = Write("yy4.mat", v4("y", {0, 1, 2}) + v4("y", {5, 6}));
+  EXPECT_THAT([&] { ReadMat(twice, o); },
+              ThrowsMessage<DataError>(
+                  AllOf(HasSubstr("yy4.mat: variable name 'y' appears 2 times in the file "
+                                  "(variables 1, 2)"),
+                        HasSubstr("output data"))));
+  // Found by mat_fuzz: a 44-byte Level 4 file with a sparse variable claiming
+  // 1073754112 x 0 and a 0 x 22 double, both named ''. The double was size
+  // checked, but matio read the sparse one by the shared name (a 4 GB malloc).
+  const std::string fuzz(
+      "\x20\0\0\0\0\x30\0\x40\0\0\0\0\0\0\0\0\x02\0\0\0\0\x24\0\0"
+      "\0\0\0\0\0\0\x16\0\0\0\0\0\0\0\x02\0\0\0\0\0",
+      44);
+  const std::string path = Write("v4_repeated_name.mat", fuzz);
+  MatReadOptions by_index;
+  by_index.time_variable = "0";
+  EXPECT_THAT([&] { ReadMat(path, by_index); },
+              ThrowsMessage<DataError>(HasSubstr("variable name '' appears 2 times")));
+}
+
 TEST_F(BadInputTest, MatVariableListIsCappedAndLongNamesAreExcerpts) {
   std::string file = MatHeader();
   for (int i = 0; i < 30; ++i) file += DoubleMatrix(fmt::format("v{}", i), 1, 1, {1.0});
