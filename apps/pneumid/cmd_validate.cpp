@@ -130,7 +130,7 @@ ValidationResult ValidateIdentified(const ValidateArgs& args, const IdentifiedMo
   residual_options.max_lag = args.max_lag;
   ValidationResult result;
   result.sim = SimulateIdentified(identified, data, args.skip, initial);
-  result.warnings = ExtrapolationWarnings(identified, data, 0);
+  result.warnings = ExtrapolationWarnings(identified, data, 0, &result.sim.yhat);
   for (const std::string& w : result.warnings) {
     std::cerr << "pneumid validate: warning: " << w << "\n";
   }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every `pneumid ...` command line of README.md and docs/*.md still works:
 #  - concrete commands in code blocks are run, in document order (README first),
-#    in one scratch directory holding the repository's data/ folder, so that a
+#    in one scratch directory holding the repository's data/, config/ and
+#    tests/ folders (the docs run from the repository's root), so that a
 #    file written by one command (step.csv) is read by the next;
 #  - synopses (with [options], A|B, DATA, FILE, ...), inline `pneumid ...` spans
 #    and commands that need a network peer or hardware (udp://, comedi,
@@ -14,6 +15,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/lib.sh" "$@"
 
 ln -s "$SRC/data" "$TMP/data"
 ln -s "$SRC/config" "$TMP/config"
+ln -s "$SRC/tests" "$TMP/tests"
 "$PY" - "$SRC" "$PNEUMID" "$TMP" <<'PYEOF' || fail "documented commands (see above)"
 import glob, os, re, shlex, subprocess, sys
 

@@ -22,6 +22,7 @@
 namespace pneumid {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
@@ -137,6 +138,48 @@ TEST(NarxTest, TheFreeRunIsHeldWithinTheOutputBand) {
   const std::vector<double> expected{1, 2, 4, 8, 10, 10, 10, 10};
   for (Eigen::Index t = 0; t < s.size(); ++t)
     EXPECT_EQ(s(t), expected[static_cast<std::size_t>(t)]);
+}
+
+// validate warns where a NARX run leaves what its estimation data support:
+// the doubling run above is held at y_max in 4 of its 8 samples; an input
+// beyond the range the normalisation maps onto [-1, 1] (u_offset +- u_scale)
+// by more than 5 % of it.
+TEST(NarxTest, ExtrapolationWarningsNameTheOutputBandAndTheInputRange) {
+  IdentifiedModel im;
+  im.method = "narx";
+  NarxModel& m = im.narx.emplace();
+  m.ny = 1;
+  m.nu = 1;
+  m.nk = 1;
+  m.degree = 1;
+  m.terms = {NarxTerm{0}, NarxTerm{1}};
+  m.theta = {2.0, 1.0};
+  m.y_max = 10.0;
+  m.y_min = -1.0;
+  Eigen::VectorXd t(8), u = Eigen::VectorXd::Zero(8), y = Eigen::VectorXd::Zero(8);
+  for (Eigen::Index i = 0; i < 8; ++i) t(i) = 0.1 * static_cast<double>(i);
+  y(0) = 1.0;
+  const Dataset data(t, u, y, {{"u", ""}}, {{"y", ""}});
+  const Eigen::VectorXd run = m.Simulate(u, y);
+  EXPECT_THAT(ExtrapolationWarnings(im, data, 0, &run),
+              ElementsAre(AllOf(HasSubstr("the free run of the model 'narx' is held at the "
+                                          "edge of its output band [-1, 10]"),
+                                HasSubstr("in 4 of 8 samples (0 at -1, 4 at 10)"))));
+  EXPECT_TRUE(ExtrapolationWarnings(im, data).empty());  // no run given
+  m.theta = {0.5, 1.0};                                  // y(t) = 0.5 y(t-1): inside the band
+  const Eigen::VectorXd stable = m.Simulate(u, y);
+  EXPECT_TRUE(ExtrapolationWarnings(im, data, 0, &stable).empty());
+  // Estimated on u in [0, 10]: up to 10.5 is within 5 % of that range.
+  m.u_offset = 5.0;
+  m.u_scale = 5.0;
+  Eigen::VectorXd inside(8), outside(8);
+  inside << 0, 2, 4, 6, 8, 10, 10.5, -0.5;
+  outside << 0, 2, 4, 6, 8, 10, 10.6, 12;
+  EXPECT_TRUE(ExtrapolationWarnings(im, Dataset(t, inside, y, {{"u", ""}}, {{"y", ""}})).empty());
+  EXPECT_THAT(
+      ExtrapolationWarnings(im, Dataset(t, outside, y, {{"u", ""}}, {{"y", ""}})),
+      ElementsAre(AllOf(HasSubstr("the input reaches [0, 12], beyond the input range [0, 10]"),
+                        HasSubstr("(2 of 8 samples more than 5 % of that range outside)"))));
 }
 
 // ForgetsItsStart against its definition: runs from the first outputs

@@ -585,10 +585,51 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
   return m;
 }
 
+namespace {
+
+// The NARX parts of ExtrapolationWarnings: the input beyond the range the
+// normalisation maps onto [-1, 1] (the estimation input's), and a free run
+// held at its output band's edge.
+void NarxExtrapolationWarnings(const IdentifiedModel& model, const Eigen::VectorXd& u,
+                               const Eigen::VectorXd* simulated, std::vector<std::string>* w) {
+  const NarxModel& n = *model.narx;
+  const std::string name = model.method.empty() ? "" : " '" + model.method + "'";
+  if (!model.input_map && !(n.u_offset == 0.0 && n.u_scale == 1.0) && n.u_scale > 0.0) {
+    const double c1 = n.u_offset - n.u_scale, cm = n.u_offset + n.u_scale;
+    const double margin = 0.05 * (cm - c1);
+    const double lo = u.minCoeff(), hi = u.maxCoeff();
+    if (lo < c1 - margin || hi > cm + margin) {
+      const Eigen::Index outside = (u.array() < c1 - margin || u.array() > cm + margin).count();
+      w->push_back(fmt::format(
+          "the input reaches [{:g}, {:g}], beyond the input range [{:g}, {:g}] that the "
+          "model{} was estimated on ({} of {} samples more than 5 % of that range outside): its "
+          "polynomial extrapolates there",
+          lo, hi, c1, cm, name, outside, u.size()));
+    }
+  }
+  if (simulated == nullptr || simulated->size() == 0 || !std::isfinite(n.y_min) ||
+      !std::isfinite(n.y_max) || !(n.y_max > n.y_min))
+    return;
+  const double tol = 1e-9 * (n.y_max - n.y_min);
+  const Eigen::Index low = (simulated->array() <= n.y_min + tol).count();
+  const Eigen::Index high = (simulated->array() >= n.y_max - tol).count();
+  if (low + high == 0) return;
+  w->push_back(fmt::format(
+      "the free run of the model{} is held at the edge of its output band [{:g}, {:g}] (the "
+      "estimation output's range widened by a quarter each way) in {} of {} samples ({} at "
+      "{:g}, {} at {:g}): there its polynomial ran away from the region it was estimated on, "
+      "and the fit measures the band, not the model's dynamics",
+      name, n.y_min, n.y_max, low + high, simulated->size(), low, n.y_min, high, n.y_max));
+}
+
+}  // namespace
+
 std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, const Dataset& data,
-                                               int input) {
+                                               int input, const Eigen::VectorXd* simulated) {
   std::vector<std::string> w;
-  if (!model.input_map || input < 0 || input >= data.num_inputs() || data.size() == 0) return w;
+  if (input < 0 || input >= data.num_inputs() || data.size() == 0) return w;
+  if (model.narx) NarxExtrapolationWarnings(model, data.u(input), simulated, &w);
+  if (!model.input_map) return w;
   const Eigen::VectorXd u = data.u(input);
   const double c1 = model.input_map->u().front(), cm = model.input_map->u().back();
   const double margin = 0.05 * (cm - c1);

@@ -160,9 +160,15 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
 /// map is held there: an extrapolation the estimation data do not support),
 /// and an input inside an interval the estimation data left the map
 /// undetermined in (IdentifiedModel::input_map_undetermined), one warning
-/// per interval visited.
+/// per interval visited. NARX models: an input that leaves the estimation
+/// input's range (the one its normalisation maps onto [-1, 1]) by more than
+/// 5 % of it, and, given the model's free run on `data` (`simulated`, e.g.
+/// SimulateNonlinear's), samples where that run is held at the edge of the
+/// model's output band (NarxModel::y_min, y_max): the polynomial ran away
+/// there, and a fit measures the band rather than the model.
 std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, const Dataset& data,
-                                               int input = 0);
+                                               int input = 0,
+                                               const Eigen::VectorXd* simulated = nullptr);
 
 /// Simulated output of a nonlinear model on `data` (see the module comment
 /// and each estimator's header), with v = f(u) (or u) and G of static gain
