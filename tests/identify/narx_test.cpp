@@ -119,9 +119,8 @@ TEST(NarxTest, RoundTripsThroughJson) {
               ThrowsMessage<InvalidArgument>(HasSubstr("'y_max' must be a finite number")));
 }
 
-// The free run is held within the band: y(t) = 2 y(t-1) + u(t-1) from y = 1
-// doubles each sample until it meets y_max, and stays there.
-TEST(NarxTest, TheFreeRunIsHeldWithinTheOutputBand) {
+// y(t) = 2 y(t-1) + u(t-1) with the output band [-1, 10].
+NarxModel DoublingModel() {
   NarxModel m;
   m.ny = 1;
   m.nu = 1;
@@ -131,6 +130,13 @@ TEST(NarxTest, TheFreeRunIsHeldWithinTheOutputBand) {
   m.theta = {2.0, 1.0};
   m.y_max = 10.0;
   m.y_min = -1.0;
+  return m;
+}
+
+// The free run is held within the band: the doubling model from y = 1
+// doubles each sample until it meets y_max, and stays there.
+TEST(NarxTest, TheFreeRunIsHeldWithinTheOutputBand) {
+  const NarxModel m = DoublingModel();
   const Eigen::VectorXd u = Eigen::VectorXd::Zero(8);
   Eigen::VectorXd y = Eigen::VectorXd::Zero(8);
   y(0) = 1.0;
@@ -147,15 +153,7 @@ TEST(NarxTest, TheFreeRunIsHeldWithinTheOutputBand) {
 TEST(NarxTest, ExtrapolationWarningsNameTheOutputBandAndTheInputRange) {
   IdentifiedModel im;
   im.method = "narx";
-  NarxModel& m = im.narx.emplace();
-  m.ny = 1;
-  m.nu = 1;
-  m.nk = 1;
-  m.degree = 1;
-  m.terms = {NarxTerm{0}, NarxTerm{1}};
-  m.theta = {2.0, 1.0};
-  m.y_max = 10.0;
-  m.y_min = -1.0;
+  NarxModel& m = im.narx.emplace(DoublingModel());
   Eigen::VectorXd t(8), u = Eigen::VectorXd::Zero(8), y = Eigen::VectorXd::Zero(8);
   for (Eigen::Index i = 0; i < 8; ++i) t(i) = 0.1 * static_cast<double>(i);
   y(0) = 1.0;
