@@ -250,11 +250,17 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
         }
         m.flags = AssessModel(m, estimation, request.input, request.output, options.quality);
         if (scored != nullptr) {
-          const FitMetrics f = ScoreSimulation(
-              *scored, request.output,
-              SimulateModel(m, *scored, request.input, request.output, options.validation_initial),
-              score_from);
+          const Eigen::VectorXd yhat =
+              SimulateModel(m, *scored, request.input, request.output, options.validation_initial);
+          const FitMetrics f = ScoreSimulation(*scored, request.output, yhat, score_from);
           m.validation_fit_percent = f.fit_percent;
+          // Where the held-out part leaves what the estimation data support
+          // (validate's warnings), the held-out fit says so beside it.
+          const Dataset part =
+              score_from > 0 ? SliceDataset(*scored, score_from, scored->size()) : *scored;
+          const Eigen::VectorXd part_yhat = yhat.tail(part.size());
+          for (const std::string& w : ExtrapolationWarnings(m, part, request.input, &part_yhat))
+            m.notes.push_back("held-out part: " + w);
           if (std::optional<std::string> note =
                   OtherStartNote(m, *scored, request, options.validation_initial, score_from))
             m.notes.push_back(std::move(*note));

@@ -24,8 +24,11 @@
 namespace pneumid {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::Contains;
 using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::StartsWith;
 using ::testing::ThrowsMessage;
 
 Dataset Recorded(const std::string& name) {
@@ -186,6 +189,19 @@ TEST(GeneralizationTest, WarnsWhenTheInputLeavesTheMapsRange) {
   ASSERT_EQ(w.size(), 1u);
   EXPECT_THAT(w[0], HasSubstr("beyond the input map's range [5, 35]"));
   EXPECT_TRUE(ExtrapolationWarnings(m, low).empty());
+  // identify's held-out fit on that record says so beside it.
+  IdentifyOptions o;
+  o.num_threads = 1;
+  o.nonlinear.choose_structure = false;
+  const Dataset val = Recorded("gen_val_stairs");
+  const IdentificationSummary s = IdentifyModels({"hammerstein"}, low, r, o, &val);
+  ASSERT_EQ(s.models.size(), 1u);
+  EXPECT_THAT(s.models[0].notes,
+              Contains(AllOf(StartsWith("held-out part: the input reaches"),
+                             HasSubstr("beyond the input map's range [5, 35]"))));
+  const IdentificationSummary own = IdentifyModels({"hammerstein"}, low, r, o, &low);
+  ASSERT_EQ(own.models.size(), 1u);
+  EXPECT_THAT(own.models[0].notes, Not(Contains(StartsWith("held-out part:"))));
 }
 
 TEST(GeneralizationTest, StructureSearchErrorsAreClear) {

@@ -111,7 +111,9 @@ using IdentifyProgress =
 /// a method that fails is listed in failures with its reason and the others
 /// still run. Each model is flagged (AssessModel on the estimation data),
 /// scored on the held-out data when given (`validation`, scored from its first
-/// sample, simulated from options.validation_initial; or the split's rest), and
+/// sample, simulated from options.validation_initial; or the split's rest;
+/// where the held-out part leaves what the estimation data support, each of
+/// ExtrapolationWarnings' warnings is a note "held-out part: ..."), and
 /// the list is ranked (RankModels with options.quality). The nonlinear
 /// methods' structure search (NonlinearOptions::choose_structure) chooses on
 /// the same held-out part: `validation`, or the split's rest, named "the last
