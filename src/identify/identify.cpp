@@ -210,6 +210,18 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
                              : "choose another --split or give --validation data");
   }
   std::vector<std::string> warnings;
+  {
+    // A constant estimation input leaves the input's effect undetermined: a
+    // linear model fits the output's transient from its initial state (ARX's
+    // regressors are rank deficient), and every nonlinear method refuses it.
+    const Eigen::VectorXd u = estimation.u(request.input);
+    if (u.size() > 0 && !(u.maxCoeff() > u.minCoeff()))
+      warnings.push_back(fmt::format(
+          "the estimation data{} hold a constant input (u = {:g} over {} samples): no model "
+          "can tell the input's effect from them (its gain is undetermined; a fit measures the "
+          "output's transient from its initial state); record a step, a staircase or a PRBS",
+          head ? fmt::format(" (the first {:.0f} %)", 100.0 * options.split) : "", u[0], u.size()));
+  }
   if (held_out != nullptr) {
     // A held-out part on one input level scores each model's steady state
     // there, not its dynamics: a ranking (and a structure search) on it says
@@ -256,8 +268,9 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
           m.validation_fit_percent = f.fit_percent;
           // Where the held-out part leaves what the estimation data support
           // (validate's warnings), the held-out fit says so beside it.
-          const Dataset part =
-              score_from > 0 ? SliceDataset(*scored, score_from, scored->size()) : *scored;
+          std::optional<Dataset> slice;
+          if (score_from > 0) slice = SliceDataset(*scored, score_from, scored->size());
+          const Dataset& part = slice ? *slice : *scored;
           const Eigen::VectorXd part_yhat = yhat.tail(part.size());
           for (const std::string& w : ExtrapolationWarnings(m, part, request.input, &part_yhat))
             m.notes.push_back("held-out part: " + w);

@@ -248,6 +248,23 @@ TEST(GeneralizationTest, StructureSearchErrorsAreClear) {
   const Dataset flat_tail = Dataset::FromUniform(0.01, u, y);
   EXPECT_THAT([&] { IdentifyModels({"hammerstein"}, flat_tail, {}, split); },
               ThrowsMessage<InvalidArgument>(HasSubstr("holds a constant output")));
+  // A constant estimation input: ARX still fits the output's transient from
+  // its initial state (y(t) = 0.9 y(t-1) + 0.1 u(t-1) from y(0) = 0 at u = 40),
+  // and the summary says that no model can tell the input's effect.
+  Eigen::VectorXd uc = Eigen::VectorXd::Constant(200, 40.0), yc(200);
+  yc[0] = 0.0;
+  for (Eigen::Index t = 1; t < 200; ++t) yc[t] = 0.9 * yc[t - 1] + 0.1 * uc[t - 1];
+  IdentifyOptions single;
+  single.num_threads = 1;
+  const IdentificationSummary on_one_level =
+      IdentifyModels({"arx"}, Dataset::FromUniform(0.01, uc, yc), {}, single);
+  ASSERT_EQ(on_one_level.warnings.size(), 1u);
+  EXPECT_THAT(on_one_level.warnings[0],
+              AllOf(HasSubstr("estimation data hold a constant input (u = 40 over 200 samples)"),
+                    HasSubstr("gain is undetermined")));
+  uc.tail(100).setConstant(60.0);
+  EXPECT_TRUE(
+      IdentifyModels({"arx"}, Dataset::FromUniform(0.01, uc, yc), {}, single).warnings.empty());
   EXPECT_THAT(
       [&] { ChooseBlockStructure("arx", est, {}, o); },
       ThrowsMessage<InvalidArgument>(HasSubstr("for hammerstein, wiener, hw and narx, got 'arx'")));

@@ -587,6 +587,21 @@ IdentifiedModel IdentifyNonlinear(const std::string& method, const Dataset& data
 
 namespace {
 
+// Warns when u goes more than 5 % of [c1, cm] beyond it: the range ('what')
+// a model was estimated on; 'consequence' says what the model does there.
+void InputRangeWarning(const Eigen::VectorXd& u, double c1, double cm, const std::string& what,
+                       const std::string& name, const std::string& consequence,
+                       std::vector<std::string>* w) {
+  const double margin = 0.05 * (cm - c1);
+  const double lo = u.minCoeff(), hi = u.maxCoeff();
+  if (lo >= c1 - margin && hi <= cm + margin) return;
+  const Eigen::Index outside = (u.array() < c1 - margin || u.array() > cm + margin).count();
+  w->push_back(fmt::format(
+      "the input reaches [{:g}, {:g}], beyond {} [{:g}, {:g}] that the model{} was estimated on "
+      "({} of {} samples more than 5 % of that range outside): {}",
+      lo, hi, what, c1, cm, name, outside, u.size(), consequence));
+}
+
 // The NARX parts of ExtrapolationWarnings: the input beyond the range the
 // normalisation maps onto [-1, 1] (the estimation input's), and a free run
 // held at its output band's edge.
@@ -594,19 +609,9 @@ void NarxExtrapolationWarnings(const IdentifiedModel& model, const Eigen::Vector
                                const Eigen::VectorXd* simulated, std::vector<std::string>* w) {
   const NarxModel& n = *model.narx;
   const std::string name = model.method.empty() ? "" : " '" + model.method + "'";
-  if (!model.input_map && !(n.u_offset == 0.0 && n.u_scale == 1.0) && n.u_scale > 0.0) {
-    const double c1 = n.u_offset - n.u_scale, cm = n.u_offset + n.u_scale;
-    const double margin = 0.05 * (cm - c1);
-    const double lo = u.minCoeff(), hi = u.maxCoeff();
-    if (lo < c1 - margin || hi > cm + margin) {
-      const Eigen::Index outside = (u.array() < c1 - margin || u.array() > cm + margin).count();
-      w->push_back(fmt::format(
-          "the input reaches [{:g}, {:g}], beyond the input range [{:g}, {:g}] that the "
-          "model{} was estimated on ({} of {} samples more than 5 % of that range outside): its "
-          "polynomial extrapolates there",
-          lo, hi, c1, cm, name, outside, u.size()));
-    }
-  }
+  if (!model.input_map && !(n.u_offset == 0.0 && n.u_scale == 1.0) && n.u_scale > 0.0)
+    InputRangeWarning(u, n.u_offset - n.u_scale, n.u_offset + n.u_scale, "the input range", name,
+                      "its polynomial extrapolates there", w);
   if (simulated == nullptr || simulated->size() == 0 || !std::isfinite(n.y_min) ||
       !std::isfinite(n.y_max) || !(n.y_max > n.y_min))
     return;
@@ -631,17 +636,11 @@ std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, con
   if (model.narx) NarxExtrapolationWarnings(model, data.u(input), simulated, &w);
   if (!model.input_map) return w;
   const Eigen::VectorXd u = data.u(input);
-  const double c1 = model.input_map->u().front(), cm = model.input_map->u().back();
-  const double margin = 0.05 * (cm - c1);
-  const double lo = u.minCoeff(), hi = u.maxCoeff();
-  if (lo < c1 - margin || hi > cm + margin) {
-    const Eigen::Index outside = (u.array() < c1 - margin || u.array() > cm + margin).count();
-    w.push_back(fmt::format(
-        "the input reaches [{:g}, {:g}], beyond the input map's range [{:g}, {:g}] that the "
-        "model{} was estimated on ({} of {} samples more than 5 % of that range outside): the "
-        "map is held at its end values there, an extrapolation the data do not support",
-        lo, hi, c1, cm, model.method.empty() ? "" : " '" + model.method + "'", outside, u.size()));
-  }
+  InputRangeWarning(u, model.input_map->u().front(), model.input_map->u().back(),
+                    "the input map's range", model.method.empty() ? "" : " '" + model.method + "'",
+                    "the map is held at its end values there, an extrapolation the data do not "
+                    "support",
+                    &w);
   for (const auto& [a, b] : model.input_map_undetermined) {
     const double margin = 0.01 * (b - a);
     const Eigen::Index inside = (u.array() > a + margin && u.array() < b - margin).count();
