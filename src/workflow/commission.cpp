@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -452,10 +453,59 @@ void Diagnose(CommissionResult& r) {
     settling = settling || f.rfind("settling", 0) == 0;
   }
   if (ripple) {
-    r.limits.push_back(
-        "ripple: the loop cycles at some levels (the actuator has no steady input there, e.g. a "
-        "valve pulse below its minimum width)");
-    r.suggestions.push_back("avoid those levels, or a less aggressive design (--aggressiveness)");
+    // Where the held input's mean lies inside one of the actuator's input
+    // gaps, the actuator has no steady input for that level: the modulation
+    // alternates the gap's ends and the plant's and sensor's lags decide what
+    // of it shows. Name those levels and the gaps.
+    const std::vector<InputGap> gaps = r.settings.input_gaps.empty()
+                                           ? std::vector<InputGap>{}
+                                           : ParseInputGaps(r.settings.input_gaps);
+    std::vector<std::string> in_gap;
+    double worst = 0.0;
+    const ClosedLoopMetrics& m = cl.metrics;
+    for (std::size_t i = 0; i < m.steps.size(); ++i) {
+      const StepMetrics& s = m.steps[i];
+      if (s.time <= 0.0 || !(s.ripple > RippleLimit(s, r.experiment))) continue;
+      // The mean input over the window whose ripple was measured: the last
+      // quarter of the step's hold, which ends at the next step or at a load
+      // step inside it (closed_loop.cpp).
+      const double end =
+          i + 1 < m.steps.size() ? m.steps[i + 1].time : std::numeric_limits<double>::infinity();
+      const Eigen::Index n = cl.t.size();
+      Eigen::Index k0 = 0;
+      while (k0 < n && cl.t[k0] < s.time - 1e-9) ++k0;
+      Eigen::Index k1 = k0 + 1;
+      while (k1 < n && cl.t[k1] < end - 1e-9 && !(cl.d.size() == n && cl.d[k1] != cl.d[k1 - 1]))
+        ++k1;
+      const Eigen::Index tail = std::max<Eigen::Index>((k1 - k0) / 4, 8);
+      if (k1 > n || k1 - k0 < 2 * tail) continue;
+      const double sum = cl.u.segment(k1 - tail, tail).sum();
+      const double count = static_cast<double>(tail);
+      const double mean = sum / count;
+      for (const InputGap& g : gaps)
+        if (mean > g.lo && mean < g.hi) {
+          in_gap.push_back(
+              fmt::format("{:.4g} (input {:.3g}, gap {:g}..{:g})", s.to, mean, g.lo, g.hi));
+          worst = std::max(worst, s.ripple);
+        }
+    }
+    if (!in_gap.empty()) {
+      r.limits.push_back(fmt::format(
+          "ripple: the set-point(s) {} need a mean input inside the actuator's input gaps, where "
+          "no input holds the output steady (a valve pulse below its minimum width): the "
+          "modulation alternates the gap's ends and the plant's and sensor's lags smooth what "
+          "they can ({:.3g} peak to peak at worst here)",
+          fmt::join(in_gap, ", "), worst));
+      r.suggestions.push_back(
+          "avoid set-points whose input lies in those gaps, or narrow the gaps (valves with a "
+          "shorter minimum pulse, a lower PWM frequency); a controller cannot hold them more "
+          "steadily than the actuator");
+    } else {
+      r.limits.push_back(
+          "ripple: the loop cycles at some levels (the actuator has no steady input there, e.g. "
+          "a valve pulse below its minimum width)");
+      r.suggestions.push_back("avoid those levels, or a less aggressive design (--aggressiveness)");
+    }
   }
   if (overshoot)
     r.suggestions.push_back(

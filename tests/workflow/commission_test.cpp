@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <tuple>
 #include <vector>
 
@@ -21,6 +22,7 @@
 namespace pneumid {
 namespace {
 
+using ::testing::Contains;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
@@ -332,6 +334,31 @@ TEST(Commission, AStopRequestDuringTheRestBeforeAVerificationRunEndsThere) {
   EXPECT_TRUE(r.attempts.empty());
   EXPECT_EQ(plant.measured_armed, 1);  // the hold's first sample; the second sees the stop
   EXPECT_EQ(plant.last_u, 0.0);        // u_min: the safe input
+}
+
+TEST(Commission, ARippleInsideAValveGapNamesTheSetPointsAndTheGap) {
+  // Without a sensor filter the default twin's fast chamber shows the
+  // modulation across the exhaust valve's gap (duty 85..100 % at 300 Hz, no
+  // exhaust pulse of the minimum width): the forces there (135-193 N) ripple
+  // by tens of newtons, and the diagnosis names those set-points and the gap.
+  const std::string config = TempDir("ipa-no-filter") + "/ipa.toml";
+  {
+    std::ofstream f(config);
+    f << "[sensors]\npressure_filter_time_constant = 0.0\n";
+  }
+  PlantOptions po;
+  po.config_path = config;
+  CommissionPlant made = MakeCommissionPlant("ipa", std::nullopt, po);
+  CommissionOptions o;
+  o.directory = TempDir("ipa-no-filter");
+  SetDefaultSpecification(o, PlantActuator(*made.plant));
+  SetInputGaps(o, *made.plant, "plant");
+  const CommissionResult r = Commission(*made.plant, o);
+  EXPECT_FALSE(r.passed());
+  EXPECT_THAT(r.limits,
+              Contains(AllOf(HasSubstr("need a mean input inside the actuator's input gaps"),
+                             HasSubstr("gap 85..100"))));
+  EXPECT_THAT(r.limits, Not(Contains(HasSubstr("the loop cycles at some levels"))));
 }
 
 TEST(Commission, InvalidOptionsNameTheField) {
