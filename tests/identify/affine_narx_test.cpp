@@ -72,6 +72,22 @@ TEST(AffineNarxTest, RecoversTheSystemFromNoiseFreeData) {
   const Record v = Simulate(3000, 11);
   const Eigen::VectorXd sim = res.narx.Simulate(res.map.Evaluate(v.u), v.y);
   EXPECT_LT((sim - v.y).cwiseAbs().maxCoeff(), 1e-4);
+  // The free run's band, as a polynomial NARX's: the estimation output's
+  // range widened by a quarter each way. A model whose run leaves it
+  // (theta of z(t-1) raised to 1.5: z grows by half each sample until its
+  // -z^2 term turns it down without bound) is held at the band's edges, not
+  // carried to infinity.
+  const double lo = r.y.minCoeff(), hi = r.y.maxCoeff();
+  EXPECT_NEAR(res.narx.y_min, lo - 0.25 * (hi - lo), 1e-9);
+  EXPECT_NEAR(res.narx.y_max, hi + 0.25 * (hi - lo), 1e-9);
+  NarxModel runaway = res.narx;
+  runaway.theta[1] = 1.5;
+  const Eigen::VectorXd held = runaway.Simulate(res.map.Evaluate(v.u), v.y);
+  ASSERT_TRUE(held.allFinite());
+  EXPECT_GE(held.minCoeff(), res.narx.y_min);
+  EXPECT_LE(held.maxCoeff(), res.narx.y_max);
+  EXPECT_GT((held.array() == res.narx.y_min || held.array() == res.narx.y_max).count(),
+            held.size() / 2);
 }
 
 TEST(AffineNarxTest, RunsAsAnIdentifyMethodAndThroughTheModelFile) {

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <Eigen/Dense>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/evaluation/fit_metrics.hpp"
+#include "pneumid/identify/nonlinear/narx_simulation_fit.hpp"
 #include "pneumid/identify/nonlinear/static_map_fit.hpp"
 
 namespace pneumid {
@@ -290,6 +292,10 @@ AffineNarxResult EstimateAffineNarx(const Eigen::VectorXd& u, const Eigen::Vecto
   result.map = StaticMap(knots, std::vector<double>(alpha.data(), alpha.data() + num_knots),
                          StaticMapExtrapolation::kClamp);
   result.narx = AffineNarxModel(reg, mapped, ab, d, options.nk, Ts, y_scale);
+  // The free run's band, as a polynomial NARX's (narx_model.hpp): a run that
+  // leaves the region estimated on is held at its edge, not carried to
+  // infinity, and ExtrapolationWarnings says so.
+  std::tie(result.narx.y_min, result.narx.y_max) = NarxDataBand(y, NarxSimulationFitOptions{}.band);
   FillSummary(reg, alternation, knots, prediction, y_scale, num_params, &result.summary);
   const Eigen::VectorXd zt = y.tail(rows) / y_scale;
   result.one_step_fit_percent = NrmseFit(zt, (prediction + reg.z_powers.col(1)).eval());
