@@ -173,8 +173,9 @@ ControlScenarioOptions ToScenarioOptions(const ControlArgs& c) {
   return o;
 }
 
-std::vector<ControlRun> SimulateControl(const ControlArgs& c) {
+std::vector<ControlRun> SimulateControl(const ControlArgs& c, std::vector<std::string>* warnings) {
   ControlScenarioResult scenario = RunControlScenario(ToScenarioOptions(c));
+  if (warnings != nullptr) *warnings = scenario.warnings;
   if (!c.output.empty()) WriteCsv(c.output, scenario.runs);
   if (!c.plot.empty()) WritePlot(c.plot, scenario.runs, c, scenario.plant_spec, scenario.actuator);
   return std::move(scenario.runs);
@@ -187,7 +188,9 @@ nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs) {
 namespace {
 
 void Execute(const ControlArgs& c) {
-  const std::vector<Run> runs = SimulateControl(c);
+  std::vector<std::string> warnings;
+  const std::vector<Run> runs = SimulateControl(c, &warnings);
+  for (const std::string& w : warnings) std::cerr << "pneumid control: warning: " << w << "\n";
   if (c.json) {
     std::cout << ControlJson(runs).dump(2) << "\n";
     return;

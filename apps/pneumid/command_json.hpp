@@ -63,7 +63,9 @@ ControlScenarioOptions ToScenarioOptions(const ControlArgs& c);
 /// The simulations of `control` (one, or one per rule with --compare:
 /// RunControlScenario), after writing -o and --plot when given.
 /// @throws InvalidArgument / DataError for invalid settings or an unreadable model.
-std::vector<ControlRun> SimulateControl(const ControlArgs& c);
+/// `warnings`, when given, receives the scenario's (ControlScenarioResult::warnings).
+std::vector<ControlRun> SimulateControl(const ControlArgs& c,
+                                        std::vector<std::string>* warnings = nullptr);
 
 /// What `control --json` prints for these runs.
 nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs);

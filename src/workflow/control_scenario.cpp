@@ -1,6 +1,9 @@
 #include "pneumid/workflow/control_scenario.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <utility>
 
 #include <fmt/format.h>
@@ -61,7 +64,69 @@ void ResolvePlantInputGaps(const Actuator& actuator, const std::string& plant_na
   input_gaps = InputGapsToString(actuator.input_gaps);
 }
 
+std::optional<std::pair<double, double>> SteadyOutputRange(const TransferFunction& model,
+                                                           const ControllerSpec& spec, double u_min,
+                                                           double u_max) {
+  if (!std::isfinite(u_min) || !std::isfinite(u_max) || !(u_max > u_min)) return std::nullopt;
+  if (!spec.input_map && !spec.output_map && !spec.narx_model) return std::nullopt;
+  std::vector<double> inputs;
+  constexpr int kSamples = 400;
+  for (int i = 0; i <= kSamples; ++i)
+    inputs.push_back(u_min + (u_max - u_min) * static_cast<double>(i) / kSamples);
+  // A piecewise-linear map takes its extremes at its knots or the limits.
+  if (spec.input_map)
+    for (double k : spec.input_map->u())
+      if (k > u_min && k < u_max) inputs.push_back(k);
+  std::sort(inputs.begin(), inputs.end());
+  const double dc = model.DcGain();
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo, y_prev = 0.0;
+  for (double u : inputs) {
+    double y = 0.0;
+    if (spec.narx_model) {
+      y = spec.narx_model->SteadyOutput(u, y_prev);
+    } else {
+      y = dc * (spec.input_map ? spec.input_map->Evaluate(u) : u);
+      if (spec.output_map) y = spec.output_map->Evaluate(y);
+    }
+    if (!std::isfinite(y)) return std::nullopt;
+    lo = std::min(lo, y);
+    hi = std::max(hi, y);
+    y_prev = y;
+  }
+  return std::make_pair(lo, hi);
+}
+
 namespace {
+
+// Set-points of the scenario beyond the steady outputs its model reaches
+// within the input limits (by more than 1 % of that range): one warning.
+std::optional<std::string> UnreachableSetpoints(const Signal& setpoint, double duration, double Ts,
+                                                const TransferFunction& model,
+                                                const ControllerSpec& spec, double u_min,
+                                                double u_max) {
+  const std::optional<std::pair<double, double>> range =
+      SteadyOutputRange(model, spec, u_min, u_max);
+  if (!range) return std::nullopt;
+  const auto [lo, hi] = *range;
+  const double tol = 0.01 * (hi - lo);
+  double r_lo = std::numeric_limits<double>::infinity(), r_hi = -r_lo;
+  long outside = 0, samples = 0;
+  for (double t = 0.0; t < duration - 1e-9 * Ts; t += Ts, ++samples) {
+    const double r = setpoint(t);
+    if (!std::isfinite(r)) continue;
+    r_lo = std::min(r_lo, r);
+    r_hi = std::max(r_hi, r);
+    if (r < lo - tol || r > hi + tol) ++outside;
+  }
+  if (outside == 0) return std::nullopt;
+  return fmt::format(
+      "the set-point reaches [{:.4g}, {:.4g}], beyond the steady outputs [{:.4g}, {:.4g}] that "
+      "the controller's model reaches with the input within its limits [{:g}, {:g}] ({} of {} "
+      "samples): there the input saturates and the output stays short of the set-point; keep "
+      "the set-points within that range, or widen the input limits or the actuator (a higher "
+      "supply pressure, larger valves)",
+      r_lo, r_hi, lo, hi, u_min, u_max, outside, samples);
+}
 
 // The controller specifications to run: the given one, or one per compared rule.
 std::vector<ControllerSpec> ScenarioSpecs(const ControlScenarioOptions& o,
@@ -103,6 +168,9 @@ ControlScenarioResult RunControlScenario(const ControlScenarioOptions& o) {
   loop.actuator.u_min = settings.limits.u_min;
   loop.actuator.u_max = settings.limits.u_max;
   const ControllerSpec base = WithModelInputMap(ToControllerSpec(settings), o.model);
+  if (std::optional<std::string> w = UnreachableSetpoints(
+          *setpoint, o.duration, o.Ts, model, base, settings.limits.u_min, settings.limits.u_max))
+    result.warnings.push_back(std::move(*w));
   for (const ControllerSpec& spec : ScenarioSpecs(o, base)) {
     if (!plant) plant = MakePlant(result.plant_spec, o.Ts, plant_options);
     ControlScenarioRun run;

@@ -22,7 +22,9 @@
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -69,6 +71,11 @@ struct ControlScenarioResult {
   std::vector<ControlScenarioRun> runs;  ///< one, or one per compared rule
   std::string plant_spec;                ///< the plant simulated (the model when none given)
   Actuator actuator;                     ///< the plant's actuator: channels, input range, gaps
+  /// What the scenario asks that its model says it cannot do: set-points
+  /// beyond the steady outputs the controller's model reaches with the input
+  /// held anywhere within its limits (SteadyOutputRange); `control` prints
+  /// them on stderr.
+  std::vector<std::string> warnings;
   /// One run's ToJson, or {"compare": [...]} for several: `control --json`.
   nlohmann::ordered_json ToJson() const;
 };
@@ -80,6 +87,17 @@ nlohmann::ordered_json ControlScenarioJson(const std::vector<ControlScenarioRun>
 /// @throws InvalidArgument for invalid options, settings or specs (naming them);
 ///         DataError for an unreadable model file; Cancelled when `stop` is set.
 ControlScenarioResult RunControlScenario(const ControlScenarioOptions& options);
+
+/// The steady outputs a controller's model reaches with its input held
+/// anywhere in [u_min, u_max] (sampled at 401 inputs and the map's knots):
+/// G(1) f(u), through the output map g when there is one (Hammerstein,
+/// Wiener, Hammerstein-Wiener), or the input-affine NARX's fixed point
+/// (spec.narx_model). nullopt for a model without a map or NARX (a linear
+/// model's operating point is not known to the controller), for open input
+/// limits, or when the model has no steady state at some input.
+std::optional<std::pair<double, double>> SteadyOutputRange(const TransferFunction& model,
+                                                           const ControllerSpec& spec,
+                                                           double u_min, double u_max);
 
 /// Input limits of a design against a plant: a limit left open (not finite)
 /// takes the actuator's physical input range (IPA: duty 0..100 %).
