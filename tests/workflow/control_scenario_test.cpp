@@ -1,9 +1,11 @@
 // RunControlScenario (workflow/control_scenario.hpp): the steady outputs a
 // controller's model reaches within its input limits, in closed form for a
-// static map behind a gain and through an output map, and the warning of a
+// static map behind a gain and through an output map, the fixed points of an
+// input-affine NARX, and the warning of a
 // scenario whose set-point lies beyond them.
 #include "pneumid/workflow/control_scenario.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -11,6 +13,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "../control/chamber_narx.hpp"
+#include "pneumid/control/narx_linearizing_controller.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 #include "pneumid/models/static_map.hpp"
 
@@ -49,6 +53,20 @@ TEST(ControlScenarioTest, SteadyOutputRangeIsTheGainTimesTheMapOverTheInputLimit
   // No map (a linear model's operating point is unknown) or open limits: none.
   EXPECT_FALSE(SteadyOutputRange(g, ControllerSpec{}, 0.0, 100.0).has_value());
   EXPECT_FALSE(SteadyOutputRange(g, spec, 0.0, std::numeric_limits<double>::infinity()));
+}
+
+TEST(ControlScenarioTest, SteadyOutputRangeOfAnInputAffineNarxIsItsFixedPoints) {
+  // chamber_narx.hpp: 0 = -0.03 z - 0.02 z^2 + v (0.12 - 0.05 z), z = y / 200.
+  // v = 1 (u = 100): z^2 + 4 z - 6 = 0, z = sqrt(10) - 2; the map's least
+  // value, v = -0.01 at u = 5: 0.02 z^2 + 0.0295 z + 0.0012 = 0.
+  ControllerSpec spec;
+  spec.narx_model =
+      InputAffineNarx(testing_models::ChamberNarx(0.01), testing_models::ChamberValve());
+  const auto range = SteadyOutputRange(TransferFunction::Fopdt(1.0, 0.1, 0.0), spec, 0.0, 100.0);
+  ASSERT_TRUE(range.has_value());
+  const double z_low = (-0.0295 + std::sqrt(0.0295 * 0.0295 - 4 * 0.02 * 0.0012)) / 0.04;
+  EXPECT_NEAR(range->first, 200.0 * z_low, 1e-3);
+  EXPECT_NEAR(range->second, 200.0 * (std::sqrt(10.0) - 2.0), 1e-3);
 }
 
 TEST(ControlScenarioTest, ASetPointBeyondTheModelsReachIsAWarning) {
