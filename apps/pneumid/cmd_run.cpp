@@ -32,6 +32,9 @@ RunWorkflowOptions ToWorkflowOptions(const RunArgs& o) {
   w.safety = o.safety;
   w.log = o.rt.log;
   w.live_status = StderrIsTerminal() && !o.rt.json;
+  w.warn = [](const std::string& message) {
+    std::cerr << "pneumid run: warning: " << message << "\n";
+  };
   return w;
 }
 

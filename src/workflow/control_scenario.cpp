@@ -96,14 +96,10 @@ std::optional<std::pair<double, double>> SteadyOutputRange(const TransferFunctio
   return std::make_pair(lo, hi);
 }
 
-namespace {
-
-// Set-points of the scenario beyond the steady outputs its model reaches
-// within the input limits (by more than 1 % of that range): one warning.
-std::optional<std::string> UnreachableSetpoints(const Signal& setpoint, double duration, double Ts,
-                                                const TransferFunction& model,
-                                                const ControllerSpec& spec, double u_min,
-                                                double u_max) {
+std::optional<std::string> UnreachableSetpointWarning(const Signal& setpoint, double duration,
+                                                      double Ts, const TransferFunction& model,
+                                                      const ControllerSpec& spec, double u_min,
+                                                      double u_max) {
   const std::optional<std::pair<double, double>> range =
       SteadyOutputRange(model, spec, u_min, u_max);
   if (!range) return std::nullopt;
@@ -127,6 +123,8 @@ std::optional<std::string> UnreachableSetpoints(const Signal& setpoint, double d
       "supply pressure, larger valves)",
       r_lo, r_hi, lo, hi, u_min, u_max, outside, samples);
 }
+
+namespace {
 
 // The controller specifications to run: the given one, or one per compared rule.
 std::vector<ControllerSpec> ScenarioSpecs(const ControlScenarioOptions& o,
@@ -168,7 +166,7 @@ ControlScenarioResult RunControlScenario(const ControlScenarioOptions& o) {
   loop.actuator.u_min = settings.limits.u_min;
   loop.actuator.u_max = settings.limits.u_max;
   const ControllerSpec base = WithModelInputMap(ToControllerSpec(settings), o.model);
-  if (std::optional<std::string> w = UnreachableSetpoints(
+  if (std::optional<std::string> w = UnreachableSetpointWarning(
           *setpoint, o.duration, o.Ts, model, base, settings.limits.u_min, settings.limits.u_max))
     result.warnings.push_back(std::move(*w));
   for (const ControllerSpec& spec : ScenarioSpecs(o, base)) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <utility>
 
 #include <fmt/format.h>
@@ -162,6 +163,14 @@ RunWorkflowResult RunRealtimeWorkflow(const RunWorkflowOptions& o, const Realtim
   ControllerAdapter controller(std::move(built.controller));
 
   const auto sp = ParseSignal(o.setpoint);
+  if (o.warn) {
+    ControllerSettings c = o.controller;
+    c.limits = limits;
+    if (std::optional<std::string> w = UnreachableSetpointWarning(
+            *sp, config.loop.duration, Ts, model, WithModelInputMap(ToControllerSpec(c), o.model),
+            limits.u_min, limits.u_max))
+      o.warn(*w);
+  }
   const Eigen::VectorXd r = sp->Sample(Ts, config.loop.Samples());
   const std::vector<double> setpoint(r.data(), r.data() + r.size());
   if (auto* sim = dynamic_cast<SimBackend*>(io.get())) sim->SetLoadSteps(o.load_steps);

@@ -3,8 +3,10 @@
 // the model documents held in memory, and the checks that name the flags.
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -63,6 +65,31 @@ const std::set<std::string> kRunKeys = {"compute_max_us",
                                         "scheduling",
                                         "termination",
                                         "wall_time"};
+
+TEST(RunWorkflow, ASetPointBeyondTheModelsReachIsReportedBeforeTheLoop) {
+  // A static map f (0 -> 0, 50 -> 40, 100 -> 60) behind G(1) = 2: the model
+  // reaches 0..120 with the duty in 0..100 % (control_scenario.hpp).
+  const auto dir = std::filesystem::temp_directory_path() / "pneumid_run_workflow_reach";
+  std::filesystem::create_directories(dir);
+  const std::string map = (dir / "map.json").string();
+  std::ofstream(map) << R"({"u": [0, 50, 100], "y": [0, 40, 60]})";
+  RunWorkflowOptions o;
+  o.model = "fopdt:K=2,tau=0.2,theta=0";
+  o.controller.input_map = map;
+  o.setpoint = "staircase:levels=50 150,dwell=0.5";
+  std::vector<std::string> warnings;
+  o.warn = [&](const std::string& w) { warnings.push_back(w); };
+  const RunWorkflowResult r = RunRealtimeWorkflow(o, FastSim(1.0));
+  EXPECT_EQ(r.summary.termination, Termination::kSuccess);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("the set-point reaches [50, 150], beyond the steady outputs [0, 120]"),
+            std::string::npos)
+      << warnings[0];
+  warnings.clear();
+  o.setpoint = "staircase:levels=50 110,dwell=0.5";
+  RunRealtimeWorkflow(o, FastSim(1.0));
+  EXPECT_TRUE(warnings.empty());
+}
 
 TEST(RunWorkflow, ASimulatorRunGivesTheKeysOfRunJson) {
   const RunWorkflowResult r = RunRealtimeWorkflow(RunWorkflowOptions{}, FastSim(1.0));

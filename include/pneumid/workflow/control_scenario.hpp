@@ -99,6 +99,15 @@ std::optional<std::pair<double, double>> SteadyOutputRange(const TransferFunctio
                                                            const ControllerSpec& spec,
                                                            double u_min, double u_max);
 
+/// The warning for a set-point that goes beyond the steady outputs of
+/// SteadyOutputRange by more than 1 % of that range, sampled every Ts over
+/// [0, duration): the range reached, the model's, the limits and how many
+/// samples; nullopt when none does or the range is unknown.
+std::optional<std::string> UnreachableSetpointWarning(const Signal& setpoint, double duration,
+                                                      double Ts, const TransferFunction& model,
+                                                      const ControllerSpec& spec, double u_min,
+                                                      double u_max);
+
 /// Input limits of a design against a plant: a limit left open (not finite)
 /// takes the actuator's physical input range (IPA: duty 0..100 %).
 /// @throws InvalidArgument when u_min > u_max, naming the actuator's range.

@@ -23,6 +23,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -87,6 +88,10 @@ struct RunWorkflowOptions {
   std::string log;
   /// Redraw a one-line status on stderr while the loop runs (a terminal's).
   bool live_status = false;
+  /// Receives, before the loop starts, what the run asks that the
+  /// controller's model says it cannot do (UnreachableSetpointWarning); none
+  /// = not reported.
+  std::function<void(const std::string&)> warn;
 
   /// False (with the reason, naming the flag) for an empty model or set-point,
   /// a load step that is not finite or before t = 0, invalid safety overrides
