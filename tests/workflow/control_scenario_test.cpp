@@ -6,14 +6,14 @@
 #include "pneumid/workflow/control_scenario.hpp"
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
+#include <limits>
 #include <string>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "../control/chamber_narx.hpp"
+#include "gain_map_model.hpp"
 #include "pneumid/control/narx_linearizing_controller.hpp"
 #include "pneumid/lti/transfer_function.hpp"
 #include "pneumid/models/static_map.hpp"
@@ -70,13 +70,9 @@ TEST(ControlScenarioTest, SteadyOutputRangeOfAnInputAffineNarxIsItsFixedPoints) 
 }
 
 TEST(ControlScenarioTest, ASetPointBeyondTheModelsReachIsAWarning) {
-  const auto dir = std::filesystem::temp_directory_path() / "pneumid_control_scenario";
-  std::filesystem::create_directories(dir);
-  const std::string map = (dir / "map.json").string();
-  std::ofstream(map) << R"({"u": [0, 50, 100], "y": [0, 40, 60]})";
   ControlScenarioOptions o;
-  o.model = "fopdt:K=2,tau=0.2,theta=0";
-  o.controller.input_map = map;
+  o.model = testing_models::kGainMapModel;
+  o.controller.input_map = testing_models::WriteGainMapFile("pneumid_control_scenario");
   o.controller.limits.u_min = 0.0;
   o.controller.limits.u_max = 100.0;
   o.Ts = 0.01;

@@ -3,13 +3,13 @@
 // the model documents held in memory, and the checks that name the flags.
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "gain_map_model.hpp"
 #include "pneumid/common/check.hpp"
 #include "pneumid/models/model_file.hpp"
 #include "pneumid/workflow/run_workflow.hpp"
@@ -67,15 +67,10 @@ const std::set<std::string> kRunKeys = {"compute_max_us",
                                         "wall_time"};
 
 TEST(RunWorkflow, ASetPointBeyondTheModelsReachIsReportedBeforeTheLoop) {
-  // A static map f (0 -> 0, 50 -> 40, 100 -> 60) behind G(1) = 2: the model
-  // reaches 0..120 with the duty in 0..100 % (control_scenario.hpp).
-  const auto dir = std::filesystem::temp_directory_path() / "pneumid_run_workflow_reach";
-  std::filesystem::create_directories(dir);
-  const std::string map = (dir / "map.json").string();
-  std::ofstream(map) << R"({"u": [0, 50, 100], "y": [0, 40, 60]})";
+  // gain_map_model.hpp: the model reaches 0..120 with the duty in 0..100 %.
   RunWorkflowOptions o;
-  o.model = "fopdt:K=2,tau=0.2,theta=0";
-  o.controller.input_map = map;
+  o.model = testing_models::kGainMapModel;
+  o.controller.input_map = testing_models::WriteGainMapFile("pneumid_run_workflow_reach");
   o.setpoint = "staircase:levels=50 150,dwell=0.5";
   std::vector<std::string> warnings;
   o.warn = [&](const std::string& w) { warnings.push_back(w); };
