@@ -371,15 +371,8 @@ async function identify(): Promise<void> {
       li.append(b, ' ' + (f.message ?? f.reason ?? f.error ?? (f.method ? '' : JSON.stringify(f))));
       warn.appendChild(li);
     }
-    const warnings = Array.isArray(res.warnings) ? res.warnings : [];
-    for (const w of warnings) {
-      const li = document.createElement('li');
-      const b = document.createElement('strong');
-      b.textContent = 'warning:';
-      li.append(b, ' ' + w);
-      warn.appendChild(li);
-    }
-    warn.hidden = nfail === 0 && warnings.length === 0;
+    const warnings = appendWarnings(warn, res.warnings);
+    warn.hidden = nfail === 0 && warnings === 0;
     clearStale(IDENTIFY_RESULTS);
     showIdentify(res);
   } catch (e) {
@@ -799,6 +792,20 @@ function scheduleControl(): void {
   debouncedTune();
 }
 
+// Appends one "warning: ..." item per string of `warnings` (an answer's
+// "warnings", if an array) to the list; how many.
+function appendWarnings(list: HTMLElement, warnings: unknown): number {
+  const items = Array.isArray(warnings) ? warnings : [];
+  for (const w of items) {
+    const li = document.createElement('li');
+    const b = document.createElement('strong');
+    b.textContent = 'warning:';
+    li.append(b, ' ' + String(w));
+    list.appendChild(li);
+  }
+  return items.length;
+}
+
 async function runControl(): Promise<void> {
   const seq = ++controlSeq;
   controlAbort?.abort();
@@ -825,6 +832,10 @@ async function runControl(): Promise<void> {
     $('control-state').textContent =
       `${res.controller ?? ''} on ${res.plant ?? ''}: server ${(t1 - t0).toFixed(0)} ms, ` +
       `drawn ${(t2 - t1).toFixed(0)} ms, change to redraw ${latency.toFixed(0)} ms`;
+    // A set-point beyond what the model reaches within the input limits.
+    const warnList = $('control-warnings');
+    warnList.innerHTML = '';
+    warnList.hidden = appendWarnings(warnList, res.warnings) === 0;
   } catch (e) {
     if (seq !== controlSeq) return;
     pendingSince = 0;

@@ -768,9 +768,11 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b, const std::atomi
   Get(b, "noise", c.noise);
   Get(b, "seed", c.seed);
   c.load_steps = LoadSteps(b);
-  const std::vector<cli::ControlRun> runs = cli::SimulateControl(c);
+  std::vector<std::string> warnings;
+  const std::vector<cli::ControlRun> runs = cli::SimulateControl(c, &warnings);
   nlohmann::ordered_json j = cli::ControlJson(runs);
   j["trace"] = Trace(runs.front().result);
+  j["warnings"] = warnings;
   return j;
 }
 
