@@ -462,6 +462,7 @@ void Diagnose(CommissionResult& r) {
                                            : ParseInputGaps(r.settings.input_gaps);
     std::vector<std::string> in_gap;
     double worst = 0.0;
+    int elsewhere = 0;  // ripple failures at levels held by an input outside the gaps
     const ClosedLoopMetrics& m = cl.metrics;
     for (std::size_t i = 0; i < m.steps.size(); ++i) {
       const StepMetrics& s = m.steps[i];
@@ -482,12 +483,15 @@ void Diagnose(CommissionResult& r) {
       const double sum = cl.u.segment(k1 - tail, tail).sum();
       const double count = static_cast<double>(tail);
       const double mean = sum / count;
-      for (const InputGap& g : gaps)
-        if (mean > g.lo && mean < g.hi) {
-          in_gap.push_back(
-              fmt::format("{:.4g} (input {:.3g}, gap {:g}..{:g})", s.to, mean, g.lo, g.hi));
-          worst = std::max(worst, s.ripple);
-        }
+      const auto gap = std::find_if(gaps.begin(), gaps.end(),
+                                    [&](const InputGap& g) { return mean > g.lo && mean < g.hi; });
+      if (gap == gaps.end()) {
+        ++elsewhere;
+        continue;
+      }
+      in_gap.push_back(
+          fmt::format("{:.4g} (input {:.3g}, gap {:g}..{:g})", s.to, mean, gap->lo, gap->hi));
+      worst = std::max(worst, s.ripple);
     }
     if (!in_gap.empty()) {
       r.limits.push_back(fmt::format(
@@ -500,7 +504,8 @@ void Diagnose(CommissionResult& r) {
           "avoid set-points whose input lies in those gaps, or narrow the gaps (valves with a "
           "shorter minimum pulse, a lower PWM frequency); a controller cannot hold them more "
           "steadily than the actuator");
-    } else {
+    }
+    if (in_gap.empty() || elsewhere > 0) {
       r.limits.push_back(
           "ripple: the loop cycles at some levels (the actuator has no steady input there, e.g. "
           "a valve pulse below its minimum width)");
