@@ -15,11 +15,21 @@ settling time, the largest steady-state ripple (peak to peak, % of the
 set-point, and at levels of 20 N and above), the largest |steady-state
 error|, IAE over the DMC's, commission's wall time and plant time.
 
+With `--random SEED`, `--count N` variants are drawn instead, every
+parameter at once from the issue's ranges (inlet and exhaust conductance
+x0.7..1.3, each dead volume x0.8..1.2, supply 0.5..0.6 MPa, sensor filter
+0..0.25 s, 0 or 1 sample of transport delay), each measured on a staircase
+of its own (seven levels drawn from 10..180 N in steps of 5 N, dwell 2 s,
+-15 N load step in the last second); the row names the variant and its
+levels.
+
 Usage: /usr/bin/python3 bench/commission_variants.py build/pneumid [--only NAME]
+       /usr/bin/python3 bench/commission_variants.py build/pneumid --random 7 --count 8
 """
 import argparse
 import json
 import pathlib
+import random
 import re
 import subprocess
 import sys
@@ -71,6 +81,34 @@ def write_variant(spec, path):
     path.write_text(text)
 
 
+def random_variants(seed, count):
+    """count variants with every parameter drawn from the issue's ranges, and
+    a staircase of seven levels of 10..180 N for each: (variants, scenarios)."""
+    rng = random.Random(seed)
+    variants, scenarios = {}, {}
+    for _ in range(count):
+        spec = {"inlet_conductance": rng.uniform(0.7, 1.3),
+                "exhaust_conductance": rng.uniform(0.7, 1.3),
+                "dead_volume_a": rng.uniform(0.8, 1.2),
+                "dead_volume_b": rng.uniform(0.8, 1.2),
+                "pressure": ("=", round(rng.uniform(0.5e6, 0.6e6), -3)),
+                "pressure_filter_time_constant": ("=", round(rng.uniform(0.0, 0.25), 3)),
+                "transport_delay_samples": ("=", rng.choice([0, 1]))}
+        levels = [rng.choice(range(10, 181, 5)) for _ in range(7)]
+        name = ("inlet x{:.2f}, exhaust x{:.2f}, dead volumes x{:.2f}/x{:.2f}, {:.3f} MPa, "
+                "filter {:.3f} s, delay {}; levels {}").format(
+                    spec["inlet_conductance"], spec["exhaust_conductance"],
+                    spec["dead_volume_a"], spec["dead_volume_b"], spec["pressure"][1] / 1e6,
+                    spec["pressure_filter_time_constant"][1],
+                    spec["transport_delay_samples"][1], " ".join(map(str, levels)))
+        variants[name] = spec
+        n = len(levels)
+        scenarios[name] = ["--setpoint", "staircase:levels={},dwell=2".format(
+            " ".join(map(str, levels))), "--duration", str(2 * n),
+            "--load-step", "at={},size=-15".format(2 * n - 1)]
+    return variants, scenarios
+
+
 def metrics(j):
     steps = [s for s in j["steps"] if s["time"] > 0]
     ripple = [100 * s["ripple"] / abs(s["to"]) for s in steps if s["ripple"] is not None]
@@ -96,18 +134,26 @@ def main():
                          "\"--setpoint staircase:levels=30 140 70,dwell=1.5 --duration 4.5\"")
     ap.add_argument("--extra", default="",
                     help="extra arguments for commission, e.g. \"--Ts 0.005\"")
+    ap.add_argument("--random", type=int, default=None, metavar="SEED",
+                    help="draw --count variants and scenarios from the issue's ranges")
+    ap.add_argument("--count", type=int, default=8)
     args = ap.parse_args()
     scenario = args.scenario.split(" --") if args.scenario else []
     scenario = SCENARIO if not scenario else [
         a for i, s in enumerate(scenario)
         for a in (("--" if i else "") + s).split(" ", 1)]
+    variants = VARIANTS
+    scenarios = {}
+    if args.random is not None:
+        variants, scenarios = random_variants(args.random, args.count)
     print("| twin | chosen model | worst overshoot % | slowest settling s | ripple % (>= 20 N) "
           "| max abs sse N | IAE / DMC | commission wall s | plant time s | verdict |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
-        for name, spec in VARIANTS.items():
+        for name, spec in variants.items():
             if args.only and args.only != name:
                 continue
+            scenario_of = scenarios.get(name, scenario)
             work = pathlib.Path(tmp) / f"{len(list(pathlib.Path(tmp).iterdir()))}"
             work.mkdir()
             toml = work / "twin.toml"
@@ -123,11 +169,11 @@ def main():
                 continue
             cj = json.loads(c.stdout)
             run = subprocess.run([args.pneumid, "control", "--config",
-                                  str(work / "c" / "controller.toml"), *scenario, "--json"],
+                                  str(work / "c" / "controller.toml"), *scenario_of, "--json"],
                                  capture_output=True, text=True, check=True)
             dmc = subprocess.run([args.pneumid, "control", "--controller", "dmc", "--model",
                                   "fopdt-paper", "--rule", "shridhar-cooper", "--plant",
-                                  f"ipa:config={toml}", *scenario, "--json"],
+                                  f"ipa:config={toml}", *scenario_of, "--json"],
                                  capture_output=True, text=True, check=True)
             m = metrics(json.loads(run.stdout))
             iae_dmc = json.loads(dmc.stdout)["iae"]
