@@ -332,10 +332,16 @@ void BindExtras(py::module_& m) {
         o.compare_rules = compare;
         o.controller = SettingsFromKeywords(settings);
         std::string text;
+        std::vector<std::string> warnings;
         {
           py::gil_scoped_release release;
-          text = RunControlScenario(o).ToJson().dump();
+          ControlScenarioResult result = RunControlScenario(o);
+          text = result.ToJson().dump();
+          warnings = std::move(result.warnings);
         }
+        // What `pneumid control` says on stderr: Python warnings (UserWarning).
+        for (const std::string& w : warnings)
+          if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
         return py::module_::import("json").attr("loads")(text);
       },
       "model"_a, "plant"_a = "", "Ts"_a = 0.01, "setpoint"_a, "duration"_a,
@@ -344,7 +350,9 @@ void BindExtras(py::module_& m) {
       "The closed-loop scenario of `pneumid control` (workflow/control_scenario.hpp): a "
       "controller designed from the model spec, run against the plant spec (empty: the model) "
       "through the set-point spec with load_steps = [(at_s, size), ...]; compare = rule names "
-      "runs one per rule. Returns the dict `pneumid control --json` prints (the same numbers). "
+      "runs one per rule. Returns the dict `pneumid control --json` prints (the same numbers); "
+      "what `control` warns of on stderr (a set-point beyond the model's reach) is a "
+      "UserWarning. "
       "Controller settings are the keywords of make_controller after `Ts` (type, rule, M, P, "
       "lambda_, u_min, u_max, constrained, Kc, Ti, Td, Kff, disturbance, input_gaps), with its "
       "defaults; input limits left open take the plant's range.");

@@ -160,3 +160,22 @@ def test_simulate_control_is_control_json():
         duration=4, compare=["shridhar-cooper", "paper-modified"]) == compared
     with pytest.raises(pneumid.InvalidArgument, match="unknown controller setting 'lamda'"):
         pneumid.simulate_control("fopdt-paper", setpoint="step:to=1", duration=1, lamda=2.0)
+
+
+def test_simulate_control_warns_as_control_does():
+    """A set-point beyond the steady outputs of a Hammerstein model's map (the
+    v0.1.0 staircase model reaches 0.07..193 N at duty 0..100 %) is a
+    UserWarning with the words `pneumid control` prints on stderr."""
+    model = str(SOURCE / "tests" / "data" / "model_files" / "v0.1.0-6962d7c" /
+                "stair.nonlinear.json") + "#hammerstein"
+    args = ["--model", model, "--plant", "ipa", "--setpoint", "staircase:levels=50 250,dwell=1",
+            "--duration", "2"]
+    out = subprocess.run([str(BINARY), "control", *args, "--json"], check=True,
+                         capture_output=True, text=True)
+    stderr = out.stderr.strip().split("pneumid control: warning: ", 1)[1]
+    with pytest.warns(UserWarning) as caught:
+        got = pneumid.simulate_control(model, plant="ipa", setpoint="staircase:levels=50 250,dwell=1",
+                                       duration=2)
+    assert [str(w.message) for w in caught] == [stderr]
+    assert "beyond the steady outputs [0.06562, 193.2]" in stderr
+    assert got == json.loads(out.stdout)
