@@ -71,6 +71,7 @@ TEST(RunWorkflow, ASetPointBeyondTheModelsReachIsReportedBeforeTheLoop) {
   RunWorkflowOptions o;
   o.model = testing_models::kGainMapModel;
   o.controller.input_map = testing_models::WriteGainMapFile("pneumid_run_workflow_reach");
+  o.controller.input_gaps = "plant";  // resolved against the backend's plant, not by the warning
   o.setpoint = "staircase:levels=50 150,dwell=0.5";
   std::vector<std::string> warnings;
   o.warn = [&](const std::string& w) { warnings.push_back(w); };
