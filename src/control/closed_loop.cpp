@@ -81,6 +81,7 @@ nlohmann::ordered_json StepMetrics::ToJson() const {
   j["to"] = to;
   PutStepResponse(*this, j);
   j["ripple"] = Number(ripple);
+  j["steady_input"] = Number(steady_input);
   return j;
 }
 
@@ -145,6 +146,10 @@ bool ClosedLoopOptions::IsValid(std::string* error) const {
   return true;
 }
 
+Eigen::Index ClosedLoopOptions::Samples(double Ts) const {
+  return std::max<Eigen::Index>(2, std::llround(duration / Ts));
+}
+
 ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen::VectorXd& r,
                                            const Eigen::VectorXd& y, const Eigen::VectorXd& u,
                                            double r_before, double u_before,
@@ -201,7 +206,10 @@ ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen
     s.steady_state_error = segment_error(k0, k1);
     const double step = std::abs(s.to - s.from);
     const Eigen::Index tail = std::max<Eigen::Index>((k1 - k0) / 4, 8);
-    if (k1 - k0 >= 2 * tail) s.ripple = RippleHalfBand(y, k1 - tail, k1);
+    if (k1 - k0 >= 2 * tail) {
+      s.ripple = RippleHalfBand(y, k1 - tail, k1);
+      s.steady_input = u.segment(k1 - tail, tail).mean();
+    }
     s.settling_band =
         std::max(options.settling_threshold * step, std::isfinite(s.ripple) ? s.ripple : 0.0);
     if (options.settling_band_floor) {
@@ -288,7 +296,7 @@ ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const 
   PNEUMID_CHECK(std::abs(plant.Ts() - Ts) <= 1e-9 * Ts,
                 "the plant samples at Ts = {} s but the controller at Ts = {} s", plant.Ts(), Ts);
   setpoint.CheckSampleTime(Ts);
-  const Eigen::Index n = std::max<Eigen::Index>(2, std::llround(options.duration / Ts));
+  const Eigen::Index n = options.Samples(Ts);
   ClosedLoopResult res;
   res.t = Eigen::VectorXd::LinSpaced(n, 0.0, static_cast<double>(n - 1) * Ts);
   res.r.resize(n);

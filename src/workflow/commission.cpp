@@ -463,26 +463,11 @@ void Diagnose(CommissionResult& r) {
     std::vector<std::string> in_gap;
     double worst = 0.0;
     int elsewhere = 0;  // ripple failures at levels held by an input outside the gaps
-    const ClosedLoopMetrics& m = cl.metrics;
-    for (std::size_t i = 0; i < m.steps.size(); ++i) {
-      const StepMetrics& s = m.steps[i];
+    for (const StepMetrics& s : cl.metrics.steps) {
       if (s.time <= 0.0 || !(s.ripple > RippleLimit(s, r.experiment))) continue;
-      // The mean input over the window whose ripple was measured: the last
-      // quarter of the step's hold, which ends at the next step or at a load
-      // step inside it (closed_loop.cpp).
-      const double end =
-          i + 1 < m.steps.size() ? m.steps[i + 1].time : std::numeric_limits<double>::infinity();
-      const Eigen::Index n = cl.t.size();
-      Eigen::Index k0 = 0;
-      while (k0 < n && cl.t[k0] < s.time - 1e-9) ++k0;
-      Eigen::Index k1 = k0 + 1;
-      while (k1 < n && cl.t[k1] < end - 1e-9 && !(cl.d.size() == n && cl.d[k1] != cl.d[k1 - 1]))
-        ++k1;
-      const Eigen::Index tail = std::max<Eigen::Index>((k1 - k0) / 4, 8);
-      if (k1 > n || k1 - k0 < 2 * tail) continue;
-      const double sum = cl.u.segment(k1 - tail, tail).sum();
-      const double count = static_cast<double>(tail);
-      const double mean = sum / count;
+      // The input that held the level, over the window whose ripple was measured.
+      const double mean = s.steady_input;
+      if (!std::isfinite(mean)) continue;
       const auto gap = std::find_if(gaps.begin(), gaps.end(),
                                     [&](const InputGap& g) { return mean > g.lo && mean < g.hi; });
       if (gap == gaps.end()) {

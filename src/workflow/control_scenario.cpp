@@ -96,8 +96,8 @@ std::optional<std::pair<double, double>> SteadyOutputRange(const TransferFunctio
   return std::make_pair(lo, hi);
 }
 
-std::optional<std::string> UnreachableSetpointWarning(const Signal& setpoint, double duration,
-                                                      double Ts, const TransferFunction& model,
+std::optional<std::string> UnreachableSetpointWarning(const Eigen::VectorXd& setpoint,
+                                                      const TransferFunction& model,
                                                       const ControllerSpec& spec, double u_min,
                                                       double u_max) {
   const std::optional<std::pair<double, double>> range =
@@ -106,9 +106,8 @@ std::optional<std::string> UnreachableSetpointWarning(const Signal& setpoint, do
   const auto [lo, hi] = *range;
   const double tol = 0.01 * (hi - lo);
   double r_lo = std::numeric_limits<double>::infinity(), r_hi = -r_lo;
-  long outside = 0, samples = 0;
-  for (double t = 0.0; t < duration - 1e-9 * Ts; t += Ts, ++samples) {
-    const double r = setpoint(t);
+  long outside = 0;
+  for (double r : setpoint) {
     if (!std::isfinite(r)) continue;
     r_lo = std::min(r_lo, r);
     r_hi = std::max(r_hi, r);
@@ -121,7 +120,7 @@ std::optional<std::string> UnreachableSetpointWarning(const Signal& setpoint, do
       "samples): there the input saturates and the output stays short of the set-point; keep "
       "the set-points within that range, or widen the input limits or the actuator (a higher "
       "supply pressure, larger valves)",
-      r_lo, r_hi, lo, hi, u_min, u_max, outside, samples);
+      r_lo, r_hi, lo, hi, u_min, u_max, outside, setpoint.size());
 }
 
 namespace {
@@ -166,8 +165,9 @@ ControlScenarioResult RunControlScenario(const ControlScenarioOptions& o) {
   loop.actuator.u_min = settings.limits.u_min;
   loop.actuator.u_max = settings.limits.u_max;
   const ControllerSpec base = WithModelInputMap(ToControllerSpec(settings), o.model);
-  if (std::optional<std::string> w = UnreachableSetpointWarning(
-          *setpoint, o.duration, o.Ts, model, base, settings.limits.u_min, settings.limits.u_max))
+  if (std::optional<std::string> w =
+          UnreachableSetpointWarning(setpoint->Sample(o.Ts, loop.Samples(o.Ts)), model, base,
+                                     settings.limits.u_min, settings.limits.u_max))
     result.warnings.push_back(std::move(*w));
   for (const ControllerSpec& spec : ScenarioSpecs(o, base)) {
     if (!plant) plant = MakePlant(result.plant_spec, o.Ts, plant_options);

@@ -87,14 +87,15 @@ bool IsMatPath(const std::string& path) {
   return ext == ".mat";
 }
 
-// The controller of the run, clamped to the safety layer's output range, with
-// the input gaps "plant" of the backend's plant.
-BuiltController BuildController(const RunWorkflowOptions& o, const TransferFunction& model,
-                                double Ts, const InputLimits& limits, const IoBackend& io) {
+// The controller specification of the run: clamped to the safety layer's
+// output range, with the input gaps "plant" of the backend's plant and the
+// model's input map.
+ControllerSpec RunControllerSpec(const RunWorkflowOptions& o, const InputLimits& limits,
+                                 const IoBackend& io) {
   ControllerSettings c = o.controller;
   c.limits = limits;
   ResolvePlantInputGaps(io.actuator(), io.Describe(), c.input_gaps);
-  return MakeController(model, Ts, WithModelInputMap(ToControllerSpec(c), o.model));
+  return WithModelInputMap(ToControllerSpec(c), o.model);
 }
 
 // Without a clamp from the options or the configuration: the plant's input
@@ -154,7 +155,8 @@ RunWorkflowResult RunRealtimeWorkflow(const RunWorkflowOptions& o, const Realtim
   InputLimits limits;
   limits.u_min = safety.u_min;
   limits.u_max = safety.u_max;
-  BuiltController built = BuildController(o, model, Ts, limits, *io);
+  const ControllerSpec controller_spec = RunControllerSpec(o, limits, *io);
+  BuiltController built = MakeController(model, Ts, controller_spec);
   RunWorkflowResult out;
   out.controller = built.controller->Describe();
   out.io = io->Describe();
@@ -163,18 +165,11 @@ RunWorkflowResult RunRealtimeWorkflow(const RunWorkflowOptions& o, const Realtim
   ControllerAdapter controller(std::move(built.controller));
 
   const auto sp = ParseSignal(o.setpoint);
-  if (o.warn) {
-    // The steady outputs do not depend on the modulation across input gaps
-    // (whose "plant" BuildController resolves against the backend).
-    ControllerSettings c = o.controller;
-    c.limits = limits;
-    c.input_gaps.clear();
-    if (std::optional<std::string> w = UnreachableSetpointWarning(
-            *sp, config.loop.duration, Ts, model, WithModelInputMap(ToControllerSpec(c), o.model),
-            limits.u_min, limits.u_max))
-      o.warn(*w);
-  }
   const Eigen::VectorXd r = sp->Sample(Ts, config.loop.Samples());
+  if (o.warn)
+    if (std::optional<std::string> w =
+            UnreachableSetpointWarning(r, model, controller_spec, limits.u_min, limits.u_max))
+      o.warn(*w);
   const std::vector<double> setpoint(r.data(), r.data() + r.size());
   if (auto* sim = dynamic_cast<SimBackend*>(io.get())) sim->SetLoadSteps(o.load_steps);
 
@@ -202,7 +197,7 @@ RunWorkflowResult RunRealtimeWorkflow(const RunWorkflowOptions& o, const Realtim
   if (o.offline) {
     // The same scenario simulated offline (no real time, no I/O) for comparison.
     auto plant = MakePlant(config.plant, Ts, o.plant_options);
-    BuiltController again = BuildController(o, model, Ts, limits, *io);
+    BuiltController again = MakeController(model, Ts, controller_spec);
     out.offline = SimulateClosedLoop(*again.controller, *plant, *sp, clo).metrics.ToJson();
   }
   return out;

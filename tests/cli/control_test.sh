@@ -132,7 +132,7 @@ expect_ok "json keys" control --controller dmc --model fopdt-paper --Ts 0.01 \
   --setpoint "staircase:levels=0 1,dwell=0.5" --duration 1 --json
 check_json "json keys" "list(j) == ['label', 'controller', 'plant', 'settings', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'worst_overshoot_step', 'worst_settling_step', 'iae', 'ise', 'itae', 'tv_u', 'u_min', 'u_max', 'load_peak_deviation', 'load_recovery_time', 'steps']"
 check_json "settings keys" "list(j['settings']) == ['rule', 'P', 'M', 'lambda', 'formula']"
-check_json "step keys" "sorted(j['steps'][0]) == sorted(['time', 'from', 'to', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'ripple'])"
+check_json "step keys" "sorted(j['steps'][0]) == sorted(['time', 'from', 'to', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'ripple', 'steady_input'])"
 check_json "no load step" "j['load_peak_deviation'] is None and j['settings']['rule'] == 'shridhar-cooper'"
 # P and M without lambda override the default rule (not explicit), as in `pneumid run`.
 expect_ok "override" control --model fopdt-paper --Ts 0.01 --setpoint step:from=0,to=1,at=0 \

@@ -168,7 +168,7 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
   for (const auto& [key, value] : j["steps"][0].items()) keys.push_back(key);
   EXPECT_THAT(keys, ::testing::ElementsAre("time", "from", "to", "rise_time", "overshoot_percent",
                                            "settling_time", "steady_state_error", "first_move",
-                                           "settling_band", "settled", "ripple"));
+                                           "settling_band", "settled", "ripple", "steady_input"));
   EXPECT_EQ(j["steps"][0]["settling_time"], 0.3);
   EXPECT_TRUE(j["steps"][0]["first_move"].is_null());
 }
@@ -338,6 +338,32 @@ TEST(ClosedLoopMetricsTest, SettlingBandWidensToTheMeasuredRippleOnly) {
   EXPECT_NEAR(c.settling_band, 2.0, 1e-9);
   EXPECT_TRUE(c.settled);
   EXPECT_NEAR(c.settling_time, 0.1 * std::log(50.0), 0.01);
+}
+
+// The input that holds a level is the mean input over the ripple's window,
+// the last quarter of the hold ending at a load step inside it: with u = 10
+// until 2 s, alternating 80/100 (mean 90) over [2, 3.2) and 50 after a load
+// step at 3.2 s, the 0..4 s hold ends at 3.2 s and its window is [2.4, 3.2):
+// steady_input 90 (the whole hold's mean would be 38.75). A 6-sample hold
+// has none.
+TEST(ClosedLoopMetricsTest, SteadyInputIsTheMeanInputOverTheRippleWindow) {
+  const int n = 406;
+  const double Ts = 0.01;
+  Eigen::VectorXd t(n), r(n), y = Eigen::VectorXd::Zero(n), u(n);
+  for (int k = 0; k < n; ++k) {
+    t[k] = k * Ts;
+    r[k] = k < 400 ? 100.0 : 50.0;
+    u[k] = k < 200 ? 10.0 : k < 320 ? (k % 2 == 0 ? 80.0 : 100.0) : 50.0;
+  }
+  ClosedLoopOptions o;
+  o.duration = n * Ts;
+  o.load_steps.push_back(LoadStep{3.2, -15.0});
+  const ClosedLoopMetrics m = ComputeClosedLoopMetrics(t, r, y, u, 0.0, 0.0, o);
+  ASSERT_EQ(m.steps.size(), 2u);
+  EXPECT_NEAR(m.steps[0].steady_input, 90.0, 1e-12);
+  EXPECT_TRUE(std::isnan(m.steps[1].steady_input));
+  EXPECT_TRUE(m.steps[1].ToJson()["steady_input"].is_null());
+  EXPECT_EQ(m.steps[0].ToJson()["steady_input"], 90.0);
 }
 
 }  // namespace

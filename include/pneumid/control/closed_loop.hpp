@@ -113,6 +113,8 @@ struct ClosedLoopOptions {
   /// u0 is finite, settling_threshold is in (0, 1) and actuator is valid; otherwise false
   /// with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
+  /// The samples the simulation takes at Ts: round(duration / Ts), at least 2.
+  Eigen::Index Samples(double Ts) const;
 };
 
 /// Response metrics of one set-point change (see the file comment).
@@ -131,12 +133,16 @@ struct StepMetrics {
   double first_move = std::numeric_limits<double>::quiet_NaN();
   double settling_band = std::numeric_limits<double>::quiet_NaN();  ///< output units (see above)
   double ripple = std::numeric_limits<double>::quiet_NaN();  ///< measured ripple peak-to-peak
+  /// The mean applied input over the window whose ripple is measured (the
+  /// last quarter of the step's hold, ending at a load step inside it): the
+  /// input that holds `to`; NaN when the hold is too short.
+  double steady_input = std::numeric_limits<double>::quiet_NaN();
   /// The output entered the band before the last 10 % of the segment and stayed in it.
   bool settled = false;
 
   /// {time, from, to, rise_time, overshoot_percent, settling_time,
-  /// steady_state_error, first_move, settling_band, settled, ripple}; NaN is
-  /// written as null.
+  /// steady_state_error, first_move, settling_band, settled, ripple,
+  /// steady_input}; NaN is written as null.
   nlohmann::ordered_json ToJson() const;
 };
 

@@ -27,6 +27,7 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 #include "pneumid/control/closed_loop.hpp"
@@ -99,12 +100,12 @@ std::optional<std::pair<double, double>> SteadyOutputRange(const TransferFunctio
                                                            const ControllerSpec& spec,
                                                            double u_min, double u_max);
 
-/// The warning for a set-point that goes beyond the steady outputs of
-/// SteadyOutputRange by more than 1 % of that range, sampled every Ts over
-/// [0, duration): the range reached, the model's, the limits and how many
+/// The warning for a set-point, sampled as the loop runs it (Signal::Sample),
+/// that goes beyond the steady outputs of SteadyOutputRange by more than 1 %
+/// of that range: the range reached, the model's, the limits and how many
 /// samples; nullopt when none does or the range is unknown.
-std::optional<std::string> UnreachableSetpointWarning(const Signal& setpoint, double duration,
-                                                      double Ts, const TransferFunction& model,
+std::optional<std::string> UnreachableSetpointWarning(const Eigen::VectorXd& setpoint,
+                                                      const TransferFunction& model,
                                                       const ControllerSpec& spec, double u_min,
                                                       double u_max);
 
