@@ -181,8 +181,9 @@ std::vector<ControlRun> SimulateControl(const ControlArgs& c, std::vector<std::s
   return std::move(scenario.runs);
 }
 
-nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs) {
-  return ControlScenarioJson(runs);
+nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs,
+                                   const std::vector<std::string>& warnings) {
+  return ControlScenarioJson(runs, warnings);
 }
 
 namespace {
@@ -192,7 +193,7 @@ void Execute(const ControlArgs& c) {
   const std::vector<Run> runs = SimulateControl(c, &warnings);
   for (const std::string& w : warnings) std::cerr << "pneumid control: warning: " << w << "\n";
   if (c.json) {
-    std::cout << ControlJson(runs).dump(2) << "\n";
+    std::cout << ControlJson(runs, warnings).dump(2) << "\n";
     return;
   }
   PrintTable(runs);

@@ -67,8 +67,9 @@ ControlScenarioOptions ToScenarioOptions(const ControlArgs& c);
 std::vector<ControlRun> SimulateControl(const ControlArgs& c,
                                         std::vector<std::string>* warnings = nullptr);
 
-/// What `control --json` prints for these runs.
-nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs);
+/// What `control --json` prints for these runs and the scenario's warnings.
+nlohmann::ordered_json ControlJson(const std::vector<ControlRun>& runs,
+                                   const std::vector<std::string>& warnings);
 
 // ---------------------------------------------------------------- tune
 

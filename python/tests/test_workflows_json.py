@@ -179,3 +179,4 @@ def test_simulate_control_warns_as_control_does():
     assert [str(w.message) for w in caught] == [stderr]
     assert "beyond the steady outputs [0.06562, 193.2]" in stderr
     assert got == json.loads(out.stdout)
+    assert got["warnings"] == [stderr]

@@ -37,15 +37,22 @@ nlohmann::ordered_json ControlScenarioRun::ToJson() const {
   return j;
 }
 
-nlohmann::ordered_json ControlScenarioJson(const std::vector<ControlScenarioRun>& runs) {
-  if (runs.size() == 1) return runs[0].ToJson();
+nlohmann::ordered_json ControlScenarioJson(const std::vector<ControlScenarioRun>& runs,
+                                           const std::vector<std::string>& warnings) {
   nlohmann::ordered_json j;
-  j["compare"] = nlohmann::json::array();
-  for (const ControlScenarioRun& run : runs) j["compare"].push_back(run.ToJson());
+  if (runs.size() == 1) {
+    j = runs[0].ToJson();
+  } else {
+    j["compare"] = nlohmann::json::array();
+    for (const ControlScenarioRun& run : runs) j["compare"].push_back(run.ToJson());
+  }
+  j["warnings"] = warnings;
   return j;
 }
 
-nlohmann::ordered_json ControlScenarioResult::ToJson() const { return ControlScenarioJson(runs); }
+nlohmann::ordered_json ControlScenarioResult::ToJson() const {
+  return ControlScenarioJson(runs, warnings);
+}
 
 void ResolvePlantInputRange(const Actuator& actuator, double& u_min, double& u_max) {
   if (!std::isfinite(u_min)) u_min = actuator.u_min;

@@ -130,9 +130,19 @@ check_output "plot compare" "DMC paper-modified (P=126, M=10, lambda=1.92)" "$tm
 # JSON keys are a contract: the run, its settings and its metrics (ClosedLoopMetrics::ToJson).
 expect_ok "json keys" control --controller dmc --model fopdt-paper --Ts 0.01 \
   --setpoint "staircase:levels=0 1,dwell=0.5" --duration 1 --json
-check_json "json keys" "list(j) == ['label', 'controller', 'plant', 'settings', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'worst_overshoot_step', 'worst_settling_step', 'iae', 'ise', 'itae', 'tv_u', 'u_min', 'u_max', 'load_peak_deviation', 'load_recovery_time', 'steps']"
+check_json "json keys" "list(j) == ['label', 'controller', 'plant', 'settings', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'worst_overshoot_step', 'worst_settling_step', 'iae', 'ise', 'itae', 'tv_u', 'u_min', 'u_max', 'load_peak_deviation', 'load_recovery_time', 'steps', 'warnings'] and j['warnings'] == []"
 check_json "settings keys" "list(j['settings']) == ['rule', 'P', 'M', 'lambda', 'formula']"
 check_json "step keys" "sorted(j['steps'][0]) == sorted(['time', 'from', 'to', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'ripple', 'steady_input'])"
+# A set-point beyond the steady outputs of a Hammerstein model's map (the
+# v0.1.0 staircase model reaches 0.07..193 N at duty 0..100 %): the warning on
+# stderr is also in the JSON's warnings.
+expect_ok "reach warning" control --model \
+  "$SRC/tests/data/model_files/v0.1.0-6962d7c/stair.nonlinear.json#hammerstein" --plant ipa \
+  --setpoint "staircase:levels=50 250,dwell=1" --duration 2 --json
+check_output "reach warning" "pneumid control: warning: the set-point reaches [50, 250], beyond the steady outputs [0.06562, 193.2]" "$TMP/err"
+check_json "reach warning" "len(j['warnings']) == 1 and j['warnings'][0].startswith('the set-point reaches [50, 250], beyond')"
+expect_ok "json keys" control --controller dmc --model fopdt-paper --Ts 0.01 \
+  --setpoint "staircase:levels=0 1,dwell=0.5" --duration 1 --json
 check_json "no load step" "j['load_peak_deviation'] is None and j['settings']['rule'] == 'shridhar-cooper'"
 # P and M without lambda override the default rule (not explicit), as in `pneumid run`.
 expect_ok "override" control --model fopdt-paper --Ts 0.01 --setpoint step:from=0,to=1,at=0 \

@@ -770,9 +770,8 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b, const std::atomi
   c.load_steps = LoadSteps(b);
   std::vector<std::string> warnings;
   const std::vector<cli::ControlRun> runs = cli::SimulateControl(c, &warnings);
-  nlohmann::ordered_json j = cli::ControlJson(runs);
+  nlohmann::ordered_json j = cli::ControlJson(runs, warnings);
   j["trace"] = Trace(runs.front().result);
-  j["warnings"] = warnings;
   return j;
 }
 

@@ -81,8 +81,10 @@ struct ControlScenarioResult {
   nlohmann::ordered_json ToJson() const;
 };
 
-/// One run's ToJson, or {"compare": [one per run]} for several (`control --json`).
-nlohmann::ordered_json ControlScenarioJson(const std::vector<ControlScenarioRun>& runs);
+/// One run's ToJson, or {"compare": [one per run]} for several, with
+/// "warnings": the scenario's warnings (`control --json`).
+nlohmann::ordered_json ControlScenarioJson(const std::vector<ControlScenarioRun>& runs,
+                                           const std::vector<std::string>& warnings);
 
 /// Designs the controller(s) and simulates the scenario.
 /// @throws InvalidArgument for invalid options, settings or specs (naming them);
