@@ -91,12 +91,13 @@ void AddVerification(HtmlDocument& doc, const CommissionResult& r, const SignalL
                   "Set-point (dashed), output and input of the verification run.");
     Table t;
     t.caption = "Per step (settling band: 2 % of the step or the measured ripple)";
-    t.header = {"time [s]",          "from", "to", "overshoot [%]", "settling [s]", "ripple (p-p)",
-                "steady-state error"};
+    t.header = {"time [s]",           "from",         "to",
+                "overshoot [%]",      "settling [s]", "ripple (p-p)",
+                "steady-state error", "steady input"};
     for (const StepMetrics& s : a.result.metrics.steps)
       t.rows.push_back({Num(s.time), Num(s.from), Num(s.to), Num(s.overshoot_percent),
                         s.settled ? Num(s.settling_time) : "not settled", Num(s.ripple),
-                        Num(s.steady_state_error)});
+                        Num(s.steady_state_error), Num(s.steady_input)});
     doc.AddTable(t);
     if (!a.failures.empty()) doc.AddList(a.failures);
   }
