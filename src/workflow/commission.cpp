@@ -414,8 +414,8 @@ std::vector<std::string> Judge(const ClosedLoopMetrics& m, const CommissionOptio
   return failures;
 }
 
-// What limits a loop that failed, and what to try.
-void Diagnose(CommissionResult& r) {
+// What limits a loop that failed against the specification of `o`, and what to try.
+void Diagnose(CommissionResult& r, const CommissionOptions& o) {
   const CommissionAttempt& a = r.attempts.back();
   const ClosedLoopResult& cl = a.result;
   // Saturation on 10-sample means: a modulated input touches the limits by
@@ -446,20 +446,24 @@ void Diagnose(CommissionResult& r) {
       r.suggestions.push_back("a longer --budget (more levels), or other nonlinear methods");
     }
   }
-  bool ripple = false, overshoot = false, settling = false;
+  // Limits of the actuator, the dead time or the model's fit, which explain
+  // slow steps and steady-state errors.
+  const std::size_t general = r.limits.size();
+  bool ripple = false, overshoot = false, settling = false, sse = false;
   for (const std::string& f : a.failures) {
     ripple = ripple || f.rfind("ripple", 0) == 0;
     overshoot = overshoot || f.rfind("overshoot", 0) == 0;
     settling = settling || f.rfind("settling", 0) == 0;
+    sse = sse || f.rfind("steady-state error", 0) == 0;
   }
+  const std::vector<InputGap> gaps = r.settings.input_gaps.empty()
+                                         ? std::vector<InputGap>{}
+                                         : ParseInputGaps(r.settings.input_gaps);
   if (ripple) {
     // Where the held input's mean lies inside one of the actuator's input
     // gaps, the actuator has no steady input for that level: the modulation
     // alternates the gap's ends and the plant's and sensor's lags decide what
     // of it shows. Name those levels and the gaps.
-    const std::vector<InputGap> gaps = r.settings.input_gaps.empty()
-                                           ? std::vector<InputGap>{}
-                                           : ParseInputGaps(r.settings.input_gaps);
     std::vector<std::string> in_gap;
     double worst = 0.0;
     int elsewhere = 0;  // ripple failures at levels held by an input outside the gaps
@@ -497,11 +501,57 @@ void Diagnose(CommissionResult& r) {
       r.suggestions.push_back("avoid those levels, or a less aggressive design (--aggressiveness)");
     }
   }
-  if (overshoot)
-    r.suggestions.push_back(
-        fmt::format("a lower --aggressiveness than {:g}, or --controller dmc", a.aggressiveness));
+  // Failures that none of the limits found explains.
+  bool unexplained = (settling || sse) && general == 0;
+  if (overshoot) {
+    // Steps that end at a level held by an input inside a gap or at its
+    // edge (within 2 % of the input range): there the actuator's gain jumps
+    // (a valve's pulse at its minimum width) and the modulation wanders,
+    // where the model's map is smooth.
+    const double edge = 0.02 * (r.settings.limits.u_max - r.settings.limits.u_min);
+    std::vector<std::string> at_gap;
+    int elsewhere = 0;  // overshoot failures at levels away from the gaps
+    for (const StepMetrics& s : cl.metrics.steps) {
+      if (s.time <= 0.0 || !(JudgedOvershoot(s, r.experiment) > o.overshoot)) continue;
+      const double u = s.steady_input;
+      const auto gap = std::find_if(gaps.begin(), gaps.end(), [&](const InputGap& g) {
+        return std::isfinite(edge) && u > g.lo - edge && u < g.hi + edge;
+      });
+      if (gap == gaps.end()) {
+        ++elsewhere;
+        continue;
+      }
+      at_gap.push_back(fmt::format("{:.4g} -> {:.4g} (input {:.3g}, gap {:g}..{:g})", s.from, s.to,
+                                   u, gap->lo, gap->hi));
+    }
+    unexplained = unexplained || elsewhere > 0;
+    if (!at_gap.empty()) {
+      r.limits.push_back(fmt::format(
+          "overshoot at the actuator's input gaps: the step(s) {} end at a level held by an "
+          "input inside a gap or at its edge, where the actuator's gain jumps (a valve's pulse "
+          "at its minimum width) and the modulation across the gap wanders; the model's map is "
+          "smooth there",
+          fmt::join(at_gap, ", ")));
+      r.suggestions.push_back(
+          "set-points away from those inputs, a looser overshoot specification for steps "
+          "there, or narrower gaps (valves with a shorter minimum pulse, a lower PWM "
+          "frequency)");
+    }
+    // A softer design than the kept one was verified already: say so rather
+    // than suggest it again.
+    double softest = a.aggressiveness;
+    for (const CommissionAttempt& b : r.attempts) softest = std::min(softest, b.aggressiveness);
+    if (softest < a.aggressiveness)
+      r.suggestions.push_back(
+          fmt::format("softer designs (down to aggressiveness {:g}) did not pass either; another "
+                      "controller (--controller {})",
+                      softest, r.settings.controller == "mpc" ? "dmc" : "mpc"));
+    else if (elsewhere > 0 || at_gap.empty())
+      r.suggestions.push_back(
+          fmt::format("a lower --aggressiveness than {:g}, or --controller dmc", a.aggressiveness));
+  }
   if (settling) r.suggestions.push_back("a longer settling specification, or a faster design");
-  if (r.limits.empty() && !a.failures.empty())
+  if ((r.limits.empty() || unexplained) && !a.failures.empty())
     r.limits.push_back("model error at some levels (the design predicted the specification)");
 }
 
@@ -1120,7 +1170,7 @@ CommissionResult CommissionIntegrating(Plant& plant, const CommissionOptions& o,
         pd, o.overshoot, o.settling, 0.00125 * span, ex.range_min, ex.range_max);
   } else {
     r.termination = Termination::kPartial;
-    Diagnose(r);
+    Diagnose(r, o);
     r.message = fmt::format(
         "the plant integrates its input; the {} does not meet the "
         "specification: {}",
@@ -1331,7 +1381,7 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
         o.controller, r.chosen_model, o.overshoot, o.settling, ex.range_min, ex.range_max);
   } else {
     r.termination = Termination::kPartial;
-    Diagnose(r);
+    Diagnose(r, o);
     r.message = fmt::format("the {} on {} does not meet the specification: {}", o.controller,
                             r.chosen_model, r.attempts.back().failures.front());
   }

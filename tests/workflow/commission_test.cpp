@@ -361,6 +361,31 @@ TEST(Commission, ARippleInsideAValveGapNamesTheSetPointsAndTheGap) {
   EXPECT_THAT(r.limits, Not(Contains(HasSubstr("the loop cycles at some levels"))));
 }
 
+TEST(Commission, AnOvershootAtAValveGapNamesTheStepAndTheGap) {
+  // The GPC over 20..150 N on the default twin undershoots the step down
+  // from 150 N (held inside the exhaust valve's gap, duty 85..100 %) to
+  // 134.4 N (duty 84.4 %, at the gap's edge) by 6.9 % at every
+  // aggressiveness: the diagnosis names the step and the gap, says the
+  // softer designs were tried, and does not call it a model error.
+  CommissionPlant made = MakeCommissionPlant("ipa", std::nullopt, PlantOptions{});
+  CommissionOptions o;
+  o.directory = TempDir("ipa-gpc-gap");
+  o.controller = "gpc";
+  o.range_min = 20.0;
+  o.range_max = 150.0;
+  SetDefaultSpecification(o, PlantActuator(*made.plant));
+  SetInputGaps(o, *made.plant, "plant");
+  const CommissionResult r = Commission(*made.plant, o);
+  ASSERT_FALSE(r.passed());
+  EXPECT_THAT(r.limits,
+              Contains(AllOf(HasSubstr("overshoot at the actuator's input gaps"),
+                             HasSubstr("150 -> 134.4 (input 84"), HasSubstr("gap 85..100"))));
+  EXPECT_THAT(r.limits, Not(Contains(HasSubstr("model error"))));
+  EXPECT_THAT(r.suggestions,
+              Contains(HasSubstr("softer designs (down to aggressiveness 0.125) did not pass")));
+  EXPECT_THAT(r.suggestions, Not(Contains(HasSubstr("a lower --aggressiveness"))));
+}
+
 TEST(Commission, InvalidOptionsNameTheField) {
   auto plant = MakePlant("fopdt:K=2,tau=0.5,theta=0.1", 0.01);
   CommissionOptions o = Options("invalid");
