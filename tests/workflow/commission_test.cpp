@@ -336,6 +336,15 @@ TEST(Commission, AStopRequestDuringTheRestBeforeAVerificationRunEndsThere) {
   EXPECT_EQ(plant.last_u, 0.0);        // u_min: the safe input
 }
 
+// Commission on the IPA twin of `po` with the default specification and the
+// plant's input gaps, as `pneumid commission --plant ipa` does.
+CommissionResult CommissionIpa(const PlantOptions& po, CommissionOptions o) {
+  CommissionPlant made = MakeCommissionPlant("ipa", std::nullopt, po);
+  SetDefaultSpecification(o, PlantActuator(*made.plant));
+  SetInputGaps(o, *made.plant, "plant");
+  return Commission(*made.plant, o);
+}
+
 TEST(Commission, ARippleInsideAValveGapNamesTheSetPointsAndTheGap) {
   // Without a sensor filter the default twin's fast chamber shows the
   // modulation across the exhaust valve's gap (duty 85..100 % at 300 Hz, no
@@ -348,12 +357,9 @@ TEST(Commission, ARippleInsideAValveGapNamesTheSetPointsAndTheGap) {
   }
   PlantOptions po;
   po.config_path = config;
-  CommissionPlant made = MakeCommissionPlant("ipa", std::nullopt, po);
   CommissionOptions o;
   o.directory = TempDir("ipa-no-filter");
-  SetDefaultSpecification(o, PlantActuator(*made.plant));
-  SetInputGaps(o, *made.plant, "plant");
-  const CommissionResult r = Commission(*made.plant, o);
+  const CommissionResult r = CommissionIpa(po, o);
   EXPECT_FALSE(r.passed());
   EXPECT_THAT(r.limits,
               Contains(AllOf(HasSubstr("need a mean input inside the actuator's input gaps"),
@@ -367,15 +373,12 @@ TEST(Commission, AnOvershootAtAValveGapNamesTheStepAndTheGap) {
   // 134.4 N (duty 84.4 %, at the gap's edge) by 6.9 % at every
   // aggressiveness: the diagnosis names the step and the gap, says the
   // softer designs were tried, and does not call it a model error.
-  CommissionPlant made = MakeCommissionPlant("ipa", std::nullopt, PlantOptions{});
   CommissionOptions o;
   o.directory = TempDir("ipa-gpc-gap");
   o.controller = "gpc";
   o.range_min = 20.0;
   o.range_max = 150.0;
-  SetDefaultSpecification(o, PlantActuator(*made.plant));
-  SetInputGaps(o, *made.plant, "plant");
-  const CommissionResult r = Commission(*made.plant, o);
+  const CommissionResult r = CommissionIpa(PlantOptions{}, o);
   ASSERT_FALSE(r.passed());
   EXPECT_THAT(r.limits,
               Contains(AllOf(HasSubstr("overshoot at the actuator's input gaps"),
