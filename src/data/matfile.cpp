@@ -138,6 +138,9 @@ struct VarInfo {
   }
 };
 
+/// Channels one variable may give when it is selected whole.
+constexpr std::size_t kMaxChannelsPerVariable = 1000;
+
 template <typename T>
 void CopyAs(const void* data, std::size_t n, Eigen::MatrixXd& out) {
   const T* p = static_cast<const T*>(data);
@@ -185,6 +188,15 @@ class MatReader {
   void Select(const std::string& spec, const std::string& role, std::vector<Eigen::VectorXd>* cols,
               std::vector<Channel>* channels) {
     if (const VarInfo* v = Find(spec)) {
+      // Each column becomes a channel; more than any experiment logs is a
+      // corrupt header or a matrix stored with its samples along the rows.
+      if (v->numeric() && v->rows() > 0 && v->cols() > kMaxChannelsPerVariable) {
+        throw DataError(fmt::format(
+            "{}: {} variable '{}' ({} {}) would give {} channels, more than {}: store samples "
+            "along the rows (N x k), or select one column with '{}:K'",
+            path_, role, v->label, v->shape(), ClassName(v->class_type), v->cols(),
+            kMaxChannelsPerVariable, v->label));
+      }
       const Eigen::MatrixXd& m = Read(*v, role);
       for (Eigen::Index c = 0; c < m.cols(); ++c) {
         cols->push_back(m.col(c));
@@ -281,16 +293,18 @@ class MatReader {
                       "an N x k matrix",
                       path_, v.label, v.dims.size(), v.shape()));
     }
+    // An empty variable holds no samples, whatever its other dimension claims
+    // (a 22-byte v4 file claiming 0 x 5e6 made a channel per column: 2 GB).
+    if (v.dims[0] == 0 || v.dims[1] == 0) {
+      throw DataError(fmt::format("{}: variable '{}' is empty ({} {}): it holds no {} samples",
+                                  path_, v.label, v.shape(), ClassName(v.class_type), role));
+    }
     // A corrupt header can claim any size; zlib expands at most ~1032:1, so a
     // variable cannot hold more than about 1100 bytes per byte of file.
     const double claimed = static_cast<double>(v.dims[0]) * static_cast<double>(v.dims[1]) *
                            static_cast<double>(ElementSize(v.class_type));
-    // An empty variable (0 x N) holds no data whatever N claims, but matio
-    // walks its N columns: a dimension beyond what the file could hold is
-    // corrupt too (a 22-byte file claiming 0 x 1.4e9 took 11 s).
-    const double largest = static_cast<double>(std::max(v.dims[0], v.dims[1]));
     const double limit = 1100.0 * static_cast<double>(file_size_) + 1e6;
-    if (claimed > limit || largest > limit) {
+    if (claimed > limit) {
       throw DataError(
           fmt::format("{}: variable '{}' claims {} elements ({}), more than the file "
                       "can hold: the file is corrupt",

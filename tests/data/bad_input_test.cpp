@@ -411,8 +411,42 @@ TEST_F(BadInputTest, MatEmptyVariableWithAHugeDimensionIsCorrupt) {
   MatReadOptions by_index;
   by_index.time_variable = "0";
   EXPECT_THAT([&] { ReadMat(path, by_index); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("variable '' is empty (0x1415643158 "
+                                                       "double): it holds no time samples"))));
+}
+
+TEST_F(BadInputTest, MatEmptyVariableMakesNoChannelPerColumn) {
+  // Found by mat_fuzz: a Level 4 variable '2' of 0 x 1000000 doubles, selected
+  // by name, became a million empty channels (400 MB) before its length was
+  // checked; a larger claim went beyond 2 GB.
+  const std::string v4("\0\0\0\0\0\0\0\0\x40\x42\x0f\0\0\0\0\0\x02\0\0\0\x32\0", 22);
+  const std::string path = Write("v4_empty_named.mat", v4);
+  MatReadOptions by_name;
+  by_name.time_variable = "2";
+  EXPECT_THAT([&] { ReadMat(path, by_name); },
               ThrowsMessage<DataError>(
-                  AllOf(HasSubstr("0x1415643158"), HasSubstr("more than the file can hold"))));
+                  HasSubstr("variable '2' is empty (0x1000000 double): it holds no time samples")));
+}
+
+TEST_F(BadInputTest, MatVariableWithMoreColumnsThanChannelsIsRejected) {
+  // A 2 x 1001 variable selected whole would be 1001 channels of 2 samples:
+  // samples stored along the columns, or a corrupt header.
+  std::string v4;
+  for (std::uint32_t h : {0u, 2u, 1001u, 0u, 2u}) PutU32(&v4, h);
+  v4 += std::string("u\0", 2);
+  v4 += std::string(2 * 1001 * sizeof(double), '\0');
+  const std::string path = Write("wide4.mat", v4);
+  MatReadOptions o;
+  o.time_variable = "";
+  o.sample_time = 0.1;
+  o.input_variables = {"u"};
+  o.output_variables = {};
+  EXPECT_THAT([&] { ReadMat(path, o); },
+              ThrowsMessage<DataError>(HasSubstr(
+                  "input variable 'u' (2x1001 double) would give 1001 channels, more than 1000: "
+                  "store samples along the rows (N x k), or select one column with 'u:K'")));
+  o.input_variables = {"u:1000"};
+  EXPECT_EQ(ReadMat(path, o).size(), 2);
 }
 
 TEST_F(BadInputTest, MatRepeatedVariableNameIsRejected) {
