@@ -56,6 +56,8 @@ void PrintTable(const std::vector<Run>& runs) {
       {"settling band (2 % or ripple)",
        [](const Run& r) { return "+-" + Fmt(r.result.metrics.settling_band); }},
       {"steady-state error", [](const Run& r) { return Fmt(r.result.metrics.steady_state_error); }},
+      {"steady-state error (worst step)",
+       [](const Run& r) { return Fmt(r.result.metrics.worst_steady_state_error); }},
       {"IAE", [](const Run& r) { return Fmt(r.result.metrics.iae); }},
       {"ISE", [](const Run& r) { return Fmt(r.result.metrics.ise); }},
       {"ITAE", [](const Run& r) { return Fmt(r.result.metrics.itae); }},
@@ -68,6 +70,7 @@ void PrintTable(const std::vector<Run>& runs) {
        [](const Run& r) { return Fmt(r.result.metrics.load_recovery_time, " s"); }},
   };
   std::size_t w0 = 20;
+  for (const auto& row : rows) w0 = std::max(w0, row.first.size() + 2);
   std::vector<std::size_t> widths;
   for (const Run& r : runs) {
     std::size_t w = r.built.Label().size();

@@ -70,6 +70,14 @@ void SummarizeWorstStep(ClosedLoopMetrics* m) {
   const StepMetrics& worst = steps[m->worst_settling_step];
   m->settling_time = m->settled ? worst.settling_time : kNaN;
   m->settling_band = worst.settling_band;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const double e = steps[i].steady_state_error;
+    if (std::isfinite(e) && !(m->worst_steady_state_error_step >= 0 &&
+                              std::abs(e) <= std::abs(m->worst_steady_state_error))) {
+      m->worst_steady_state_error = e;
+      m->worst_steady_state_error_step = static_cast<int>(i);
+    }
+  }
 }
 
 }  // namespace
@@ -93,6 +101,10 @@ nlohmann::ordered_json ClosedLoopMetrics::ToJson() const {
                                   : nlohmann::ordered_json();
   j["worst_settling_step"] = worst_settling_step >= 0 ? nlohmann::ordered_json(worst_settling_step)
                                                       : nlohmann::ordered_json();
+  j["worst_steady_state_error"] = Number(worst_steady_state_error);
+  j["worst_steady_state_error_step"] = worst_steady_state_error_step >= 0
+                                           ? nlohmann::ordered_json(worst_steady_state_error_step)
+                                           : nlohmann::ordered_json();
   j["iae"] = Number(iae);
   j["ise"] = Number(ise);
   j["itae"] = Number(itae);

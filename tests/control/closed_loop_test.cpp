@@ -154,11 +154,12 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
   const nlohmann::ordered_json j = m.ToJson();
   std::vector<std::string> keys;
   for (const auto& [key, value] : j.items()) keys.push_back(key);
-  EXPECT_THAT(keys, ::testing::ElementsAre("rise_time", "overshoot_percent", "settling_time",
-                                           "steady_state_error", "first_move", "settling_band",
-                                           "settled", "worst_overshoot_step", "worst_settling_step",
-                                           "iae", "ise", "itae", "tv_u", "u_min", "u_max",
-                                           "load_peak_deviation", "load_recovery_time", "steps"));
+  EXPECT_THAT(keys, ::testing::ElementsAre(
+                        "rise_time", "overshoot_percent", "settling_time", "steady_state_error",
+                        "first_move", "settling_band", "settled", "worst_overshoot_step",
+                        "worst_settling_step", "worst_steady_state_error",
+                        "worst_steady_state_error_step", "iae", "ise", "itae", "tv_u", "u_min",
+                        "u_max", "load_peak_deviation", "load_recovery_time", "steps"));
   EXPECT_EQ(j["rise_time"], 0.1);
   EXPECT_TRUE(j["overshoot_percent"].is_null());
   EXPECT_TRUE(j["load_recovery_time"].is_null());
@@ -227,6 +228,12 @@ TEST(ClosedLoopMetricsTest, SummaryTakesTheWorstStep) {
   EXPECT_TRUE(std::isnan(bad.settling_time));
   EXPECT_EQ(bad.worst_settling_step, 2);
   EXPECT_TRUE(bad.steps[1].settled);
+  // It ends at 21 for 20: r - y = -1 there, the summary's worst steady-state
+  // error (the others are the ~1e-6 tails of decaying responses).
+  EXPECT_NEAR(bad.steps[2].steady_state_error, -1.0, 1e-3);
+  EXPECT_EQ(bad.worst_steady_state_error, bad.steps[2].steady_state_error);
+  EXPECT_EQ(bad.worst_steady_state_error_step, 2);
+  EXPECT_LT(std::abs(m.worst_steady_state_error), 1e-3);
 }
 
 // A load step inside a set-point segment ends the step's window: the dip it

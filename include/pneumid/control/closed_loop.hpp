@@ -23,8 +23,10 @@
 //     steps (the largest overshoot; the longest settling time, NaN when a step
 //     did not settle), worst_overshoot_step and worst_settling_step name the
 //     step (index into `steps`; the first unsettled one when one did not
-//     settle), settled says that every step settled, settling_band is that
-//     of the worst-settling step; rise_time and first_move are those of the
+//     settle), worst_steady_state_error is the steps' steady-state error of
+//     largest magnitude (signed) and worst_steady_state_error_step its step
+//     (steady_state_error stays the final segment's), settled says that every step settled,
+//     settling_band is that of the worst-settling step; rise_time and first_move are those of the
 //     first step (steps[0] holds all of the first step's metrics). All are
 //     NaN (settled false) when the set-point never changes;
 //   settling_band: the half-width of the band |y - r| <= band the settling
@@ -163,6 +165,9 @@ struct ClosedLoopMetrics {
   bool settled = false;                                             ///< every step settled
   int worst_overshoot_step = -1;  ///< index into steps of overshoot_percent (-1: none)
   int worst_settling_step = -1;   ///< index into steps of settling_time / settled (-1: none)
+  /// The steps' steady-state error of largest magnitude, signed (output units; NaN: no step).
+  double worst_steady_state_error = std::numeric_limits<double>::quiet_NaN();
+  int worst_steady_state_error_step = -1;  ///< index into steps of it (-1: none)
   /// IAE = sum |e| Ts (output units s), with e = r - y without the measurement noise.
   double iae = 0.0, ise = 0.0, itae = 0.0;  ///< ITAE = sum t |e| Ts (output units s^2)
   /// @var ise
@@ -180,9 +185,9 @@ struct ClosedLoopMetrics {
   /// The metrics of `pneumid control --json` and `pneumid run --json`:
   /// rise_time, overshoot_percent, settling_time, steady_state_error,
   /// first_move, settling_band, settled, worst_overshoot_step,
-  /// worst_settling_step, iae, ise, itae, tv_u, u_min, u_max, load_peak_deviation,
-  /// load_recovery_time and steps (StepMetrics::ToJson); NaN (a quantity that
-  /// does not exist in the run) is written as null.
+  /// worst_settling_step, worst_steady_state_error, worst_steady_state_error_step, iae, ise, itae,
+  /// tv_u, u_min, u_max, load_peak_deviation, load_recovery_time and steps (StepMetrics::ToJson);
+  /// NaN (a quantity that does not exist in the run) is written as null.
   nlohmann::ordered_json ToJson() const;
 };
 
