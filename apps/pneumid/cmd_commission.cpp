@@ -279,7 +279,8 @@ const Registrar reg(
                      "Output range LO:HI the controller must serve (default: the reachable "
                      "range found by the sweep, less 5 % at each end)");
       app.add_option("--budget", c->options.budget,
-                     "Plant time in s for the experiment and the first verification run")
+                     "Plant time in s for the experiment and the verification runs (the first "
+                     "design's and the redesigns')")
           ->capture_default_str()
           ->check(Positive());
       app.add_option("--controller", c->options.controller, "Controller: mpc, dmc, gpc or pid")

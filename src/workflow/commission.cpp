@@ -573,7 +573,7 @@ VerificationStaircase PlanVerification(const CommissionOptions& o, bool small_st
   v.fractions = small_steps ? std::vector<double>{0.0, 0.25, 0.6,  0.85, 1.0,  0.88,
                                                   0.7, 0.78, 0.35, 0.1,  0.18, 0.0}
                             : std::vector<double>{0.0, 0.25, 0.6, 0.85, 1.0, 0.7, 0.35, 0.1, 0.0};
-  v.dwell = std::isnan(o.verification_dwell) ? std::max(2.0, 4 * o.settling) : o.verification_dwell;
+  v.dwell = std::isnan(o.verification_dwell) ? std::max(1.0, 2 * o.settling) : o.verification_dwell;
   return v;
 }
 
@@ -589,11 +589,13 @@ double RestBeforeRun(const Plant& plant, const CommissionExperiment& ex, double 
 // be reachable, or the reachable one less 5 % at each end), the dwell per
 // level, and a budget that leaves room for 11 levels. "" or the reason. The
 // excitation's time, *excitation, is what the budget leaves after the
-// verification run of `verification` s, and at least the 11 levels (the
-// verification then comes on top of a budget too short for both).
+// verification runs of `run` s each, and at least the 11 levels (the
+// verification then comes on top of a budget too short for both): the first
+// design's run, and as many of the `retunes` redesigns' runs as cost the
+// excitation at most a quarter of what one run leaves it (a slow plant's
+// runs would otherwise starve the experiment its model comes from).
 std::string PlanExcitation(const CommissionOptions& o, const Recorder& rec, double u_lo,
-                           double u_hi, double verification, CommissionExperiment& ex,
-                           double* excitation) {
+                           double u_hi, double run, CommissionExperiment& ex, double* excitation) {
   const double Ts = rec.Ts();
   std::string error;
   if (std::isfinite(o.range_min)) {
@@ -614,12 +616,15 @@ std::string PlanExcitation(const CommissionOptions& o, const Recorder& rec, doub
   ex.dwell = std::max(ex.dead_time + 4 * ex.time_constant, 10 * Ts);
   ex.dwell = std::ceil(ex.dwell / Ts - 1e-9) * Ts;
   const double left = o.budget - rec.time();
+  int redesigns = o.retunes;
+  while (redesigns > 0 && left - (1 + redesigns) * run < 0.75 * (left - run)) --redesigns;
+  const double verification = (1 + redesigns) * run;
   if (error.empty() && left < 11 * ex.dwell) {
     error = fmt::format(
         "the budget of {:g} s is too short for the time scale found (tau = {:.3g} s, theta = "
         "{:.3g} s: {:.3g} s per level): the probe and sweep took {:.1f} s and the excitation "
         "needs at least {:.1f} s more (a budget of {:.0f} s or more; {:.0f} s to hold the "
-        "verification run too)",
+        "verification runs too)",
         o.budget, ex.time_constant, ex.dead_time, ex.dwell, rec.time(), 11 * ex.dwell,
         std::ceil(rec.time() + 11 * ex.dwell),
         std::ceil(rec.time() + 11 * ex.dwell + verification));
@@ -1320,11 +1325,12 @@ CommissionResult Commission(Plant& plant, const CommissionOptions& options) {
   try {
     Probe p;
     error = ProbeAndSweep(rec, o, u_lo, u_hi, ex, p);
-    // The budget holds the experiment and the first verification run (with
-    // the rest before it on a plant that cannot be reset) when it can.
-    const double verification = VerificationRunTime(o, policy, plant, ex);
+    // The budget holds the experiment and the verification runs of the first
+    // design and of the redesigns (each with the rest before it on a plant
+    // that cannot be reset) when it can (PlanExcitation).
+    const double run = VerificationRunTime(o, policy, plant, ex);
     double excitation = 0.0;
-    if (error.empty()) error = PlanExcitation(o, rec, u_lo, u_hi, verification, ex, &excitation);
+    if (error.empty()) error = PlanExcitation(o, rec, u_lo, u_hi, run, ex, &excitation);
     if (!error.empty()) {
       rec.Hold(u_lo, Ts);
       FinishData(rec, act, r);

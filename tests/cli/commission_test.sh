@@ -131,14 +131,23 @@ assert gap and max(gap) > 2 * e["noise_peak_to_peak"], (gap, e["noise_peak_to_pe
 assert any(s["to"] < 12 and s["time"] > 0 for s in j["verification"]["steps"]), j["verification"]
 v = j["verification"]
 assert v["overshoot_judged_percent"] <= min(v["overshoot_percent"], 5.0), v["overshoot_judged_percent"]
-# Its softer designs fail and the peak of the one kept (aggressiveness 0.5)
-# is the ripple: the fastest design is tried, and kept for its lower IAE.
+# Its softer designs fail and the peak of the first design (aggressiveness
+# 0.5) is mostly the ripple: the fastest design is tried once, and kept (the
+# last attempt) only for an IAE at least 5 % lower with an overshoot beyond
+# half the ripple no more than 5 % of the specification (0.25 %) above.
 a = j["attempts"]
-assert a[-1]["aggressiveness"] == 1.0 and a[-1]["passed"], [(b["aggressiveness"], b["passed"]) for b in a]
+seen = [(b["aggressiveness"], b["passed"], round(b["overshoot_judged_percent"], 2), round(b["iae"], 1)) for b in a]
 half = [b for b in a if b["aggressiveness"] == 0.5]
-assert half and half[0]["passed"] and a[-1]["iae"] < 0.95 * half[0]["iae"], [(b["aggressiveness"], b["iae"]) for b in a]
+fast = [b for b in a if b["aggressiveness"] == 1.0]
+assert half and half[0]["passed"] and fast and fast[0]["passed"], seen
+assert all(not b["passed"] for b in a if b["aggressiveness"] < 0.5), seen
+better = (fast[0]["iae"] < 0.95 * half[0]["iae"] and
+          fast[0]["overshoot_judged_percent"] <= min(0.8 * 5.0, half[0]["overshoot_judged_percent"] + 0.25))
+assert a[-1]["aggressiveness"] == (1.0 if better else 0.5), seen
+open(sys.argv[1] + ".kept", "w").write("%g" % a[-1]["aggressiveness"])
 PYEOF
-grep -q '^aggressiveness = 1$' "$TMP/cl/controller.toml" || fail "chamber-lag controller.toml: not the fastest design"
+grep -q "^aggressiveness = $(cat "$TMP/cl.json.kept")\$" "$TMP/cl/controller.toml" ||
+  fail "chamber-lag controller.toml: not the kept design ($(cat "$TMP/cl.json.kept"))"
 
 # A GPC has no tuning to specifications of its own: it runs the horizons and
 # move suppression of the DMC's auto design with the T filter A, written

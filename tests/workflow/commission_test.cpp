@@ -81,7 +81,7 @@ TEST(Commission, TheProbeMeasuresAFirstOrderPlantWithDeadTime) {
   o.range_min = 2.0;
   o.range_max = 18.0;
   o.settling = 2.0;  // tau = 0.5 s, theta = 0.1 s: about 4 (tau + theta)
-  o.budget = 160.0;  // the experiment, and a verification run of 12 levels of 8 s
+  o.budget = 160.0;  // the experiment, and a verification run of 12 levels of 4 s
   const CommissionResult r = Commission(*plant, o);
   EXPECT_NEAR(r.experiment.gain, 2.0, 0.01);
   EXPECT_NEAR(r.experiment.time_constant, 0.5, 0.015);

@@ -16,8 +16,11 @@
 //                 range (levels from the three measured points, shuffled, so the
 //                 output moves both ways by large and small steps), dwell
 //                 theta + 4 tau (at least 10 samples), filling what the
-//                 budget leaves after one verification run (stage 6, with
-//                 the rest before it on a plant that cannot be reset), and
+//                 budget leaves after the verification runs (stage 6: the
+//                 first design's and up to `retunes` redesigns', as many as
+//                 cost the excitation at most a quarter of what one run
+//                 leaves it; each with the rest before it on a plant that
+//                 cannot be reset), and
 //                 at least 11 levels (a budget too short for them is an
 //                 error that says what the time scale needs); a
 //                 second sequence on levels between the first's (30 % of the
@@ -41,7 +44,7 @@
 //   6. verify     a staircase across the range in both directions (levels at
 //                 0, 25, 60, 85, 100, 88, 70, 78, 35, 10, 18 and 0 % of the
 //                 range: three small steps among the large ones), dwell
-//                 max(2 s, 4 x the settling specification)) and a load step
+//                 max(1 s, 2 x the settling specification)) and a load step
 //                 (-8 % of the range) half-way through the last level, closed
 //                 loop on the plant. Pass: the worst step's overshoot within
 //                 the specification, every step settled within the settling
@@ -121,9 +124,11 @@ struct CommissionOptions {
   double range_min = std::numeric_limits<double>::quiet_NaN();
   double range_max = std::numeric_limits<double>::quiet_NaN();  ///< upper end of that range
   /// Plant time in s the experiment (probe, sweep and excitation) and the
-  /// first verification run may take together; each further design's
-  /// verification run comes on top. A budget that cannot hold both keeps the
-  /// excitation's 11 levels, and the verification comes on top of it.
+  /// verification runs may take together: the excitation leaves room for
+  /// the first design's run and up to `retunes` redesigns' runs (as many as
+  /// cost it at most a quarter of what one run leaves it); further runs come
+  /// on top. A budget that cannot hold
+  /// them keeps the excitation's 11 levels, and the runs come on top of it.
   double budget = 120.0;
   /// Input limits (input units); NaN = the plant's physical range (IPA 0..100 %).
   double u_min = std::numeric_limits<double>::quiet_NaN();
@@ -151,7 +156,7 @@ struct CommissionOptions {
   int retunes = 2;
   /// Candidate identification methods (identify.hpp names).
   std::vector<std::string> methods = {"arx", "oe", "n4sid", "hammerstein", "affine-narx"};
-  /// Dwell of the verification staircase in s; NaN = max(2 s, 4 x settling).
+  /// Dwell of the verification staircase in s; NaN = max(1 s, 2 x settling).
   double verification_dwell = std::numeric_limits<double>::quiet_NaN();
   /// Load step of the verification in output units; NaN = -8 % of the range.
   double load_step = std::numeric_limits<double>::quiet_NaN();
