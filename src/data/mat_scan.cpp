@@ -2,6 +2,7 @@
 
 #include <zlib.h>
 
+#include <bit>
 #include <cstdint>
 #include <cstring>
 
@@ -318,21 +319,36 @@ void ScanMatV4(const std::string& path, std::string_view bytes) {
     }
     std::int32_t h[5];
     std::memcpy(h, rest.data(), sizeof(h));
-    // The type MOPT decides the byte order, as in matio; the other fields must
-    // then be sane, or matio would allocate what they claim.
+    // The type MOPT is read in whichever byte order makes it valid; the other
+    // fields, as matio reads them, in the byte order its M digit declares
+    // (0: little-endian, 1: big-endian), whatever order the type was stored
+    // in. They must then be sane, or matio would allocate what they claim (a
+    // big-endian header whose type declares little-endian data, M = 0, made
+    // it allocate its name length unswapped: 2 GB).
     auto valid_type = [](std::int32_t t) {
       return t >= 0 && t <= 4052 && (t / 100) % 10 == 0 && (t / 10) % 10 <= 5 && t % 10 <= 2;
     };
-    if (!valid_type(h[0])) {
-      for (auto& v : h)
-        v = static_cast<std::int32_t>(__builtin_bswap32(static_cast<std::uint32_t>(v)));
-    }
+    auto swap = [](std::int32_t v) {
+      return static_cast<std::int32_t>(__builtin_bswap32(static_cast<std::uint32_t>(v)));
+    };
+    if (!valid_type(h[0])) h[0] = swap(h[0]);
     if (!valid_type(h[0])) {
       if (index == 1) return;  // not v4: matio decides
       throw DataError(
           fmt::format("{}: variable {} at offset {}: invalid header (type {}): the "
                       "file is corrupt",
                       path, index, offset, h[0]));
+    }
+    const int machine = h[0] / 1000;  // 0 IEEE little-endian, 1 IEEE big-endian, 2-4 VAX, Cray
+    if (machine > 1) {
+      throw DataError(
+          fmt::format("{}: variable {} at offset {}: type {} declares a VAX or Cray number "
+                      "format (M = {}), which is not read; save the data as IEEE (MATLAB -v4 on "
+                      "any current machine)",
+                      path, index, offset, h[0], machine));
+    }
+    if ((machine == 1) == (std::endian::native == std::endian::little)) {
+      for (int i = 1; i < 5; ++i) h[i] = swap(h[i]);
     }
     if (h[1] < 0 || h[2] < 0 || (h[3] != 0 && h[3] != 1) || h[4] < 0) {
       throw DataError(

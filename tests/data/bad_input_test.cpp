@@ -449,6 +449,42 @@ TEST_F(BadInputTest, MatVariableWithMoreColumnsThanChannelsIsRejected) {
   EXPECT_EQ(ReadMat(path, o).size(), 2);
 }
 
+TEST_F(BadInputTest, MatLevel4HeaderIsReadInTheByteOrderItsTypeDeclares) {
+  // A Level 4 header's fields follow the byte order that the M digit of its
+  // type declares (0 little-endian, 1 big-endian), as matio reads them.
+  auto be32 = [](std::string* s, std::uint32_t v) {
+    for (int shift = 24; shift >= 0; shift -= 8)
+      s->push_back(static_cast<char>((v >> shift) & 0xFF));
+  };
+  MatReadOptions o;
+  o.input_variables = {};
+  o.output_variables = {"y"};
+  o.sample_time = 0.1;
+  // Big-endian throughout (type 1000: IEEE big-endian doubles): reads.
+  std::string big;
+  for (std::uint32_t h : {1000u, 3u, 1u, 0u, 2u}) be32(&big, h);
+  big += std::string("y\0", 2);
+  for (double v : {0.5, 1.5, 2.5}) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &v, sizeof(bits));
+    be32(&big, static_cast<std::uint32_t>(bits >> 32));
+    be32(&big, static_cast<std::uint32_t>(bits));
+  }
+  const Dataset d = ReadMat(Write("big4.mat", big), o);
+  ASSERT_EQ(d.size(), 3);
+  EXPECT_EQ(d.outputs()(2, 0), 2.5);
+  // Found by mat_fuzz: a big-endian header whose type (2) declares
+  // little-endian data; matio read the name length 123 as 0x7B000000 and
+  // allocated 2 GB for it.
+  std::string mixed;
+  for (std::uint32_t h : {2u, 1u, 3u, 0u, 123u}) be32(&mixed, h);
+  mixed += std::string(122, 'x') + std::string(1, '\0') + std::string(24, '\0');
+  EXPECT_THAT([&] { ReadMat(Write("mixed4.mat", mixed), o); },
+              ThrowsMessage<DataError>(AllOf(HasSubstr("variable 1 ('xxxxxxxx"),
+                                             HasSubstr("claims 16777216x50331648"),
+                                             HasSubstr("the file is truncated or corrupt"))));
+}
+
 TEST_F(BadInputTest, MatRepeatedVariableNameIsRejected) {
   // Level-4 header: type 0 (little-endian double), rows, columns, real, name length.
   auto v4 = [](const std::string& name, const std::vector<double>& values) {
