@@ -169,7 +169,17 @@ class Scanner {
   /// Checks an miMATRIX element whose data claims `nbytes`; `data` holds the
   /// claimed bytes, or (partial) only their start.
   void CheckMatrix(std::string_view data, std::uint64_t nbytes, bool partial, int depth) {
-    if (nbytes == 0) return;  // an empty array
+    if (nbytes == 0) {
+      // An empty cell element or struct field; a variable has at least its
+      // flags, dimensions and name, and matio reads them from the bytes that
+      // follow an empty one (their "dimensions" made it ask for 3.4 GB).
+      if (depth == 0)
+        Fail(
+            fmt::format("{}: an array of 0 bytes, without the flags, dimensions and name "
+                        "every variable has: the file is corrupt",
+                        Variable()));
+      return;
+    }
     if (depth > kMaxDepth) {
       Fail(fmt::format("{}: arrays nested more than {} deep: the file is corrupt", Variable(),
                        kMaxDepth));

@@ -485,6 +485,28 @@ TEST_F(BadInputTest, MatLevel4HeaderIsReadInTheByteOrderItsTypeDeclares) {
                                              HasSubstr("the file is truncated or corrupt"))));
 }
 
+TEST_F(BadInputTest, MatVariableOfZeroBytesIsCorrupt) {
+  // Found by mat_fuzz: a variable whose miMATRIX tag claims 0 bytes, followed
+  // by more elements. matio reads the variable's flags, dimensions and name
+  // from those, and took an miINT32 claiming 0x65000001 bytes as dimensions
+  // (3.4 GB); an array of 0 bytes is only an empty cell element or field.
+  std::string flags;
+  PutU32(&flags, 6);
+  PutU32(&flags, 0);
+  std::string dims;
+  PutU32(&dims, 5);
+  PutU32(&dims, 0x65000001u);
+  std::string body;
+  PutU32(&body, 14);
+  PutU32(&body, 0);
+  body += Element(6, "") + Element(5, dims);
+  const std::string path = Write("zero.mat", MatHeader() + body);
+  EXPECT_THAT([&] { ReadMat(path); },
+              ThrowsMessage<DataError>(HasSubstr(
+                  "variable 1: an array of 0 bytes, without the flags, dimensions and name every "
+                  "variable has: the file is corrupt")));
+}
+
 TEST_F(BadInputTest, MatRepeatedVariableNameIsRejected) {
   // Level-4 header: type 0 (little-endian double), rows, columns, real, name length.
   auto v4 = [](const std::string& name, const std::vector<double>& values) {
