@@ -283,6 +283,16 @@ class Scanner {
       if ((k == 2 && cls != kClassStruct) || (k == 4 && cls == kClassStruct)) {
         CheckElementCount(cls, elements * fields, dims, nbytes);
       }
+      // The contents of a cell array or a struct are arrays; matio fails on
+      // another element there and leaks the contents it has read.
+      if (((cls == kClassCell && k >= 3) || (cls == kClassStruct && k >= 5)) &&
+          e.type != kMiMatrix) {
+        Fail(
+            fmt::format("{}: element {} of its {} contents has type {}, not miMATRIX (14): the "
+                        "file is corrupt",
+                        Variable(), k - (cls == kClassCell ? 2 : 4),
+                        cls == kClassCell ? "cell" : "struct", e.type));
+      }
       if (k >= 3 && e.type == kMiMatrix) CheckMatrix(e.data, e.nbytes, partial, depth + 1);
       at += e.size_on_disk;
     }

@@ -507,6 +507,38 @@ TEST_F(BadInputTest, MatVariableOfZeroBytesIsCorrupt) {
                   "variable has: the file is corrupt")));
 }
 
+TEST_F(BadInputTest, MatStructContentsMustBeArrays) {
+  // Found by mat_fuzz: a struct whose field holds an element of another type
+  // than miMATRIX; matio fails on it and leaks the fields it has read.
+  auto structure = [](const std::string& content) {
+    std::string flags, dims, body;
+    PutU32(&flags, 2);  // mxSTRUCT_CLASS
+    PutU32(&flags, 0);
+    PutU32(&dims, 1);
+    PutU32(&dims, 1);
+    body = Element(6, flags) + Element(5, dims) + Element(1, "s");
+    PutU32(&body, (4u << 16) | 5u);  // field name length 8, small miINT32
+    PutU32(&body, 8);
+    body += Element(1, std::string("a\0\0\0\0\0\0\0", 8)) + content;
+    return Element(14, body);
+  };
+  const std::string good =
+      Write("struct_ok.mat", MatHeader() + structure(DoubleMatrix("", 1, 1, {2.0})) +
+                                 DoubleMatrix("y", 3, 1, {0, 1, 2}));
+  MatReadOptions o;
+  o.input_variables = {};
+  o.output_variables = {"y"};
+  o.sample_time = 0.1;
+  EXPECT_EQ(ReadMat(good, o).size(), 3);
+  const std::string bad =
+      Write("struct_bad.mat", MatHeader() + structure(Element(9, std::string(8, '\0'))) +
+                                  DoubleMatrix("y", 3, 1, {0, 1, 2}));
+  EXPECT_THAT([&] { ReadMat(bad, o); },
+              ThrowsMessage<DataError>(HasSubstr(
+                  "variable 1 ('s'): element 1 of its struct contents has type 9, not miMATRIX "
+                  "(14): the file is corrupt")));
+}
+
 TEST_F(BadInputTest, MatRepeatedVariableNameIsRejected) {
   // Level-4 header: type 0 (little-endian double), rows, columns, real, name length.
   auto v4 = [](const std::string& name, const std::vector<double>& values) {
