@@ -46,17 +46,31 @@ double RippleHalfBand(const Eigen::VectorXd& y, Eigen::Index begin, Eigen::Index
   }
   return worst;
 }
+// Index of the step whose finite size(step) is largest (the first of equal
+// ones); -1 when no step has one.
+template <typename Size>
+int LargestStep(const std::vector<StepMetrics>& steps, Size size) {
+  int worst = -1;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const double v = size(steps[i]);
+    if (std::isfinite(v) && (worst < 0 || v > size(steps[worst]))) worst = static_cast<int>(i);
+  }
+  return worst;
+}
+
 // The summary's worst-step metrics (closed_loop.hpp): the largest overshoot,
-// the longest settling time or the first step that did not settle.
+// the longest settling time or the first step that did not settle, the
+// steady-state error of largest magnitude.
 void SummarizeWorstStep(ClosedLoopMetrics* m) {
   const std::vector<StepMetrics>& steps = m->steps;
-  for (std::size_t i = 0; i < steps.size(); ++i) {
-    const double os = steps[i].overshoot_percent;
-    if (std::isfinite(os) && !(m->worst_overshoot_step >= 0 && os <= m->overshoot_percent)) {
-      m->overshoot_percent = os;
-      m->worst_overshoot_step = static_cast<int>(i);
-    }
-  }
+  m->worst_overshoot_step =
+      LargestStep(steps, [](const StepMetrics& s) { return s.overshoot_percent; });
+  if (m->worst_overshoot_step >= 0)
+    m->overshoot_percent = steps[m->worst_overshoot_step].overshoot_percent;
+  m->worst_steady_state_error_step =
+      LargestStep(steps, [](const StepMetrics& s) { return std::abs(s.steady_state_error); });
+  if (m->worst_steady_state_error_step >= 0)
+    m->worst_steady_state_error = steps[m->worst_steady_state_error_step].steady_state_error;
   m->settled = true;
   for (std::size_t i = 0; i < steps.size() && m->settled; ++i) {
     if (!steps[i].settled) {
@@ -70,14 +84,6 @@ void SummarizeWorstStep(ClosedLoopMetrics* m) {
   const StepMetrics& worst = steps[m->worst_settling_step];
   m->settling_time = m->settled ? worst.settling_time : kNaN;
   m->settling_band = worst.settling_band;
-  for (std::size_t i = 0; i < steps.size(); ++i) {
-    const double e = steps[i].steady_state_error;
-    if (std::isfinite(e) && !(m->worst_steady_state_error_step >= 0 &&
-                              std::abs(e) <= std::abs(m->worst_steady_state_error))) {
-      m->worst_steady_state_error = e;
-      m->worst_steady_state_error_step = static_cast<int>(i);
-    }
-  }
 }
 
 }  // namespace

@@ -122,7 +122,7 @@ $PY -c 'import json,sys; j=json.load(open(sys.argv[1])); assert j["verification"
 # levels showed there, and judges the overshoot beyond half the ripple.
 "$PNEUMID" commission --plant ipa --plant-config "$SRC/config/ipa_chamber_lag.toml" -o "$TMP/cl" \
   --json > "$TMP/cl.json" || fail "commission on the chamber-lag twin exited $?: $(head -c 600 "$TMP/cl.json")"
-$PY - "$TMP/cl.json" <<'PYEOF' || fail "chamber-lag JSON"
+$PY - "$TMP/cl.json" "$TMP/cl/controller.toml" <<'PYEOF' || fail "chamber-lag JSON"
 import json, sys
 j = json.load(open(sys.argv[1]))
 e = j["experiment"]
@@ -144,10 +144,9 @@ assert all(not b["passed"] for b in a if b["aggressiveness"] < 0.5), seen
 better = (fast[0]["iae"] < 0.95 * half[0]["iae"] and
           fast[0]["overshoot_judged_percent"] <= min(0.8 * 5.0, half[0]["overshoot_judged_percent"] + 0.25))
 assert a[-1]["aggressiveness"] == (1.0 if better else 0.5), seen
-open(sys.argv[1] + ".kept", "w").write("%g" % a[-1]["aggressiveness"])
+kept = "aggressiveness = %g" % a[-1]["aggressiveness"]
+assert kept in open(sys.argv[2]).read().splitlines(), ("controller.toml: not the kept design", kept)
 PYEOF
-grep -q "^aggressiveness = $(cat "$TMP/cl.json.kept")\$" "$TMP/cl/controller.toml" ||
-  fail "chamber-lag controller.toml: not the kept design ($(cat "$TMP/cl.json.kept"))"
 
 # A GPC has no tuning to specifications of its own: it runs the horizons and
 # move suppression of the DMC's auto design with the T filter A, written
