@@ -44,11 +44,14 @@ class Scanner {
  public:
   Scanner(const std::string& path, bool swap) : path_(path), swap_(swap) {}
 
-  void ScanFile(std::string_view bytes) {
+  MatScan ScanFile(std::string_view bytes) {
+    MatScan scan;
+    scan.v5 = true;
     std::size_t offset = 128;
     for (int index = 1; offset < bytes.size(); ++index) {
       index_ = index;
       name_.clear();
+      top_ = MatScanVariable{};
       const std::string_view rest = bytes.substr(offset);
       if (rest.size() < 8) {
         Fail(
@@ -68,9 +71,15 @@ class Scanner {
       } else if (e.nbytes > rest.size() - 8) {
         Truncated(e, offset, bytes.size());
       }
-      offset += e.type == kMiCompressed ? 8 + static_cast<std::size_t>(e.nbytes)
-                                        : std::min<std::size_t>(e.size_on_disk, rest.size());
+      const std::size_t size = e.type == kMiCompressed
+                                   ? 8 + static_cast<std::size_t>(e.nbytes)
+                                   : std::min<std::size_t>(e.size_on_disk, rest.size());
+      top_.offset = offset;
+      top_.size = size;
+      scan.variables.push_back(std::move(top_));
+      offset += size;
     }
+    return scan;
   }
 
  private:
@@ -222,6 +231,10 @@ class Scanner {
                         Variable(), e.type, e.nbytes));
       } else if (k == 0) {
         cls = U32(e.data, 0) & 0xFF;
+        if (depth == 0) {
+          top_.array_class = cls;
+          top_.complex = (U32(e.data, 0) & 0x0800) != 0;
+        }
       } else if (k == 1 && e.type != kMiInt32) {
         // matio reads the dimensions as int32 whatever the tag says, so a
         // mistyped tag would reach it unchecked (10 "dimensions" from 50
@@ -252,6 +265,7 @@ class Scanner {
             Fail(fmt::format("{}: negative dimension {}: the file is corrupt", Variable(), n));
           elements *= static_cast<double>(n);
           dims += (d == 0 ? "" : "x") + std::to_string(n);
+          if (depth == 0) top_.dims.push_back(static_cast<std::size_t>(n));
         }
       } else if (k == 2 && e.type != kMiInt8) {
         // matio skips only the tag of a name of another type and reads on
@@ -260,6 +274,7 @@ class Scanner {
                          Variable(), e.type));
       } else if (k == 2 && depth == 0) {
         name_ = Excerpt(e.data);
+        top_.name = std::string(e.data.substr(0, e.data.find('\0')));
       } else if (k == 3 && cls == kClassStruct &&
                  (!e.small || e.type != kMiInt32 || e.nbytes != 4)) {
         // matio takes the word after the tag as the length, which only the
@@ -320,6 +335,7 @@ class Scanner {
   bool swap_;
   int index_ = 0;
   std::string name_;
+  MatScanVariable top_;  ///< the top-level variable being checked
 };
 
 /// MAT v4 (MAT-File Format, ch. 1, "Level 4 MAT-files"): a sequence of
@@ -396,23 +412,23 @@ void ScanMatV4(const std::string& path, std::string_view bytes) {
 
 }  // namespace
 
-void ScanMatFile(const std::string& path, std::string_view bytes) {
+MatScan ScanMatFile(const std::string& path, std::string_view bytes) {
   if (bytes.size() < 128 || (bytes.substr(126, 2) != "IM" && bytes.substr(126, 2) != "MI")) {
     ScanMatV4(path, bytes);
-    return;
+    return {};
   }
   const std::string_view endian = bytes.substr(126, 2);
   const bool swap = endian == "MI";
   std::uint16_t version = 0;
   std::memcpy(&version, bytes.data() + 124, 2);
   if (swap) version = __builtin_bswap16(version);
-  if (version == 0x0200) return;  // v7.3 (HDF5): the HDF5 library checks its own sizes
+  if (version == 0x0200) return {};  // v7.3 (HDF5): the HDF5 library checks its own sizes
   if (version != 0x0100) {
     // matio reads a header with another version as v4: check it as v4 too.
     ScanMatV4(path, bytes);
-    return;
+    return {};
   }
-  Scanner(path, swap).ScanFile(bytes);
+  return Scanner(path, swap).ScanFile(bytes);
 }
 
 }  // namespace pneumid::internal

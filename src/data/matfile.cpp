@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -109,6 +110,8 @@ std::string ClassName(matio_classes c) {
       return "function handle";
     case MAT_C_OPAQUE:
       return "opaque";
+    case MAT_C_EMPTY:
+      return "unknown class";
     default:
       return "integer";
   }
@@ -147,6 +150,38 @@ void CopyAs(const void* data, std::size_t n, Eigen::MatrixXd& out) {
   for (std::size_t i = 0; i < n; ++i) out.data()[i] = static_cast<double>(p[i]);
 }
 
+/// Whether matio is given a top-level element of a v5 file: numeric arrays
+/// only. pneumid reads nothing else, and matio's readers of cell arrays,
+/// structs, objects and function handles fail on corrupt contents without
+/// freeing what they have read (each found by fuzzing), so they never reach it.
+bool Readable(const internal::MatScanVariable& v) {
+  return v.array_class >= MAT_C_DOUBLE && v.array_class <= MAT_C_UINT64;
+}
+
+/// Writes the header and the numeric variables of the v5 file `bytes` to a
+/// new temporary file and returns its path.
+std::string WriteNumericCopy(std::string_view bytes, const internal::MatScan& scan) {
+  std::string path = (std::filesystem::temp_directory_path() / "pneumid-mat-XXXXXX").string();
+  const int fd = ::mkstemp(path.data());
+  if (fd < 0) throw DataError(fmt::format("cannot create a temporary file {}", path));
+  std::string out(bytes.substr(0, 128));
+  for (const auto& v : scan.variables) {
+    if (Readable(v)) out += bytes.substr(v.offset, v.size);
+  }
+  std::size_t done = 0;
+  while (done < out.size()) {
+    const ssize_t n = ::write(fd, out.data() + done, out.size() - done);
+    if (n <= 0) {
+      ::close(fd);
+      ::unlink(path.c_str());
+      throw DataError(fmt::format("cannot write the temporary file {}", path));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  return path;
+}
+
 class MatReader {
  public:
   explicit MatReader(const std::string& path) : path_(path) {
@@ -158,18 +193,26 @@ class MatReader {
     if (S_ISDIR(st.st_mode)) throw DataError(fmt::format("{}: is a directory", path));
     if (st.st_size == 0) throw DataError(fmt::format("{}: empty file (not a MAT file)", path));
     file_size_ = static_cast<std::size_t>(st.st_size);
+    internal::MatScan scan;
+    std::string copy;  // a copy of the file without its non-numeric variables
     {
       // Sizes claimed by the file are checked before matio trusts them.
       const internal::MappedFile file(path);
-      internal::ScanMatFile(path, file.view());
+      scan = internal::ScanMatFile(path, file.view());
+      if (std::any_of(scan.variables.begin(), scan.variables.end(),
+                      [](const auto& v) { return !Readable(v); })) {
+        copy = WriteNumericCopy(file.view(), scan);
+      }
     }
     g_matio_message.clear();
-    mat_.reset(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
+    mat_.reset(Mat_Open(copy.empty() ? path.c_str() : copy.c_str(), MAT_ACC_RDONLY));
+    if (!copy.empty()) ::unlink(copy.c_str());  // matio holds it open
     if (!mat_) {
       throw DataError(fmt::format("{}: cannot open as a MAT file (v4, v5{}){}", path,
                                   MatHasV73() ? " or v7.3" : "; v7.3 needs matio with HDF5",
                                   MatioDetail()));
     }
+    std::vector<VarInfo> listed;
     while (true) {
       VarPtr v(Mat_VarReadNextInfo(mat_.get()));
       if (!v) break;
@@ -179,9 +222,32 @@ class MatReader {
       info.class_type = v->class_type;
       info.complex = v->isComplex != 0;
       for (int d = 0; d < v->rank; ++d) info.dims.push_back(v->dims[d]);
-      vars_.push_back(std::move(info));
+      listed.push_back(std::move(info));
     }
     Mat_Rewind(mat_.get());
+    if (copy.empty()) {
+      vars_ = std::move(listed);
+      return;
+    }
+    // The variables left out of the copy are listed, in file order, as the
+    // scan read them, so that selecting one says what it is.
+    std::size_t next = 0;
+    for (const auto& v : scan.variables) {
+      if (Readable(v)) {
+        if (next < listed.size()) vars_.push_back(std::move(listed[next++]));
+      } else if (v.array_class != 0) {
+        VarInfo info;
+        info.name = v.name;
+        info.label = Excerpt(v.name);
+        // (A class beyond the format's 17 is listed as unknown.)
+        info.class_type =
+            v.array_class <= MAT_C_OPAQUE ? static_cast<matio_classes>(v.array_class) : MAT_C_EMPTY;
+        info.complex = v.complex;
+        info.dims = v.dims;
+        vars_.push_back(std::move(info));
+      }
+    }
+    for (; next < listed.size(); ++next) vars_.push_back(std::move(listed[next]));
   }
 
   /// Columns selected by `spec`, with their channel names.

@@ -539,6 +539,54 @@ TEST_F(BadInputTest, MatStructContentsMustBeArrays) {
                   "(14): the file is corrupt")));
 }
 
+TEST_F(BadInputTest, MatNonNumericVariablesNeverReachMatio) {
+  // Found by mat_fuzz: a function-handle variable holding a nested array of 0
+  // columns; matio failed inside it and leaked what it had read. Cell arrays,
+  // structs, objects and function handles are listed from the scan and left
+  // out of what matio reads; the numeric variables around them still read.
+  std::string flags, dims, body;
+  PutU32(&flags, 16);  // mxFUNCTION_CLASS
+  PutU32(&flags, 0);
+  PutU32(&dims, 1);
+  PutU32(&dims, 2);
+  body = Element(6, flags) + Element(5, dims) + Element(1, "f");
+  body += DoubleMatrix("", 1, 0, {});
+  const std::string path =
+      Write("function.mat", MatHeader() + DoubleMatrix("t", 3, 1, {0, 1, 2}) + Element(14, body) +
+                                DoubleMatrix("y", 3, 1, {4, 5, 6}));
+  MatReadOptions o;
+  o.time_variable = "t";
+  o.input_variables = {};
+  o.output_variables = {"y"};
+  const Dataset d = ReadMat(path, o);
+  ASSERT_EQ(d.size(), 3);
+  EXPECT_EQ(d.outputs()(2, 0), 6.0);
+  o.output_variables = {"f"};
+  EXPECT_THAT([&] { ReadMat(path, o); },
+              ThrowsMessage<DataError>(HasSubstr(
+                  "variable 'f' (function handle): output data must be a real numeric array")));
+  o.output_variables = {"z"};
+  EXPECT_THAT([&] { ReadMat(path, o); },
+              ThrowsMessage<DataError>(
+                  HasSubstr("available variables: 't' (3x1 double), 'f' (1x2 function handle), "
+                            "'y' (3x1 double)")));
+  // Found by mat_fuzz: a class number beyond the format's 17 is no matio class.
+  std::string odd_flags;
+  PutU32(&odd_flags, 200);
+  PutU32(&odd_flags, 0);
+  const std::string odd = Write(
+      "class200.mat",
+      MatHeader() +
+          Element(14, Element(6, odd_flags) + Element(5, dims) + Element(1, "q") + Element(9, "")) +
+          DoubleMatrix("y", 3, 1, {4, 5, 6}));
+  o.time_variable = "";
+  o.sample_time = 0.1;
+  o.output_variables = {"q"};
+  EXPECT_THAT([&] { ReadMat(odd, o); },
+              ThrowsMessage<DataError>(HasSubstr("variable 'q' (unknown class): output data must "
+                                                 "be a real numeric array")));
+}
+
 TEST_F(BadInputTest, MatRepeatedVariableNameIsRejected) {
   // Level-4 header: type 0 (little-endian double), rows, columns, real, name length.
   auto v4 = [](const std::string& name, const std::vector<double>& values) {
