@@ -966,7 +966,32 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
     return true;
   };
   const ControllerSettings given = settings;
+  // A further run is made within the budget, or when no design has passed
+  // yet (a failing design is not kept to save plant time).
+  const double run_time =
+      cl.duration + (policy.rest_before_run ? RestBeforeRun(plant, ex, dwell) : 0.0);
+  const auto any_passed = [&] {
+    return std::any_of(r.attempts.begin(), r.attempts.end(),
+                       [](const CommissionAttempt& a) { return a.passed; });
+  };
+  bool budget_stopped = false;
+  const auto fits = [&] {
+    if (r.plant_time + run_time <= o.budget + 1e-6) return true;
+    budget_stopped = true;
+    return false;
+  };
   for (int attempt = 0; attempt <= o.retunes; ++attempt) {
+    if (attempt > 0 && any_passed()) {
+      // A softer design that fails on more than its overshoot (it settles
+      // too late, or is still away from the set-point) makes the next one
+      // slower still: the passing design is kept.
+      const auto& last = r.attempts.back().failures;
+      const bool slower = std::any_of(last.begin(), last.end(), [&](const std::string& f) {
+        return f.rfind("overshoot", 0) != 0 &&
+               !(policy.retune_on_ripple && f.rfind("ripple", 0) == 0);
+      });
+      if (slower || !fits()) break;
+    }
     if (!run(attempt == 0 && first ? std::move(*first)
                                    : MakeDesign(settings, model, Ts, r.controller_model)))
       return false;
@@ -1012,7 +1037,7 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
   const bool tried_fastest =
       std::any_of(tried.begin(), tried.end(),
                   [](const ControllerSettings& s) { return s.aggressiveness >= 1.0; });
-  if (policy.tighten && softened_in_vain && !tried_fastest) {
+  if (policy.tighten && softened_in_vain && !tried_fastest && fits()) {
     const std::size_t k = r.attempts.size() - 1;
     ControllerSettings fastest = given;
     fastest.aggressiveness = 1.0;
@@ -1023,6 +1048,12 @@ bool Verify(CommissionResult& r, Plant& plant, const CommissionOptions& o,
         t.overshoot_judged_percent <= b.overshoot_judged_percent + 0.05 * o.overshoot &&
         t.result.metrics.iae < 0.95 * b.result.metrics.iae;
     if (!better) keep_last(k);
+  }
+  if (budget_stopped) {
+    r.suggestions.push_back(fmt::format(
+        "a longer --budget: {:.1f} s of the {:g} s were left, less than another verification "
+        "run ({:.1f} s), so the passing design was not redesigned further",
+        std::max(0.0, o.budget - r.plant_time), o.budget, run_time));
   }
   Report(o, "verify", 1.0);
   return true;

@@ -61,7 +61,11 @@
 //                 design at aggressiveness 1 is tried once and kept if it
 //                 passes with its overshoot beyond half the ripple within
 //                 the margin and no more than 5 % of the specification above
-//                 the kept one's, and an IAE at least 5 % lower. What limits
+//                 the kept one's, and an IAE at least 5 % lower. Once a
+//                 design has passed, another is verified only when its run
+//                 fits in what is left of the budget, and softening stops
+//                 when a softer design fails on more than its overshoot
+//                 (settling, steady-state error). What limits
 //                 the loop (saturation, dead time, model error, ripple) is
 //                 stated with what to try.
 //
@@ -126,8 +130,9 @@ struct CommissionOptions {
   /// Plant time in s the experiment (probe, sweep and excitation) and the
   /// verification runs may take together: the excitation leaves room for
   /// the first design's run and up to `retunes` redesigns' runs (as many as
-  /// cost it at most a quarter of what one run leaves it); further runs come
-  /// on top. A budget that cannot hold
+  /// cost it at most a quarter of what one run leaves it); once a design has
+  /// passed, further runs are made only within the budget, and only while no
+  /// design has passed do they come on top of it. A budget that cannot hold
   /// them keeps the excitation's 11 levels, and the runs come on top of it.
   double budget = 120.0;
   /// Input limits (input units); NaN = the plant's physical range (IPA 0..100 %).
