@@ -146,6 +146,10 @@ better = (fast[0]["iae"] < 0.95 * half[0]["iae"] and
 assert a[-1]["aggressiveness"] == (1.0 if better else 0.5), seen
 kept = "aggressiveness = %g" % a[-1]["aggressiveness"]
 assert kept in open(sys.argv[2]).read().splitlines(), ("controller.toml: not the kept design", kept)
+# Softening stops at the first softer design that fails on its settling (a
+# softer one would settle later still), and the runs stay within the budget.
+assert len([b for b in a if b["aggressiveness"] < 0.5]) == 1, seen
+assert j["plant_time"] <= 120.0 + 1e-6, j["plant_time"]
 PYEOF
 
 # A GPC has no tuning to specifications of its own: it runs the horizons and
