@@ -226,7 +226,8 @@ static Registrar reg(
       AddDataOptions(app, args->data);
       AddPreprocessOptions(app, args->preprocess);
       app.add_option("-m,--method,--methods", args->methods,
-                     "Comma-separated methods, or all: reaction-curve, tangent, smith, "
+                     "Comma-separated methods, all, or auto (the reaction curve for a step "
+                     "test, else fit-p1d, arx, oe, bj, iv4): reaction-curve, tangent, smith, "
                      "sundaresan, broida, sopdt, ptn, strejc, areas, fit-p1d, fit-p2d, fit-p2du, "
                      "fit-p3d, fit-p1di, arx, armax, oe, bj, iv4, n4sid, cra, spa; nonlinear "
                      "(not in all): static-map, hammerstein, wiener, hw, narx, affine-narx")
@@ -344,7 +345,8 @@ static Registrar reg(
                    "Draw the progress bar even when stderr is not a terminal");
       app.callback([args, na, nb, nk, max_terms] {
         args->nonlinear.choose_structure = na->count() == 0 && nb->count() == 0 && nk->count() == 0;
-        const std::vector<std::string> methods = ParseMethodList(args->methods);
+        const std::vector<std::string> methods =
+            args->methods == "auto" ? std::vector<std::string>{} : ParseMethodList(args->methods);
         if ((na->count() > 0 || nb->count() > 0) &&
             std::find(methods.begin(), methods.end(), "affine-narx") != methods.end())
           std::cerr << "pneumid identify: warning: affine-narx is first order (y(t-1) and "

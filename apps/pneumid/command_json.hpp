@@ -84,7 +84,7 @@ struct TuneArgs {
 struct IdentifyArgs {
   DataOptions data;
   PreprocessArgs preprocess;
-  std::string methods = "reaction-curve";
+  std::string methods = "auto";
   IdentifyRequest request;
   std::string loss = "none";
   NonlinearOptions nonlinear;

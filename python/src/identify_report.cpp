@@ -338,7 +338,7 @@ void BindIdentify(py::module_& m) {
         }
         return py::module_::import("json").attr("loads")(text);
       },
-      "data"_a, "methods"_a = "reaction-curve", "input"_a = 0, "output"_a = 0, "order"_a = 2,
+      "data"_a, "methods"_a = "auto", "input"_a = 0, "output"_a = 0, "order"_a = 2,
       "na"_a = py::none(), "nb"_a = py::none(), "nk"_a = py::none(), "nc"_a = 1, "nd"_a = 1,
       "nf"_a = 3, "feedthrough"_a = false, "n4sid_weight"_a = "moesp", "operating_point"_a = "auto",
       "loss"_a = "none", "split"_a = 0.0, "validation"_a = py::none(), "window"_a = "",
@@ -347,7 +347,8 @@ void BindIdentify(py::module_& m) {
       "min_segment"_a = py::none(), "degree"_a = py::none(), "max_terms"_a = py::none(),
       "err_tolerance"_a = py::none(), "focus"_a = "prediction",
       "The identification of `pneumid identify DATA --json` (workflow/identify_workflow.hpp): "
-      "methods as a list or the --method text ('fit-p1d,arx', 'all'), the flags' settings by "
+      "methods as a list or the --method text ('fit-p1d,arx', 'all', 'auto': the default, as the "
+      "command's), the flags' settings by "
       "their names (na, nb, nk None as when the flags are not given: hammerstein, wiener, hw "
       "and narx then choose their structure; knots, settle, min_segment, degree, max_terms, "
       "err_tolerance None: the command's defaults; focus 'prediction' or 'simulation' as "

@@ -5,11 +5,13 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/parametric/process_model.hpp"
+#include "pneumid/identify/step/step_analysis.hpp"
 
 namespace pneumid {
 
@@ -77,10 +79,23 @@ IdentifyWorkflowResult RunIdentifyWorkflow(const IdentifyWorkflowOptions& o, con
                 "--validation and --split exclude each other: give held-out data as a file or "
                 "as a fraction of DATA");
   PNEUMID_CHECK(o.IsValid(&why), "{}", why);
-  const std::vector<std::string> methods = ParseMethodList(o.methods);
+  const bool automatic = o.methods == "auto";
+  std::vector<std::string> methods =
+      automatic ? std::vector<std::string>{"reaction-curve"} : ParseMethodList(o.methods);
   const PreprocessOptions prep = o.preprocess.ToOptions();
   IdentifyWorkflowResult out;
   out.data = Preprocess(raw, prep, &out.record);
+  std::string not_a_step;  // auto: why the reaction curve does not apply
+  if (automatic) {
+    try {
+      AnalyzeStep(out.data, o.request.input, o.request.output);
+    } catch (const DataError& e) {
+      not_a_step = e.what();
+      // (Its advice to use a fit-* method is what follows.)
+      not_a_step = not_a_step.substr(0, not_a_step.find("; use a fit-* method"));
+      methods = ParseMethodList(kGeneralInputMethods);
+    }
+  }
   std::optional<Dataset> validation;
   // The validation data get the estimation data's preprocessing, with the
   // offsets measured on the estimation data (not re-estimated).
@@ -91,6 +106,14 @@ IdentifyWorkflowResult RunIdentifyWorkflow(const IdentifyWorkflowOptions& o, con
   options.nonlinear = o.nonlinear;
   out.summary = IdentifyModels(methods, out.data, o.request, options,
                                validation ? &*validation : nullptr, progress);
+  if (!not_a_step.empty()) {
+    out.summary.warnings.insert(
+        out.summary.warnings.begin(),
+        fmt::format("the paper's reaction curve needs a step test and this record is not one "
+                    "({}): identified with the methods for general inputs, {} (choose others "
+                    "with --method)",
+                    not_a_step, fmt::join(methods, ", ")));
+  }
   if (!out.record.IsIdentity())
     for (IdentifiedModel& m : out.summary.models) m.preprocessing = out.record;
   return out;

@@ -98,6 +98,13 @@ check_json "arx produced" '[m["method"] for m in j["models"]] == ["arx"]'
 check_json "failure listed" 'j["failures"][0]["method"] == "reaction-curve" and j["failures"][0]["reason"] and j["termination"] == "partial"'
 check_output "failure on stderr" "reaction-curve failed" "$TMP/err"
 expect_error "no model at all" "no method produced a model" identify "$TMP/prbs.csv" -m reaction-curve,tangent
+# Without --method: the reaction curve on a step test, the methods for
+# general inputs on any other record, with a warning saying why.
+expect_ok "auto on a PRBS" identify "$TMP/prbs.csv" --json
+check_json "auto: general methods" 'sorted(m["method"] for m in j["models"]) == ["arx", "bj", "fit-p1d", "iv4", "oe"] and j["warnings"] and "not a single step" in j["warnings"][0]'
+check_output "auto warning on stderr" "identified with the methods for general inputs, fit-p1d, arx, oe, bj, iv4" "$TMP/err"
+expect_ok "auto on a step test" identify "$DATA/fopdt.csv" --json
+check_json "auto: reaction curve" '[m["method"] for m in j["models"]] == ["reaction-curve"] and j["warnings"] == []'
 
 # A pole near z = -1 is flagged and never ranked best while a model without
 # such a flag exists (no_convergence and residuals_not_white do not move a

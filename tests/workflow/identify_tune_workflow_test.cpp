@@ -69,6 +69,28 @@ TEST(IdentifyWorkflow, NoModelIsAnEmptySummaryAndNullJson) {
   EXPECT_TRUE(r.ToJson().is_null());
 }
 
+TEST(IdentifyWorkflow, AutoTakesTheReactionCurveForAStepTestOnly) {
+  // The default: the paper's method on a step test, no warning.
+  IdentifyWorkflowOptions o;
+  ASSERT_EQ(o.methods, "auto");
+  const IdentifyWorkflowResult step = RunIdentifyWorkflow(o, StepData());
+  ASSERT_EQ(step.summary.models.size(), 1u);
+  EXPECT_EQ(step.summary.models.front().method, "reaction-curve");
+  EXPECT_TRUE(step.summary.warnings.empty());
+  // The cascaded-tanks benchmark's estimation record (a multisine input): the
+  // methods for general inputs, and a warning that gives the reason.
+  const Dataset tanks = LoadDataset(std::string(PNEUMID_SOURCE_DIR) + "/data/tanks/estimation.csv");
+  const IdentifyWorkflowResult general = RunIdentifyWorkflow(o, tanks);
+  EXPECT_EQ(general.summary.models.size() + general.summary.failures.size(), 5u);
+  EXPECT_GE(general.summary.models.size(), 4u);
+  ASSERT_FALSE(general.summary.warnings.empty());
+  EXPECT_NE(general.summary.warnings.front().find("the input is not a single step"),
+            std::string::npos)
+      << general.summary.warnings.front();
+  EXPECT_NE(general.summary.warnings.front().find("fit-p1d, arx, oe, bj, iv4"), std::string::npos);
+  EXPECT_GT(general.summary.models.front().fit_percent, 70.0);
+}
+
 TEST(IdentifyWorkflow, InvalidOptionsNameTheFlag) {
   const Dataset data = StepData();
   IdentifyWorkflowOptions o;

@@ -5,7 +5,7 @@
 // that the same data and settings give the same models everywhere.
 //
 //   IdentifyWorkflowOptions o;
-//   o.methods = "fit-p1d,arx";           // as --method: names or "all"
+//   o.methods = "fit-p1d,arx";           // as --method: names, "all" or "auto"
 //   o.preprocess.detrend = "constant";   // as --detrend, --window, ...
 //   o.split = 0.7;                       // or validation data below
 //   const IdentifyWorkflowResult r = RunIdentifyWorkflow(o, data);
@@ -47,10 +47,17 @@ struct PreprocessSettings {
   PreprocessOptions ToOptions() const;
 };
 
+/// The methods "auto" chooses for a record whose input is not a single step:
+/// process-model fit, ARX, OE, BJ and IV4, each simulated against the data.
+inline constexpr const char* kGeneralInputMethods = "fit-p1d,arx,oe,bj,iv4";
+
 /// What to identify (see the file comment).
 struct IdentifyWorkflowOptions {
-  /// Comma-separated method names, or "all" (ParseMethodList).
-  std::string methods = "reaction-curve";
+  /// Comma-separated method names, "all" (ParseMethodList), or "auto": the
+  /// paper's reaction curve when the input is a single step (AnalyzeStep
+  /// accepts the record), else kGeneralInputMethods, with a warning in
+  /// summary.warnings that gives the reason.
+  std::string methods = "auto";
   PreprocessSettings preprocess;  ///< applied to the data (and, as recorded, to validation data)
   IdentifyRequest request;        ///< channels and orders
   std::string loss = "none";      ///< loss of the fit-* methods: none, huber, cauchy
