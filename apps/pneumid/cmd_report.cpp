@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
@@ -15,6 +16,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
+#include "pneumid/identify/identify.hpp"
 #include "pneumid/report/identification_report.hpp"
 #include "progress.hpp"
 #include "validators.hpp"
@@ -30,7 +32,7 @@ std::vector<std::string> SplitComma(const std::string& s) {
 struct ReportArgs {
   pneumid::cli::DataOptions data;
   pneumid::cli::PreprocessArgs preprocess;
-  std::string methods = "reaction-curve,ptn,arx";
+  std::string methods = "auto";
   std::string out_dir;
   std::string title;
   int order = 2, na = 3, nb = 3, nk = 1;
@@ -43,7 +45,11 @@ struct ReportArgs {
 void Run(const ReportArgs& a) {
   using namespace pneumid;
   ReportOptions o;
-  o.methods = SplitComma(a.methods);
+  // "auto": the paper's three on a step test, else the methods for general
+  // inputs (AutoMethods, once the data are read).
+  const std::vector<std::string> for_a_step = {"reaction-curve", "ptn", "arx"};
+  const bool automatic = a.methods == "auto";
+  o.methods = automatic ? for_a_step : SplitComma(a.methods);
   o.request.order = a.order;
   o.request.na = a.na;
   o.request.nb = a.nb;
@@ -84,6 +90,16 @@ void Run(const ReportArgs& a) {
   const Dataset data =
       Preprocess(cli::LoadFromOptions(a.data), cli::ToPreprocessOptions(a.preprocess), &record);
   if (!record.IsIdentity()) o.preprocessing = record;
+  if (automatic) {
+    std::string not_a_step;
+    o.methods = AutoMethods(data, o.request, for_a_step, &not_a_step);
+    if (!not_a_step.empty())
+      std::cerr << fmt::format(
+          "pneumid report: warning: the paper's step-response methods need a step test and this "
+          "record is not one ({}): identified with the methods for general inputs, {} (choose "
+          "others with --method)\n",
+          not_a_step, fmt::join(o.methods, ", "));
+  }
   ReportSummary s;
   {
     cli::ProgressBar bar("report", a.progress || cli::StderrIsTerminal());
@@ -129,7 +145,8 @@ const pneumid::cli::Registrar reg(
       pneumid::cli::AddPreprocessOptions(app, a->preprocess);
       app.add_option("-m,--method,--methods", a->methods,
                      "Comma-separated identification methods (names of `pneumid identify "
-                     "--method`)")
+                     "--method`), or auto: reaction-curve, ptn and arx for a step test, else "
+                     "fit-p1d, arx, oe, bj, iv4")
           ->capture_default_str();
       app.add_option("--output-dir,-o", a->out_dir,
                      "Directory for report.html and models.json (created when missing)")

@@ -15,6 +15,7 @@
 #include "pneumid/identify/evaluation/validation.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/identify/parametric/parametric.hpp"
+#include "pneumid/identify/step/step_analysis.hpp"
 
 namespace pneumid {
 
@@ -73,6 +74,23 @@ std::vector<std::string> ParseMethodList(const std::string& list) {
   }
   PNEUMID_CHECK(!out.empty(), "the method list needs at least one method name, got '{}'", list);
   return out;
+}
+
+std::vector<std::string> AutoMethods(const Dataset& data, const IdentifyRequest& request,
+                                     const std::vector<std::string>& for_a_step,
+                                     std::string* why_not_a_step) {
+  if (why_not_a_step != nullptr) why_not_a_step->clear();
+  try {
+    AnalyzeStep(data, request.input, request.output);
+    return for_a_step;
+  } catch (const DataError& e) {
+    if (why_not_a_step != nullptr) {
+      // (Its advice to use a fit-* method is what the caller does.)
+      const std::string what = e.what();
+      *why_not_a_step = what.substr(0, what.find("; use a fit-* method"));
+    }
+    return ParseMethodList(kGeneralInputMethods);
+  }
 }
 
 IdentifiedModel Identify(const std::string& method, const Dataset& data,

@@ -11,7 +11,6 @@
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/identified_model_io.hpp"
 #include "pneumid/identify/parametric/process_model.hpp"
-#include "pneumid/identify/step/step_analysis.hpp"
 
 namespace pneumid {
 
@@ -86,16 +85,7 @@ IdentifyWorkflowResult RunIdentifyWorkflow(const IdentifyWorkflowOptions& o, con
   IdentifyWorkflowResult out;
   out.data = Preprocess(raw, prep, &out.record);
   std::string not_a_step;  // auto: why the reaction curve does not apply
-  if (automatic) {
-    try {
-      AnalyzeStep(out.data, o.request.input, o.request.output);
-    } catch (const DataError& e) {
-      not_a_step = e.what();
-      // (Its advice to use a fit-* method is what follows.)
-      not_a_step = not_a_step.substr(0, not_a_step.find("; use a fit-* method"));
-      methods = ParseMethodList(kGeneralInputMethods);
-    }
-  }
+  if (automatic) methods = AutoMethods(out.data, o.request, {"reaction-curve"}, &not_a_step);
   std::optional<Dataset> validation;
   // The validation data get the estimation data's preprocessing, with the
   // offsets measured on the estimation data (not re-estimated).

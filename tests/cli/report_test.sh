@@ -50,6 +50,26 @@ assert [m['method'] for m in d['models']]==['reaction-curve','arx'], d['models']
 assert d['figures']==4 and d['tables']==3, d
 " "$WORK/json" || fail "--json output wrong"
 
+# The default methods (auto): the paper's three on the step test above, the
+# methods for general inputs on a record that is not a step test (the
+# cascaded tanks), with a warning that says why.
+"$PNEUMID" report "$SRC/data/tanks/estimation.csv" -o "$WORK/tanks" --json >"$WORK/tanks.json" \
+  2>"$WORK/tanks.err" || fail "report on the tanks exited with $?: $(cat "$WORK/tanks.err")"
+"$PY" -c "
+import json,sys
+d=json.load(open(sys.argv[1]))
+assert sorted(m['method'] for m in d['models'])==['arx','bj','fit-p1d','iv4','oe'], d['models']
+" "$WORK/tanks.json" || fail "report auto on the tanks: not the methods for general inputs"
+grep -q "the input is not a single step" "$WORK/tanks.err" || fail "report auto: no warning"
+grep -q -- "--method auto" "$WORK/tanks/report.html" || fail "report auto: command line"
+"$PNEUMID" report "$WORK/step.csv" --output-col F -o "$WORK/out6" --json >"$WORK/json6" 2>"$WORK/err6"
+"$PY" -c "
+import json,sys
+d=json.load(open(sys.argv[1]))
+assert sorted(m['method'] for m in d['models'])==['arx','ptn','reaction-curve'], d['models']
+" "$WORK/json6" || fail "report auto on a step test: not reaction-curve, ptn, arx"
+[ -s "$WORK/err6" ] && fail "report auto on a step test warned: $(cat "$WORK/err6")"
+
 # Canonical flag names, the older ones as aliases; the report's command line uses the canonical ones.
 grep -q -- "--method reaction-curve,arx --output-dir" "$WORK/out2/report.html" \
   || fail "report command line does not use --method/--output-dir"

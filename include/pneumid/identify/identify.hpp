@@ -73,6 +73,19 @@ bool IsIdentifyMethod(const std::string& name);
 /// @throws InvalidArgument naming an unknown method, or for an empty list.
 std::vector<std::string> ParseMethodList(const std::string& list);
 
+/// The methods for a record whose input is not a single step: process-model
+/// fit, ARX, OE, BJ and IV4, each simulated against the data.
+inline constexpr const char* kGeneralInputMethods = "fit-p1d,arx,oe,bj,iv4";
+
+/// What the method list "auto" stands for on `data` (channels request.input
+/// and request.output): `for_a_step` when the step analysis accepts the
+/// record (AnalyzeStep: one step in the input, from a steady state to a
+/// steady state), else kGeneralInputMethods, with the step analysis's reason
+/// in *why_not_a_step (cleared otherwise; may be null).
+std::vector<std::string> AutoMethods(const Dataset& data, const IdentifyRequest& request,
+                                     const std::vector<std::string>& for_a_step,
+                                     std::string* why_not_a_step);
+
 /// Identifies the input column request.input -> output column request.output
 /// of `data` with one method and scores the model on the data.
 /// @throws InvalidArgument for an unknown method (listing the valid names),

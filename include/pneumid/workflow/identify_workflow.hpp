@@ -47,15 +47,11 @@ struct PreprocessSettings {
   PreprocessOptions ToOptions() const;
 };
 
-/// The methods "auto" chooses for a record whose input is not a single step:
-/// process-model fit, ARX, OE, BJ and IV4, each simulated against the data.
-inline constexpr const char* kGeneralInputMethods = "fit-p1d,arx,oe,bj,iv4";
-
 /// What to identify (see the file comment).
 struct IdentifyWorkflowOptions {
   /// Comma-separated method names, "all" (ParseMethodList), or "auto": the
-  /// paper's reaction curve when the input is a single step (AnalyzeStep
-  /// accepts the record), else kGeneralInputMethods, with a warning in
+  /// paper's reaction curve when the input is a single step, else
+  /// kGeneralInputMethods (AutoMethods, identify.hpp), with a warning in
   /// summary.warnings that gives the reason.
   std::string methods = "auto";
   PreprocessSettings preprocess;  ///< applied to the data (and, as recorded, to validation data)
