@@ -7,7 +7,6 @@
 #include <sstream>
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
@@ -91,14 +90,9 @@ void Run(const ReportArgs& a) {
       Preprocess(cli::LoadFromOptions(a.data), cli::ToPreprocessOptions(a.preprocess), &record);
   if (!record.IsIdentity()) o.preprocessing = record;
   if (automatic) {
-    std::string not_a_step;
-    o.methods = AutoMethods(data, o.request, for_a_step, &not_a_step);
-    if (!not_a_step.empty())
-      std::cerr << fmt::format(
-          "pneumid report: warning: the paper's step-response methods need a step test and this "
-          "record is not one ({}): identified with the methods for general inputs, {} (choose "
-          "others with --method)\n",
-          not_a_step, fmt::join(o.methods, ", "));
+    std::string auto_warning;
+    o.methods = AutoMethods(data, o.request, for_a_step, &auto_warning);
+    if (!auto_warning.empty()) std::cerr << "pneumid report: warning: " << auto_warning << "\n";
   }
   ReportSummary s;
   {

@@ -154,9 +154,13 @@ void CopyAs(const void* data, std::size_t n, Eigen::MatrixXd& out) {
 /// only. pneumid reads nothing else, and matio's readers of cell arrays,
 /// structs, objects and function handles fail on corrupt contents without
 /// freeing what they have read (each found by fuzzing), so they never reach it.
-bool Readable(const internal::MatScanVariable& v) {
-  return v.array_class >= MAT_C_DOUBLE && v.array_class <= MAT_C_UINT64;
+/// The matio class of a scanned variable; MAT_C_EMPTY for a class number
+/// beyond the format's 17 (not a value of matio's enum).
+matio_classes ClassOf(const internal::MatScanVariable& v) {
+  return v.array_class <= MAT_C_OPAQUE ? static_cast<matio_classes>(v.array_class) : MAT_C_EMPTY;
 }
+
+bool Readable(const internal::MatScanVariable& v) { return IsNumericClass(ClassOf(v)); }
 
 /// Writes the header and the numeric variables of the v5 file `bytes` to a
 /// new temporary file and returns its path.
@@ -239,9 +243,7 @@ class MatReader {
         VarInfo info;
         info.name = v.name;
         info.label = Excerpt(v.name);
-        // (A class beyond the format's 17 is listed as unknown.)
-        info.class_type =
-            v.array_class <= MAT_C_OPAQUE ? static_cast<matio_classes>(v.array_class) : MAT_C_EMPTY;
+        info.class_type = ClassOf(v);
         info.complex = v.complex;
         info.dims = v.dims;
         vars_.push_back(std::move(info));

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
@@ -78,18 +79,23 @@ std::vector<std::string> ParseMethodList(const std::string& list) {
 
 std::vector<std::string> AutoMethods(const Dataset& data, const IdentifyRequest& request,
                                      const std::vector<std::string>& for_a_step,
-                                     std::string* why_not_a_step) {
-  if (why_not_a_step != nullptr) why_not_a_step->clear();
+                                     std::string* warning) {
+  if (warning != nullptr) warning->clear();
   try {
     AnalyzeStep(data, request.input, request.output);
     return for_a_step;
   } catch (const DataError& e) {
-    if (why_not_a_step != nullptr) {
-      // (Its advice to use a fit-* method is what the caller does.)
+    std::vector<std::string> general = ParseMethodList(kGeneralInputMethods);
+    if (warning != nullptr) {
+      // (Its advice to use a fit-* method is what is done here.)
       const std::string what = e.what();
-      *why_not_a_step = what.substr(0, what.find("; use a fit-* method"));
+      *warning = fmt::format(
+          "the step-test methods ({}) need a step test and this record is not one ({}): "
+          "identified with the methods for general inputs, {} (choose others with --method)",
+          fmt::join(for_a_step, ", "), what.substr(0, what.find("; use a fit-* method")),
+          fmt::join(general, ", "));
     }
-    return ParseMethodList(kGeneralInputMethods);
+    return general;
   }
 }
 

@@ -5,7 +5,6 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
@@ -79,13 +78,13 @@ IdentifyWorkflowResult RunIdentifyWorkflow(const IdentifyWorkflowOptions& o, con
                 "as a fraction of DATA");
   PNEUMID_CHECK(o.IsValid(&why), "{}", why);
   const bool automatic = o.methods == "auto";
-  std::vector<std::string> methods =
-      automatic ? std::vector<std::string>{"reaction-curve"} : ParseMethodList(o.methods);
+  std::vector<std::string> methods;  // auto: chosen once the data are preprocessed
+  if (!automatic) methods = ParseMethodList(o.methods);
   const PreprocessOptions prep = o.preprocess.ToOptions();
   IdentifyWorkflowResult out;
   out.data = Preprocess(raw, prep, &out.record);
-  std::string not_a_step;  // auto: why the reaction curve does not apply
-  if (automatic) methods = AutoMethods(out.data, o.request, {"reaction-curve"}, &not_a_step);
+  std::string auto_warning;  // auto on a record that is not a step test
+  if (automatic) methods = AutoMethods(out.data, o.request, {"reaction-curve"}, &auto_warning);
   std::optional<Dataset> validation;
   // The validation data get the estimation data's preprocessing, with the
   // offsets measured on the estimation data (not re-estimated).
@@ -96,14 +95,8 @@ IdentifyWorkflowResult RunIdentifyWorkflow(const IdentifyWorkflowOptions& o, con
   options.nonlinear = o.nonlinear;
   out.summary = IdentifyModels(methods, out.data, o.request, options,
                                validation ? &*validation : nullptr, progress);
-  if (!not_a_step.empty()) {
-    out.summary.warnings.insert(
-        out.summary.warnings.begin(),
-        fmt::format("the paper's reaction curve needs a step test and this record is not one "
-                    "({}): identified with the methods for general inputs, {} (choose others "
-                    "with --method)",
-                    not_a_step, fmt::join(methods, ", ")));
-  }
+  if (!auto_warning.empty())
+    out.summary.warnings.insert(out.summary.warnings.begin(), auto_warning);
   if (!out.record.IsIdentity())
     for (IdentifiedModel& m : out.summary.models) m.preprocessing = out.record;
   return out;

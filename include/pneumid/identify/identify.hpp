@@ -80,11 +80,12 @@ inline constexpr const char* kGeneralInputMethods = "fit-p1d,arx,oe,bj,iv4";
 /// What the method list "auto" stands for on `data` (channels request.input
 /// and request.output): `for_a_step` when the step analysis accepts the
 /// record (AnalyzeStep: one step in the input, from a steady state to a
-/// steady state), else kGeneralInputMethods, with the step analysis's reason
-/// in *why_not_a_step (cleared otherwise; may be null).
+/// steady state), else kGeneralInputMethods. *warning (may be null) is then
+/// the warning that says so, with the step analysis's reason and the methods
+/// chosen; it is cleared for a step test.
 std::vector<std::string> AutoMethods(const Dataset& data, const IdentifyRequest& request,
                                      const std::vector<std::string>& for_a_step,
-                                     std::string* why_not_a_step);
+                                     std::string* warning);
 
 /// Identifies the input column request.input -> output column request.output
 /// of `data` with one method and scores the model on the data.
