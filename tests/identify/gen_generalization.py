@@ -19,6 +19,9 @@ Records (columns t,u,y,y_true):
   gen_val_prbs.csv   7 random levels in [18, 82] %, 0.5 s clock, 20 s (seeded)
   gen_val_gap.csv    staircase 25 90 12 60 35 75 50 8 65 %, 1.2 s per level:
                      90 and 12 lie where gen_est.csv leaves the map undetermined
+  gen_est_first_high.csv  staircase 75 20 50 35 95 65 5 85 45 25 60 40 15 10 30 %, 1.3 s per
+                     level: its first level, switched on from rest at t = 0, is
+                     visited only while the output rises from 0
 
 Run from the repository root:
     /usr/bin/python3 tests/identify/gen_generalization.py
@@ -77,6 +80,9 @@ def main():
           "validation multi-level PRBS")
     write("gen_val_gap", staircase([25, 90, 12, 60, 35, 75, 50, 8, 65], 120), 105,
           "validation staircase through the undetermined intervals")
+    write("gen_est_first_high", staircase([75, 20, 50, 35, 95, 65, 5, 85, 45, 25, 60, 40, 15, 10, 30],
+                                         130), 106,
+          "estimation staircase whose first level lies far from the rest at u = 0")
 
 
 if __name__ == "__main__":

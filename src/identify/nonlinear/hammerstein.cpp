@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include <ceres/ceres.h>
@@ -48,9 +49,11 @@ struct Layout {
 };
 
 // x(t) = -sum a_i x(t-i) + sum_k b_k v(t-nk-k) with x and v in steady state
-// x = v = v(0) before the record (G(1) = 1 by the layout).
+// x = v = rest before the record (G(1) = 1 by the layout); rest is v(0) when
+// not finite (at rest at the first input).
 template <typename T>
-void SimulateUnitGain(const T* p, const Layout& l, const std::vector<T>& v, std::vector<T>* x) {
+void SimulateUnitGain(const T* p, const Layout& l, const std::vector<T>& v, std::vector<T>* x,
+                      double rest = std::numeric_limits<double>::quiet_NaN()) {
   const T* a = p;
   T b_last = T(1.0);
   for (int i = 0; i < l.na; ++i) b_last += a[i];
@@ -58,7 +61,7 @@ void SimulateUnitGain(const T* p, const Layout& l, const std::vector<T>& v, std:
   const auto b = [&](int k) { return k + 1 < l.nb ? p[l.na + k] : b_last; };
   const auto n = static_cast<long>(v.size());
   x->resize(v.size());
-  const T v0 = v[0];
+  const T v0 = std::isfinite(rest) ? T(rest) : v[0];
   for (long t = 0; t < n; ++t) {
     T s = T(0.0);
     for (int i = 1; i <= l.na; ++i) s -= a[i - 1] * (t - i >= 0 ? (*x)[t - i] : v0);
@@ -91,7 +94,11 @@ T OutputMap(const std::vector<double>& knots, const T* beta, const T& x) {
   return (1.0 - w) * beta[h.j] + w * beta[h.j + 1];
 }
 
-// Simulation errors y - yhat of the Hammerstein model.
+// Simulation errors y - yhat of the Hammerstein model, from the rest that
+// gives the first measured output (x = v = y(0) before the record, as
+// SimulateNonlinear starts a record): a record that starts at rest away from
+// f(u(0)), such as a staircase switched on at t = 0 from standstill, then
+// does not pull the first level's map value toward y(0).
 // With `monotone` (sign +-1) the map parameters are alpha_1 and the square
 // roots of the increments: alpha_j = alpha_{j-1} + monotone * q_j^2.
 struct HammersteinError {
@@ -99,6 +106,7 @@ struct HammersteinError {
   const Eigen::VectorXd* y;
   std::vector<Tent> tents;  // of u(t)
   double monotone = 0.0;
+  double rest = std::numeric_limits<double>::quiet_NaN();
   template <typename T>
   bool operator()(T const* const* params, T* residuals) const {
     const T* p = params[0];
@@ -106,7 +114,7 @@ struct HammersteinError {
     if (monotone != 0.0)
       for (int j = 1; j < l.m; ++j) values[j] = values[j - 1] + monotone * values[j] * values[j];
     std::vector<T> x;
-    SimulateUnitGain(p, l, MapThroughTents(values.data(), tents), &x);
+    SimulateUnitGain(p, l, MapThroughTents(values.data(), tents), &x, rest);
     for (std::size_t t = 0; t < tents.size(); ++t)
       residuals[t] = (*y)[static_cast<Eigen::Index>(t)] - x[t];
     return true;
@@ -458,7 +466,7 @@ BlockModelResult EstimateHammerstein(const Eigen::VectorXd& u, const Eigen::Vect
 
   // 2. Output-error refinement.
   RefineOutputError(
-      std::make_unique<HammersteinError>(HammersteinError{l, &y, std::move(tents), monotone}),
+      std::make_unique<HammersteinError>(HammersteinError{l, &y, std::move(tents), monotone, y[0]}),
       u.size(), o, &theta, &s);
   if (monotone != 0.0) {
     Eigen::Ref<Eigen::VectorXd> a = theta.segment(l.map_offset(), l.m);

@@ -342,13 +342,36 @@ std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u) 
     const double margin = 0.01 * (c[j + 1] - c[j]);
     if (u[t] > c[j] + margin && u[t] < c[j + 1] - margin) inside[j] = true;
   }
-  const auto slope = [&](std::size_t j) { return std::abs(f[j + 1] - f[j]) / (c[j + 1] - c[j]); };
+  const auto slope = [&](std::size_t j) { return (f[j + 1] - f[j]) / (c[j + 1] - c[j]); };
+  std::vector<double> spacing(m - 1);
+  for (std::size_t j = 0; j + 1 < m; ++j) spacing[j] = c[j + 1] - c[j];
+  std::nth_element(spacing.begin(),
+                   spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2),
+                   spacing.end());
+  const double median_spacing = spacing[spacing.size() / 2];
+  const double span = c.back() - c.front();
   for (std::size_t j = 0; j + 1 < m; ++j) {
     if (inside[j] || std::abs(f[j + 1] - f[j]) < 0.05 * range) continue;
     double beside = 0.0;
-    if (j > 0) beside = std::max(beside, slope(j - 1));
-    if (j + 2 < m) beside = std::max(beside, slope(j + 1));
-    if (slope(j) >= 2.5 * beside) gaps.push_back({c[j], c[j + 1], f[j + 1] - f[j]});
+    if (j > 0) beside = std::max(beside, std::abs(slope(j - 1)));
+    if (j + 2 < m) beside = std::max(beside, std::abs(slope(j + 1)));
+    // The flatter intervals beside it, extended to its middle, against the
+    // chord (a steeper neighbour is itself the candidate for the jump).
+    const double mid = 0.5 * (c[j] + c[j + 1]);
+    const double chord = 0.5 * (f[j] + f[j + 1]);
+    const double own = std::abs(slope(j));
+    double spread = 0.0;
+    if (j > 0 && std::abs(slope(j - 1)) <= own)
+      spread = std::max(spread, std::abs(f[j] + slope(j - 1) * (mid - c[j]) - chord));
+    if (j + 2 < m && std::abs(slope(j + 1)) <= own)
+      spread = std::max(spread, std::abs(f[j + 1] - slope(j + 1) * (c[j + 1] - mid) - chord));
+    // A wide interval: at least twice the knots' median spacing and 15 % of
+    // their span, over which the map changes by 10 % of its range or more.
+    const double width = c[j + 1] - c[j];
+    const bool wide = width >= 2.0 * median_spacing && width >= 0.15 * span &&
+                      std::abs(f[j + 1] - f[j]) >= 0.1 * range;
+    if (own >= 2.5 * beside || spread >= 0.4 * std::abs(f[j + 1] - f[j]) || wide)
+      gaps.push_back({c[j], c[j + 1], f[j + 1] - f[j]});
   }
   return gaps;
 }

@@ -130,9 +130,10 @@ StaticMapFitResult FitStaticMap(const Dataset& data, int input = 0, int output =
 /// @throws InvalidArgument for an empty or non-finite u, num_knots 1 or < 0.
 std::vector<double> PlaceMapKnots(const Eigen::VectorXd& u, int num_knots = 0, int max_levels = 60);
 
-/// A knot interval of a map whose value changes much more steeply than on
-/// the intervals beside it with no data inside: the data leave the map
-/// undetermined there (a jump may lie anywhere between the two knots).
+/// A knot interval of a map with no data inside whose value changes much
+/// more steeply than on the intervals beside it, or bends away from their
+/// lines: the data leave the map undetermined there (a jump may lie anywhere
+/// between the two knots).
 struct MapGap {
   /// Lower knot of the gap (input units).
   double u_lo = 0.0, u_hi = 0.0;  ///< the knots around the gap
@@ -142,9 +143,18 @@ struct MapGap {
 
 /// The gaps of `map` fitted on input u: intervals (c_j, c_j+1) that hold no
 /// sample of u strictly inside (beyond 1 % of the interval from either knot),
-/// whose change |f(c_j+1) - f(c_j)| is at least 5 % of the map's range and
-/// whose slope is at least 2.5 times the steeper of the neighbouring
-/// intervals' slopes.
+/// whose change |f(c_j+1) - f(c_j)| is at least 5 % of the map's range, and
+/// either whose slope is at least 2.5 times the steeper of the neighbouring
+/// intervals' slopes (a jump), or where a flatter neighbouring interval's
+/// line, extended to the interval's middle, misses the chord there by 40 % of
+/// the interval's change or more (a flat neighbour misses by half of it, a
+/// parabola through three equally spaced knots by a third): a bend the
+/// interpolation cannot place, e.g. levels 70 and 86 % on the default twin,
+/// around its exhaust's jump at 85-86 %, whose slope is 2.0 times that of
+/// 62-70 %, or 14 and 24 %, around the inlet's jump at 14-15 %), or that is
+/// wide (at least twice the knots' median spacing and 15 % of their span)
+/// with a change of 10 % of the range or more: levels 24 and 56 % leave the
+/// default twin's map bent by 6 N between them, levels 73 and 91 % its jump.
 std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u);
 
 /// The weighted least-squares non-decreasing (`increasing`) or non-increasing
