@@ -196,6 +196,11 @@ TEST(GeneralizationTest, AFirstLevelSwitchedOnFromRestIsEstimatedAsTheOthers) {
     EXPECT_NEAR(m.input_map->y()[j], TrueMap(c[j]), 0.5) << c[j];
   for (const char* name : {"gen_val_stairs", "gen_val_prbs"})
     EXPECT_GT(Fit(m, Recorded(name), InitialCondition::kZero), 97.0) << name;
+  // The Hammerstein-Wiener fit starts from the rest whose output-map value is
+  // y(0) (it validated by 92.4 and 88.2 % when it started at rest at u(0)).
+  const IdentifiedModel hw = Identify("hw", est, IdentifyRequest{}, Defaults());
+  for (const char* name : {"gen_val_stairs", "gen_val_prbs"})
+    EXPECT_GT(Fit(hw, Recorded(name), InitialCondition::kZero), 97.0) << name;
 }
 
 TEST(GeneralizationTest, TheBestRankedModelHoldsOnAThirdExperiment) {

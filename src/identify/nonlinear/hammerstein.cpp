@@ -49,11 +49,10 @@ struct Layout {
 };
 
 // x(t) = -sum a_i x(t-i) + sum_k b_k v(t-nk-k) with x and v in steady state
-// x = v = rest before the record (G(1) = 1 by the layout); rest is v(0) when
-// not finite (at rest at the first input).
+// x = v = v0 before the record (G(1) = 1 by the layout).
 template <typename T>
-void SimulateUnitGain(const T* p, const Layout& l, const std::vector<T>& v, std::vector<T>* x,
-                      double rest = std::numeric_limits<double>::quiet_NaN()) {
+void SimulateUnitGainFrom(const T* p, const Layout& l, const std::vector<T>& v, std::vector<T>* x,
+                          const T& v0) {
   const T* a = p;
   T b_last = T(1.0);
   for (int i = 0; i < l.na; ++i) b_last += a[i];
@@ -61,7 +60,6 @@ void SimulateUnitGain(const T* p, const Layout& l, const std::vector<T>& v, std:
   const auto b = [&](int k) { return k + 1 < l.nb ? p[l.na + k] : b_last; };
   const auto n = static_cast<long>(v.size());
   x->resize(v.size());
-  const T v0 = std::isfinite(rest) ? T(rest) : v[0];
   for (long t = 0; t < n; ++t) {
     T s = T(0.0);
     for (int i = 1; i <= l.na; ++i) s -= a[i - 1] * (t - i >= 0 ? (*x)[t - i] : v0);
@@ -71,6 +69,14 @@ void SimulateUnitGain(const T* p, const Layout& l, const std::vector<T>& v, std:
     }
     (*x)[t] = s;
   }
+}
+
+// As SimulateUnitGainFrom, at rest at `rest`, or at the first input v(0)
+// when rest is not finite.
+template <typename T>
+void SimulateUnitGain(const T* p, const Layout& l, const std::vector<T>& v, std::vector<T>* x,
+                      double rest = std::numeric_limits<double>::quiet_NaN()) {
+  SimulateUnitGainFrom(p, l, v, x, std::isfinite(rest) ? T(rest) : v[0]);
 }
 
 // The input map through the tents of u: v(t) = (1 - w) alpha_j + w alpha_{j+1}.
@@ -92,6 +98,28 @@ T OutputMap(const std::vector<double>& knots, const T* beta, const T& x) {
   const Tent h = TentAt(knots, xv);
   const T w = (x - knots[h.j]) / (knots[h.j + 1] - knots[h.j]);
   return (1.0 - w) * beta[h.j] + w * beta[h.j + 1];
+}
+
+// The rest x of the linear part whose output-map value is the first measured
+// output y0: the preimage under the piecewise-linear map (values beta on the
+// knots) nearest to `near` (the rest at the first input), or `near` itself
+// when y0 lies outside the map's values (as SimulateNonlinear starts a
+// Wiener or Hammerstein-Wiener model on a record).
+template <typename T>
+T RestFromFirstOutput(const std::vector<double>& knots, const T* beta, double y0, const T& near) {
+  T best = near;
+  double distance = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j + 1 < knots.size(); ++j) {
+    const double b0 = Value(beta[j]), b1 = Value(beta[j + 1]);
+    if (!((b0 - y0) * (b1 - y0) <= 0.0) || b0 == b1) continue;
+    const T x = knots[j] + (y0 - beta[j]) / (beta[j + 1] - beta[j]) * (knots[j + 1] - knots[j]);
+    const double d = std::abs(Value(x) - Value(near));
+    if (d < distance) {
+      distance = d;
+      best = x;
+    }
+  }
+  return best;
 }
 
 // Simulation errors y - yhat of the Hammerstein model, from the rest that
@@ -121,7 +149,8 @@ struct HammersteinError {
   }
 };
 
-// Simulation errors of the Wiener model.
+// Simulation errors of the Wiener model, from the rest whose output-map value
+// is the first measured output (RestFromFirstOutput).
 struct WienerError {
   Layout l;
   const Eigen::VectorXd* y;
@@ -132,7 +161,8 @@ struct WienerError {
     const T* p = params[0];
     std::vector<T> v(static_cast<std::size_t>(u->size())), x;
     for (std::size_t t = 0; t < v.size(); ++t) v[t] = T((*u)[static_cast<Eigen::Index>(t)]);
-    SimulateUnitGain(p, l, v, &x);
+    SimulateUnitGainFrom(p, l, v, &x,
+                         RestFromFirstOutput(knots, p + l.map_offset(), (*y)[0], v[0]));
     for (std::size_t t = 0; t < v.size(); ++t)
       residuals[t] =
           (*y)[static_cast<Eigen::Index>(t)] - OutputMap(knots, p + l.map_offset(), x[t]);
@@ -140,7 +170,8 @@ struct WienerError {
   }
 };
 
-// Simulation errors of the Hammerstein-Wiener model. The map parameters are
+// Simulation errors of the Hammerstein-Wiener model, from the rest whose
+// output-map value is the first measured output (RestFromFirstOutput). The map parameters are
 // the inner values f(c_2), .., f(c_{m-1}) of the input map (its end values
 // are fixed: f(c_1) = c_1, f(c_m) = c_m), then the m values of the output map
 // on `out_knots`.
@@ -158,8 +189,9 @@ struct HwError {
     alpha.back() = T(in_knots.back());
     for (std::size_t j = 1; j + 1 < m; ++j) alpha[j] = p[l.map_offset() + j - 1];
     std::vector<T> x;
-    SimulateUnitGain(p, l, MapThroughTents(alpha.data(), tents), &x);
     const T* beta = p + l.map_offset() + (m - 2);
+    const std::vector<T> v = MapThroughTents(alpha.data(), tents);
+    SimulateUnitGainFrom(p, l, v, &x, RestFromFirstOutput(out_knots, beta, (*y)[0], v[0]));
     for (std::size_t t = 0; t < tents.size(); ++t)
       residuals[t] = (*y)[static_cast<Eigen::Index>(t)] - OutputMap(out_knots, beta, x[t]);
     return true;
@@ -526,7 +558,8 @@ BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd&
   StaticMap f = MapOf(knots, theta, l.map_offset());
   if (o.knots.empty()) {  // placed here, not given
     std::vector<double> final_x;
-    SimulateUnitGain(theta.data(), l, v, &final_x);
+    SimulateUnitGainFrom(theta.data(), l, v, &final_x,
+                         RestFromFirstOutput(knots, theta.data() + l.map_offset(), y[0], v[0]));
     f = TrimToRange(f, final_x);
   }
   return Finish(theta, l, Ts, std::move(f), std::move(s));
@@ -584,7 +617,10 @@ BlockModelResult EstimateHammersteinWiener(const Eigen::VectorXd& u, const Eigen
   fv << c1, theta.segment(lj.map_offset(), m - 2), cm;
   BlockModelResult r = Finish(theta, lj, Ts, MapOf(in_knots, fv, 0), std::move(s));
   std::vector<double> final_x;
-  SimulateUnitGain(theta.data(), lj, MapThroughTents(fv.data(), tents), &final_x);
+  const std::vector<double> final_v = MapThroughTents(fv.data(), tents);
+  SimulateUnitGainFrom(
+      theta.data(), lj, final_v, &final_x,
+      RestFromFirstOutput(out_knots, theta.data() + lj.map_offset() + m - 2, y[0], final_v[0]));
   r.output_map = TrimToRange(MapOf(out_knots, theta, lj.map_offset() + m - 2), final_x);
   return r;
 }
