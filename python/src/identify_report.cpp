@@ -126,6 +126,10 @@ void BindIdentify(py::module_& m) {
           "How the estimator ended: 'convergence', 'no_convergence', ...")
       .def_readonly("validation_fit_percent", &IdentifiedModel::validation_fit_percent,
                     "NRMSE fit [%] on held-out data (identify_models), NaN when none.")
+      .def_readonly("determined_fit_percent", &IdentifiedModel::determined_fit_percent,
+                    "NRMSE fit on the held-out samples outside the input intervals the "
+                    "estimation data leave undetermined, which the ranking uses when the "
+                    "held-out data visit them (NaN otherwise)")
       .def_property_readonly(
           "flags",
           [](const IdentifiedModel& r) {

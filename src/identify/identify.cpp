@@ -168,6 +168,103 @@ std::optional<std::string> OtherStartNote(const IdentifiedModel& m, const Datase
       std::isfinite(fit) ? fmt::format("{:.2f} %", fit) : std::string("not finite"), name(other));
 }
 
+// Samples a model with this linear part takes to settle within 2 % after its
+// input changes: its delay plus the decay of its slowest stable pole (0 when
+// it has none).
+Eigen::Index SettlingSamples(const TransferFunction& g) {
+  double slowest = 0.0;
+  const Eigen::VectorXcd poles = g.Poles();
+  for (Eigen::Index i = 0; i < poles.size(); ++i)
+    if (std::abs(poles[i]) < 1.0) slowest = std::max(slowest, std::abs(poles[i]));
+  const double decay = slowest > 0.0 ? std::ceil(std::log(0.02) / std::log(slowest)) : 0.0;
+  Eigen::Index delay = 0;
+  const Eigen::VectorXd& num = g.num();
+  while (delay < num.size() && num[delay] == 0.0) ++delay;
+  delay += static_cast<Eigen::Index>(g.den().size()) - static_cast<Eigen::Index>(num.size());
+  return std::max<Eigen::Index>(delay, 0) + static_cast<Eigen::Index>(decay);
+}
+
+// Ranking on what the estimation data determine (IdentifiedModel::
+// determined_fit_percent): when the held-out samples [from, N) of `scored`
+// visit input intervals that the models' input maps leave undetermined (a
+// jump or bend between two estimation levels that no sample placed), every
+// model's fit there measures how its interpolation happens to fall, not what
+// the data said: a polynomial NARX can outscore a Hammerstein model there
+// and then run away on the next record. The models are then scored also on
+// the other held-out samples, the samples within the slowest block model's
+// settling time after each visit excluded; `sims` holds each model's
+// simulation of `scored`. Too few samples left (under a fifth of the
+// held-out part or 50): a warning instead.
+void ScoreOnDeterminedSamples(std::vector<IdentifiedModel>* models,
+                              const std::vector<Eigen::VectorXd>& sims, const Dataset& scored,
+                              Eigen::Index from, const IdentifyRequest& request,
+                              std::vector<std::string>* warnings) {
+  std::vector<std::pair<double, double>> gaps;
+  Eigen::Index settle = 0;
+  for (const IdentifiedModel& m : *models) {
+    for (const auto& g : m.input_map_undetermined)
+      if (std::find(gaps.begin(), gaps.end(), g) == gaps.end()) gaps.push_back(g);
+    if (m.input_map && m.discrete) settle = std::max(settle, SettlingSamples(*m.discrete));
+  }
+  if (gaps.empty()) return;
+  std::sort(gaps.begin(), gaps.end());
+  const Eigen::VectorXd u = scored.u(request.input);
+  const Eigen::VectorXd y = scored.y(request.output);
+  const Eigen::Index n = scored.size(), held = n - from;
+  settle = std::min(settle, held / 4);
+  const auto inside = [&](double x) {
+    return std::any_of(gaps.begin(), gaps.end(),
+                       [x](const auto& g) { return x > g.first && x < g.second; });
+  };
+  std::vector<bool> keep(static_cast<std::size_t>(n), true);
+  Eigen::Index last_visit = -1, visits = 0;
+  for (Eigen::Index t = 0; t < n; ++t) {
+    if (inside(u[t])) last_visit = t;
+    if (t >= from && last_visit >= 0 && t - last_visit <= settle) {
+      keep[static_cast<std::size_t>(t)] = false;
+      if (last_visit == t) ++visits;
+    }
+  }
+  if (visits == 0) return;
+  Eigen::Index kept = 0;
+  for (Eigen::Index t = from; t < n; ++t) kept += keep[static_cast<std::size_t>(t)] ? 1 : 0;
+  std::vector<std::string> names;
+  for (const auto& [lo, hi] : gaps) names.push_back(fmt::format("({:g}, {:g})", lo, hi));
+  const std::string where = fmt::format(
+      "the held-out data visit input intervals the estimation data leave undetermined ({}) in "
+      "{} of their {} samples",
+      fmt::join(names, ", "), visits, held);
+  if (kept < std::max<Eigen::Index>(50, held / 5)) {
+    warnings->push_back(fmt::format(
+        "{}: too few samples ({}) lie outside them and the {} samples after each visit for a "
+        "ranking on what the estimation data determine; the models are ranked by their fit "
+        "there all the same, which measures how each interpolates, not what the data said",
+        where, kept, settle));
+    return;
+  }
+  double mean = 0.0;
+  for (Eigen::Index t = from; t < n; ++t)
+    if (keep[static_cast<std::size_t>(t)]) mean += y[t];
+  mean /= static_cast<double>(kept);
+  double spread = 0.0;
+  for (Eigen::Index t = from; t < n; ++t)
+    if (keep[static_cast<std::size_t>(t)]) spread += (y[t] - mean) * (y[t] - mean);
+  if (!(spread > 0.0)) return;
+  for (std::size_t i = 0; i < models->size(); ++i) {
+    const Eigen::VectorXd& yhat = sims[i];
+    if (yhat.size() != n || !yhat.allFinite()) continue;
+    double err = 0.0;
+    for (Eigen::Index t = from; t < n; ++t)
+      if (keep[static_cast<std::size_t>(t)]) err += (y[t] - yhat[t]) * (y[t] - yhat[t]);
+    (*models)[i].determined_fit_percent = 100.0 * (1.0 - std::sqrt(err / spread));
+  }
+  warnings->push_back(fmt::format(
+      "{}: the models are ranked by their fit on the other {} held-out samples (the {} samples "
+      "after each visit excluded too), where the estimation data say what a model should do; "
+      "each model's held-out fit over all samples is reported beside it",
+      where, kept, settle));
+}
+
 }  // namespace
 
 IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, const Dataset& data,
@@ -263,6 +360,7 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
 
   const std::size_t n = methods.size();
   std::vector<std::optional<IdentifiedModel>> results(n);
+  std::vector<Eigen::VectorXd> simulations(n);  // of `scored`, when held out
   std::vector<std::string> errors(n);
   std::mutex progress_mutex;
   std::size_t started = 0;
@@ -290,6 +388,7 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
               SimulateModel(m, *scored, request.input, request.output, options.validation_initial);
           const FitMetrics f = ScoreSimulation(*scored, request.output, yhat, score_from);
           m.validation_fit_percent = f.fit_percent;
+          simulations[i] = yhat;
           // Where the held-out part leaves what the estimation data support
           // (validate's warnings), the held-out fit says so beside it.
           std::optional<Dataset> slice;
@@ -324,13 +423,17 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
   s.warnings = std::move(warnings);
   s.estimation_samples = estimation.size();
   s.validation_samples = scored == nullptr ? 0 : scored->size() - score_from;
+  std::vector<Eigen::VectorXd> sims;
   for (std::size_t i = 0; i < n; ++i) {
     if (results[i]) {
       s.models.push_back(std::move(*results[i]));
+      sims.push_back(std::move(simulations[i]));
     } else {
       s.failures.emplace_back(methods[i], errors[i]);
     }
   }
+  if (scored != nullptr)
+    ScoreOnDeterminedSamples(&s.models, sims, *scored, score_from, request, &s.warnings);
   RankModels(&s.models, options.quality);
   if (s.models.empty()) {
     s.termination = Termination::kFailure;

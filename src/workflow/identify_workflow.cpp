@@ -1,5 +1,6 @@
 #include "pneumid/workflow/identify_workflow.hpp"
 
+#include <cmath>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -53,10 +54,18 @@ nlohmann::json IdentifyWorkflowResult::ToJson() const {
   if (models.empty()) return nullptr;
   const bool held_out = summary.validation_samples > 0;
   nlohmann::json j = ModelFileDocument(models);
-  for (std::size_t i = 0; i < models.size(); ++i)
+  bool determined = false;
+  for (std::size_t i = 0; i < models.size(); ++i) {
     j["models"][i]["rank_reason"] = RankReason(models[i]);
+    if (std::isfinite(models[i].determined_fit_percent)) {
+      j["models"][i]["determined_fit_percent"] = models[i].determined_fit_percent;
+      determined = true;
+    }
+  }
   j["best"] = models.front().method;
-  j["ranked_by"] = held_out ? "validation_fit_percent" : "fit_percent";
+  j["ranked_by"] = determined ? "determined_fit_percent"
+                   : held_out ? "validation_fit_percent"
+                              : "fit_percent";
   j["estimation_samples"] = summary.estimation_samples;
   j["validation_samples"] = summary.validation_samples;
   j["failures"] = nlohmann::json::array();

@@ -179,6 +179,37 @@ TEST(GeneralizationTest, HammersteinWithDefaultsHoldsOnExperimentsOfOtherDesigns
               ThrowsMessage<InvalidArgument>(HasSubstr("input_map_undetermined")));
 }
 
+TEST(GeneralizationTest, AHeldOutRecordInTheUndeterminedIntervalsRanksOnTheRest) {
+  // gen_val_gap visits 90 and 12 %, where gen_est leaves the map undetermined
+  // ((10, 15) and (85, 95)): there the polynomial NARX happens to interpolate
+  // better (85.4 % over the whole record against the Hammerstein's 82.8 %),
+  // and ranked by that it came first, though it holds worse everywhere the
+  // data say what the plant does.
+  IdentifyOptions o = Defaults();
+  o.num_threads = 1;
+  const Dataset est = Recorded("gen_est"), gap = Recorded("gen_val_gap");
+  const IdentificationSummary s = IdentifyModels({"narx", "hammerstein"}, est, {}, o, &gap);
+  ASSERT_EQ(s.models.size(), 2u);
+  const IdentifiedModel& best = s.models.front();
+  const IdentifiedModel& narx = s.models.back();
+  EXPECT_EQ(best.method, "hammerstein");
+  EXPECT_EQ(narx.method, "narx");
+  EXPECT_GT(narx.validation_fit_percent, best.validation_fit_percent);
+  EXPECT_GT(best.determined_fit_percent, 98.0);
+  EXPECT_LT(narx.determined_fit_percent, best.determined_fit_percent - 3.0);
+  EXPECT_THAT(RankReason(best), HasSubstr("on the held-out samples outside the input intervals"));
+  EXPECT_THAT(s.warnings, Contains(AllOf(HasSubstr("(10, 15), (85, 95)"),
+                                         HasSubstr("the models are ranked by their fit on the "
+                                                   "other"))));
+  EXPECT_GT(Fit(best, Recorded("gen_val_prbs"), InitialCondition::kZero), 98.0);
+  // A held-out record that stays where the data determine the map: the
+  // ranking is by the whole held-out fit, as before.
+  const Dataset stairs = Recorded("gen_val_stairs");
+  const IdentificationSummary plain = IdentifyModels({"hammerstein"}, est, {}, o, &stairs);
+  ASSERT_EQ(plain.models.size(), 1u);
+  EXPECT_TRUE(std::isnan(plain.models[0].determined_fit_percent));
+}
+
 TEST(GeneralizationTest, AFirstLevelSwitchedOnFromRestIsEstimatedAsTheOthers) {
   // The staircase starts at 75 % from rest at u = 0 (y = 0), and its first
   // level is visited only while the output rises. The output-error

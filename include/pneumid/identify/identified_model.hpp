@@ -141,6 +141,13 @@ struct IdentifiedModel {
   /// NRMSE fit on held-out validation data (NaN when none were given); the
   /// ranking uses it instead of fit_percent when present.
   double validation_fit_percent = std::numeric_limits<double>::quiet_NaN();
+  /// NRMSE fit on the held-out samples the estimation data determine: those
+  /// outside the input intervals the estimation data leave undetermined (the
+  /// identified models' input_map_undetermined), a settling time after each
+  /// visit excluded too (IdentifyModels). Set only when the held-out data
+  /// visit such intervals; the ranking then uses it instead of
+  /// validation_fit_percent. NaN otherwise; not written to model files.
+  double determined_fit_percent = std::numeric_limits<double>::quiet_NaN();
   /// Reasons not to trust the model (empty: none found).
   std::vector<ModelFlagNote> flags;
   /// The preprocessing of the data the model was identified from (window,

@@ -306,8 +306,9 @@ int RankGroup(const IdentifiedModel& model) {
 }
 
 double RankScore(const IdentifiedModel& model) {
-  const double s = std::isfinite(model.validation_fit_percent) ? model.validation_fit_percent
-                                                               : model.fit_percent;
+  const double s = std::isfinite(model.determined_fit_percent)   ? model.determined_fit_percent
+                   : std::isfinite(model.validation_fit_percent) ? model.validation_fit_percent
+                                                                 : model.fit_percent;
   return std::isnan(s) ? -std::numeric_limits<double>::infinity() : s;
 }
 
@@ -316,6 +317,11 @@ std::string RankReason(const IdentifiedModel& model) {
   std::string why =
       held_out ? fmt::format("held-out simulation fit {:.2f} %", model.validation_fit_percent)
                : fmt::format("estimation fit {:.2f} % (no held-out data)", model.fit_percent);
+  if (held_out && std::isfinite(model.determined_fit_percent))
+    why += fmt::format(
+        ", ranked by its {:.2f} % on the held-out samples outside the input intervals the "
+        "estimation data leave undetermined",
+        model.determined_fit_percent);
   std::vector<std::string> soft, hard;
   for (const ModelFlagNote& f : model.flags)
     (f.flag == ModelFlag::kNoConvergence || f.flag == ModelFlag::kResidualsNotWhite ? soft : hard)

@@ -32,7 +32,10 @@
 //                        ARMAX and BJ the note adds the test of the one-step
 //                        prediction errors).
 // Ranking by evidence: within each group by the held-out simulation fit when
-// held-out data were given, else by the estimation fit; the groups are
+// held-out data were given (by the fit on the held-out samples the estimation
+// data determine, IdentifiedModel::determined_fit_percent, when the held-out
+// data visit input intervals the estimation data leave undetermined), else
+// by the estimation fit; the groups are
 // 0 (no flag, or only no_convergence / residuals_not_white: flagged, but
 // its fit is what it is), 1 (nyquist_pole), 2 (unstable, not_finite). So a
 // model whose estimator stopped early but validates best is ranked best,
