@@ -177,11 +177,13 @@ Eigen::Index SettlingSamples(const TransferFunction& g) {
   for (Eigen::Index i = 0; i < poles.size(); ++i)
     if (std::abs(poles[i]) < 1.0) slowest = std::max(slowest, std::abs(poles[i]));
   const double decay = slowest > 0.0 ? std::ceil(std::log(0.02) / std::log(slowest)) : 0.0;
+  // A discrete numerator in ascending powers of z^-1: its leading zeros
+  // delay, and so does the transfer function's own delay.
   Eigen::Index delay = 0;
   const Eigen::VectorXd& num = g.num();
   while (delay < num.size() && num[delay] == 0.0) ++delay;
-  delay += static_cast<Eigen::Index>(g.den().size()) - static_cast<Eigen::Index>(num.size());
-  return std::max<Eigen::Index>(delay, 0) + static_cast<Eigen::Index>(decay);
+  if (g.IsDiscrete() && g.Ts() > 0.0) delay += std::lround(g.delay() / g.Ts());
+  return delay + static_cast<Eigen::Index>(decay);
 }
 
 // Ranking on what the estimation data determine (IdentifiedModel::
