@@ -210,6 +210,23 @@ TEST(GeneralizationTest, AHeldOutRecordInTheUndeterminedIntervalsRanksOnTheRest)
   EXPECT_TRUE(std::isnan(plain.models[0].determined_fit_percent));
 }
 
+TEST(GeneralizationTest, TheSearchFindsTheOrdersOfASecondOrderSystem) {
+  // gen_nonlinear_systems.py: poles 0.9 and 0.8 behind one sample of delay
+  // (na = nb = 2, nk = 1). A first-order model fits them best behind four
+  // samples; with the orders chosen there (na = 2, nb = 3) the search now
+  // tries the shorter delays and the orders again (it stopped at nk = 4).
+  for (const char* method : {"hammerstein", "wiener"}) {
+    LoadOptions lo;
+    lo.output_columns = {"y"};
+    const Dataset d = LoadDataset(
+        std::string(PNEUMID_SOURCE_DIR) + "/tests/identify/data/" + method + ".csv", lo);
+    const IdentifiedModel m = Identify(method, d, IdentifyRequest{}, Defaults());
+    ASSERT_FALSE(m.notes.empty()) << method;
+    EXPECT_THAT(m.notes[0], HasSubstr("structure chosen on held-out data: na = 2, nb = 2, nk = 1"))
+        << method;
+  }
+}
+
 TEST(GeneralizationTest, AFirstLevelSwitchedOnFromRestIsEstimatedAsTheOthers) {
   // The staircase starts at 75 % from rest at u = 0 (y = 0), and its first
   // level is visited only while the output rises. The output-error
