@@ -450,6 +450,10 @@ void HttpServer::Run() {
       }
       ++s.active;
       s.sockets.insert(fd);
+      // Waiting for its header from now on, before its session's thread
+      // runs: a burst of connections that send nothing can then always be
+      // made room for (under load their threads may not have started yet).
+      s.waiting[fd] = std::chrono::steady_clock::now();
     }
     std::thread([&s, fd, sock = std::move(socket)]() mutable {
       try {
@@ -459,6 +463,7 @@ void HttpServer::Run() {
       }
       std::lock_guard lock(s.mutex);
       s.sockets.erase(fd);
+      s.waiting.erase(fd);
       --s.active;
       s.idle.notify_all();
     }).detach();
