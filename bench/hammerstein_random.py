@@ -25,11 +25,8 @@ import sys
 import tempfile
 import pathlib
 
-
-def simulate(pneumid, signal, duration, seed, out):
-    subprocess.run([pneumid, "simulate", "--plant", "ipa", "--input", signal, "--duration",
-                    f"{duration:g}", "--seed", str(seed), "-o", str(out)], check=True,
-                   capture_output=True)
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from hammerstein_variants import simulate  # noqa: E402
 
 
 def main():
@@ -52,7 +49,8 @@ def main():
                 levels = [rng.randint(3, 97) for _ in range(rng.randint(8, 14))]
             dwell = round(rng.uniform(1.2, 2.5), 1)
             est = f"staircase:levels={' '.join(map(str, levels))},dwell={dwell}"
-            simulate(a.pneumid, est, len(levels) * dwell, rng.randint(1, 999), d / "est.csv")
+            simulate(a.pneumid, None, est, len(levels) * dwell, rng.randint(1, 999),
+                     d / "est.csv")
             r = subprocess.run([a.pneumid, "identify", str(d / "est.csv"), "-m", "hammerstein",
                                 "-o", str(d / "h.json")], capture_output=True, text=True)
             if r.returncode != 0:
@@ -71,7 +69,7 @@ def main():
             ]
             row = []
             for signal, duration in records:
-                simulate(a.pneumid, signal, duration, rng.randint(1, 999), d / "val.csv")
+                simulate(a.pneumid, None, signal, duration, rng.randint(1, 999), d / "val.csv")
                 v = subprocess.run([a.pneumid, "validate", str(d / "h.json") + "#hammerstein",
                                     str(d / "val.csv"), "--json"], capture_output=True, text=True)
                 res = json.loads(v.stdout) if v.returncode == 0 else {}

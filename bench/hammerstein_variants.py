@@ -44,8 +44,11 @@ METHODS = "fit-p1d,arx,hammerstein,wiener,hw,narx,affine-narx"
 
 
 def simulate(pneumid, twin, signal, duration, seed, out):
-    subprocess.run([pneumid, "simulate", "--plant", "ipa", "--plant-config", str(twin), "--input",
-                    signal, "--duration", str(duration), "--seed", str(seed), "-o", str(out)],
+    """`pneumid simulate` of the IPA twin (config `twin`, or the default twin
+    when None) under the input `signal`, written to `out`."""
+    twin_config = ["--plant-config", str(twin)] if twin is not None else []
+    subprocess.run([pneumid, "simulate", "--plant", "ipa", *twin_config, "--input", signal,
+                    "--duration", f"{duration:g}", "--seed", str(seed), "-o", str(out)],
                    check=True, capture_output=True)
 
 

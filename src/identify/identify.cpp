@@ -13,6 +13,7 @@
 
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/strings.hpp"
+#include "pneumid/identify/evaluation/fit_metrics.hpp"
 #include "pneumid/identify/evaluation/validation.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/identify/parametric/parametric.hpp"
@@ -216,7 +217,7 @@ void ScoreOnDeterminedSamples(std::vector<IdentifiedModel>* models,
   settle = std::min(settle, held / 4);
   const auto inside = [&](double x) {
     return std::any_of(gaps.begin(), gaps.end(),
-                       [x](const auto& g) { return x > g.first && x < g.second; });
+                       [x](const auto& g) { return VisitsMapGap(x, g.first, g.second); });
   };
   std::vector<bool> keep(static_cast<std::size_t>(n), true);
   Eigen::Index last_visit = -1, visits = 0;
@@ -244,21 +245,20 @@ void ScoreOnDeterminedSamples(std::vector<IdentifiedModel>* models,
         where, kept, settle));
     return;
   }
-  double mean = 0.0;
-  for (Eigen::Index t = from; t < n; ++t)
-    if (keep[static_cast<std::size_t>(t)]) mean += y[t];
-  mean /= static_cast<double>(kept);
-  double spread = 0.0;
-  for (Eigen::Index t = from; t < n; ++t)
-    if (keep[static_cast<std::size_t>(t)]) spread += (y[t] - mean) * (y[t] - mean);
-  if (!(spread > 0.0)) return;
+  // The measured output and each model's simulation on the kept samples.
+  Eigen::VectorXd y_kept(kept), sim_kept(kept);
+  const auto gather = [&](const Eigen::VectorXd& x, Eigen::VectorXd* out) {
+    Eigen::Index i = 0;
+    for (Eigen::Index t = from; t < n; ++t)
+      if (keep[static_cast<std::size_t>(t)]) (*out)[i++] = x[t];
+  };
+  gather(y, &y_kept);
+  if (!(y_kept.maxCoeff() > y_kept.minCoeff())) return;  // constant there: no fit defined
   for (std::size_t i = 0; i < models->size(); ++i) {
     const Eigen::VectorXd& yhat = sims[i];
     if (yhat.size() != n || !yhat.allFinite()) continue;
-    double err = 0.0;
-    for (Eigen::Index t = from; t < n; ++t)
-      if (keep[static_cast<std::size_t>(t)]) err += (y[t] - yhat[t]) * (y[t] - yhat[t]);
-    (*models)[i].determined_fit_percent = 100.0 * (1.0 - std::sqrt(err / spread));
+    gather(yhat, &sim_kept);
+    (*models)[i].determined_fit_percent = NrmseFit(y_kept, sim_kept);
   }
   warnings->push_back(fmt::format(
       "{}: the models are ranked by their fit on the other {} held-out samples (the {} samples "

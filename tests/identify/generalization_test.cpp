@@ -95,6 +95,25 @@ TEST(FindMapGapsTest, NamesTheStepsBetweenVisitedLevels) {
   EXPECT_TRUE(FindMapGaps(f, v).empty());
 }
 
+TEST(FindMapGapsTest, ASampleVisitsAGapOnlyBeyondOnePercentOfItsWidthFromItsEnds) {
+  // Gap (85, 90): the margin is 0.05 at either end.
+  EXPECT_FALSE(VisitsMapGap(85.0, 85.0, 90.0));
+  EXPECT_FALSE(VisitsMapGap(85.04, 85.0, 90.0));  // a visited level's noise
+  EXPECT_TRUE(VisitsMapGap(85.06, 85.0, 90.0));
+  EXPECT_TRUE(VisitsMapGap(87.5, 85.0, 90.0));
+  EXPECT_TRUE(VisitsMapGap(89.94, 85.0, 90.0));
+  EXPECT_FALSE(VisitsMapGap(89.96, 85.0, 90.0));
+  EXPECT_FALSE(VisitsMapGap(80.0, 85.0, 90.0));
+  EXPECT_FALSE(VisitsMapGap(95.0, 85.0, 90.0));
+  // FindMapGaps counts the same samples: one within the margin leaves the gap.
+  const StaticMap f({0, 5, 10, 15, 20, 25}, {0, 5, 10, 47.5, 52.5, 57.5});
+  Eigen::VectorXd u(7);
+  u << 0, 5, 10, 10.04, 15, 20, 25;
+  ASSERT_EQ(FindMapGaps(f, u).size(), 1u);
+  u[3] = 10.06;
+  EXPECT_TRUE(FindMapGaps(f, u).empty());
+}
+
 TEST(FindMapGapsTest, NamesABendTheLevelsBesideItCannotPlace) {
   // Levels 62, 70, 86 and 91 % of the default twin (its map there: 85.0,
   // 106.8, 193.5, 193.5 N; the exhaust's jump lies at 85-86 %): 70-86 rises

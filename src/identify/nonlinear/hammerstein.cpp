@@ -104,7 +104,9 @@ T OutputMap(const std::vector<double>& knots, const T* beta, const T& x) {
 // output y0: the preimage under the piecewise-linear map (values beta on the
 // knots) nearest to `near` (the rest at the first input), or `near` itself
 // when y0 lies outside the map's values (as SimulateNonlinear starts a
-// Wiener or Hammerstein-Wiener model on a record).
+// Wiener or Hammerstein-Wiener model on a record). StaticMap::NearestPreimage
+// for the parameters as Ceres varies them (T a Jet in the cost functors);
+// the estimates themselves use NearestPreimage.
 template <typename T>
 T RestFromFirstOutput(const std::vector<double>& knots, const T* beta, double y0, const T& near) {
   T best = near;
@@ -559,7 +561,7 @@ BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd&
   if (o.knots.empty()) {  // placed here, not given
     std::vector<double> final_x;
     SimulateUnitGainFrom(theta.data(), l, v, &final_x,
-                         RestFromFirstOutput(knots, theta.data() + l.map_offset(), y[0], v[0]));
+                         f.NearestPreimage(y[0], v[0]).value_or(v[0]));
     f = TrimToRange(f, final_x);
   }
   return Finish(theta, l, Ts, std::move(f), std::move(s));
@@ -618,10 +620,10 @@ BlockModelResult EstimateHammersteinWiener(const Eigen::VectorXd& u, const Eigen
   BlockModelResult r = Finish(theta, lj, Ts, MapOf(in_knots, fv, 0), std::move(s));
   std::vector<double> final_x;
   const std::vector<double> final_v = MapThroughTents(fv.data(), tents);
-  SimulateUnitGainFrom(
-      theta.data(), lj, final_v, &final_x,
-      RestFromFirstOutput(out_knots, theta.data() + lj.map_offset() + m - 2, y[0], final_v[0]));
-  r.output_map = TrimToRange(MapOf(out_knots, theta, lj.map_offset() + m - 2), final_x);
+  const StaticMap output_map = MapOf(out_knots, theta, lj.map_offset() + m - 2);
+  SimulateUnitGainFrom(theta.data(), lj, final_v, &final_x,
+                       output_map.NearestPreimage(y[0], final_v[0]).value_or(final_v[0]));
+  r.output_map = TrimToRange(output_map, final_x);
   return r;
 }
 

@@ -13,6 +13,7 @@
 #include "pneumid/identify/evaluation/model_evaluation.hpp"
 #include "pneumid/identify/evaluation/validation.hpp"
 #include "pneumid/identify/nonlinear/narx_simulation_fit.hpp"
+#include "pneumid/identify/nonlinear/static_map_fit.hpp"
 #include "pneumid/lti/conversion.hpp"
 #include "pneumid/lti/response.hpp"
 
@@ -676,8 +677,8 @@ std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, con
                     "support",
                     &w);
   for (const auto& [a, b] : model.input_map_undetermined) {
-    const double margin = 0.01 * (b - a);
-    const Eigen::Index inside = (u.array() > a + margin && u.array() < b - margin).count();
+    const auto inside = static_cast<Eigen::Index>(std::count_if(
+        u.begin(), u.end(), [a = a, b = b](double x) { return VisitsMapGap(x, a, b); }));
     if (inside == 0) continue;
     w.push_back(fmt::format(
         "the input visits ({:g}, {:g}) in {} of {} samples, where the data the model{} was "

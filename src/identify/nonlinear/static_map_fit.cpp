@@ -325,6 +325,11 @@ std::string MapGap::Describe() const {
       u_lo, u_hi, change);
 }
 
+bool VisitsMapGap(double u, double lo, double hi) {
+  const double margin = 0.01 * (hi - lo);
+  return u > lo + margin && u < hi - margin;
+}
+
 std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u) {
   const std::vector<double>& c = map.u();
   const std::vector<double>& f = map.y();
@@ -339,8 +344,7 @@ std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u) 
     const auto it = std::upper_bound(c.begin(), c.end(), u[t]);
     if (it == c.begin() || it == c.end()) continue;
     const auto j = static_cast<std::size_t>(it - c.begin()) - 1;
-    const double margin = 0.01 * (c[j + 1] - c[j]);
-    if (u[t] > c[j] + margin && u[t] < c[j + 1] - margin) inside[j] = true;
+    if (VisitsMapGap(u[t], c[j], c[j + 1])) inside[j] = true;
   }
   const auto slope = [&](std::size_t j) { return (f[j + 1] - f[j]) / (c[j + 1] - c[j]); };
   std::vector<double> spacing(m - 1);

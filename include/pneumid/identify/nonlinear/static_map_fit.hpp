@@ -141,8 +141,15 @@ struct MapGap {
   std::string Describe() const;   ///< "between u = 85 and 95 the map changes by 58 (...)"
 };
 
+/// Whether the input value u visits the open interval (lo, hi) of a map gap:
+/// it lies inside by more than 1 % of the interval's width from either end,
+/// so a sample at one of the visited levels that bound the gap (or within
+/// its rounding or noise) does not count. FindMapGaps, ExtrapolationWarnings
+/// and the ranking of IdentifyModels share this test.
+bool VisitsMapGap(double u, double lo, double hi);
+
 /// The gaps of `map` fitted on input u: intervals (c_j, c_j+1) that hold no
-/// sample of u strictly inside (beyond 1 % of the interval from either knot),
+/// sample of u strictly inside (VisitsMapGap: beyond 1 % of the interval from either knot),
 /// whose change |f(c_j+1) - f(c_j)| is at least 5 % of the map's range, and
 /// either whose slope is at least 2.5 times the steeper of the neighbouring
 /// intervals' slopes (a jump), or where a flatter neighbouring interval's
