@@ -51,6 +51,8 @@ void PrintTable(const std::vector<Run>& runs) {
        [](const Run& r) { return Fmt(r.result.metrics.rise_time, " s"); }},
       {"overshoot (worst step)",
        [](const Run& r) { return Fmt(r.result.metrics.overshoot_percent, " %"); }},
+      {"overshoot beyond ripple",
+       [](const Run& r) { return Fmt(r.result.metrics.overshoot_beyond_ripple_percent, " %"); }},
       {"settling time (worst step)",
        [](const Run& r) { return Fmt(r.result.metrics.settling_time, " s"); }},
       {"settling band (2 % or ripple)",

@@ -67,6 +67,10 @@ void SummarizeWorstStep(ClosedLoopMetrics* m) {
       LargestStep(steps, [](const StepMetrics& s) { return s.overshoot_percent; });
   if (m->worst_overshoot_step >= 0)
     m->overshoot_percent = steps[m->worst_overshoot_step].overshoot_percent;
+  const int beyond =
+      LargestStep(steps, [](const StepMetrics& s) { return s.overshoot_beyond_ripple_percent; });
+  if (beyond >= 0)
+    m->overshoot_beyond_ripple_percent = steps[beyond].overshoot_beyond_ripple_percent;
   m->worst_steady_state_error_step =
       LargestStep(steps, [](const StepMetrics& s) { return std::abs(s.steady_state_error); });
   if (m->worst_steady_state_error_step >= 0)
@@ -96,6 +100,7 @@ nlohmann::ordered_json StepMetrics::ToJson() const {
   PutStepResponse(*this, j);
   j["ripple"] = Number(ripple);
   j["steady_input"] = Number(steady_input);
+  j["overshoot_beyond_ripple_percent"] = Number(overshoot_beyond_ripple_percent);
   return j;
 }
 
@@ -105,6 +110,7 @@ nlohmann::ordered_json ClosedLoopMetrics::ToJson() const {
   j["worst_overshoot_step"] = worst_overshoot_step >= 0
                                   ? nlohmann::ordered_json(worst_overshoot_step)
                                   : nlohmann::ordered_json();
+  j["overshoot_beyond_ripple_percent"] = Number(overshoot_beyond_ripple_percent);
   j["worst_settling_step"] = worst_settling_step >= 0 ? nlohmann::ordered_json(worst_settling_step)
                                                       : nlohmann::ordered_json();
   j["worst_steady_state_error"] = Number(worst_steady_state_error);
@@ -255,6 +261,10 @@ ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen
           !(s.settling_time <= ts(std::max<Eigen::Index>(0, ys.size() - 1 - hold))))
         s.settling_time = kNaN;
       s.settled = std::isfinite(s.settling_time);
+      s.overshoot_beyond_ripple_percent = s.overshoot_percent;
+      if (std::isfinite(s.overshoot_percent) && std::isfinite(s.ripple) && step > 0.0)
+        s.overshoot_beyond_ripple_percent =
+            std::max(0.0, s.overshoot_percent - 100.0 * 0.5 * s.ripple / step);
     }
     m.steps.push_back(s);
   }

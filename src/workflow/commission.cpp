@@ -361,10 +361,8 @@ double RippleLimit(const StepMetrics& s, const CommissionExperiment& ex) {
 // else the peak itself. Percent of the step.
 double JudgedOvershoot(const StepMetrics& s, const CommissionExperiment& ex) {
   if (!std::isfinite(s.overshoot_percent)) return s.overshoot_percent;
-  const double step = std::abs(s.to - s.from);
-  if (!std::isfinite(s.ripple) || s.ripple > RippleLimit(s, ex) || step <= 0.0)
-    return s.overshoot_percent;
-  return std::max(0.0, s.overshoot_percent - 100.0 * 0.5 * s.ripple / step);
+  if (!std::isfinite(s.ripple) || s.ripple > RippleLimit(s, ex)) return s.overshoot_percent;
+  return s.overshoot_beyond_ripple_percent;
 }
 
 // The largest judged overshoot of a verification run's steps (its start from

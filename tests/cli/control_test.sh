@@ -130,9 +130,9 @@ check_output "plot compare" "DMC paper-modified (P=126, M=10, lambda=1.92)" "$tm
 # JSON keys are a contract: the run, its settings and its metrics (ClosedLoopMetrics::ToJson).
 expect_ok "json keys" control --controller dmc --model fopdt-paper --Ts 0.01 \
   --setpoint "staircase:levels=0 1,dwell=0.5" --duration 1 --json
-check_json "json keys" "list(j) == ['label', 'controller', 'plant', 'settings', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'worst_overshoot_step', 'worst_settling_step', 'worst_steady_state_error', 'worst_steady_state_error_step', 'iae', 'ise', 'itae', 'tv_u', 'u_min', 'u_max', 'load_peak_deviation', 'load_recovery_time', 'steps', 'warnings'] and j['warnings'] == []"
+check_json "json keys" "list(j) == ['label', 'controller', 'plant', 'settings', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'worst_overshoot_step', 'overshoot_beyond_ripple_percent', 'worst_settling_step', 'worst_steady_state_error', 'worst_steady_state_error_step', 'iae', 'ise', 'itae', 'tv_u', 'u_min', 'u_max', 'load_peak_deviation', 'load_recovery_time', 'steps', 'warnings'] and j['warnings'] == []"
 check_json "settings keys" "list(j['settings']) == ['rule', 'P', 'M', 'lambda', 'formula']"
-check_json "step keys" "sorted(j['steps'][0]) == sorted(['time', 'from', 'to', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'ripple', 'steady_input'])"
+check_json "step keys" "sorted(j['steps'][0]) == sorted(['time', 'from', 'to', 'rise_time', 'overshoot_percent', 'settling_time', 'steady_state_error', 'first_move', 'settling_band', 'settled', 'ripple', 'steady_input', 'overshoot_beyond_ripple_percent'])"
 # A set-point beyond the steady outputs of a Hammerstein model's map (the
 # v0.1.0 staircase model reaches 0.07..193 N at duty 0..100 %): the warning on
 # stderr is also in the JSON's warnings.

@@ -154,12 +154,13 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
   const nlohmann::ordered_json j = m.ToJson();
   std::vector<std::string> keys;
   for (const auto& [key, value] : j.items()) keys.push_back(key);
-  EXPECT_THAT(keys, ::testing::ElementsAre(
-                        "rise_time", "overshoot_percent", "settling_time", "steady_state_error",
-                        "first_move", "settling_band", "settled", "worst_overshoot_step",
-                        "worst_settling_step", "worst_steady_state_error",
-                        "worst_steady_state_error_step", "iae", "ise", "itae", "tv_u", "u_min",
-                        "u_max", "load_peak_deviation", "load_recovery_time", "steps"));
+  EXPECT_THAT(keys,
+              ::testing::ElementsAre(
+                  "rise_time", "overshoot_percent", "settling_time", "steady_state_error",
+                  "first_move", "settling_band", "settled", "worst_overshoot_step",
+                  "overshoot_beyond_ripple_percent", "worst_settling_step",
+                  "worst_steady_state_error", "worst_steady_state_error_step", "iae", "ise", "itae",
+                  "tv_u", "u_min", "u_max", "load_peak_deviation", "load_recovery_time", "steps"));
   EXPECT_EQ(j["rise_time"], 0.1);
   EXPECT_TRUE(j["overshoot_percent"].is_null());
   EXPECT_TRUE(j["load_recovery_time"].is_null());
@@ -169,7 +170,8 @@ TEST(ClosedLoopMetricsTest, ToJsonKeepsTheCommandLineKeys) {
   for (const auto& [key, value] : j["steps"][0].items()) keys.push_back(key);
   EXPECT_THAT(keys, ::testing::ElementsAre("time", "from", "to", "rise_time", "overshoot_percent",
                                            "settling_time", "steady_state_error", "first_move",
-                                           "settling_band", "settled", "ripple", "steady_input"));
+                                           "settling_band", "settled", "ripple", "steady_input",
+                                           "overshoot_beyond_ripple_percent"));
   EXPECT_EQ(j["steps"][0]["settling_time"], 0.3);
   EXPECT_TRUE(j["steps"][0]["first_move"].is_null());
 }
@@ -345,6 +347,51 @@ TEST(ClosedLoopMetricsTest, SettlingBandWidensToTheMeasuredRippleOnly) {
   EXPECT_NEAR(c.settling_band, 2.0, 1e-9);
   EXPECT_TRUE(c.settled);
   EXPECT_NEAR(c.settling_time, 0.1 * std::log(50.0), 0.01);
+}
+
+// The overshoot beyond the ripple: a response that reaches 100 N without
+// overshoot and then ripples by +-3 N (6 N peak to peak) peaks 3 % above the
+// step but 0 % beyond half its ripple; with a bump of 8 N at 0.5 s on top
+// (the response alone, without the ripple, overshoots by 8 - 100 exp(-5) =
+// 7.33 %), the part beyond the ripple is the response's overshoot.
+TEST(ClosedLoopMetricsTest, OvershootBeyondRippleIsTheResponsesOwnOvershoot) {
+  const int n = 400;
+  const double Ts = 0.01;
+  Eigen::VectorXd t(n), r(n), u = Eigen::VectorXd::Zero(n), flat(n), bump(n), clean(n);
+  for (int k = 0; k < n; ++k) {
+    t[k] = k * Ts;
+    r[k] = 100.0;
+    const double approach = 100.0 * (1.0 - std::exp(-t[k] / 0.1));
+    const double ripple = k % 2 == 0 ? 3.0 : -3.0;
+    flat[k] = approach + ripple;
+    clean[k] = approach + 8.0 * std::exp(-std::pow((t[k] - 0.5) / 0.05, 2));
+    bump[k] = clean[k] + ripple;
+  }
+  ClosedLoopOptions o;
+  o.duration = n * Ts;
+  const ClosedLoopMetrics a = ComputeClosedLoopMetrics(t, r, flat, u, 0.0, 0.0, o);
+  ASSERT_EQ(a.steps.size(), 1u);
+  EXPECT_NEAR(a.steps[0].overshoot_percent, 3.0, 1e-6);
+  EXPECT_NEAR(a.steps[0].overshoot_beyond_ripple_percent, 0.0, 0.01);
+  const ClosedLoopMetrics b = ComputeClosedLoopMetrics(t, r, bump, u, 0.0, 0.0, o);
+  const ClosedLoopMetrics c = ComputeClosedLoopMetrics(t, r, clean, u, 0.0, 0.0, o);
+  ASSERT_EQ(b.steps.size(), 1u);
+  EXPECT_NEAR(c.overshoot_percent, 8.0 - 100.0 * std::exp(-5.0), 0.01);
+  EXPECT_NEAR(b.overshoot_percent, c.overshoot_percent + 3.0, 0.01);
+  EXPECT_NEAR(b.steps[0].overshoot_beyond_ripple_percent, c.overshoot_percent, 0.02);
+  EXPECT_NEAR(b.overshoot_beyond_ripple_percent, b.steps[0].overshoot_beyond_ripple_percent, 1e-12);
+  // A hold too short for a ripple window (10 samples): the overshoot itself.
+  const int m = 10;
+  Eigen::VectorXd ts(m), rs = Eigen::VectorXd::Constant(m, 100.0), us = Eigen::VectorXd::Zero(m);
+  Eigen::VectorXd ys(m);
+  ys << 40, 80, 105, 102, 100, 100, 100, 100, 100, 100;
+  for (int k = 0; k < m; ++k) ts[k] = k * Ts;
+  o.duration = m * Ts;
+  const ClosedLoopMetrics d = ComputeClosedLoopMetrics(ts, rs, ys, us, 0.0, 0.0, o);
+  ASSERT_EQ(d.steps.size(), 1u);
+  EXPECT_TRUE(std::isnan(d.steps[0].ripple));
+  EXPECT_NEAR(d.steps[0].overshoot_percent, 5.0, 1e-9);
+  EXPECT_NEAR(d.steps[0].overshoot_beyond_ripple_percent, 5.0, 1e-9);
 }
 
 // The input that holds a level is the mean input over the ripple's window,

@@ -141,10 +141,19 @@ struct StepMetrics {
   double steady_input = std::numeric_limits<double>::quiet_NaN();
   /// The output entered the band before the last 10 % of the segment and stayed in it.
   bool settled = false;
+  /// The overshoot beyond half the step's steady ripple, percent of the step:
+  /// max(0, overshoot_percent - 50 ripple / |to - from|), overshoot_percent
+  /// itself when the ripple is not measured. At a level the actuator holds
+  /// only by modulation (a force inside a valve's input gap) the output
+  /// ripples around the set-point by itself; on a step small against that
+  /// ripple the peak is the ripple's, not the response's, and this is the
+  /// part of it the response adds (what `pneumid commission` judges when the
+  /// ripple is within its limit).
+  double overshoot_beyond_ripple_percent = std::numeric_limits<double>::quiet_NaN();
 
   /// {time, from, to, rise_time, overshoot_percent, settling_time,
   /// steady_state_error, first_move, settling_band, settled, ripple,
-  /// steady_input}; NaN is written as null.
+  /// steady_input, overshoot_beyond_ripple_percent}; NaN is written as null.
   nlohmann::ordered_json ToJson() const;
 };
 
@@ -164,7 +173,9 @@ struct ClosedLoopMetrics {
   double settling_band = std::numeric_limits<double>::quiet_NaN();  ///< of the worst-settling step
   bool settled = false;                                             ///< every step settled
   int worst_overshoot_step = -1;  ///< index into steps of overshoot_percent (-1: none)
-  int worst_settling_step = -1;   ///< index into steps of settling_time / settled (-1: none)
+  /// Largest StepMetrics::overshoot_beyond_ripple_percent over the steps (NaN: no step).
+  double overshoot_beyond_ripple_percent = std::numeric_limits<double>::quiet_NaN();
+  int worst_settling_step = -1;  ///< index into steps of settling_time / settled (-1: none)
   /// The steps' steady-state error of largest magnitude, signed (output units; NaN: no step).
   double worst_steady_state_error = std::numeric_limits<double>::quiet_NaN();
   int worst_steady_state_error_step = -1;  ///< index into steps of it (-1: none)
