@@ -134,7 +134,8 @@ assert v["overshoot_judged_percent"] <= min(v["overshoot_percent"], 5.0), v["ove
 # Its softer designs fail and the peak of the first design (aggressiveness
 # 0.5) is mostly the ripple: the fastest design is tried once, and kept (the
 # last attempt) only for an IAE at least 5 % lower with an overshoot beyond
-# half the ripple no more than 5 % of the specification (0.25 %) above.
+# half the ripple within 80 % of the specification (it is kept here: 1.47 %,
+# IAE 31.3 against 39.1).
 a = j["attempts"]
 seen = [(b["aggressiveness"], b["passed"], round(b["overshoot_judged_percent"], 2), round(b["iae"], 1)) for b in a]
 half = [b for b in a if b["aggressiveness"] == 0.5]
@@ -142,8 +143,9 @@ fast = [b for b in a if b["aggressiveness"] == 1.0]
 assert half and half[0]["passed"] and fast and fast[0]["passed"], seen
 assert all(not b["passed"] for b in a if b["aggressiveness"] < 0.5), seen
 better = (fast[0]["iae"] < 0.95 * half[0]["iae"] and
-          fast[0]["overshoot_judged_percent"] <= min(0.8 * 5.0, half[0]["overshoot_judged_percent"] + 0.25))
+          fast[0]["overshoot_judged_percent"] <= 0.8 * 5.0)
 assert a[-1]["aggressiveness"] == (1.0 if better else 0.5), seen
+assert better, seen
 kept = "aggressiveness = %g" % a[-1]["aggressiveness"]
 assert kept in open(sys.argv[2]).read().splitlines(), ("controller.toml: not the kept design", kept)
 # Softening stops at the first softer design that fails on its settling (a
