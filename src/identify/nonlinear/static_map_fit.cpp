@@ -374,7 +374,14 @@ std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u) 
     const double width = c[j + 1] - c[j];
     const bool wide = width >= 2.0 * median_spacing && width >= 0.15 * span &&
                       std::abs(f[j + 1] - f[j]) >= 0.1 * range;
-    if (own >= 2.5 * beside || spread >= 0.4 * std::abs(f[j + 1] - f[j]) || wide)
+    // A large change: a third of the map's range or more, twice as steep as
+    // the steeper neighbour (the larger the change, the less steepness it
+    // takes: levels 79 and 93 % hold the default twin's jump at 85-86 % and
+    // 40 % of its range, only 2.3 times as steep as 66-79 %; a parabola
+    // through equally spaced knots steepens by at most 5/3 from its second
+    // interval on).
+    const bool large = std::abs(f[j + 1] - f[j]) >= range / 3.0 && own >= 2.0 * beside;
+    if (own >= 2.5 * beside || spread >= 0.4 * std::abs(f[j + 1] - f[j]) || wide || large)
       gaps.push_back({c[j], c[j + 1], f[j + 1] - f[j]});
   }
   return gaps;

@@ -161,7 +161,10 @@ bool VisitsMapGap(double u, double lo, double hi);
 /// 62-70 %, or 14 and 24 %, around the inlet's jump at 14-15 %), or that is
 /// wide (at least twice the knots' median spacing and 15 % of their span)
 /// with a change of 10 % of the range or more: levels 24 and 56 % leave the
-/// default twin's map bent by 6 N between them, levels 73 and 91 % its jump.
+/// default twin's map bent by 6 N between them, levels 73 and 91 % its jump;
+/// or whose change is a third of the range or more and at least twice as
+/// steep as the steeper neighbour (levels 79 and 93 % hold the default
+/// twin's exhaust jump and 40 % of its range, 2.3 times as steep as 66-79 %).
 std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u);
 
 /// The weighted least-squares non-decreasing (`increasing`) or non-increasing
