@@ -120,11 +120,12 @@ class OutputMapController : public Controller {
 
 /// The map a controller inverts: `f` itself when it is monotone; else, when
 /// it dips by at most `tolerance` of its range after rising (a fitted map in
-/// a dead band or a saturation, where the output hardly moves), its
-/// monotone envelope (MonotoneEnvelope).
+/// a dead band or a saturation, where the output hardly moves, or between
+/// closely spaced knots, where it wiggles by its noise), its monotone
+/// envelope (MonotoneEnvelope).
 /// @throws InvalidArgument for a map that falls by more (the message gives
 /// the drop).
-StaticMap InvertibleInputMap(const StaticMap& f, double tolerance = 0.02);
+StaticMap InvertibleInputMap(const StaticMap& f, double tolerance = 0.05);
 
 /// The map an actuator with input gaps realises on average: inside each gap
 /// (lo, hi) the input is modulated between lo and hi (DutyModulator), so the
