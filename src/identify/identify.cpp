@@ -183,7 +183,7 @@ Eigen::Index SettlingSamples(const TransferFunction& g) {
   Eigen::Index delay = 0;
   const Eigen::VectorXd& num = g.num();
   while (delay < num.size() && num[delay] == 0.0) ++delay;
-  if (g.IsDiscrete() && g.Ts() > 0.0) delay += std::lround(g.delay() / g.Ts());
+  if (g.IsDiscrete()) delay += g.DelaySamples();
   return delay + static_cast<Eigen::Index>(decay);
 }
 

@@ -360,7 +360,6 @@ double RippleLimit(const StepMetrics& s, const CommissionExperiment& ex) {
 // and a small step at such a level would otherwise fail on the ripple alone),
 // else the peak itself. Percent of the step.
 double JudgedOvershoot(const StepMetrics& s, const CommissionExperiment& ex) {
-  if (!std::isfinite(s.overshoot_percent)) return s.overshoot_percent;
   if (!std::isfinite(s.ripple) || s.ripple > RippleLimit(s, ex)) return s.overshoot_percent;
   return s.overshoot_beyond_ripple_percent;
 }
