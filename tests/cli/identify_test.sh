@@ -141,6 +141,12 @@ expect_ok "split at one level" identify "$TMP/onestep.csv" -m arx,fit-p1d --spli
 check_output "one-level warning" "warning: the last 40 % of $TMP/onestep.csv holds a constant input (u = 50 over" "$TMP/err"
 expect_ok "split at one level, json" identify "$TMP/onestep.csv" -m arx,fit-p1d --split 0.6 --json
 check_json "warnings key" 'len(j["warnings"]) == 1 and "holds a constant input" in j["warnings"][0]'
+# A held-out part shorter than half the best model's settling time (the
+# cascaded tanks' last 1 %: 10 samples against about 170): warned.
+expect_ok "short held-out part" identify "$SRC/data/tanks/estimation.csv" -m oe --split 0.99 --json
+check_json "short held-out warning" 'any("holds 10 samples (40 s), fewer than half of what the best-ranked model \x27oe\x27 takes to settle" in w for w in j["warnings"])'
+expect_ok "long enough held-out part" identify "$SRC/data/tanks/estimation.csv" -m oe --split 0.8 --json
+check_json "no short held-out warning" 'not any("takes to settle" in w for w in j["warnings"])'
 expect_ok "no warnings" identify "$TMP/prbs.csv" -m arx --split 0.7 --json
 check_json "empty warnings" 'j["warnings"] == []'
 expect_ok "stairs" simulate --plant ipa --input "staircase:levels=10 40 70 25 55 85,dwell=1" --duration 6 \

@@ -357,6 +357,36 @@ TEST(GeneralizationTest, WarnsWhenTheInputLeavesTheMapsRange) {
   EXPECT_THAT(own.models[0].notes, Not(Contains(StartsWith("held-out part:"))));
 }
 
+// A held-out part shorter than half the best-ranked model's settling time
+// (the 0.955 pole's 2 % decay and its delay: about 87 samples for the true
+// system, 156 for the default ARX) is scored mostly on the start of each
+// simulation: warned, for a discrete (ARX) and a continuous (fit-p1d) best
+// model; 300 held-out samples are not.
+TEST(GeneralizationTest, AHeldOutPartShorterThanHalfTheSettlingIsWarned) {
+  const Dataset est = Recorded("gen_est");
+  const auto warned = [](const IdentificationSummary& s) {
+    return std::any_of(s.warnings.begin(), s.warnings.end(), [](const std::string& w) {
+      return w.find("takes to settle after an input change") != std::string::npos;
+    });
+  };
+  for (const char* method : {"arx", "fit-p1d"}) {
+    IdentifyOptions o;
+    o.num_threads = 1;
+    o.split = 0.99;  // 30 held-out samples
+    const IdentificationSummary short_part = IdentifyModels({method}, est, {}, o);
+    ASSERT_EQ(short_part.models.size(), 1u) << method;
+    EXPECT_TRUE(warned(short_part)) << method;
+    const auto w = std::find_if(short_part.warnings.begin(), short_part.warnings.end(),
+                                [](const std::string& x) { return x.find("settle") != x.npos; });
+    ASSERT_NE(w, short_part.warnings.end());
+    EXPECT_THAT(*w, HasSubstr("holds 30 samples (0.3 s)"));
+    EXPECT_THAT(*w, HasSubstr(std::string("the best-ranked model '") + method + "'"));
+    EXPECT_THAT(*w, HasSubstr("choose a smaller --split"));
+    o.split = 0.9;  // 300 held-out samples
+    EXPECT_FALSE(warned(IdentifyModels({method}, est, {}, o))) << method;
+  }
+}
+
 TEST(GeneralizationTest, StructureSearchErrorsAreClear) {
   const Dataset est = Recorded("gen_est");
   NonlinearOptions o;
