@@ -639,15 +639,80 @@ double SetpointWeightForOvershoot(const PidControllerFactory& factory, Evaluator
   return b_lo;
 }
 
-/// pid (file comment): loop shaping, then the set-point weight.
+/// The SIMC closed-loop time constant tau_c [pid.hpp, 1] whose response
+/// meets t* (result.response_time_aimed): with Ti = tau the loop is about
+/// exp(-theta s) / (tau_c s + 1), whose 10-90 % rise takes 2.2 tau_c and whose
+/// 2 % settling takes theta + 3.9 tau_c. NaN when the model has no FOPDT
+/// description (K, tau > 0, theta >= 0) or the settling time asked for is not
+/// longer than its dead time.
+double SimcTimeConstant(const AutoTuneResult& result, ResponseMeasure measure) {
+  const FopdtEstimate& f = result.fopdt;
+  const double t = result.response_time_aimed;
+  if (!(std::isfinite(f.K) && f.K != 0.0 && f.tau > 0.0 && f.theta >= 0.0 && t > 0.0)) return kNaN;
+  const double tau_c = measure == ResponseMeasure::kRise ? t / 2.2 : (t - f.theta) / 3.9;
+  return tau_c > 0.0 ? tau_c : kNaN;
+}
+
+/// A PID candidate of DesignPid: its gains, set-point weight and how its step
+/// does on the model and on the robustness rows.
+struct PidCandidate {
+  PidControllerFactory factory;
+  double b = 1.0;
+  PredictedMetrics nominal;
+  bool passes = false;  ///< nominal OS met, settled, every robustness row passes
+};
+
+PidCandidate EvaluatePidCandidate(const PidControllerFactory& factory, Evaluator& evaluator,
+                                  const AutoTuneOptions& options, const AutoTuneResult& result) {
+  PidCandidate c{factory};
+  c.b = SetpointWeightForOvershoot(factory, evaluator, options.max_overshoot);
+  c.nominal = evaluator.Run(*factory.Make(c.b), 0);
+  c.passes = c.nominal.settled &&
+             c.nominal.overshoot_percent <= options.max_overshoot + kOvershootTolerance;
+  for (int i = 1; i < kPlantCount && c.passes; ++i)
+    c.passes = RobustRowPasses(evaluator.Run(*factory.Make(c.b), i), result);
+  return c;
+}
+
+/// pid (file comment): loop shaping, then the set-point weight; the SIMC PI
+/// for the same response time instead when it settles sooner and passes too.
 ChosenDesign DesignPid(const TransferFunction& model, double Ts, const AutoTuneOptions& options,
                        Evaluator& evaluator, AutoTuneResult& result) {
   ShapePidLoop(model, Ts, options, result);
-  const PidControllerFactory factory{Ts, result.pid, result.derivative_filter, evaluator.limits};
-  const double b = SetpointWeightForOvershoot(factory, evaluator, options.max_overshoot);
-  result.setpoint_weight = b;
+  PidCandidate chosen_pid = EvaluatePidCandidate(
+      {Ts, result.pid, result.derivative_filter, evaluator.limits}, evaluator, options, result);
+  const double tau_c = options.pid_simc ? SimcTimeConstant(result, options.measure) : kNaN;
+  if (std::isfinite(tau_c)) {
+    const PidGains simc = TunePid(result.fopdt.K, result.fopdt.tau, result.fopdt.theta, Ts,
+                                  PidTuningRule::kSimc, tau_c);
+    PidCandidate c = EvaluatePidCandidate({Ts, simc, result.derivative_filter, evaluator.limits},
+                                          evaluator, options, result);
+    if (c.passes && (!chosen_pid.passes ||
+                     c.nominal.settling_time < chosen_pid.nominal.settling_time)) {
+      const PredictedMetrics shaped = chosen_pid.nominal;
+      chosen_pid = std::move(c);
+      result.pid = simc;
+      const LoopMargins margins =
+          DiscreteLoopMargins(LinearPlant(model, Ts).model(), simc, result.derivative_filter, Ts);
+      result.crossover = margins.crossover;
+      result.phase_margin = margins.phase_margin;
+      result.gain_margin = margins.gain_margin;
+      result.review.back() = {
+          "loop shaping", ReviewStatus::kOk,
+          fmt::format("SIMC PI with tau_c = {} (Ti = {}), crossover {:.4g} rad/s, phase margin "
+                      "{:.3g} deg, gain margin {:.3g}: its step settles in {} against {} for the "
+                      "loop shaped to crossover {:.4g} rad/s and phase margin {:.3g} deg",
+                      Seconds(tau_c), Seconds(simc.Ti), result.crossover, result.phase_margin,
+                      result.gain_margin, Seconds(chosen_pid.nominal.settling_time),
+                      Seconds(shaped.settling_time), result.crossover_target,
+                      result.phase_margin_target)};
+    }
+  }
+  result.setpoint_weight = chosen_pid.b;
   ChosenDesign chosen;
-  chosen.make_controller = [factory, b] { return factory.Make(b); };
+  chosen.make_controller = [factory = chosen_pid.factory, b = chosen_pid.b] {
+    return factory.Make(b);
+  };
   return chosen;
 }
 

@@ -64,6 +64,18 @@
 // C_1 = C/Kc), else PID with Td = Ti/4 [1, sec. 4.4]. The set-point weight b
 // (P = Kc (b r - y)) does not change L; it is the largest b in [0, 1] whose
 // step meets OS [1, sec. 3.4] (b = 1 when the loop itself does).
+// On a lag-dominant model (tau >> theta) that loop's integral time comes out
+// below tau, and its slow closed-loop pole near the PI zero, which b keeps
+// from overshooting, leaves a long tail: on the IPA's Hammerstein model
+// (tau 0.217 s, theta 0.01 s) Ti = 0.098 s, the steps settled in 1.35 s
+// and the commissioned loop overshot 8-10 % on the actuator. The SIMC PI
+// [6] for the same t* is designed too (pid.hpp: Ti = min(tau, 4 (tau_c +
+// theta)), the pole cancelled, the loop about exp(-theta s)/(tau_c s + 1)):
+//   tau_c = t* / 2.2 (rise)   or   (t* - theta) / 3.9 (settling),
+// with its own set-point weight, and it replaces the shaped design when it
+// passes (nominal OS, settled, every robustness row) and settles sooner or
+// the shaped one does not pass (AutoTuneOptions::pid_simc; the review's
+// "loop shaping" item then names it and both settling times).
 //
 // Design review (AutoTuneResult::review): nominal stability (the step
 // settles), offset-free steady state (a constant output disturbance of 20 %
@@ -84,6 +96,8 @@
 //     review", Ind. Eng. Chem. Res. 49 (2010) 3505-3515.
 // [5] R. Shridhar, D. J. Cooper, "A tuning strategy for unconstrained SISO
 //     model predictive control", Ind. Eng. Chem. Res. 36 (1997) 729-746.
+// [6] S. Skogestad, "Simple analytic rules for model reduction and PID
+//     controller tuning", J. Process Control 13 (2003) 291-309.
 #pragma once
 
 #include <limits>
@@ -153,6 +167,10 @@ struct AutoTuneOptions {
   /// limit is finite (ControllerSpec::constrained); with a finite limit the
   /// dmc is a QDMC anyway (file comment).
   bool constrained = false;
+  /// pid: also design the SIMC PI for the same response time (file comment)
+  /// and keep it when its step settles sooner and it passes where the loop
+  /// shaped to crossover and phase margin does; false: loop shaping only.
+  bool pid_simc = true;
   /// True when the options are usable (controller not gpc, response_time NaN or > 0,
   /// max_overshoot >= 0, aggressiveness in [0, 1], valid limits with u_min < u_max, M >= 0;
   /// mpc: the noise variances NaN or as MpcOptions::IsValid wants them); otherwise false
