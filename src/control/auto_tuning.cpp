@@ -642,15 +642,17 @@ double SetpointWeightForOvershoot(const PidControllerFactory& factory, Evaluator
 /// The SIMC closed-loop time constant tau_c [pid.hpp, 1] whose response
 /// meets t* (result.response_time_aimed): with Ti = tau the loop is about
 /// exp(-theta s) / (tau_c s + 1), whose 10-90 % rise takes 2.2 tau_c and whose
-/// 2 % settling takes theta + 3.9 tau_c. NaN when the model has no FOPDT
-/// description (K, tau > 0, theta >= 0) or the settling time asked for is not
-/// longer than its dead time.
-double SimcTimeConstant(const AutoTuneResult& result, ResponseMeasure measure) {
+/// 2 % settling takes theta + 3.9 tau_c; at least the effective dead time
+/// theta + Ts/2, SIMC's "tight control" bound for robustness [1, sec. 4]: on
+/// a delay-dominant model (tau 0.1 s, theta 0.3 s) tau_c = t*/2.2 = 0.18 s
+/// overshot 14.8 %, tau_c = theta + Ts/2 4.9 %. NaN when the model has no
+/// FOPDT description (K, tau > 0, theta >= 0).
+double SimcTimeConstant(const AutoTuneResult& result, ResponseMeasure measure, double Ts) {
   const FopdtEstimate& f = result.fopdt;
   const double t = result.response_time_aimed;
   if (!(std::isfinite(f.K) && f.K != 0.0 && f.tau > 0.0 && f.theta >= 0.0 && t > 0.0)) return kNaN;
   const double tau_c = measure == ResponseMeasure::kRise ? t / 2.2 : (t - f.theta) / 3.9;
-  return tau_c > 0.0 ? tau_c : kNaN;
+  return std::max(tau_c, f.theta + Ts / 2.0);
 }
 
 /// A PID candidate of DesignPid: its gains, set-point weight and how its step
@@ -675,20 +677,28 @@ PidCandidate EvaluatePidCandidate(const PidControllerFactory& factory, Evaluator
 }
 
 /// pid (file comment): loop shaping, then the set-point weight; the SIMC PI
-/// for the same response time instead when it settles sooner and passes too.
+/// for the same response time instead when it settles sooner and passes too,
+/// or settles where the shaped loop does not.
 ChosenDesign DesignPid(const TransferFunction& model, double Ts, const AutoTuneOptions& options,
                        Evaluator& evaluator, AutoTuneResult& result) {
   ShapePidLoop(model, Ts, options, result);
   PidCandidate chosen_pid = EvaluatePidCandidate(
       {Ts, result.pid, result.derivative_filter, evaluator.limits}, evaluator, options, result);
-  const double tau_c = options.pid_simc ? SimcTimeConstant(result, options.measure) : kNaN;
+  const double tau_c = options.pid_simc ? SimcTimeConstant(result, options.measure, Ts) : kNaN;
   if (std::isfinite(tau_c)) {
     const PidGains simc = TunePid(result.fopdt.K, result.fopdt.tau, result.fopdt.theta, Ts,
                                   PidTuningRule::kSimc, tau_c);
     PidCandidate c = EvaluatePidCandidate({Ts, simc, result.derivative_filter, evaluator.limits},
                                           evaluator, options, result);
-    if (c.passes && (!chosen_pid.passes ||
-                     c.nominal.settling_time < chosen_pid.nominal.settling_time)) {
+    // Kept when it passes and settles sooner, or passes where the shaped
+    // loop does not; when neither passes, when it settles on the model and
+    // the shaped loop does not (a t* too fast for the dead time: a stable
+    // loop whose review says so, not an unstable one).
+    const bool better =
+        c.passes ? !chosen_pid.passes ||
+                       c.nominal.settling_time < chosen_pid.nominal.settling_time
+                 : !chosen_pid.passes && c.nominal.settled && !chosen_pid.nominal.settled;
+    if (better) {
       const PredictedMetrics shaped = chosen_pid.nominal;
       chosen_pid = std::move(c);
       result.pid = simc;

@@ -72,10 +72,12 @@
 // [6] for the same t* is designed too (pid.hpp: Ti = min(tau, 4 (tau_c +
 // theta)), the pole cancelled, the loop about exp(-theta s)/(tau_c s + 1)):
 //   tau_c = t* / 2.2 (rise)   or   (t* - theta) / 3.9 (settling),
-// with its own set-point weight, and it replaces the shaped design when it
-// passes (nominal OS, settled, every robustness row) and settles sooner or
-// the shaped one does not pass (AutoTuneOptions::pid_simc; the review's
-// "loop shaping" item then names it and both settling times).
+// at least theta + Ts/2 (SIMC's bound for robustness), with its own
+// set-point weight, and it replaces the shaped design when it passes
+// (nominal OS, settled, every robustness row) and settles sooner or the
+// shaped one does not pass; when neither passes, when it settles on the
+// model and the shaped one does not (AutoTuneOptions::pid_simc; the
+// review's "loop shaping" item then names it and both settling times).
 //
 // Design review (AutoTuneResult::review): nominal stability (the step
 // settles), offset-free steady state (a constant output disturbance of 20 %
@@ -168,8 +170,9 @@ struct AutoTuneOptions {
   /// dmc is a QDMC anyway (file comment).
   bool constrained = false;
   /// pid: also design the SIMC PI for the same response time (file comment)
-  /// and keep it when its step settles sooner and it passes where the loop
-  /// shaped to crossover and phase margin does; false: loop shaping only.
+  /// and keep it when it passes and settles sooner than the loop shaped to
+  /// crossover and phase margin, or passes or settles where that loop does
+  /// not; false: loop shaping only.
   bool pid_simc = true;
   /// True when the options are usable (controller not gpc, response_time NaN or > 0,
   /// max_overshoot >= 0, aggressiveness in [0, 1], valid limits with u_min < u_max, M >= 0;
