@@ -588,6 +588,15 @@ ReviewItem LoopShapingItem(const PidDesignPoint& point, const AutoTuneResult& re
                       result.gain_margin)};
 }
 
+/// The crossover and margins the discrete loop of result.pid (derivative
+/// filter result.derivative_filter) achieves on the zoh model Gd, into result.
+void StoreLoopMargins(const TransferFunction& Gd, double Ts, AutoTuneResult& result) {
+  const LoopMargins margins = DiscreteLoopMargins(Gd, result.pid, result.derivative_filter, Ts);
+  result.crossover = margins.crossover;
+  result.phase_margin = margins.phase_margin;
+  result.gain_margin = margins.gain_margin;
+}
+
 /// PID loop shaping (file comment): wc and PM from t* and the knob, PI or PID
 /// from the phase the controller must supply, Ti and Kc on the discrete loop,
 /// the margins it achieves and the "loop shaping" review item.
@@ -613,10 +622,7 @@ void ShapePidLoop(const TransferFunction& model, double Ts, const AutoTuneOption
   result.pid.Td = point.use_pid ? Ti.Ti / 4.0 : 0.0;
   result.pid.Kc =
       sgn / (std::abs(PidShape(Ti.Ti, result.pid.Td, N, Ts, point.w_design)) * plant_mag);
-  const LoopMargins margins = DiscreteLoopMargins(Gd, result.pid, N, Ts);
-  result.crossover = margins.crossover;
-  result.phase_margin = margins.phase_margin;
-  result.gain_margin = margins.gain_margin;
+  StoreLoopMargins(Gd, Ts, result);
   result.review.push_back(LoopShapingItem(point, result));
 }
 
@@ -702,11 +708,7 @@ ChosenDesign DesignPid(const TransferFunction& model, double Ts, const AutoTuneO
       const PredictedMetrics shaped = chosen_pid.nominal;
       chosen_pid = std::move(c);
       result.pid = simc;
-      const LoopMargins margins =
-          DiscreteLoopMargins(LinearPlant(model, Ts).model(), simc, result.derivative_filter, Ts);
-      result.crossover = margins.crossover;
-      result.phase_margin = margins.phase_margin;
-      result.gain_margin = margins.gain_margin;
+      StoreLoopMargins(LinearPlant(model, Ts).model(), Ts, result);
       result.review.back() = {
           "loop shaping", ReviewStatus::kOk,
           fmt::format("SIMC PI with tau_c = {} (Ti = {}), crossover {:.4g} rad/s, phase margin "

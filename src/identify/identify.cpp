@@ -4,7 +4,6 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
-#include <limits>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -18,6 +17,7 @@
 #include "pneumid/identify/evaluation/validation.hpp"
 #include "pneumid/identify/nonlinear/nonlinear.hpp"
 #include "pneumid/identify/parametric/parametric.hpp"
+#include "pneumid/lti/conversion.hpp"
 #include "pneumid/identify/step/step_analysis.hpp"
 
 namespace pneumid {
@@ -188,19 +188,15 @@ Eigen::Index SettlingSamples(const TransferFunction& g) {
   return delay + static_cast<Eigen::Index>(decay);
 }
 
-// Samples the model `m` takes to settle after its input changes: of its
-// discrete linear part (SettlingSamples), else of its continuous transfer
-// function (delay plus ln 50 over the slowest stable pole's decay rate);
-// -1 for a model without a linear part (NARX) or with no stable pole.
+// Samples the model `m` takes to settle after its input changes
+// (SettlingSamples): of its discrete linear part, else of its continuous
+// transfer function sampled at Ts with a zero-order hold; -1 for a model
+// without a linear part (NARX) or a continuous one with no stable pole.
 Eigen::Index ModelSettlingSamples(const IdentifiedModel& m, double Ts) {
   if (m.discrete) return SettlingSamples(*m.discrete);
   if (m.tf.IsDiscrete() || m.tf.den().size() < 2 || !(Ts > 0.0)) return -1;
-  double rate = std::numeric_limits<double>::infinity();
-  const Eigen::VectorXcd poles = m.tf.Poles();
-  for (Eigen::Index i = 0; i < poles.size(); ++i)
-    if (poles[i].real() < 0.0) rate = std::min(rate, -poles[i].real());
-  if (!std::isfinite(rate)) return -1;
-  return static_cast<Eigen::Index>(std::ceil((m.tf.delay() + std::log(50.0) / rate) / Ts));
+  if (!(m.tf.Poles().real().array() < 0.0).any()) return -1;
+  return SettlingSamples(C2D(m.tf, Ts));
 }
 
 // A held-out part shorter than half the time the best-ranked model takes to
@@ -220,9 +216,9 @@ void WarnHeldOutShorterThanSettling(const IdentificationSummary& s, double Ts,
     if (2 * s.validation_samples < settle)
       warnings->push_back(fmt::format(
           "{} holds {} samples ({:.4g} s), fewer than half of what the best-ranked model '{}' "
-          "takes to settle after an input change ({} samples, {:.4g} s): the held-out fits (and the structure "
-          "search on them) score mostly the start each model is simulated from, not how it "
-          "follows the input; {}",
+          "takes to settle after an input change ({} samples, {:.4g} s): the held-out fits (and "
+          "the structure search on them) score mostly the start each model is simulated from, "
+          "not how it follows the input; {}",
           what, s.validation_samples, static_cast<double>(s.validation_samples) * Ts, m.method,
           settle, static_cast<double>(settle) * Ts,
           validation ? "give a longer validation record" : "choose a smaller --split"));

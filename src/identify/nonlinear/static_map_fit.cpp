@@ -355,7 +355,8 @@ std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u) 
   const double median_spacing = spacing[spacing.size() / 2];
   const double span = c.back() - c.front();
   for (std::size_t j = 0; j + 1 < m; ++j) {
-    if (inside[j] || std::abs(f[j + 1] - f[j]) < 0.05 * range) continue;
+    const double change = std::abs(f[j + 1] - f[j]);
+    if (inside[j] || change < 0.05 * range) continue;
     double beside = 0.0;
     if (j > 0) beside = std::max(beside, std::abs(slope(j - 1)));
     if (j + 2 < m) beside = std::max(beside, std::abs(slope(j + 1)));
@@ -372,16 +373,16 @@ std::vector<MapGap> FindMapGaps(const StaticMap& map, const Eigen::VectorXd& u) 
     // A wide interval: at least twice the knots' median spacing and 15 % of
     // their span, over which the map changes by 10 % of its range or more.
     const double width = c[j + 1] - c[j];
-    const bool wide = width >= 2.0 * median_spacing && width >= 0.15 * span &&
-                      std::abs(f[j + 1] - f[j]) >= 0.1 * range;
+    const bool wide =
+        width >= 2.0 * median_spacing && width >= 0.15 * span && change >= 0.1 * range;
     // A large change: a third of the map's range or more, twice as steep as
     // the steeper neighbour (the larger the change, the less steepness it
     // takes: levels 79 and 93 % hold the default twin's jump at 85-86 % and
     // 40 % of its range, only 2.3 times as steep as 66-79 %; a parabola
     // through equally spaced knots steepens by at most 5/3 from its second
     // interval on).
-    const bool large = std::abs(f[j + 1] - f[j]) >= range / 3.0 && own >= 2.0 * beside;
-    if (own >= 2.5 * beside || spread >= 0.4 * std::abs(f[j + 1] - f[j]) || wide || large)
+    const bool large = change >= range / 3.0 && own >= 2.0 * beside;
+    if (own >= 2.5 * beside || spread >= 0.4 * change || wide || large)
       gaps.push_back({c[j], c[j + 1], f[j + 1] - f[j]});
   }
   return gaps;
