@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -81,7 +82,9 @@ IpaCalibrationOptions CalibrationOptions(const CalibrateArgs& args) {
 Dataset LoadDataFile(const CalibrateArgs& args, const std::string& path) {
   DataOptions data = args.data;
   data.path = path;
-  return LoadFromOptions(data);
+  Dataset loaded = LoadFromOptions(data);
+  RequireSingleInputOutput(loaded, data, "calibrate");
+  return loaded;
 }
 
 /// The experiments to calibrate on, each with its weight.

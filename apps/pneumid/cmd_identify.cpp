@@ -135,12 +135,15 @@ void Run(const IdentifyArgs& args) {
     DataOptions v = args.data;
     v.path = args.validation;
     validation_raw.emplace(LoadFromOptions(v));
+    RequireSingleInputOutput(*validation_raw, v, "identify");
   }
+  const Dataset raw = LoadFromOptions(args.data);
+  RequireSingleInputOutput(raw, args.data, "identify");
   IdentifyWorkflowResult outcome;
   {
     ProgressBar bar("identify", args.progress || StderrIsTerminal());
     outcome =
-        RunIdentifyWorkflow(ToWorkflowOptions(args), LoadFromOptions(args.data),
+        RunIdentifyWorkflow(ToWorkflowOptions(args), raw,
                             validation_raw ? &*validation_raw : nullptr,
                             [&bar](std::size_t done, std::size_t total, const std::string& method) {
                               bar(static_cast<double>(done) / static_cast<double>(total), method);
@@ -150,7 +153,22 @@ void Run(const IdentifyArgs& args) {
     std::cerr << fmt::format("pneumid identify: {} failed: {}\n", method, reason);
   for (const std::string& w : outcome.summary.warnings)
     std::cerr << fmt::format("pneumid identify: warning: {}\n", w);
-  if (outcome.summary.models.empty()) throw DataError(outcome.summary.message);
+  if (outcome.summary.models.empty()) {
+    // --json still prints what was tried, so that a script sees every
+    // method's reason (the exit status is non-zero all the same).
+    if (args.json) {
+      nlohmann::json j = {{"models", nlohmann::json::array()},
+                          {"best", nullptr},
+                          {"failures", nlohmann::json::array()},
+                          {"termination", ToString(outcome.summary.termination)},
+                          {"message", outcome.summary.message},
+                          {"warnings", outcome.summary.warnings}};
+      for (const auto& [method, reason] : outcome.summary.failures)
+        j["failures"].push_back({{"method", method}, {"reason", reason}});
+      std::cout << j.dump(2) << "\n";
+    }
+    throw DataError(outcome.summary.message);
+  }
   const Dataset& data = outcome.data;
   const PreprocessRecord& record = outcome.record;
   const IdentificationSummary& summary = outcome.summary;

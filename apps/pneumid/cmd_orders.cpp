@@ -1,6 +1,7 @@
 // pneumid orders DATA: ARX order and delay selection table (arxstruc/selstruc).
 #include <iostream>
 #include <memory>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -34,7 +35,9 @@ void Run(const OrdersArgs& a) {
   PNEUMID_CHECK(a.split == 0.0 || (a.split > 0.0 && a.split < 1.0),
                 "--split must be in (0, 1), got {}", a.split);
   PNEUMID_CHECK(a.top >= 0, "--top must be >= 0, got {}", a.top);
-  const Dataset data = Preprocess(LoadFromOptions(a.data), ToPreprocessOptions(a.preprocess));
+  Dataset loaded = LoadFromOptions(a.data);
+  RequireSingleInputOutput(loaded, a.data, "orders");
+  const Dataset data = Preprocess(std::move(loaded), ToPreprocessOptions(a.preprocess));
   OrderSelection s;
   if (a.split > 0.0) {
     const auto [est, val] = SplitDataset(data, a.split);

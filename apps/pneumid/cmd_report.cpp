@@ -5,6 +5,7 @@
 // the commands that reproduce it) and DIR/models.json.
 #include <iostream>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -86,8 +87,10 @@ void Run(const ReportArgs& a) {
   o.commands = {cmd};
 
   PreprocessRecord record;
+  Dataset loaded = cli::LoadFromOptions(a.data);
+  cli::RequireSingleInputOutput(loaded, a.data, "report");
   const Dataset data =
-      Preprocess(cli::LoadFromOptions(a.data), cli::ToPreprocessOptions(a.preprocess), &record);
+      Preprocess(std::move(loaded), cli::ToPreprocessOptions(a.preprocess), &record);
   if (!record.IsIdentity()) o.preprocessing = record;
   if (automatic) {
     std::string auto_warning;

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -96,7 +97,9 @@ CompareResult SimulateIdentified(const IdentifiedModel& m, const Dataset& data, 
 Dataset LoadValidationData(const ValidateArgs& args,
                            const std::optional<IdentifiedModel>& identified) {
   const PreprocessOptions prep = ToPreprocessOptions(args.preprocess);
-  Dataset data = Preprocess(LoadFromOptions(args.data), prep);
+  Dataset loaded = LoadFromOptions(args.data);
+  RequireSingleInputOutput(loaded, args.data, "validate");
+  Dataset data = Preprocess(std::move(loaded), prep);
   if (identified && identified->preprocessing) {
     PreprocessOptions rest = prep;
     rest.window = {};

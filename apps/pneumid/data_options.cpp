@@ -69,6 +69,40 @@ Dataset LoadFromOptions(const DataOptions& options) {
   return LoadDataset(options.path, ToLoadOptions(options));
 }
 
+namespace {
+
+std::string Names(const std::vector<Channel>& channels) {
+  std::string out;
+  for (const Channel& c : channels) out += (out.empty() ? "" : ", ") + c.name;
+  return out;
+}
+
+}  // namespace
+
+void RequireSingleInputOutput(const Dataset& data, const DataOptions& options,
+                              const std::string& command) {
+  const std::size_t nu = data.input_channels().size();
+  const std::size_t ny = data.output_channels().size();
+  PNEUMID_CHECK(nu != 0,
+                "{} selects no input column (--input-col '{}'): time-series models (no input) "
+                "are not available; name the input with --input-col",
+                options.path, options.input_col);
+  PNEUMID_CHECK(ny != 0,
+                "{} selects no output column (--output-col '{}'); name the output with "
+                "--output-col",
+                options.path, options.output_col);
+  PNEUMID_CHECK(nu == 1,
+                "{} selects {} input columns ({}): pneumid {} fits and scores single-input "
+                "single-output models and would use only the first; choose one input with "
+                "--input-col",
+                options.path, nu, Names(data.input_channels()), command);
+  PNEUMID_CHECK(ny == 1,
+                "{} selects {} output columns ({}): pneumid {} fits and scores "
+                "single-input single-output models and would use only the first; choose one "
+                "output with --output-col (one model per output)",
+                options.path, ny, Names(data.output_channels()), command);
+}
+
 void AddPreprocessOptions(CLI::App& app, PreprocessArgs& args) {
   const std::string group = "Preprocessing (in this order)";
   app.add_option("--window", args.window,

@@ -47,6 +47,15 @@ LoadOptions ToLoadOptions(const DataOptions& options);
 /// Loads the selected data. @throws DataError / InvalidArgument as LoadDataset.
 Dataset LoadFromOptions(const DataOptions& options);
 
+/// Checks that `data` (loaded with `options`) hold exactly one input and one
+/// output column: `command` (identify, orders, validate, report, calibrate)
+/// fits and scores single-input single-output models, and would otherwise
+/// use the first column of each and drop the others without a word.
+/// @throws InvalidArgument naming the file, the columns selected and the flag
+/// that selects one.
+void RequireSingleInputOutput(const Dataset& data, const DataOptions& options,
+                              const std::string& command);
+
 // Preprocessing of the loaded data (identify, validate, orders, report), in
 // the order of PreprocessOptions (data/preprocess.hpp):
 //   --window T0:T1       keep T0 <= t <= T1 (s; either side may be empty)

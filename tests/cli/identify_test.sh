@@ -98,6 +98,23 @@ check_json "arx produced" '[m["method"] for m in j["models"]] == ["arx"]'
 check_json "failure listed" 'j["failures"][0]["method"] == "reaction-curve" and j["failures"][0]["reason"] and j["termination"] == "partial"'
 check_output "failure on stderr" "reaction-curve failed" "$TMP/err"
 expect_error "no model at all" "no method produced a model" identify "$TMP/prbs.csv" -m reaction-curve,tangent
+# --json still prints the failures (and the exit status is non-zero).
+expect_error "no model, --json" "no method produced a model" identify "$TMP/prbs.csv" -m reaction-curve,tangent --json
+check_json "failures in JSON" 'j["models"] == [] and j["best"] is None and [f["method"] for f in j["failures"]] == ["reaction-curve", "tangent"] and j["termination"] == "failure"'
+# Two input columns (or none): an error naming them, not a model of the first.
+$PY - "$TMP/prbs.csv" "$TMP/miso.csv" <<'PYEOF'
+import sys
+rows = [l.rstrip("\n").split(",") for l in open(sys.argv[1]) if not l.startswith("#")]
+with open(sys.argv[2], "w") as f:
+    f.write("t,u,u2,y\n")
+    for k, r in enumerate(rows[1:]):
+        f.write(f"{r[0]},{r[1]},{(k * 7919) % 13 - 6},{r[2]}\n")
+PYEOF
+expect_error "two inputs" "selects 2 input columns (u, u2)" identify "$TMP/miso.csv" --input-col u,u2 -m arx
+expect_error "two inputs, validate" "selects 2 input columns (u, u2)" validate fopdt-paper "$TMP/miso.csv" --input-col u,u2
+expect_error "two inputs, orders" "selects 2 input columns (u, u2)" orders "$TMP/miso.csv" --input-col u,u2
+expect_error "no input" "time-series models (no input) are not available" identify "$TMP/miso.csv" --input-col '' -m arx
+expect_ok "one of two inputs" identify "$TMP/miso.csv" --input-col u -m arx --json
 # Without --method: the reaction curve on a step test, the methods for
 # general inputs on any other record, with a warning saying why.
 expect_ok "auto on a PRBS" identify "$TMP/prbs.csv" --json
