@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <new>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -126,6 +127,12 @@ int main(int argc, char** argv) {
   } catch (const pneumid::DataError& e) {
     std::cerr << "pneumid" << (current.empty() ? "" : " " + current) << ": error: " << e.what()
               << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "pneumid" << (current.empty() ? "" : " " + current)
+              << ": error: out of memory: the problem is too large for this machine (a sample time "
+                 "much shorter than the model's time scale, long horizons or delays, or a long "
+                 "record); choose a longer sample time or shorter data\n";
     return 1;
   } catch (const std::exception& e) {
     std::cerr << "pneumid" << (current.empty() ? "" : " " + current) << ": error: " << e.what()

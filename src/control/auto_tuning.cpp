@@ -672,7 +672,7 @@ struct PidCandidate {
 
 PidCandidate EvaluatePidCandidate(const PidControllerFactory& factory, Evaluator& evaluator,
                                   const AutoTuneOptions& options, const AutoTuneResult& result) {
-  PidCandidate c{factory};
+  PidCandidate c{factory, 1.0, {}, false};
   c.b = SetpointWeightForOvershoot(factory, evaluator, options.max_overshoot);
   c.nominal = evaluator.Run(*factory.Make(c.b), 0);
   c.passes = c.nominal.settled &&

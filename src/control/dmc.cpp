@@ -19,6 +19,11 @@ bool DmcOptions::IsValid(std::string* error) const {
   };
   if (P < 1) return fail(fmt::format("prediction horizon P must be >= 1, got {}", P));
   if (M < 1 || M > P) return fail(fmt::format("need 1 <= M <= P, got M = {}, P = {}", M, P));
+  if (P > kMaxPredictionHorizon || M > kMaxControlHorizon)
+    return fail(fmt::format(
+        "horizons P = {} and M = {} exceed the largest ones taken, P = {} and M = {} (a sample "
+        "time much shorter than the plant's time scale: choose a longer one)",
+        P, M, kMaxPredictionHorizon, kMaxControlHorizon));
   if (!(lambda >= 0.0) || !std::isfinite(lambda))
     return fail(fmt::format("lambda must be finite and >= 0, got {}", lambda));
   if (output_weights.size() != 0 &&

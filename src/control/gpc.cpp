@@ -65,6 +65,11 @@ bool GpcOptions::IsValid(std::string* error) const {
   if (N1 < 1 || N2 < N1)
     return fail(fmt::format("need 1 <= N1 <= N2, got N1 = {}, N2 = {}", N1, N2));
   if (Nu < 1 || Nu > N2) return fail(fmt::format("need 1 <= Nu <= N2, got Nu = {}", Nu));
+  if (N2 > kMaxPredictionHorizon || Nu > kMaxControlHorizon)
+    return fail(fmt::format(
+        "horizons N2 = {} and Nu = {} exceed the largest ones taken, N2 = {} and Nu = {} (a "
+        "sample time much shorter than the plant's time scale: choose a longer one)",
+        N2, Nu, kMaxPredictionHorizon, kMaxControlHorizon));
   if (!(lambda >= 0.0) || !std::isfinite(lambda))
     return fail(fmt::format("lambda must be finite and >= 0, got {}", lambda));
   if (!t_equals_a && t_polynomial.size() > 0 &&

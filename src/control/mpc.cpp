@@ -11,6 +11,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/enum_names.hpp"
 #include "pneumid/lti/conversion.hpp"
+#include "pneumid/lti/transfer_function.hpp"
 
 namespace pneumid {
 
@@ -37,6 +38,11 @@ bool MpcOptions::IsValid(std::string* error) const {
   };
   if (P < 1) return fail(fmt::format("prediction horizon P must be >= 1, got {}", P));
   if (M < 1 || M > P) return fail(fmt::format("need 1 <= M <= P, got M = {}, P = {}", M, P));
+  if (P > kMaxPredictionHorizon || M > kMaxControlHorizon)
+    return fail(fmt::format(
+        "horizons P = {} and M = {} exceed the largest ones taken, P = {} and M = {} (a sample "
+        "time much shorter than the plant's time scale: choose a longer one)",
+        P, M, kMaxPredictionHorizon, kMaxControlHorizon));
   if (!(output_weight > 0.0) || !std::isfinite(output_weight))
     return fail(fmt::format("output weight q must be finite and > 0, got {}", output_weight));
   if (!(lambda >= 0.0) || !std::isfinite(lambda))
@@ -78,7 +84,7 @@ StateSpace SampledStateSpace(const TransferFunction& model, double Ts) {
 
 StateSpace DelayAsStates(const StateSpace& model) {
   PNEUMID_CHECK(model.IsDiscrete(), "DelayAsStates needs a discrete model (Ts > 0)");
-  const int d = static_cast<int>(std::lround(model.delay() / model.Ts()));
+  const int d = DelayInSamples(model.delay(), model.Ts());
   if (d == 0) return StateSpace(model.A(), model.B(), model.C(), model.D(), model.Ts(), 0.0);
   const int nx = model.num_states(), nu = model.num_inputs(), ny = model.num_outputs();
   const int n = nx + d * nu;

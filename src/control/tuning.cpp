@@ -87,6 +87,9 @@ bool TuningOptions::IsValid(std::string* error) const {
   if (!(target_condition > 1.0))
     return fail(fmt::format("target_condition must exceed 1, got {}", target_condition));
   if (P > 0 && M > P) return fail(fmt::format("need M <= P, got M = {}, P = {}", M, P));
+  if (P > kMaxPredictionHorizon || M > kMaxControlHorizon)
+    return fail(fmt::format("P = {} and M = {} exceed the largest horizons taken, P = {} and M = {}",
+                            P, M, kMaxPredictionHorizon, kMaxControlHorizon));
   return true;
 }
 
@@ -112,6 +115,12 @@ TuningResult Tune(const PredictionModel& model, const TuningOptions& options) {
                        ? RoundSignificant(f.tau, options.tau_significant_digits)
                        : f.tau;
       r.P_unrounded = 5.0 * r.tau_used / Ts + f.theta / Ts + 1.0;
+      PNEUMID_CHECK(options.P > 0 || r.P_unrounded <= kMaxPredictionHorizon,
+                    "Shridhar-Cooper: the prediction horizon P = 5 tau/Ts + theta/Ts + 1 = {:g} "
+                    "samples (tau = {} s, theta = {} s, Ts = {} s) exceeds the largest taken, "
+                    "{}: choose a sample time of at least {:.3g} s",
+                    r.P_unrounded, r.tau_used, f.theta, Ts, kMaxPredictionHorizon,
+                    (5.0 * r.tau_used + f.theta) / (kMaxPredictionHorizon - 1));
       r.P = options.P > 0 ? options.P : std::max(1, static_cast<int>(std::lround(r.P_unrounded)));
       // Five moves, or P when the horizon is shorter (a plant fast for Ts).
       r.M = options.M > 0 ? options.M : std::min(5, r.P);

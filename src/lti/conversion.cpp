@@ -24,6 +24,7 @@ using Eigen::VectorXd;
 // Splits a continuous delay into whole samples and a fractional remainder in
 // [0, Ts). A ratio within a relative 1e-9 of an integer counts as an integer.
 void SplitDelay(double delay, double Ts, int* whole, double* fraction) {
+  DelayInSamples(delay, Ts);  // throws for a count an int cannot hold
   const double r = delay / Ts;
   const double n = std::round(r);
   if (std::abs(r - n) <= 1e-9 * std::max(1.0, r)) {
@@ -133,7 +134,7 @@ TransferFunction C2DMatched(const TransferFunction& g, double Ts) {
   const VectorXd dz = poly::FromRoots(zp);
   VectorXd nfull = VectorXd::Zero(dz.size());
   nfull.tail(nz.size()) = nz;
-  const int d = static_cast<int>(std::lround(g.delay() / Ts));
+  const int d = DelayInSamples(g.delay(), Ts);
   return TransferFunction(nfull, dz, Ts, d * Ts);
 }
 

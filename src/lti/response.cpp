@@ -204,7 +204,7 @@ Eigen::MatrixXd Lsim(const StateSpace& g, const Eigen::MatrixXd& u, double dt,
   PNEUMID_CHECK(x0.size() == 0 || x0.size() == g.num_states(),
                 "lsim: x0 must have nx = {} entries (or none), got {}", g.num_states(), x0.size());
   const StateSpace gd = DiscretizeForLsim(g, dt);
-  const int d = static_cast<int>(std::lround(gd.delay() / dt));
+  const int d = DelayInSamples(gd.delay(), dt);
   const Eigen::Index n = gd.num_states();
   VectorXd x = VectorXd::Zero(n);
   if (x0.size() > 0) x.head(x0.size()) = x0;  // extra delay states start at rest
@@ -243,7 +243,7 @@ Eigen::VectorXd Lsim(const TransferFunction& g, const Eigen::VectorXd& u, double
     VectorXd b = VectorXd::Zero(n);
     b.tail(num.size()) = num / den[0];
     const VectorXd a = den / den[0];
-    const Eigen::Index d = std::lround(g.delay() / dt), N = u.size();
+    const Eigen::Index d = DelayInSamples(g.delay(), dt), N = u.size();
     VectorXd y(N);
     for (Eigen::Index k = 0; k < N; ++k) {
       double acc = 0.0;
@@ -256,7 +256,7 @@ Eigen::VectorXd Lsim(const TransferFunction& g, const Eigen::VectorXd& u, double
     return y;
   }
   const StateSpace gd = DiscretizeForLsim(ToStateSpace(g), dt);
-  const int d = static_cast<int>(std::lround(gd.delay() / dt));
+  const int d = DelayInSamples(gd.delay(), dt);
   return SimulateSiso(gd, u, d, VectorXd::Zero(gd.num_states()));
 }
 

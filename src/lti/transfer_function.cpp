@@ -148,7 +148,16 @@ int TransferFunction::DelaySamples() const {
   PNEUMID_CHECK(IsDiscrete(),
                 "DelaySamples() needs a discrete model; this one is continuous (delay = {} s)",
                 delay_);
-  return static_cast<int>(std::lround(delay_ / Ts_));
+  return DelayInSamples(delay_, Ts_);
+}
+
+int DelayInSamples(double delay, double Ts) {
+  const double samples = delay / Ts;
+  PNEUMID_CHECK(std::isfinite(samples) && samples >= 0.0 && samples <= kMaxDelaySamples,
+                "a delay of {} s at a sample time of {} s is {} samples; pneumid holds delays of "
+                "0 to {:g} samples (choose a longer sample time or check the delay's unit)",
+                delay, Ts, samples, kMaxDelaySamples);
+  return static_cast<int>(std::lround(samples));
 }
 
 TransferFunction TransferFunction::WithDelay(double delay) const {

@@ -109,6 +109,28 @@ TEST(TuningTest, RejectsBadInput) {
   EXPECT_THROW(Tune(unstable, kTs, TuningOptions{}), InvalidArgument);
 }
 
+// A sample time far below the plant's time scale gives a horizon of 1.25e9
+// samples (beyond an int, and gigabytes of dynamic matrix): an error naming
+// P and the shortest sample time that works, (5 tau + theta)/(Pmax - 1),
+// not an overflow or an allocation failure. Explicit horizons are bounded too.
+TEST(TuningTest, AHorizonBeyondTheLargestTakenIsAnError) {
+  EXPECT_THAT([] { Tune(PaperFopdtModel(), 1e-9, TuningOptions{}); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::AllOf(
+                  ::testing::HasSubstr("P = 5 tau/Ts + theta/Ts + 1 = 1.251e+09"),
+                  ::testing::HasSubstr("at least 1.25e-05 s"))));
+  // Just above the bound's sample time the rule works: P <= kMaxPredictionHorizon.
+  const TuningResult r = Tune(PaperFopdtModel(), 1.26e-5, TuningOptions{});
+  EXPECT_LE(r.P, kMaxPredictionHorizon);
+  EXPECT_GT(r.P, kMaxPredictionHorizon - 1000);
+  TuningOptions e;
+  e.rule = TuningRule::kExplicit;
+  e.P = 100000;
+  e.M = 50000;
+  e.lambda = 1.0;
+  EXPECT_THAT([&] { Tune(PaperFopdtModel(), kTs, e); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("M = 1000")));
+}
+
 // The keys of `pneumid tune --json` (a contract), in order; NaN as null.
 TEST(TuningTest, ToJsonKeepsTheCommandLineKeys) {
   TuningOptions o;

@@ -91,6 +91,14 @@ TEST(TransferFunctionTest, DiscreteDelayAndPadding) {
   const std::complex<double> z = std::exp(std::complex<double>(0, w * 0.1));
   const std::complex<double> expected = 0.5 * z / (z - 0.5) * std::pow(z, -3);
   EXPECT_NEAR(std::abs(g.FrequencyResponse(w) - expected), 0.0, 1e-14);
+  // round(delay / Ts), bounded: 3e9 samples would overflow an int (it
+  // came back as a negative delay), 1e300 too; both name the count.
+  EXPECT_EQ(DelayInSamples(0.3, 0.1), 3);
+  EXPECT_EQ(DelayInSamples(1e6, 0.01), 100000000);
+  EXPECT_THAT([] { DelayInSamples(3e7, 0.01); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("is 3000000000 samples")));
+  EXPECT_THROW(DelayInSamples(1.0, 1e-300), InvalidArgument);
+  EXPECT_THROW(DelayInSamples(-0.1, 0.1), InvalidArgument);
   // Common factors z^k are dropped.
   const TransferFunction h = TransferFunction::Discrete({1.0, 0.0, 0.0}, {1.0, 0.5, 0.0}, 0.1);
   EXPECT_EQ(h.Order(), 1);

@@ -36,6 +36,14 @@
 
 namespace pneumid {
 
+/// Largest prediction horizon (samples) the predictive controllers take
+/// (DMC, GPC, MPC options and the tuning rules): beyond it the dynamic
+/// matrix alone needs gigabytes, and a sample time that fine for the plant's
+/// time scale is the thing to change.
+inline constexpr int kMaxPredictionHorizon = 100000;
+/// Largest control horizon (moves): the QP's Hessian is M x M.
+inline constexpr int kMaxControlHorizon = 1000;
+
 /// A model sampled once at the controller's period Ts, with its step response, model
 /// horizon and dynamic matrix (file comment).
 class PredictionModel {

@@ -91,6 +91,16 @@ class TransferFunction {
   double delay_ = 0.0;
 };
 
+/// Largest delay in samples that a model may carry (1e8): a delay is held
+/// as an int count of samples and, in state space, as that many states.
+inline constexpr double kMaxDelaySamples = 1e8;
+
+/// round(delay / Ts), the delay of `delay` s in samples of `Ts` s.
+/// @throws InvalidArgument (naming both and the count) for a negative or
+/// non-finite count or one above kMaxDelaySamples: the conversion to int
+/// would overflow, and a model that long has no use.
+int DelayInSamples(double delay, double Ts);
+
 /// Polynomial helpers (descending powers).
 namespace poly {
 /// Roots of p(x) = p0 x^n + ... + pn (companion matrix eigenvalues).

@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 
 #include "pneumid/common/check.hpp"
+#include "pneumid/lti/transfer_function.hpp"
 #include "../tall_skinny_qr.hpp"
 
 namespace pneumid {
@@ -18,7 +19,7 @@ int CheckAndDelay(const StateSpace& sys, const Eigen::MatrixXd& u) {
                 u.cols(), sys.num_inputs());
   PNEUMID_CHECK(u.rows() > 0, "no samples");
   PNEUMID_CHECK(u.allFinite(), "the input contains a non-finite value");
-  return static_cast<int>(std::lround(sys.delay() / sys.Ts()));
+  return DelayInSamples(sys.delay(), sys.Ts());
 }
 
 }  // namespace
