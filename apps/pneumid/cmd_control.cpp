@@ -262,7 +262,8 @@ const Registrar reg(
           if (config.controller)
             ApplyControllerConfig(app, *config.controller, c->model, c->controller);
           if (app.count("--Ts") == 0) c->Ts = config.loop.period;
-          if (app.count("--plant") == 0 && config.io == "sim") c->plant = config.plant;
+          if (app.count("--plant") == 0 && config.io == "sim" && config.plant_given)
+            c->plant = config.plant;
         }
         PNEUMID_CHECK(!c->model.empty(),
                       "--model is required (or a --config file with [controller] model)");

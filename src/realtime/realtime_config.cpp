@@ -198,6 +198,7 @@ RealtimeConfig ParseRealtimeConfig(const std::string& text, const std::string& s
       r.Get(t, "io", "backend", &c.io);
       r.Convert(t, "backend", [](const std::string& s) { ParseIoSpec(s); });
       r.Get(t, "io", "plant", &c.plant);
+      c.plant_given = t.contains("plant");
     } else if (name == "safety") {
       r.CheckKeys(t, "safety",
                   {"u_min", "u_max", "rate_max", "y_min", "y_max", "frozen_samples",

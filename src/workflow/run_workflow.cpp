@@ -81,6 +81,9 @@ nlohmann::json RunWorkflowResult::ToJson() const {
 
 namespace {
 
+// The clamp of an unbounded input (finite, as SafetyOptions needs).
+constexpr double kUnboundedInput = 1e300;
+
 bool IsMatPath(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -99,16 +102,20 @@ ControllerSpec RunControllerSpec(const RunWorkflowOptions& o, const InputLimits&
 }
 
 // Without a clamp from the options or the configuration: the plant's input
-// range where it is finite (the position twin's -100..100 %), else the
-// safety defaults.
+// range where it is finite (the position twin's -100..100 %); a simulated
+// linear plant (a model spec, whose input is unbounded, as `control` takes
+// it) gets no clamp (+-1e300); a plant server or a rig the safety defaults.
 SafetyOptions RunSafety(const RunWorkflowOptions& o, const RealtimeConfig& config,
-                        const IoBackend& io) {
+                        const IoSpec& spec, const IoBackend& io) {
   SafetyOptions safety = config.safety;
   if (!o.safety.GivesClamp() && !config.safety_range_given) {
     const Actuator a = io.actuator();
     if (std::isfinite(a.u_min) && std::isfinite(a.u_max) && a.u_min < a.u_max) {
       safety.u_min = a.u_min;
       safety.u_max = a.u_max;
+    } else if (spec.kind == IoKind::kSim && std::isinf(a.u_min) && std::isinf(a.u_max)) {
+      safety.u_min = -kUnboundedInput;
+      safety.u_max = kUnboundedInput;
     }
   }
   return safety;
@@ -151,7 +158,7 @@ RunWorkflowResult RunRealtimeWorkflow(const RunWorkflowOptions& o, const Realtim
   const double Ts = config.loop.period;
   const TransferFunction model = ParseControllerModel(o.model);
   auto io = MakeIoBackend(spec, config, o.plant_options);
-  const SafetyOptions safety = RunSafety(o, config, *io);
+  const SafetyOptions safety = RunSafety(o, config, spec, *io);
   InputLimits limits;
   limits.u_min = safety.u_min;
   limits.u_max = safety.u_max;

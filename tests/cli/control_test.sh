@@ -165,4 +165,23 @@ expect_error "input map missing" "cannot open static map file" control --model f
 echo '{"num": [1], "den": [0.2, 1]}' > "$TMP/map_none.json"
 expect_error "input map absent" "holds no static map" control --model fopdt-paper --Ts 0.01 \
   --setpoint step:from=0,to=1,at=0 --duration 0.5 --input-map "$TMP/map_none.json"
+
+# A configuration without [io] plant: the plant is the model, as without
+# --plant (it was the IPA, whose 0..100 % duty a negative-gain model could
+# not drive, and the output stayed at 0).
+cat > "$TMP/neg.toml" <<'TOML'
+[controller]
+model = "fopdt:K=-2,tau=1,theta=0.1"
+type = "mpc"
+
+[loop]
+period = 0.05
+TOML
+expect_ok "config without a plant" control --config "$TMP/neg.toml" --setpoint step:to=1,at=1 \
+  --duration 10 --json
+check_json "the model is the plant" "j['plant'].startswith('fopdt:K=-2') and j['settled'] and abs(j['steady_state_error']) < 0.01 and j['u_min'] < -0.4"
+# run on a simulated linear plant: no 0..100 clamp either.
+expect_ok "run, linear plant" run --controller mpc --model fopdt:K=-2,tau=0.5,theta=0.05 \
+  --plant fopdt:K=-2,tau=0.5,theta=0.05 --fast --setpoint step:to=1,at=0.5 --duration 4 --json
+check_json "run reaches the set-point" "j['metrics']['settled'] and abs(j['metrics']['steady_state_error']) < 0.01"
 finish

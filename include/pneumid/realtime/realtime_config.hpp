@@ -50,6 +50,9 @@ struct RealtimeConfig {
   SafetyOptions safety;       ///< [safety]: limits, fault detection, safe state
   std::string io = "sim";     ///< --io spec
   std::string plant = "ipa";  ///< plant of the sim backend (MakePlant spec)
+  /// [io] gave the plant (`control --config` simulates the model otherwise,
+  /// as `control` does without --plant; `run` the default "ipa").
+  bool plant_given = false;
   UdpBackendOptions udp;      ///< [udp]: used by a udp:// backend (host, port from io)
   ComediConfig comedi;        ///< [comedi]: used by a comedi backend (device from io)
   LogWriterOptions log;       ///< [log]: flushing and buffer capacity
