@@ -198,11 +198,11 @@ const Registrar reg(
       app.add_option("--utilization", c->utilization,
                      "Fraction of the period the controller may take")
           ->capture_default_str()
-          ->check(CLI::Range(1e-6, 1.0));
+          ->check(InRange(1e-6, 1.0));
       app.add_option("--cycles-per-instruction", c->cycles_per_instruction,
                      "Cycles per instruction assumed on the target (>= 1)")
           ->capture_default_str()
-          ->check(CLI::Range(1.0, 100.0));
+          ->check(InRange(1.0, 100.0));
       app.add_option("-o,--output", c->output, "Directory to write NAME.h, NAME.c, README.md into")
           ->required();
       app.add_option("--with-plant", c->with_plant,

@@ -27,6 +27,7 @@
 #include "pneumid/report/plot.hpp"
 #include "pneumid/workflow/identify_workflow.hpp"
 #include "progress.hpp"
+#include "validators.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -311,7 +312,7 @@ static Registrar reg(
       app.add_option("--settle", args->nonlinear.static_map.settle_fraction,
                      "static-map: fraction of each constant-input segment averaged (its end)")
           ->capture_default_str()
-          ->check(CLI::Range(0.01, 1.0));
+          ->check(InRange(0.01, 1.0));
       app.add_option("--min-segment", args->nonlinear.static_map.min_segment_duration,
                      "static-map: shortest constant-input segment used, s")
           ->capture_default_str()
@@ -341,7 +342,7 @@ static Registrar reg(
       app.add_option("--err-tolerance", args->nonlinear.narx.err_tolerance,
                      "narx: stop when 1 - sum ERR falls below this")
           ->capture_default_str()
-          ->check(CLI::Range(1e-15, 0.999999));
+          ->check(InRange(1e-15, 0.999999));
       app.add_option("--loss", args->loss, "Loss of the fit-* methods: none, huber, cauchy")
           ->capture_default_str();
       app.add_flag("--json", args->json,
@@ -356,9 +357,10 @@ static Registrar reg(
                      "simulation fit on it")
           ->check(CLI::ExistingFile);
       app.add_option("--split", args->split,
-                     "Estimate on the first fraction of DATA (e.g. 0.7) and rank by the fit on "
-                     "the rest")
-          ->check(CLI::Range(0.0, 1.0));
+                     "Estimate on the first fraction of DATA (0 < F < 1, e.g. 0.7) and rank by "
+                     "the fit on the rest (0, the default: the structure is chosen on the last "
+                     "30 % and the models estimated on the whole record)")
+          ->check(InRange(0.0, 1.0));
       app.add_flag("--progress", args->progress,
                    "Draw the progress bar even when stderr is not a terminal");
       app.callback([args, na, nb, nk, max_terms] {

@@ -85,9 +85,11 @@ const Registrar reg(
       app.add_option("--measure", c->measure,
                      "auto: what --response-time measures, rise (10-90 %, default) or settling "
                      "(2 %)");
-      app.add_option("--overshoot", c->overshoot, "auto: maximum overshoot in percent (default 5)");
+      app.add_option("--overshoot", c->overshoot, "auto: maximum overshoot in percent (default 5)")
+          ->check(NonNegative());
       app.add_option("--aggressiveness", c->aggressiveness,
-                     "auto: 0 robust .. 1 aggressive (default 0.5)");
+                     "auto: 0 robust .. 1 aggressive (default 0.5)")
+          ->check(InRange(0.0, 1.0));
       app.add_option("--u-min", c->u_min, "auto: lower input limit");
       app.add_option("--u-max", c->u_max, "auto: upper input limit");
       app.add_option("--du-max", c->du_max, "auto: largest input change per sample");

@@ -44,7 +44,7 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
       ->check(NonNegative());
   app.add_option("--aggressiveness", s.aggressiveness, "--rule auto: 0 robust .. 1 aggressive")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(InRange(0.0, 1.0));
   app.add_option("--P", s.P, "Prediction horizon (samples)")->check(AtLeast(1));
   app.add_option("--M", s.M, "Control horizon (samples)")->check(AtLeast(1));
   app.add_option("--lambda", s.lambda, "Move suppression")->check(NonNegative());

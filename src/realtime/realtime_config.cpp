@@ -1,5 +1,6 @@
 #include "pneumid/realtime/realtime_config.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -143,6 +144,21 @@ void ParseControllerSection(const Reader& r, const toml::table& t, RealtimeConfi
   r.Get(t, "controller", "y_valid_max", &s.y_valid_max);
   r.Get(t, "controller", "safe_input", &s.safe_input);
   for (const auto& [k, v] : t) cc.keys.emplace_back(k.str());
+  // NaN stands for "the rule's value" in ControllerSettings, and 0 for the
+  // rule's horizons: a file that writes them would silently get the rule's.
+  for (const auto& [k, v] : t) {
+    if (const auto* d = v.as_floating_point(); d != nullptr && std::isnan(d->get()))
+      r.Fail(v, fmt::format("[controller] {} must be a number, got nan (leave the key out for the "
+                            "rule's value)",
+                            k.str()));
+  }
+  for (const char* key : {"P", "M"}) {
+    if (const toml::node* n = t.get(key); n != nullptr && n->is_integer() &&
+                                          n->as_integer()->get() < 1)
+      r.Fail(*n, fmt::format("[controller] {} must be >= 1, got {} (leave the key out for the "
+                             "rule's value)",
+                             key, n->as_integer()->get()));
+  }
   // A model file named relative to the configuration is found beside it.
   const auto hash = cc.model.find('#');
   const std::filesystem::path file = cc.model.substr(0, hash);

@@ -180,6 +180,17 @@ TOML
 expect_ok "config without a plant" control --config "$TMP/neg.toml" --setpoint step:to=1,at=1 \
   --duration 10 --json
 check_json "the model is the plant" "j['plant'].startswith('fopdt:K=-2') and j['settled'] and abs(j['steady_state_error']) < 0.01 and j['u_min'] < -0.4"
+# NaN or a zero horizon in [controller] would stand for the rule's value: an error.
+printf '[controller]\nmodel = "fopdt-paper"\ntype = "mpc"\nlambda = nan\n' > "$TMP/nan.toml"
+expect_error "lambda = nan" "nan.toml:4:10: [controller] lambda must be a number, got nan" \
+  control --config "$TMP/nan.toml" --setpoint step:to=1 --duration 1
+printf '[controller]\nmodel = "fopdt-paper"\ntype = "dmc"\nM = 0\n' > "$TMP/m0.toml"
+expect_error "M = 0" "[controller] M must be >= 1, got 0" control --config "$TMP/m0.toml" \
+  --setpoint step:to=1 --duration 1
+expect_error "aggressiveness nan" "--aggressiveness: must be in [0, 1], got nan" tune \
+  --model fopdt-paper --Ts 0.01 --rule auto --aggressiveness nan
+expect_error "overshoot nan" "--overshoot: must be >= 0, got nan" tune --model fopdt-paper \
+  --Ts 0.01 --rule auto --overshoot nan
 # run on a simulated linear plant: no 0..100 clamp either.
 expect_ok "run, linear plant" run --controller mpc --model fopdt:K=-2,tau=0.5,theta=0.05 \
   --plant fopdt:K=-2,tau=0.5,theta=0.05 --fast --setpoint step:to=1,at=0.5 --duration 4 --json

@@ -70,7 +70,7 @@ expect_error "noise without auto" "apply to --rule auto only" tune --model fopdt
 expect_ok "auto impossible" tune --rule auto --model fopdt-paper --Ts 0.01 --response-time 0.001 --u-min 0 --u-max 100 --json
 check_json "auto impossible" "j['termination'] == 'spec_not_met' and any(r['check'] == 'specification' and r['status'] == 'fail' and 'input held at its limit' in r['message'] for r in j['review'])"
 expect_error "auto gpc" "not gpc" tune --rule auto --controller gpc --model fopdt-paper --Ts 0.01
-expect_error "auto knob" "aggressiveness must be in [0, 1]" tune --rule auto --model fopdt-paper --Ts 0.01 --aggressiveness 2
+expect_error "auto knob" "--aggressiveness: must be in [0, 1], got 2" tune --rule auto --model fopdt-paper --Ts 0.01 --aggressiveness 2
 expect_error "auto flags without auto" "apply to --rule auto only" tune --model fopdt-paper --Ts 0.01 --overshoot 3
 # --plant: the plant's input range bounds the design, as in `control --plant`,
 # so both print the same settings (on the IPA: duty 0..100 %).
