@@ -237,6 +237,9 @@ InputStep EvaluationInputStep(const InputLimits& limits, double K) {
   return input;
 }
 
+/// Largest evaluation window in samples (AutoTune simulates every candidate over it).
+constexpr double kMaxEvaluationSamples = 1e6;
+
 /// The evaluation in deviation variables: the step of `result`, the window of
 /// 10 max(t*, tau + theta) after it, the limits relative to the input before
 /// the step, and the nominal and perturbed plants of the robustness rows.
@@ -249,6 +252,18 @@ Evaluator MakeEvaluator(const TransferFunction& model, double Ts, const AutoTune
   evaluator.t_step = 5.0 * Ts;
   evaluator.window =
       std::max(10.0 * std::max(result.response_time_aimed, fopdt.tau + fopdt.theta), 50.0 * Ts);
+  // Every candidate is simulated over the window: a response time or a
+  // time constant of thousands of sample times would take minutes and
+  // gigabytes, and asks for a longer sample time.
+  PNEUMID_CHECK(evaluator.window / Ts <= kMaxEvaluationSamples,
+                "the evaluation window, 10 max(t* = {:g} s, tau + theta = {:g} s) = {:g} s, holds "
+                "{:.3g} samples of Ts = {:g} s, more than the {:g} the tuner simulates: ask for a "
+                "response time of at most {:.3g} s{}",
+                result.response_time_aimed, fopdt.tau + fopdt.theta, evaluator.window,
+                evaluator.window / Ts, Ts, kMaxEvaluationSamples, kMaxEvaluationSamples * Ts / 10.0,
+                fopdt.tau + fopdt.theta > kMaxEvaluationSamples * Ts / 10.0
+                    ? " and a longer sample time (the model's time scale needs one)"
+                    : " or choose a longer sample time");
   evaluator.limits = options.limits;
   evaluator.limits.u_min -= input_before_step;
   evaluator.limits.u_max -= input_before_step;
@@ -291,6 +306,16 @@ struct ChosenDesign {
 // ---------------------------------------------------------------------------
 // mpc/dmc: the search over the move suppression lambda
 
+/// Condition number of a symmetric matrix (infinite when it is singular).
+double ConditionNumber(const Eigen::MatrixXd& symmetric) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(symmetric, Eigen::EigenvaluesOnly);
+  const double eig_min = eig.eigenvalues().minCoeff(), eig_max = eig.eigenvalues().maxCoeff();
+  return eig_min > 0.0 ? eig_max / eig_min : kInf;
+}
+
+/// The review's bound on the QP Hessian condition (above it: fail).
+constexpr double kMaxHessianCondition = 1e8;
+
 /// The mpc or dmc controller of the horizons P, M for a move suppression
 /// lambda, built as MakeController builds it (MakePredictiveController) on
 /// the design's sampled model.
@@ -308,11 +333,14 @@ struct PredictiveControllerFactory {
   }
 
   /// The QP Hessian of lambda: the MPC's H, or A'A + lambda I for DMC.
-  Eigen::MatrixXd Hessian(double lambda) const {
-    const std::unique_ptr<Controller> controller = Make(lambda);
-    if (const auto* mpc = dynamic_cast<const MpcController*>(controller.get()))
+  Eigen::MatrixXd Hessian(double lambda) const { return Hessian(*Make(lambda), lambda); }
+
+  /// The same of `controller`, made by Make(lambda).
+  static Eigen::MatrixXd Hessian(const Controller& made, double lambda) {
+    const Controller* controller = &made;
+    if (const auto* mpc = dynamic_cast<const MpcController*>(controller))
       return mpc->hessian();
-    const auto* dmc = dynamic_cast<const DmcController*>(controller.get());
+    const auto* dmc = dynamic_cast<const DmcController*>(controller);
     PNEUMID_CHECK(dmc != nullptr, "the auto-tuner designs mpc or dmc, got {}",
                   controller->Describe());
     const Eigen::MatrixXd& A = dmc->dynamic_matrix();
@@ -323,22 +351,48 @@ struct PredictiveControllerFactory {
 /// Closed-loop evaluation of the lambda candidates of the search.
 class LambdaCandidates {
  public:
+  /// `robust_time_factor`: for the fastest robust design (no response time
+  /// given), each robustness row must also respond within this factor of the
+  /// candidate's own nominal response time, and the QP Hessian's condition
+  /// must stay within kMaxHessianCondition, as the review then asks of the
+  /// design (its t* is that response time); NaN otherwise.
   LambdaCandidates(const PredictiveControllerFactory& factory, Evaluator& evaluator,
-                   double max_overshoot, double robust_overshoot)
+                   double max_overshoot, double robust_overshoot,
+                   double robust_time_factor = kNaN)
       : factory_(factory),
         evaluator_(evaluator),
         max_overshoot_(max_overshoot),
-        robust_overshoot_(robust_overshoot) {}
+        robust_overshoot_(robust_overshoot),
+        robust_time_factor_(robust_time_factor) {}
 
   /// feasible(lambda): the nominal step meets OS and every robustness row
-  /// settles within OS_rob (the rows stop at the first that does not).
+  /// settles within OS_rob (the rows stop at the first that does not); for
+  /// the fastest robust design also the response times and the condition
+  /// above. Without the latter a plant twice as slow as the reach of the
+  /// move suppression (sopdt tau 1 s and 0.5 s at Ts = 0.01 s) got lambda =
+  /// 1.9e-5, cond(H) = 1.1e8, and a gain -20 % row 2.4 times slower than
+  /// the nominal step: a design its own review failed.
   bool Feasible(double lambda) {
     const std::unique_ptr<Controller> controller = factory_.Make(lambda);
-    bool feasible = NominalStepMeetsOvershoot(evaluator_.Run(*controller, 0), max_overshoot_);
-    for (int i = 1; feasible && i < kPlantCount; ++i)
-      feasible = RobustRowStable(evaluator_.Run(*controller, i), robust_overshoot_);
+    const PredictedMetrics nominal = evaluator_.Run(*controller, 0);
+    bool feasible = NominalStepMeetsOvershoot(nominal, max_overshoot_);
+    const bool fastest = !std::isnan(robust_time_factor_);
+    if (feasible && fastest)
+      feasible = ConditionNumber(PredictiveControllerFactory::Hessian(*controller, lambda)) <=
+                 kMaxHessianCondition;
+    const double t_allowed = !std::isnan(rows_within_) ? rows_within_
+                             : fastest ? robust_time_factor_ * OrInf(nominal.response_time)
+                                       : kInf;
+    for (int i = 1; feasible && i < kPlantCount; ++i) {
+      const PredictedMetrics row = evaluator_.Run(*controller, i);
+      feasible = RobustRowStable(row, robust_overshoot_) && OrInf(row.response_time) <= t_allowed;
+    }
     return feasible;
   }
+
+  /// From now on the robustness rows of the fastest robust design must
+  /// respond within `t` s (the review's bound, once t* is known).
+  void HoldRowsWithin(double t) { rows_within_ = t; }
 
   /// t(lambda): the nominal response time (infinite when there is none).
   double ResponseTime(double lambda) {
@@ -351,6 +405,8 @@ class LambdaCandidates {
   Evaluator& evaluator_;
   double max_overshoot_;
   double robust_overshoot_;
+  double robust_time_factor_;
+  double rows_within_ = kNaN;
 };
 
 /// lambda_f, the smallest feasible lambda: an ascending scan of 4 points per
@@ -460,7 +516,8 @@ ChosenDesign SearchPredictiveDesign(const PredictionModel& model, const AutoTune
   spec.state_noise = options.state_noise;
   spec.disturbance_noise = options.disturbance_noise;
 
-  LambdaCandidates candidates(*factory, evaluator, options.max_overshoot, result.robust_overshoot);
+  LambdaCandidates candidates(*factory, evaluator, options.max_overshoot, result.robust_overshoot,
+                              result.fastest ? 1.5 + options.aggressiveness : kNaN);
   ChosenDesign chosen;
   // Nothing robust: take the Shridhar-Cooper value and let the review say why.
   double lambda_star = lambda0;
@@ -479,6 +536,9 @@ ChosenDesign SearchPredictiveDesign(const PredictionModel& model, const AutoTune
     } else {
       // Hardly slower: 2 % of t* (0.5 % for the fastest robust design).
       const double t_ok = chosen.t_fastest + (result.fastest ? 0.005 : 0.02) * t_aim;
+      // The rows of a design hardly slower than lambda_f are held to the
+      // review's bound, (1.5 + a) t* with t* lambda_f's response.
+      if (result.fastest) candidates.HoldRowsWithin(result.robust_response_time);
       lambda_star = LargestLambdaAsFast(candidates, lambda_f, t_ok);
     }
   }
@@ -791,17 +851,10 @@ ReviewItem OffsetFreeItem(double steady_state_error, double load) {
                       load, steady_state_error)};
 }
 
-/// Condition number of a symmetric matrix (infinite when it is singular).
-double ConditionNumber(const Eigen::MatrixXd& symmetric) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(symmetric, Eigen::EigenvaluesOnly);
-  const double eig_min = eig.eigenvalues().minCoeff(), eig_max = eig.eigenvalues().maxCoeff();
-  return eig_min > 0.0 ? eig_max / eig_min : kInf;
-}
-
 /// QP Hessian condition: ok <= 1e4, warning <= 1e8, else fail.
 ReviewItem HessianConditionItem(double condition, ControllerType controller) {
-  const ReviewStatus status = condition <= 1e4   ? ReviewStatus::kOk
-                              : condition <= 1e8 ? ReviewStatus::kWarning
+  const ReviewStatus status = condition <= 1e4                    ? ReviewStatus::kOk
+                              : condition <= kMaxHessianCondition ? ReviewStatus::kWarning
                                                  : ReviewStatus::kFail;
   return {
       "QP Hessian condition", status,

@@ -407,6 +407,7 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
     b.auto_summary = a.message;
     b.auto_response_time = a.response_time_target;
     b.auto_fastest = a.fastest;
+    b.auto_converged = a.termination == AutoTuneTermination::kConverged;
     PidOptions o;
     o.gains = a.pid;
     o.setpoint_weight = a.setpoint_weight;
@@ -484,6 +485,7 @@ BuiltController BuildController(const PredictionModel& model, const ControllerSp
   b.auto_summary = a.message;
   b.auto_response_time = a.response_time_target;
   b.auto_fastest = a.fastest;
+  b.auto_converged = a.termination == AutoTuneTermination::kConverged;
   b.tuning = a.ToTuningResult();
   if (qdmc_for_limits)
     b.tuning.formula +=

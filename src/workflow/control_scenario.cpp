@@ -181,6 +181,12 @@ ControlScenarioResult RunControlScenario(const ControlScenarioOptions& o) {
     ControlScenarioRun run;
     run.built = MakeController(model, o.Ts, spec);
     run.result = SimulateClosedLoop(*run.built.controller, *plant, *setpoint, loop);
+    if (!run.built.auto_summary.empty() && !run.built.auto_converged)
+      result.warnings.push_back(fmt::format(
+          "the rule auto found no design that meets the specification on the model and on every "
+          "robustness row (gain +-20 %, one more sample of dead time), and runs the best it "
+          "found: {} (`pneumid tune --rule auto` prints the review)",
+          run.built.auto_summary));
     result.runs.push_back(std::move(run));
     plant.reset();
   }

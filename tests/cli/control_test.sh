@@ -191,6 +191,14 @@ expect_error "aggressiveness nan" "--aggressiveness: must be in [0, 1], got nan"
   --model fopdt-paper --Ts 0.01 --rule auto --aggressiveness nan
 expect_error "overshoot nan" "--overshoot: must be >= 0, got nan" tune --model fopdt-paper \
   --Ts 0.01 --rule auto --overshoot nan
+# The rule auto that cannot meet its specification says so (it ran silently).
+expect_ok "auto, impossible target" control --rule auto --model fopdt-paper --Ts 0.01 \
+  --response-time 0.001 --setpoint step:to=1 --duration 1 --json
+check_json "auto warning" "any('the rule auto found no design' in w for w in j['warnings'])"
+check_output "auto warning on stderr" "the rule auto found no design" "$TMP/err"
+expect_ok "auto, met" control --rule auto --model fopdt-paper --Ts 0.01 --setpoint step:to=1 \
+  --duration 1 --json
+check_json "no auto warning" "j['warnings'] == []"
 # run on a simulated linear plant: no 0..100 clamp either.
 expect_ok "run, linear plant" run --controller mpc --model fopdt:K=-2,tau=0.5,theta=0.05 \
   --plant fopdt:K=-2,tau=0.5,theta=0.05 --fast --setpoint step:to=1,at=0.5 --duration 4 --json

@@ -32,7 +32,14 @@
 // MPC and DMC [3, 4, 5]: P by Shridhar-Cooper from the model's settling time,
 // P = round(5 tau/Ts + theta/Ts + 1), M = 5 (M <= P) [5]; then the move
 // suppression lambda by a search in log lambda on the closed-loop simulation:
-//   feasible(lambda) = nominal OS <= OS and every robustness row passes;
+//   feasible(lambda) = nominal OS <= OS and every robustness row settles
+//              within OS_rob; for the fastest robust design (no t_r given)
+//              also each row responds within (1.5 + a) times the
+//              candidate's own nominal response (t_rob of that design) and
+//              the QP Hessian's condition is at most 1e8, the review's two
+//              other demands (without them a sopdt with tau 1 s and 0.5 s
+//              at Ts = 0.01 s got lambda = 1.9e-5, cond 1.1e8 and a failed
+//              review);
 //   lambda_f = the smallest feasible lambda (a scan of 4 points per decade over
 //              lambda_0 10^-6 .. lambda_0 10^4, lambda_0 = lambda_max(A'A)/500
 //              the Shridhar-Cooper value, refined by bisection of log lambda);

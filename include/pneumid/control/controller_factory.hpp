@@ -204,6 +204,10 @@ struct BuiltController {
   double auto_response_time = std::numeric_limits<double>::quiet_NaN();
   /// Rule "auto": t_r is the fastest robust design's (no response time given).
   bool auto_fastest = false;
+  /// Rule "auto": the design met the specification on the model and on every
+  /// robustness row (AutoTuneTermination::kConverged); false otherwise and
+  /// for other rules.
+  bool auto_converged = false;
 
   /// "pid" for a PID, "auto" for settings tuned to specifications, else the
   /// tuning rule's name (as in a comparison table).
