@@ -1,5 +1,6 @@
 #include "pneumid/identify/parametric/parametric.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gmock/gmock.h>
@@ -118,6 +119,38 @@ TEST(Parametric, OperatingPointLetsRawDataWithOffsetsNeedNoDetrending) {
   EXPECT_EQ(OperatingPointKindFromString("initial"), OperatingPointKind::kInitial);
   EXPECT_EQ(ToString(OperatingPointKind::kAuto), "auto");
   EXPECT_THROW(OperatingPointKindFromString("median"), InvalidArgument);
+}
+
+// A record that starts at rest away from zero (40 samples at u = 20 %,
+// y = 40 N of the paper's ARX, then a PRBS around it): modelled around that
+// rest, the exact model simulates the record from rest as it starts, 100 %,
+// with white residuals. Around the means (what auto took) the same
+// coefficients started 0.3 N off and scored 95 % with residuals_not_white;
+// the raw signals, from rest at zero, worse still.
+TEST(Parametric, ARecordStartingAtRestIsModelledAroundThatRest) {
+  const PolynomialModel truth = testing::PaperArx();
+  const Eigen::Index n = 600, rest = 40;
+  Eigen::VectorXd du = Eigen::VectorXd::Zero(n);
+  du.tail(n - rest) = testing::Prbs(n - rest, -5.0, 5.0, 3, 7);
+  const Eigen::VectorXd dy = testing::SimulateArx(truth, du, Eigen::VectorXd::Zero(n));
+  const double gain = 1.59796;  // the paper's ARX static gain
+  const Dataset d = Dataset::FromUniform(0.01, (du.array() + 20.0).matrix(),
+                                         (dy.array() + gain * 20.0).matrix(), 0.0);
+  for (const char* method : {"arx", "iv4", "oe"}) {
+    SCOPED_TRACE(method);
+    const IdentifiedModel m = IdentifyParametric(method, d, IdentifyRequest{});
+    EXPECT_NEAR(m.u0, 20.0, 1e-9);
+    EXPECT_NEAR(m.y0, gain * 20.0, 1e-6);
+    EXPECT_THAT(m.notes.front(), HasSubstr("the rest the record starts at"));
+    EXPECT_GT(m.fit_percent, 99.99);
+    EXPECT_TRUE(std::none_of(m.flags.begin(), m.flags.end(), [](const ModelFlagNote& f) {
+      return f.flag == ModelFlag::kResidualsNotWhite;
+    }));
+  }
+  // With the mean as operating point the same data score less from rest.
+  IdentifyRequest mean;
+  mean.operating_point = OperatingPointKind::kMean;
+  EXPECT_LT(IdentifyParametric("arx", d, mean).fit_percent, 99.0);
 }
 
 TEST(Parametric, EveryMethodFitsNoisyPaperData) {
