@@ -109,14 +109,15 @@ IdentifiedModel IdentifyStepMethod(const std::string& method, const Dataset& dat
       SetDiagonalCovariance(&m, names);
     }
     m.tf = r.tf;
-    if (r.summary.termination != Termination::kConvergence) {
-      m.notes.push_back(r.summary.BriefReport());
-    }
+    // Every fit says how it ended and where it started from (the brief
+    // report: termination, iterations, cost, the initial guess's source).
+    m.notes.push_back(r.summary.BriefReport());
     if (!r.summary.covariance_ok) {
       m.notes.push_back("parameter standard deviations unavailable (singular Jacobian)");
     }
     m.termination = r.summary.termination;
     SetOperatingPoint(data, in, out, &m);
+    m.u0 = r.params.u0;  // the input rest the fit used (it may not be u(0))
     ScoreModel(data, in, out, &m);
     return m;
   }

@@ -24,7 +24,14 @@
 // (up to the next input change), are a clean settled step (reaction curve for
 // P1D, three-point SOPDT for P2D/P2DU/P3D); for P1DI from the final ramp;
 // otherwise from a grid search over 16 lags (2 Ts to a quarter of the record)
-// and 4 delays (0, 0.1, 0.3, 1 lag) with K and y0 by linear least squares.
+// and delays (0, 0.1, 0.3, 1 lag, and 0, 1, 2, 3 samples then 1.4 times
+// apart up to a quarter of the record) with K and y0 by linear least
+// squares. The model is y = y0 + G (u - u0) with u0 the input's rest before
+// the record: the input before its first change; when the input changes
+// within the first max(3, N/100) samples (white noise, a chirp, a PRBS
+// from the start: no rest), also zero and the input's mean, each fitted
+// from its best grid point, the lowest cost kept (P1DI then also from the
+// grid, the ramp's lag and delay among its points).
 // With a zero, the fit starts from the converged model without it, with Tz = 0
 // and Tz = +-(second lag, at least T1/5); the lowest cost is kept.
 // Parameter standard deviations: sigma^2 = 2 cost / (N - p) and
@@ -36,6 +43,7 @@
 //     (Problem, Solver, Covariance).
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -79,6 +87,10 @@ struct ProcessParams {
   double Tz = 0.0;                      ///< zero time constant
   double theta = 0.0;                   ///< delay
   double y0 = 0.0;                      ///< output offset (initial steady state)
+  /// Input of that steady state (not fitted): the model is
+  /// y = y0 + G (u - u0). NaN in a guess: the input before its first change;
+  /// FitProcessModel's result always gives the one it used.
+  double u0 = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Structure, loss and Levenberg-Marquardt settings of FitProcessModel.
