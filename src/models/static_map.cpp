@@ -142,6 +142,17 @@ std::optional<double> StaticMap::NearestPreimage(double y, double u_near) const 
   return best;
 }
 
+double StaticMap::NearestPreimageOrEnd(double y, double u_near) const {
+  if (const std::optional<double> u = NearestPreimage(y, u_near)) return *u;
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < u_.size(); ++i) {
+    const double d = std::abs(y_[i] - y), d_best = std::abs(y_[best] - y);
+    if (d < d_best || (d == d_best && std::abs(u_[i] - u_near) < std::abs(u_[best] - u_near)))
+      best = i;
+  }
+  return u_[best];
+}
+
 std::optional<FlatSegment> StaticMap::DeadZone(double tolerance) const {
   PNEUMID_CHECK(tolerance >= 0.0, "the flat-segment tolerance must be >= 0, got {}", tolerance);
   std::size_t k = 0;

@@ -103,10 +103,17 @@ TEST(NonlinearMethodsTest, AWienerModelWhoseOutputMapTurnsStartsAtTheFirstMeasur
   const Eigen::VectorXd yhat = SimulateNonlinear(w, Dataset::FromUniform(Ts, u, y), 0, 0);
   ASSERT_EQ(yhat.size(), n);
   EXPECT_LT((yhat - y).cwiseAbs().maxCoeff(), 1e-9);
-  // A first output the map never reaches (150): at rest at the first input,
-  // f(40) = 40.
+  // A first output the map never reaches (150): the state of the knot whose
+  // value is nearest it, x = 100 with g = 100 (before: at rest at the first
+  // input, g(40) = 40, 110 away; a record 0.01 below the lowest value by
+  // noise so started at the rest of the first input). Without a measured
+  // output: at rest at the first input.
   const Dataset beyond = Dataset::FromUniform(Ts, u, Eigen::VectorXd::Constant(n, 150.0));
-  EXPECT_NEAR(SimulateNonlinear(w, beyond, 0, 0)[0], 40.0, 1e-9);
+  EXPECT_NEAR(SimulateNonlinear(w, beyond, 0, 0)[0], 100.0, 1e-9);
+  EXPECT_NEAR(SimulateNonlinear(w, beyond, 0, -1)[0], 40.0, 1e-9);
+  EXPECT_EQ(w.output_map->NearestPreimageOrEnd(150.0, 40.0), 100.0);
+  EXPECT_EQ(w.output_map->NearestPreimageOrEnd(-5.0, 40.0), 0.0);
+  EXPECT_EQ(w.output_map->NearestPreimageOrEnd(25.0, 40.0), 25.0);  // a preimage
 }
 
 TEST(NonlinearMethodsTest, StaticMapOfAStaircaseAndErrorsOnAStepTest) {

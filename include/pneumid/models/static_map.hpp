@@ -115,6 +115,13 @@ class StaticMap {
   /// std::nullopt when y lies outside [min y_i, max y_i].
   /// @throws InvalidArgument for a NaN y or u_near.
   std::optional<double> NearestPreimage(double y, double u_near) const;
+  /// NearestPreimage, and for a y outside [min y_i, max y_i] the knot whose
+  /// value is nearest y (of two such knots, the one nearer u_near): the
+  /// state a model with this output map starts from to show the first
+  /// measured output y, also when the measurement lies a little beyond the
+  /// map's values (noise at the rest the map's lowest knot holds).
+  /// @throws InvalidArgument for a NaN y or u_near.
+  double NearestPreimageOrEnd(double y, double u_near) const;
 
   /// The flat run at the low-input end (the knots whose values differ from
   /// y_0 by at most `tolerance`, output units, >= 0), when it spans at least

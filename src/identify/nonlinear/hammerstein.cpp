@@ -102,11 +102,15 @@ T OutputMap(const std::vector<double>& knots, const T* beta, const T& x) {
 
 // The rest x of the linear part whose output-map value is the first measured
 // output y0: the preimage under the piecewise-linear map (values beta on the
-// knots) nearest to `near` (the rest at the first input), or `near` itself
-// when y0 lies outside the map's values (as SimulateNonlinear starts a
-// Wiener or Hammerstein-Wiener model on a record). StaticMap::NearestPreimage
-// for the parameters as Ceres varies them (T a Jet in the cost functors);
-// the estimates themselves use NearestPreimage.
+// knots) nearest to `near` (the rest at the first input), or the knot whose
+// value is nearest y0 when y0 lies outside the map's values (as
+// SimulateNonlinear starts a Wiener or Hammerstein-Wiener model on a
+// record). StaticMap::NearestPreimageOrEnd for the parameters as Ceres
+// varies them (T a Jet in the cost functors); the estimates themselves use
+// NearestPreimageOrEnd. Before, y0 outside the values started the record at
+// `near`: a linear plant at rest at zero whose record starts with u = 6.67
+// and y = 0 (0.01 below the map's lowest value, by noise) was fitted 90 %
+// (noise-free: 72 %) with a kinked map.
 template <typename T>
 T RestFromFirstOutput(const std::vector<double>& knots, const T* beta, double y0, const T& near) {
   T best = near;
@@ -121,7 +125,15 @@ T RestFromFirstOutput(const std::vector<double>& knots, const T* beta, double y0
       best = x;
     }
   }
-  return best;
+  if (std::isfinite(distance)) return best;
+  std::size_t end = 0;  // y0 beyond the values: the knot of the nearest value
+  for (std::size_t j = 1; j < knots.size(); ++j) {
+    const double d = std::abs(Value(beta[j]) - y0), d_end = std::abs(Value(beta[end]) - y0);
+    if (d < d_end ||
+        (d == d_end && std::abs(knots[j] - Value(near)) < std::abs(knots[end] - Value(near))))
+      end = j;
+  }
+  return T(knots[end]);
 }
 
 // Simulation errors y - yhat of the Hammerstein model, from the rest that
@@ -561,7 +573,7 @@ BlockModelResult EstimateWiener(const Eigen::VectorXd& u, const Eigen::VectorXd&
   if (o.knots.empty()) {  // placed here, not given
     std::vector<double> final_x;
     SimulateUnitGainFrom(theta.data(), l, v, &final_x,
-                         f.NearestPreimage(y[0], v[0]).value_or(v[0]));
+                         f.NearestPreimageOrEnd(y[0], v[0]));
     f = TrimToRange(f, final_x);
   }
   return Finish(theta, l, Ts, std::move(f), std::move(s));
@@ -622,7 +634,7 @@ BlockModelResult EstimateHammersteinWiener(const Eigen::VectorXd& u, const Eigen
   const std::vector<double> final_v = MapThroughTents(fv.data(), tents);
   const StaticMap output_map = MapOf(out_knots, theta, lj.map_offset() + m - 2);
   SimulateUnitGainFrom(theta.data(), lj, final_v, &final_x,
-                       output_map.NearestPreimage(y[0], final_v[0]).value_or(final_v[0]));
+                       output_map.NearestPreimageOrEnd(y[0], final_v[0]));
   r.output_map = TrimToRange(output_map, final_x);
   return r;
 }

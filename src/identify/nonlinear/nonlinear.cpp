@@ -738,14 +738,13 @@ Eigen::VectorXd SimulateNonlinear(const IdentifiedModel& model, const Dataset& d
     double v_rest = v[0];
     if (y_first && gain) {
       const auto [lo, hi] = std::minmax_element(out.y().begin(), out.y().end());
-      if (*y_first > *lo && *y_first < *hi) {
-        if (out.IsMonotone()) {
-          v_rest = out.Inverse(*y_first) / dc;
-        } else if (const std::optional<double> x = out.NearestPreimage(*y_first, dc * v[0])) {
-          // A map that turns reaches y_first on several segments: the state
-          // nearest the rest at the first input.
-          v_rest = *x / dc;
-        }
+      if (*y_first > *lo && *y_first < *hi && out.IsMonotone()) {
+        v_rest = out.Inverse(*y_first) / dc;
+      } else {
+        // A map that turns reaches y_first on several segments: the state
+        // nearest the rest at the first input; beyond the map's values, the
+        // knot of the nearest value (the estimators start a record alike).
+        v_rest = out.NearestPreimageOrEnd(*y_first, dc * v[0]) / dc;
       }
     }
     return out.Evaluate(linear(v_rest));

@@ -177,9 +177,10 @@ std::vector<std::string> ExtrapolationWarnings(const IdentifiedModel& model, con
 /// with input v_r: the rest that gives the first measured output y(0) of
 /// column `output` (v_r = y(0) / G(1), through the output map's inverse when
 /// y(0) lies within its range: for a map that turns, the preimage nearest the
-/// rest at the first input, StaticMap::NearestPreimage), otherwise v(0) (at
-/// rest at the first input; so with `output` < 0, no measured output); a
-/// record that starts at rest anywhere then starts right.
+/// rest at the first input; beyond the map's values, the knot of the nearest
+/// value, StaticMap::NearestPreimageOrEnd), or v(0) with `output` < 0 (no
+/// measured output: at rest at the first input); a record that starts at
+/// rest anywhere then starts right.
 /// NARX: free run with its first max-lag outputs from output column `output`.
 /// @throws InvalidArgument for a model without nonlinear part, bad columns,
 ///         or a sample time that differs from the model's.
