@@ -13,6 +13,14 @@ ControllerAdapter::ControllerAdapter(std::unique_ptr<Controller> controller, dou
 
 void ControllerAdapter::Reset() { controller_->Reset(u0_, y0_); }
 
+void ControllerAdapter::Start(double y) noexcept {
+  try {
+    controller_->Reset(u0_, y);
+  } catch (...) {
+    // Kept at Reset()'s operating point; the next Update() reports a failure.
+  }
+}
+
 double ControllerAdapter::Update(std::int64_t, double r, double y) noexcept {
   try {
     return controller_->Update(r, y);

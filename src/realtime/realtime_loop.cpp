@@ -217,6 +217,7 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
   int stop_signal = -1;
   std::int64_t done = 0;
   std::int64_t t_first = 0, t_last = 0;
+  bool started = false;  // controller.Start() called (at the first valid measurement)
 
   auto body = [&] {
     summary.scheduling = options.fast ? std::string("as fast as possible (simulation time)")
@@ -249,6 +250,10 @@ LoopSummary RunLoop(const LoopOptions& options, IoBackend& io, LoopController& c
       Fault f = safety.CheckMeasurement(rs, m.y);
       IoStatus fio = rs;
       if (f == Fault::kNone) {
+        if (!started) {
+          controller.Start(m.y);
+          started = true;
+        }
         rec.u_ctrl = controller.Update(k, rec.r, m.y);
         unsigned lim = 0;
         rec.u = safety.LimitOutput(rec.u_ctrl, options.period, &lim);

@@ -85,6 +85,16 @@ stop_server
 $PY -c 'import json,sys; m=json.load(open(sys.argv[1]))["metrics"]; assert m["load_peak_deviation"] < -5, m' \
   "$TMP/simload.json" || fail "sim load step not applied: $(cat "$TMP/simload.json")"
 expect_error "bad load step" "--load-step" run --fast --duration 0.1 --load-step at=-1,size=2
+# With measurement noise the loop reproduces its offline simulation sample
+# for sample: the controller starts at the first measurement in both (it
+# started at 0 in the loop: MPC IAE 12.2296 against 12.2317 offline).
+for c in mpc gpc; do
+  "$PNEUMID" run --controller $c --model fopdt-paper --plant fopdt-paper --fast --duration 8 \
+    --setpoint "staircase:levels=0;40;80;40,dwell=2" --noise 0.5 --offline --json \
+    > "$TMP/noise_$c.json" || fail "run --noise ($c)"
+  $PY -c 'import json,sys; j=json.load(open(sys.argv[1])); m, o = j["metrics"], j["offline_metrics"]; assert m["iae"] == o["iae"] and m["tv_u"] == o["tv_u"], (m["iae"], o["iae"])' \
+    "$TMP/noise_$c.json" || fail "run --noise ($c) differs from --offline: $(cat "$TMP/noise_$c.json")"
+done
 
 # a server that stops answering: timeout fault, safe state, complete log, exit 3
 start_server --stop-answering-after 30

@@ -20,6 +20,11 @@ class ControllerAdapter : public LoopController {
   explicit ControllerAdapter(std::unique_ptr<Controller> controller, double u0 = 0.0,
                              double y0 = 0.0);
   void Reset() override;
+  /// The controller reset at (u0, y): its observer starts at the measured
+  /// output, as SimulateClosedLoop starts it (an MPC on a rig resting at
+  /// 50 N sees no 50 N error in its first period; with measurement noise
+  /// `run` reproduces its --offline simulation sample for sample).
+  void Start(double y) noexcept override;
   double Update(std::int64_t k, double r, double y) noexcept override;
   void Applied(double u) noexcept override;
   std::string Describe() const override { return controller_->Describe(); }

@@ -38,8 +38,12 @@ namespace pneumid {
 class LoopController {
  public:
   virtual ~LoopController() = default;
-  /// Called once before the first period (may allocate). y0 is the first measurement.
+  /// Called once before the first period (may allocate).
   virtual void Reset() {}
+  /// Called on the loop thread before the first Update with the first valid
+  /// measurement y (a rig need not start at the output Reset assumed); same
+  /// rules as Update. Default: nothing.
+  virtual void Start(double /*y*/) noexcept {}
   /// Input u_k for set point r and measurement y at sample k (the actuator's units,
   /// IoBackend::actuator(): for the IPA duty % from force N).
   virtual double Update(std::int64_t k, double r, double y) noexcept = 0;
