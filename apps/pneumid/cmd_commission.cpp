@@ -106,6 +106,14 @@ void ParseSpecification(const std::string& text, CommissionOptions& o) {
   }
 }
 
+// `value` formatted as `spec` with `unit`, or `none` when it is NaN (a
+// quantity the run did not measure or that has no value: an unsettled step's
+// settling time, an integrating plant's time constant).
+std::string Measured(double value, const char* spec, const char* unit, const char* none) {
+  return std::isnan(value) ? std::string(none)
+                           : fmt::format(fmt::runtime(spec), value) + unit;
+}
+
 void PrintSummary(const CommissionResult& r, const std::string& dir, double spec_overshoot) {
   const auto& ex = r.experiment;
   std::cout << fmt::format("commission {}: {}\n", ToString(r.termination), r.message);
@@ -114,12 +122,20 @@ void PrintSummary(const CommissionResult& r, const std::string& dir, double spec
     std::cout << fmt::format("experiment: {:.1f} s of plant time; stopped in the probe step\n",
                              ex.duration);
   } else {
+    const std::string reachable =
+        std::isnan(ex.reachable_min) || std::isnan(ex.reachable_max)
+            ? std::string("reachable range not measured")
+            : fmt::format("reachable {:.4g}..{:.4g}", ex.reachable_min, ex.reachable_max);
+    const std::string range = std::isnan(ex.range_min) || std::isnan(ex.range_max)
+                                  ? std::string("no range")
+                                  : fmt::format("range {:.4g}..{:.4g}", ex.range_min, ex.range_max);
     std::cout << fmt::format(
-        "experiment: {:.1f} s of plant time; probe K = {:.4g}, tau = {:.3g} s, theta = {:.3g} "
-        "s; reachable {:.4g}..{:.4g}, range {:.4g}..{:.4g}; {} + {} levels of {:.3g} s\n",
-        ex.duration, ex.gain, ex.time_constant, ex.dead_time, ex.reachable_min, ex.reachable_max,
-        ex.range_min, ex.range_max, ex.estimation_levels.size(), ex.validation_levels.size(),
-        ex.dwell);
+        "experiment: {:.1f} s of plant time; probe K = {:.4g}, tau = {}, theta = {}; {}, {}; "
+        "{} + {} levels of {}\n",
+        ex.duration, ex.gain, Measured(ex.time_constant, "{:.3g}", " s", "none (integrating)"),
+        Measured(ex.dead_time, "{:.3g}", " s", "not measured"), reachable, range,
+        ex.estimation_levels.size(), ex.validation_levels.size(),
+        Measured(ex.dwell, "{:.3g}", " s", "no dwell yet"));
   }
   if (!r.identification.models.empty()) {
     std::cout << "models (ranked on the held-out part):\n";
@@ -138,9 +154,10 @@ void PrintSummary(const CommissionResult& r, const std::string& dir, double spec
             ? fmt::format(" ({:.2f} % beyond half the ripple)", a.overshoot_judged_percent)
             : std::string();
     std::cout << fmt::format(
-        "verification (aggressiveness {:g}): worst overshoot {:.2f} %{}, worst settling {:.3f} s, "
+        "verification (aggressiveness {:g}): worst overshoot {:.2f} %{}, worst settling {}, "
         "IAE {:.4g}: {}\n",
-        a.aggressiveness, m.overshoot_percent, judged, m.settling_time, m.iae,
+        a.aggressiveness, m.overshoot_percent, judged,
+        Measured(m.settling_time, "{:.3f}", " s", "not settled"), m.iae,
         a.passed ? "pass" : "fail");
     for (const std::string& f : a.failures) std::cout << "  - " << f << "\n";
   }

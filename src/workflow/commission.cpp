@@ -296,6 +296,15 @@ std::string ProbeAndSweep(Recorder& rec, const CommissionOptions& o, double u_lo
         "s; the experiment needs a budget of about {:.0f} s or more",
         o.budget, cap, tau, std::ceil(4.0 * (7.0 * tau) + 11.0 * 4.0 * tau));
   }
+  if (!settled && !(std::isfinite(previous) && std::isfinite(before))) {
+    // Fewer than three chunks watched: nothing says how the output moves.
+    return fmt::format(
+        "the budget of {:g} s is too short to probe the plant: the probe step watches the output "
+        "for a quarter of the budget ({:.2f} s), less than the {:g} s it needs to see whether and "
+        "how fast it settles; give a budget of at least {:g} s (a commissioning takes about 60 to "
+        "120 s of plant time)",
+        o.budget, cap, 3.0 * chunk, 4.0 * 3.0 * chunk);
+  }
   if (!settled) {
     return fmt::format(
         "the output did not settle within {:.1f} s (a quarter of the budget) after an input step "
@@ -397,8 +406,11 @@ std::vector<std::string> Judge(const ClosedLoopMetrics& m, const CommissionOptio
           "settling {} > {:g} s on {}",
           s.settled ? fmt::format("{:.3f} s", s.settling_time) : std::string("not reached"),
           o.settling, step));
+    // The ripple of a step that has not settled is its unfinished transient
+    // (a plant slower than the dwell), which the settling failure reports:
+    // a sopdt with tau 1 s in 1-s dwells was said to cycle.
     const double ripple_limit = RippleLimit(s, ex);
-    if (std::isfinite(s.ripple) && s.ripple > ripple_limit)
+    if (s.settled && std::isfinite(s.ripple) && s.ripple > ripple_limit)
       failures.push_back(fmt::format(
           "ripple {:.3g} peak to peak > {:.3g} (2 % of the set-point {:.4g}, twice the "
           "sensor's {:.3g} at rest, or 1.25 x the open loop's {:.3g} near it) on {}",
@@ -465,7 +477,7 @@ void Diagnose(CommissionResult& r, const CommissionOptions& o) {
     double worst = 0.0;
     int elsewhere = 0;  // ripple failures at levels held by an input outside the gaps
     for (const StepMetrics& s : cl.metrics.steps) {
-      if (s.time <= 0.0 || !(s.ripple > RippleLimit(s, r.experiment))) continue;
+      if (s.time <= 0.0 || !s.settled || !(s.ripple > RippleLimit(s, r.experiment))) continue;
       // The input that held the level, over the window whose ripple was measured.
       const double mean = s.steady_input;
       if (!std::isfinite(mean)) continue;

@@ -188,6 +188,19 @@ echo "$out" | grep -q "cannot be reached: the output reaches" || fail "unreachab
 out=$("$PNEUMID" commission --plant ipa --budget 5 -o "$TMP/e2" 2>&1)
 [ $? -eq 1 ] || fail "short budget: exit status"
 echo "$out" | grep -q "too short" || fail "short budget: $out"
+# A budget too short for even the probe says so (it blamed an integrating
+# or unstable plant, "last change nan"), and no summary line prints nan.
+out=$("$PNEUMID" commission --plant ipa --budget 0.001 -o "$TMP/e3" 2>&1)
+[ $? -eq 1 ] || fail "tiny budget: exit status"
+echo "$out" | grep -q "too short to probe the plant" || fail "tiny budget: $out"
+echo "$out" | grep -qi "nan" && fail "tiny budget prints nan: $out"
+# A linear plant slower than the verification's dwell: its unsettled steps
+# are not called a cycling loop (ripple).
+out=$("$PNEUMID" commission --plant "sopdt:K=1,tau1=1,tau2=0.3,theta=0.1" --u-min 0 --u-max 10 \
+  -o "$TMP/e4" 2>/dev/null)
+echo "$out" | grep -q "settling not reached" || fail "slow plant: $out"
+echo "$out" | grep -q "the loop cycles" && fail "slow plant called cycling: $out"
+echo "$out" | grep -q "worst settling not settled" || fail "slow plant summary: $out"
 # An unstable plant: stopped within seconds of the probe step, the reason on
 # stderr, no probe figures of NaN on stdout, the input back at its lowest.
 out=$("$PNEUMID" commission --plant "tf:num=0.1,den=1 -1.05,Ts=0.01" --u-min 0 --u-max 10 \
