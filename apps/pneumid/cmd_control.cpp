@@ -170,7 +170,9 @@ ControlScenarioOptions ToScenarioOptions(const ControlArgs& c) {
   for (const std::string& l : c.load_steps) o.load_steps.push_back(ParseLoadStep("--load-step", l));
   // --compare: the same controller with each rule's own settings.
   if (c.compare_given) {
-    std::stringstream in(c.compare.empty() ? "shridhar-cooper,paper-modified" : c.compare);
+    const bool pid = c.controller.controller == "pid";
+    std::stringstream in(c.compare.empty() ? (pid ? "simc,imc" : "shridhar-cooper,paper-modified")
+                                           : c.compare);
     std::string item;
     while (std::getline(in, item, ',')) o.compare_rules.push_back(item);
     PNEUMID_CHECK(!o.compare_rules.empty(), "--compare: no settings given");
@@ -253,7 +255,8 @@ const Registrar reg(
       app.add_option("-o,--output", c->output, "Write the trajectories to a CSV file");
       app.add_option("--compare", c->compare,
                      "Run several tuning rules on the same scenario, side by side (default: "
-                     "shridhar-cooper,paper-modified)")
+                     "shridhar-cooper,paper-modified; auto for the design tuned to the "
+                     "specification; a pid: simc, imc, auto, default simc,imc)")
           ->expected(0, 1);
       app.callback([c, &app] {
         c->compare_given = app.count("--compare") > 0;

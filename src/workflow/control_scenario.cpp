@@ -132,7 +132,10 @@ std::optional<std::string> UnreachableSetpointWarning(const Eigen::VectorXd& set
 
 namespace {
 
-// The controller specifications to run: the given one, or one per compared rule.
+// The controller specifications to run: the given one, or one per compared
+// rule: "auto" (tuned to the specification), else a tuning rule of dmc, gpc
+// and mpc (shridhar-cooper, paper-modified) or of a pid (simc, imc). A pid
+// compared under a predictive rule ran the same PID once per rule.
 std::vector<ControllerSpec> ScenarioSpecs(const ControlScenarioOptions& o,
                                           const ControllerSpec& base) {
   if (o.compare_rules.empty()) return {base};
@@ -140,7 +143,18 @@ std::vector<ControllerSpec> ScenarioSpecs(const ControlScenarioOptions& o,
   for (const std::string& rule : o.compare_rules) {
     ControllerSpec spec = base;
     spec.tuning = TuningOptions{};
-    spec.tuning.rule = TuningRuleFromString(rule);
+    spec.auto_tune = rule == "auto";
+    if (spec.auto_tune) {
+      spec.pid_kc = spec.pid_ti = spec.pid_td = std::numeric_limits<double>::quiet_NaN();
+    } else if (base.type == ControllerType::kPid) {
+      PNEUMID_CHECK(rule == "simc" || rule == "imc",
+                    "--compare for a pid takes its tuning rules simc, imc or auto, got '{}'",
+                    rule);
+      spec.pid_rule = PidTuningRuleFromString(rule);
+      spec.pid_kc = spec.pid_ti = spec.pid_td = std::numeric_limits<double>::quiet_NaN();
+    } else {
+      spec.tuning.rule = TuningRuleFromString(rule);
+    }
     specs.push_back(spec);
   }
   return specs;
@@ -176,10 +190,14 @@ ControlScenarioResult RunControlScenario(const ControlScenarioOptions& o) {
           UnreachableSetpointWarning(setpoint->Sample(o.Ts, loop.Samples(o.Ts)), model, base,
                                      settings.limits.u_min, settings.limits.u_max))
     result.warnings.push_back(std::move(*w));
-  for (const ControllerSpec& spec : ScenarioSpecs(o, base)) {
+  const std::vector<ControllerSpec> specs = ScenarioSpecs(o, base);
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    const ControllerSpec& spec = specs[i];
     if (!plant) plant = MakePlant(result.plant_spec, o.Ts, plant_options);
     ControlScenarioRun run;
     run.built = MakeController(model, o.Ts, spec);
+    if (!o.compare_rules.empty() && spec.type == ControllerType::kPid)
+      run.built.label = "pid " + o.compare_rules[i];
     run.result = SimulateClosedLoop(*run.built.controller, *plant, *setpoint, loop);
     if (!run.built.auto_summary.empty() && !run.built.auto_converged)
       result.warnings.push_back(fmt::format(

@@ -199,6 +199,15 @@ check_output "auto warning on stderr" "the rule auto found no design" "$TMP/err"
 expect_ok "auto, met" control --rule auto --model fopdt-paper --Ts 0.01 --setpoint step:to=1 \
   --duration 1 --json
 check_json "no auto warning" "j['warnings'] == []"
+# --compare: auto among the rules; a pid compares its own rules.
+expect_ok "compare auto" control --model fopdt-paper --Ts 0.01 --setpoint step:to=1,at=0.1 \
+  --duration 2 --compare shridhar-cooper,auto --json
+check_json "compare auto labels" "[r['label'] for r in j['compare']] == ['shridhar-cooper', 'auto']"
+expect_ok "compare pid" control --controller pid --model fopdt-paper --Ts 0.01 \
+  --setpoint step:to=1,at=0.1 --duration 2 --compare --json
+check_json "compare pid rules" "[r['label'] for r in j['compare']] == ['pid simc', 'pid imc'] and j['compare'][0]['controller'] != j['compare'][1]['controller']"
+expect_error "compare pid, dmc rule" "simc, imc or auto" control --controller pid \
+  --model fopdt-paper --Ts 0.01 --setpoint step:to=1 --duration 1 --compare shridhar-cooper
 # run on a simulated linear plant: no 0..100 clamp either.
 expect_ok "run, linear plant" run --controller mpc --model fopdt:K=-2,tau=0.5,theta=0.05 \
   --plant fopdt:K=-2,tau=0.5,theta=0.05 --fast --setpoint step:to=1,at=0.5 --duration 4 --json
