@@ -4,14 +4,17 @@
 #include <atomic>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "command.hpp"
 #include "pneumid/common/check.hpp"
+#include "pneumid/plant/ipa_simulator.hpp"
 #include "pneumid/plant/plant_factory.hpp"
 #include "pneumid/realtime/plant_server.hpp"
 #include "pneumid/realtime/realtime_loop.hpp"
@@ -44,7 +47,10 @@ void Serve(const ServerOptions& o) {
   so.stop_answering_after = o.stop_answering_after;
   for (const std::string& l : o.load_steps)
     so.load_steps.push_back(ParseLoadStep("--load-step", l));
-  PlantServer server(MakePlant(o.plant, o.Ts, po), so);
+  std::unique_ptr<Plant> plant = MakePlant(o.plant, o.Ts, po);
+  PNEUMID_CHECK(o.plant_config.empty() || dynamic_cast<IpaSimulator*>(plant.get()),
+                "--plant-config applies to the ipa plant only, not to '{}'", o.plant);
+  PlantServer server(std::move(plant), so);
   InstallStopSignalHandlers();
   ClearStopRequest();
   std::cout << fmt::format("serving {} on udp://{}:{} (Ts = {:g} s, protocol v{})\n",
@@ -80,7 +86,8 @@ static Registrar reg(
       app.add_option("--noise", o->noise, "measurement noise (output units)")->check(NonNegative());
       app.add_option("--stop-answering-after", o->stop_answering_after,
                      "fault drill: go silent after this many steps (-1: never)")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(AtLeast(-1));
       app.add_option("--load-step", o->load_steps,
                      "load disturbance on the output at=T,size=D (repeatable), T in plant time "
                      "since the client's session began");

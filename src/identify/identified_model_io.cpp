@@ -108,7 +108,7 @@ nlohmann::json ToJson(const IdentifiedModel& model) {
   if (model.continuous_form) j["continuous_form"] = ToString(*model.continuous_form);
   j["fit_percent"] = model.fit_percent;
   j["iae"] = model.iae;
-  if (!model.notes.empty()) j["notes"] = model.notes;
+  j["notes"] = model.notes;  // always present (an empty list when there are none)
   j["operating_point"] = {{"u0", model.u0}, {"y0", model.y0}};
   j["termination"] = ToString(model.termination);
   if (std::isfinite(model.validation_fit_percent))

@@ -360,6 +360,11 @@ IdentifiedModel IdentifyParametricAtRest(const std::string& method, const Datase
     std::vector<double> sv(r.singular_values.data(),
                            r.singular_values.data() + r.singular_values.size());
     m.params["singular_values"] = sv;
+    if (request.na == 0)
+      m.notes.push_back(fmt::format(
+          "order {} chosen at the largest gap of the log singular values (--na 0; --na N fixes "
+          "it): {:.3g}",
+          r.order, fmt::join(sv.begin(), sv.begin() + std::min<std::size_t>(sv.size(), 8), ", ")));
     return FinishTransferFunctionModel(std::move(m), ToTransferFunction(r.model), r.summary, d);
   }
   if (method == "cra") {
