@@ -229,6 +229,15 @@ CsvHeader ReadHeader(const std::string& path, const CsvReadOptions& options, Lin
                                 path, lines.line));
   }
   header.line = lines.line;
+  // A carriage return inside the line (LineContent trims a trailing one):
+  // the file ends its lines with CR alone (classic Mac OS), and its whole
+  // content reads as one line.
+  if (const std::size_t cr = header.text.find('\r'); cr != std::string_view::npos) {
+    throw DataError(fmt::format(
+        "{}:{}: the lines end with a carriage return alone (classic Mac OS line ends), so the "
+        "file reads as one line; convert them, e.g. tr '\\r' '\\n' < {} > fixed.csv",
+        path, header.line, path));
+  }
   if (header.text.size() > kCsvMaxHeaderBytes) {
     throw DataError(fmt::format(
         "{}:{}: header row is {} bytes long (at most {}): not a header row; the file needs a "

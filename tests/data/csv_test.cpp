@@ -233,6 +233,15 @@ TEST_F(CsvTest, EmptyFile) {
   ExpectError("# only a comment\n\n", 2, "", "empty file");
 }
 
+// Lines ended by a carriage return alone (classic Mac OS) read as one line:
+// the error says so (it was an unknown column among 603 header cells);
+// CR LF line ends read as before.
+TEST_F(CsvTest, CarriageReturnLineEndsAreNamed) {
+  ExpectError("t,u,y\r0,1,2\r0.1,1,3\r", 1, "", "carriage return alone");
+  const Dataset d = ReadCsv(Write("t,u,y\r\n0,1,2\r\n0.1,1,3\r\n"));
+  EXPECT_EQ(d.size(), 2);
+}
+
 TEST_F(CsvTest, HeaderOnly) { ExpectError("# c\nt,u,y\n# nothing\n", 2, "", "header row only"); }
 
 TEST_F(CsvTest, UnknownColumnListsAvailable) {
