@@ -203,6 +203,7 @@ Eigen::MatrixXd Lsim(const StateSpace& g, const Eigen::MatrixXd& u, double dt,
   PNEUMID_CHECK(u.allFinite(), "lsim: the input contains NaN or Inf");
   PNEUMID_CHECK(x0.size() == 0 || x0.size() == g.num_states(),
                 "lsim: x0 must have nx = {} entries (or none), got {}", g.num_states(), x0.size());
+  PNEUMID_CHECK(x0.allFinite(), "lsim: the initial state x0 contains NaN or Inf");
   const StateSpace gd = DiscretizeForLsim(g, dt);
   const int d = DelayInSamples(gd.delay(), dt);
   const Eigen::Index n = gd.num_states();

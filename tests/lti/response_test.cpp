@@ -128,6 +128,10 @@ TEST(ResponseTest, StateSpaceLsimWithInitialState) {
               ThrowsMessage<InvalidArgument>(HasSubstr("x0 must have nx = 1")));
   EXPECT_THAT([&] { Lsim(g, Eigen::MatrixXd::Zero(5, 1), -0.1); },
               ThrowsMessage<InvalidArgument>(HasSubstr("dt must be > 0")));
+  // A NaN initial state is refused as a NaN input is (it gave NaN outputs).
+  EXPECT_THAT(
+      [&] { Lsim(g, Eigen::MatrixXd::Zero(5, 1), 0.1, Eigen::VectorXd::Constant(1, NAN)); },
+      ThrowsMessage<InvalidArgument>(HasSubstr("x0 contains NaN")));
 }
 
 TEST(FirstCrossingTest, InterpolatesBetweenSamples) {

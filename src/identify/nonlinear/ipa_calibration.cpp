@@ -303,8 +303,10 @@ Eigen::VectorXd SimulateIpaOnData(const IpaParameters& parameters, const Dataset
   std::string error;
   PNEUMID_CHECK(parameters.IsValid(&error), "invalid IPA parameters: {}", error);
   PNEUMID_CHECK(data.num_inputs() >= 1 && data.num_outputs() >= 1 && data.size() >= 2,
-                "{}: the IPA model needs an input, an output and at least 2 samples",
-                data.source());
+                "{}: the IPA model needs an input, an output and at least 2 samples, got {} "
+                "input(s), {} output(s), {} sample(s)",
+                data.source().empty() ? std::string("the data") : data.source(),
+                data.num_inputs(), data.num_outputs(), data.size());
   data.RequireUniform();
   return Simulate(ModelParameters(parameters, integration_tolerance), data.u(0), data.y(0),
                   data.SampleTime(), initial_state, warmup);
