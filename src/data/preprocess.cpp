@@ -800,7 +800,25 @@ Dataset Preprocess(const Dataset& data, const PreprocessOptions& options,
       r.steps.push_back(fmt::format("remove initial offset: mean of the first {} samples",
                                     options.initial_samples));
     } else {
-      const StepEvent step = DetectStep(*d, options.step);
+      StepEvent step = DetectStep(*d, options.step);
+      // The rest ends where the input first leaves its initial level (by
+      // more than 6 times its spread over the first samples, and 1e-6 of
+      // the step): on a rest followed by a PRBS the largest jump lies inside
+      // the PRBS, and the mean before it took in PRBS samples (54 samples
+      // averaged where the rest held 40).
+      const Eigen::VectorXd u = d->inputs().col(step.input);
+      const Eigen::Index m = std::max<Eigen::Index>(1, std::min<Eigen::Index>(step.index, 10));
+      const double u_rest = u.head(m).mean();
+      const double spread =
+          m > 1 ? std::sqrt((u.head(m).array() - u_rest).square().sum() / (m - 1)) : 0.0;
+      const double tolerance = std::max(6.0 * spread, 1e-6 * std::abs(step.size));
+      for (Eigen::Index k = 1; k < step.index; ++k) {
+        if (std::abs(u[k] - u_rest) > tolerance) {
+          step.index = k;
+          step.time = d->time()[k];
+          break;
+        }
+      }
       set(RemoveInitialOffset(*d, step, options.channels, &removed));
       r.steps.push_back(
           fmt::format("remove initial offset: mean of the {} samples before the step at t = {:g} s",

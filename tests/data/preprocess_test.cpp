@@ -466,6 +466,27 @@ TEST(PreprocessTest, PreprocessOptionsValidation) {
   invalid(o, "need F1 < F2");
 }
 
+// --remove-initial on a rest followed by a small step and a binary sequence
+// whose largest jump (23 <-> 17) comes later: the level is the mean over the
+// rest itself (40 samples), not over everything before that jump.
+TEST(PreprocessTest, RemoveInitialTakesTheRestBeforeTheFirstChange) {
+  const int n = 200, rest = 40;
+  Eigen::VectorXd t(n), u(n), y(n);
+  for (int k = 0; k < n; ++k) {
+    t[k] = 0.1 * k;
+    u[k] = k < rest ? 20.0 : (k < 100 ? 21.0 : ((k / 25) % 2 == 0 ? 23.0 : 17.0));
+    y[k] = k < rest ? 50.0 : 50.0 + 2.0 * (u[k] - 20.0);
+  }
+  const Dataset d(t, u, y);
+  PreprocessOptions o;
+  o.remove_initial = true;
+  PreprocessRecord r;
+  const Dataset out = Preprocess(d, o, &r);
+  EXPECT_DOUBLE_EQ(out.u()[0], 0.0);
+  EXPECT_DOUBLE_EQ(out.y()[0], 0.0);
+  EXPECT_THAT(r.steps.back(), HasSubstr("mean of the 40 samples before the step at t = 4 s"));
+}
+
 TEST(PreprocessTest, PreprocessWithoutStepsReturnsTheData) {
   const Dataset d = GoldenInput();
   PreprocessRecord r;
