@@ -75,13 +75,13 @@ void PrintTable(const std::vector<Run>& runs) {
   for (const auto& row : rows) w0 = std::max(w0, row.first.size() + 2);
   std::vector<std::size_t> widths;
   for (const Run& r : runs) {
-    std::size_t w = r.built.Label().size();
+    std::size_t w = r.label.size();
     for (const auto& row : rows) w = std::max(w, row.second(r).size());
     widths.push_back(w + 2);
   }
   std::cout << fmt::format("{:<{}}", "", w0);
   for (std::size_t i = 0; i < runs.size(); ++i)
-    std::cout << fmt::format("{:>{}}", runs[i].built.Label(), widths[i]);
+    std::cout << fmt::format("{:>{}}", runs[i].label, widths[i]);
   std::cout << "\n";
   for (const auto& row : rows) {
     std::cout << fmt::format("{:<{}}", row.first, w0);
@@ -98,7 +98,7 @@ void WriteCsv(const std::string& path, const std::vector<Run>& runs) {
   const bool one = runs.size() == 1;
   out << "t,r";
   for (const Run& r : runs) {
-    const std::string s = one ? "" : "_" + r.built.Label();
+    const std::string s = one ? "" : "_" + r.label;
     out << ",y" << s << ",y_meas" << s << ",u" << s << ",d" << s;
   }
   out << "\n";
@@ -124,12 +124,13 @@ std::string TypeName(ControllerType type) {
 }
 
 // Legend entry of a run: the controller and its settings.
-std::string ControllerLabel(const BuiltController& b) {
+std::string ControllerLabel(const Run& r) {
+  const BuiltController& b = r.built;
   if (b.type == ControllerType::kPid) {
     return fmt::format("PID {} (Kc={:.3g}, Ti={:.3g} s, Td={:.3g} s)", ToString(b.pid_rule),
                        b.pid_gains.Kc, b.pid_gains.Ti, b.pid_gains.Td);
   }
-  return fmt::format("{} {} (P={}, M={}, lambda={:.3g})", TypeName(b.type), b.Label(), b.tuning.P,
+  return fmt::format("{} {} (P={}, M={}, lambda={:.3g})", TypeName(b.type), r.label, b.tuning.P,
                      b.tuning.M, b.tuning.lambda);
 }
 
@@ -150,7 +151,7 @@ void WritePlot(const std::string& path, const std::vector<Run>& runs, const Cont
   if (!c.load_steps.empty())
     options.disturbance_time = ParseLoadStep("--load-step", c.load_steps[0]).at;
   std::vector<ClosedLoopTrace> traces;
-  for (const Run& r : runs) traces.push_back({ControllerLabel(r.built), r.result.y, r.result.u});
+  for (const Run& r : runs) traces.push_back({ControllerLabel(r), r.result.y, r.result.u});
   ClosedLoopFigure(runs[0].result.t, runs[0].result.r, traces, options).Save(path);
 }
 
@@ -206,7 +207,7 @@ void Execute(const ControlArgs& c) {
   PrintTable(runs);
   for (const Run& r : runs) {
     if (r.built.type != ControllerType::kPid)
-      std::cout << r.built.Label() << ": " << r.built.tuning.formula << "\n";
+      std::cout << r.label << ": " << r.built.tuning.formula << "\n";
   }
 }
 

@@ -337,12 +337,9 @@ struct PredictiveControllerFactory {
 
   /// The same of `controller`, made by Make(lambda).
   static Eigen::MatrixXd Hessian(const Controller& made, double lambda) {
-    const Controller* controller = &made;
-    if (const auto* mpc = dynamic_cast<const MpcController*>(controller))
-      return mpc->hessian();
-    const auto* dmc = dynamic_cast<const DmcController*>(controller);
-    PNEUMID_CHECK(dmc != nullptr, "the auto-tuner designs mpc or dmc, got {}",
-                  controller->Describe());
+    if (const auto* mpc = dynamic_cast<const MpcController*>(&made)) return mpc->hessian();
+    const auto* dmc = dynamic_cast<const DmcController*>(&made);
+    PNEUMID_CHECK(dmc != nullptr, "the auto-tuner designs mpc or dmc, got {}", made.Describe());
     const Eigen::MatrixXd& A = dmc->dynamic_matrix();
     return A.transpose() * A + lambda * Eigen::MatrixXd::Identity(A.cols(), A.cols());
   }

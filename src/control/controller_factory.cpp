@@ -96,7 +96,6 @@ TransferFunction ParseControllerModel(const std::string& model_spec) {
 }
 
 std::string BuiltController::Label() const {
-  if (!label.empty()) return label;
   if (type == ControllerType::kPid) return "pid";
   return auto_summary.empty() ? ToString(tuning.rule) : "auto";
 }

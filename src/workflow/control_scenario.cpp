@@ -28,7 +28,7 @@ bool ControlScenarioOptions::IsValid(std::string* error) const {
 
 nlohmann::ordered_json ControlScenarioRun::ToJson() const {
   nlohmann::ordered_json j;
-  j["label"] = built.Label();
+  j["label"] = label;
   j["controller"] = result.controller;
   j["plant"] = result.plant;
   j["settings"] = built.SettingsToJson();
@@ -196,8 +196,9 @@ ControlScenarioResult RunControlScenario(const ControlScenarioOptions& o) {
     if (!plant) plant = MakePlant(result.plant_spec, o.Ts, plant_options);
     ControlScenarioRun run;
     run.built = MakeController(model, o.Ts, spec);
-    if (!o.compare_rules.empty() && spec.type == ControllerType::kPid)
-      run.built.label = "pid " + o.compare_rules[i];
+    run.label = !o.compare_rules.empty() && spec.type == ControllerType::kPid
+                    ? "pid " + o.compare_rules[i]
+                    : run.built.Label();
     run.result = SimulateClosedLoop(*run.built.controller, *plant, *setpoint, loop);
     if (!run.built.auto_summary.empty() && !run.built.auto_converged)
       result.warnings.push_back(fmt::format(

@@ -209,9 +209,6 @@ struct BuiltController {
   /// for other rules.
   bool auto_converged = false;
 
-  /// When not empty, what Label() returns (a comparison of PID rules names
-  /// each run "pid simc", "pid imc", "pid auto").
-  std::string label;
   /// "pid" for a PID, "auto" for settings tuned to specifications, else the
   /// tuning rule's name (as in a comparison table).
   std::string Label() const;

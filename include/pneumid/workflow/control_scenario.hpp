@@ -62,6 +62,9 @@ struct ControlScenarioOptions {
 struct ControlScenarioRun {
   BuiltController built;   ///< the controller as designed
   ClosedLoopResult result; ///< traces and metrics
+  /// The run's name: BuiltController::Label(), but "pid RULE" ("pid simc",
+  /// "pid imc", "pid auto") for each run of a comparison of PID rules.
+  std::string label;
   /// label, controller, plant, settings and the metrics' keys
   /// (ClosedLoopMetrics::ToJson), as `control --json` prints one run.
   nlohmann::ordered_json ToJson() const;

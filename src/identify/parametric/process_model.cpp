@@ -486,23 +486,43 @@ std::pair<ProcessParams, double> GridGuessAt(ProcessStructure structure, const E
   return {p, best};
 }
 
-// The best grid point over the input rests of InputRests.
-ProcessParams GridGuess(ProcessStructure structure, const Eigen::VectorXd& u,
-                        const Eigen::VectorXd& y, double u0, Eigen::Index k0, double Ts,
-                        double duration, const std::vector<std::pair<double, double>>& extra) {
-  std::pair<ProcessParams, double> best{ProcessParams{}, std::numeric_limits<double>::infinity()};
-  best.first.K = 1.0;
-  for (double rest : InputRests(u, u0, k0)) {
-    auto at = GridGuessAt(structure, u, y, rest, Ts, duration, extra);
-    if (at.second < best.second) best = std::move(at);
-  }
-  return best.first;
+// The best grid point of each input rest of InputRests, in its order.
+std::vector<std::pair<ProcessParams, double>> GridGuesses(
+    ProcessStructure structure, const Eigen::VectorXd& u, const Eigen::VectorXd& y, double u0,
+    Eigen::Index k0, double Ts, double duration,
+    const std::vector<std::pair<double, double>>& extra) {
+  std::vector<std::pair<ProcessParams, double>> points;
+  for (double rest : InputRests(u, u0, k0))
+    points.push_back(GridGuessAt(structure, u, y, rest, Ts, duration, extra));
+  return points;
 }
 
-}  // namespace
+// The lowest-cost point of GridGuesses (the first on a tie).
+ProcessParams BestGridPoint(const std::vector<std::pair<ProcessParams, double>>& points) {
+  ProcessParams best;
+  best.K = 1.0;
+  double cost = std::numeric_limits<double>::infinity();
+  for (const auto& [p, c] : points) {
+    if (c < cost) {
+      best = p;
+      cost = c;
+    }
+  }
+  return best;
+}
 
-ProcessParams InitialProcessGuess(const Dataset& data, int input, int output,
-                                  ProcessStructure structure, bool zero, std::string* source) {
+// InitialProcessGuess, and the best grid point of each input rest when the
+// guess came from the grid search (empty otherwise), for FitProcessModel's
+// multi-start.
+struct ProcessGuess {
+  ProcessParams params;
+  std::string source;
+  std::vector<std::pair<ProcessParams, double>> rest_points;
+};
+
+ProcessGuess GuessProcess(const Dataset& data, int input, int output, ProcessStructure structure,
+                          bool zero) {
+  ProcessGuess guess;
   const Eigen::VectorXd u = data.u(input), y = data.y(output), t = data.time();
   const Eigen::Index n = data.size();
   const double duration = t[n - 1] - t[0];
@@ -530,7 +550,9 @@ ProcessParams InitialProcessGuess(const Dataset& data, int input, int output,
     // plant got K = -0.008 from it): the grid search, with the ramp's lag
     // and delay among its candidates, takes the better of them.
     if (k0 < std::max<Eigen::Index>(3, n / 100) || !std::isfinite(p.K)) {
-      p = GridGuess(structure, u, y, u0, k0, data.SampleTime(), duration, {{p.T1, p.theta}});
+      guess.rest_points =
+          GridGuesses(structure, u, y, u0, k0, data.SampleTime(), duration, {{p.T1, p.theta}});
+      p = BestGridPoint(guess.rest_points);
       from = "a grid search over lag and delay (with the final ramp's)";
     }
   } else {
@@ -586,14 +608,25 @@ ProcessParams InitialProcessGuess(const Dataset& data, int input, int output,
       have_step = false;
     }
     if (!have_step) {
-      p = GridGuess(structure, u, y, u0, k0, data.SampleTime(), duration, {});
+      guess.rest_points = GridGuesses(structure, u, y, u0, k0, data.SampleTime(), duration, {});
+      p = BestGridPoint(guess.rest_points);
       from = "a grid search over lag and delay";
     }
   }
   if (p.K == 0.0) p.K = 1.0;
   if (zero) p.Tz = 0.0;
-  if (source) *source = from;
-  return p;
+  guess.params = p;
+  guess.source = from;
+  return guess;
+}
+
+}  // namespace
+
+ProcessParams InitialProcessGuess(const Dataset& data, int input, int output,
+                                  ProcessStructure structure, bool zero, std::string* source) {
+  ProcessGuess guess = GuessProcess(data, input, output, structure, zero);
+  if (source) *source = guess.source;
+  return guess.params;
 }
 
 namespace {
@@ -921,23 +954,27 @@ ProcessFitResult FitProcessModel(const Dataset& data, int input, int output,
         data, input, output, options, &start, &result.summary.initial_guess);
     if (best) return std::move(*best);
   } else {
-    start = InitialProcessGuess(data, input, output, options.structure, false,
-                                &result.summary.initial_guess);
+    ProcessGuess guess = GuessProcess(data, input, output, options.structure, false);
+    start = guess.params;
+    result.summary.initial_guess = guess.source;
     // A record without a rest at its start: one fit from the best grid point
     // of each input rest (InputRests) besides the guess; the lowest final
     // cost wins, the guess's on a tie (the grid's coarse costs do not tell
-    // zero from a mean of 0.02 on a chirp, the fits do).
+    // zero from a mean of 0.02 on a chirp, the fits do). The grid points are
+    // the guess's own when it came from the grid.
     const std::vector<double> rests = InputRests(record.u, record.u0, k0);
     if (rests.size() > 1) {
+      if (guess.rest_points.size() != rests.size())
+        guess.rest_points = GridGuesses(options.structure, record.u, y, record.u0, k0, record.Ts,
+                                        record.duration, {});
       ProcessFitResult best = FitProcessModel(data, input, output, options, &start);
       best.summary.initial_guess = result.summary.initial_guess;
-      for (double rest : rests) {
-        ProcessParams q = GridGuessAt(options.structure, record.u, y, rest, record.Ts,
-                                      record.duration, {})
-                              .first;
+      for (std::size_t i = 0; i < rests.size(); ++i) {
+        const ProcessParams& q = guess.rest_points[i].first;
+        if (q == start) continue;  // the guess itself, fitted above
         ProcessFitResult fit = FitProcessModel(data, input, output, options, &q);
         fit.summary.initial_guess =
-            fmt::format("a grid search over lag and delay from a rest at u = {:.6g}", rest);
+            fmt::format("a grid search over lag and delay from a rest at u = {:.6g}", rests[i]);
         if (fit.summary.termination != Termination::kFailure &&
             (best.summary.termination == Termination::kFailure ||
              fit.summary.final_cost < (1.0 - 1e-6) * best.summary.final_cost))

@@ -78,19 +78,21 @@ RobustLoss RobustLossFromString(const std::string& name);
 struct ProcessParams {
   /// Static gain; P1DI: integrator gain (output units per input unit and second).
   double K = 0.0;
-  /// First real lag (time constant) T1, s.
-  double T1 = 0.0, T2 = 0.0, T3 = 0.0;  ///< real lags
-  /// P2DU natural period Tw, s (1 / natural frequency).
-  double Tw = 0.0, zeta = 0.0;          ///< P2DU natural period and damping
-  /// @var T2
-  /// Second real lag, s (P2D, P3D).
-  double Tz = 0.0;                      ///< zero time constant
+  /// Real lags (time constants), s: T1 (every structure but P2DU), T2 (P2D,
+  /// P3D), T3 (P3D).
+  double T1 = 0.0, T2 = 0.0, T3 = 0.0;
+  /// P2DU natural period Tw, s (1 / natural frequency), and damping zeta.
+  double Tw = 0.0, zeta = 0.0;
+  double Tz = 0.0;                      ///< zero time constant, s
   double theta = 0.0;                   ///< delay
   double y0 = 0.0;                      ///< output offset (initial steady state)
   /// Input of that steady state (not fitted): the model is
   /// y = y0 + G (u - u0). NaN in a guess: the input before its first change;
   /// FitProcessModel's result always gives the one it used.
   double u0 = std::numeric_limits<double>::quiet_NaN();
+
+  /// Every field equal (a NaN u0 equals nothing).
+  bool operator==(const ProcessParams&) const = default;
 };
 
 /// Structure, loss and Levenberg-Marquardt settings of FitProcessModel.
