@@ -40,6 +40,7 @@ struct ReportArgs {
   double confidence = 0.0;  ///< bands of +-K standard deviations; 0 = none
   bool json = false;
   bool progress = false;
+  bool orders_given = false;  ///< --na, --nb or --nk on the command line
 };
 
 void Run(const ReportArgs& a) {
@@ -54,6 +55,8 @@ void Run(const ReportArgs& a) {
   o.request.na = a.na;
   o.request.nb = a.nb;
   o.request.nk = a.nk;
+  // As `identify`: without --na, --nb, --nk the nonlinear structures are chosen.
+  o.choose_structure = !a.orders_given;
   o.residual_max_lag = a.max_lag;
   o.confidence = a.confidence;
   o.title = a.title;
@@ -149,9 +152,13 @@ const pneumid::cli::Registrar reg(
                      "Directory for report.html and models.json (created when missing)")
           ->required();
       app.add_option("--order", a->order, "PTn order")->capture_default_str();
-      app.add_option("--na", a->na, "ARX order of A")->capture_default_str();
-      app.add_option("--nb", a->nb, "ARX order of B")->capture_default_str();
-      app.add_option("--nk", a->nk, "ARX input delay in samples")->capture_default_str();
+      CLI::Option* na = app.add_option("--na", a->na, "ARX order of A (and of the nonlinear "
+                                       "models' linear part; without --na, --nb, --nk their "
+                                       "structure is chosen on held-out data)")
+                            ->capture_default_str();
+      CLI::Option* nb = app.add_option("--nb", a->nb, "ARX order of B")->capture_default_str();
+      CLI::Option* nk =
+          app.add_option("--nk", a->nk, "ARX input delay in samples")->capture_default_str();
       app.add_option("--max-lag", a->max_lag, "Largest lag of the residual correlations")
           ->capture_default_str()
           ->check(pneumid::cli::AtLeast(1));
@@ -161,7 +168,10 @@ const pneumid::cli::Registrar reg(
       app.add_flag("--json", a->json, "Print the summary as JSON");
       app.add_flag("--progress", a->progress,
                    "Draw the progress bar even when stderr is not a terminal");
-      app.callback([a]() { Run(*a); });
+      app.callback([a, na, nb, nk]() {
+        a->orders_given = na->count() + nb->count() + nk->count() > 0;
+        Run(*a);
+      });
     });
 
 }  // namespace

@@ -78,7 +78,8 @@ void AddControllerOptions(CLI::App& app, ControllerSettings& s) {
                  "Highest measurement a working sensor gives (see --y-valid-min)");
   app.add_option("--safe-input", s.safe_input,
                  "Input applied on a faulty sample instead of holding the last one (e.g. the "
-                 "valves' vented duty)");
+                 "valves' vented duty), within --u-min..--u-max (default, or nan: hold the last "
+                 "input)");
   app.add_option(
       "--input-gaps", s.input_gaps,
       "Inputs the actuator cannot hold, LO:HI[,LO:HI] (IPA: 0:15,85:100), or 'plant' "

@@ -239,14 +239,21 @@ void BindIdentify(py::module_& m) {
   m.def(
       "identify_models",
       [](const std::vector<std::string>& methods, const Dataset& data, int input, int output,
-         int order, int na, int nb, int nk, int nc, int nd, int nf, double split,
-         std::optional<Dataset> validation, const std::string& window, double resample,
-         bool remove_initial, const std::string& detrend, const std::string& filter, int decimate,
+         int order, std::optional<int> na, std::optional<int> nb, std::optional<int> nk, int nc,
+         int nd, int nf, double split, std::optional<Dataset> validation,
+         const std::string& window, double resample, bool remove_initial,
+         const std::string& detrend, const std::string& filter, int decimate,
          const std::string& operating_point) {
-        IdentifyRequest r = MakeRequest(input, output, order, na, nb, nk, nc, nd, nf);
+        const IdentifyRequest defaults;
+        IdentifyRequest r = MakeRequest(input, output, order, na.value_or(defaults.na),
+                                        nb.value_or(defaults.nb), nk.value_or(defaults.nk), nc,
+                                        nd, nf);
         r.operating_point = OperatingPointKindFromString(operating_point);
         IdentifyOptions o;
         o.split = split;
+        // As `pneumid identify -m`: without na, nb, nk the nonlinear structures
+        // (hammerstein, wiener, hw, narx) are chosen on the held-out data.
+        o.nonlinear.choose_structure = !na && !nb && !nk;
         const PreprocessOptions p =
             PythonPreprocessOptions(window, resample, remove_initial, detrend, filter, decimate);
         IdentificationSummary s;
@@ -269,13 +276,15 @@ void BindIdentify(py::module_& m) {
                         "termination"_a = ToString(s.termination), "message"_a = s.message,
                         "warnings"_a = s.warnings);
       },
-      "methods"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = 3, "nb"_a = 3,
-      "nk"_a = 1, "nc"_a = 1, "nd"_a = 1, "nf"_a = 3, "split"_a = 0.0, "validation"_a = py::none(),
+      "methods"_a, "data"_a, "input"_a = 0, "output"_a = 0, "order"_a = 2, "na"_a = py::none(),
+      "nb"_a = py::none(), "nk"_a = py::none(), "nc"_a = 1, "nd"_a = 1, "nf"_a = 3, "split"_a = 0.0,
+      "validation"_a = py::none(),
       "window"_a = "", "resample"_a = 0.0, "remove_initial"_a = false, "detrend"_a = "none",
       "filter"_a = "", "decimate"_a = 1, "operating_point"_a = "auto",
       "Runs several methods as `pneumid identify -m` does: each fails alone, models are "
       "flagged and ranked (unflagged first; by validation fit with `split` or `validation` "
-      "data). Returns {'models': [IdentifiedModel, best first], 'failures': [{'method', "
+      "data). na, nb, nk default to 3, 3, 1 for the linear methods; when none of them is "
+      "given the nonlinear structures are chosen on the held-out data, as the command does. Returns {'models': [IdentifiedModel, best first], 'failures': [{'method', "
       "'reason'}], 'best', 'termination', 'message', 'warnings': [what the held-out part cannot "
       "tell, e.g. a constant input]}.");
   m.def(

@@ -147,7 +147,9 @@ class Module {
 // Clip of InputLimits (controller.cpp): std::clamp to u_prev +- du_max, then
 // to [u_min, u_max]; sides that are infinite are left out.
 void EmitClip(Module& m, const InputLimits& lim) {
-  std::string body;
+  // A non-finite u (the law overflowed) stays one: PFX_step counts the fault
+  // and restarts the law instead of applying a limit.
+  std::string body = "  if (!PFX_ISFINITE(u)) return u;\n";
   if (std::isfinite(lim.du_max)) {
     body += fmt::format(
         "  {{\n    const PFX_real lo = u_prev - {0}, hi = u_prev + {0};\n"
@@ -165,7 +167,8 @@ void EmitClip(Module& m, const InputLimits& lim) {
   else if (hi)
     body += fmt::format("  if ({0} < u) u = {0};\n", m.Literal(lim.u_max));
   m.code_ +=
-      "/* u clipped to u_prev +- du_max, then to [u_min, u_max] (InputLimits::Clip). */\n"
+      "/* u clipped to u_prev +- du_max, then to [u_min, u_max] (InputLimits::Clip); a\n"
+      "   non-finite u is returned as it is (a fault). */\n"
       "static PFX_real PFX_clip(PFX_real u, PFX_real u_prev) {\n" +
       body + "  return u;\n}\n\n";
 }
@@ -1118,10 +1121,12 @@ void GenerateGuard(const Controller& c, Module& m) {
         "#ifndef PFX_SAFE_INPUT\n#define PFX_SAFE_INPUT {}\n#endif\n",
         m.Literal(g.safe_input));
   m.Member({Field::kReal, "u_hold", 0, "last valid input (held on a faulty sample)"});
-  m.Member({Field::kInt, "fault", 0, "PFX_FAULT_* of the last step"});
+  m.Member({Field::kReal, "y_hold", 0, "last valid measurement (the law restarts there)"});
+  m.Member({Field::kInt, "fault", 0, "fault of the last step: PFX_FAULT_NONE or another PFX_FAULT_ code"});
   m.Member({Field::kInt, "faults", 0, "faulty samples since the last reset"});
   m.code_ += R"C(void PFX_reset(PFX_state* s, PFX_real u0, PFX_real y0) {
   s->u_hold = u0;
+  s->y_hold = y0;
   s->fault = PFX_FAULT_NONE;
   s->faults = 0;
   PFX_core_reset(s, u0, y0);
@@ -1139,10 +1144,14 @@ PFX_real PFX_step(PFX_state* s, PFX_real setpoint, PFX_real measurement) {
     const PFX_real u = PFX_core_step(s, setpoint, measurement);
     if (PFX_ISFINITE(u)) {
       s->u_hold = u;
+      s->y_hold = measurement;
       s->fault = PFX_FAULT_NONE;
       return u;
     }
+    /* The law overflowed (a finite but huge measurement): its state may hold
+       the overflow, so it restarts at rest at the held input. */
     fault = PFX_FAULT_OUTPUT_NOT_FINITE;
+    PFX_core_reset(s, s->u_hold, s->y_hold);
   }
   s->fault = fault;
   if (s->faults < 2147483647) ++s->faults;

@@ -68,6 +68,7 @@ ControllerFault MeasurementGuard::Check(double setpoint, double measurement) con
 
 void Controller::Reset(double u0, double y0) {
   last_u_ = u0;
+  last_y_ = y0;
   last_fault_ = ControllerFault::kNone;
   fault_count_ = 0;
   DoReset(u0, y0);
@@ -79,10 +80,14 @@ double Controller::Update(double setpoint, double measurement) {
     const double u = DoUpdate(setpoint, measurement);
     if (std::isfinite(u)) {
       last_u_ = u;
+      last_y_ = measurement;
       last_fault_ = ControllerFault::kNone;
       return u;
     }
+    // The law overflowed (a finite but huge measurement): its state may hold
+    // the overflow, so it restarts at rest at the held input.
     fault = ControllerFault::kOutputNotFinite;
+    DoReset(last_u_, last_y_);
   }
   last_fault_ = fault;
   ++fault_count_;

@@ -63,6 +63,11 @@ ControllerSpec ToControllerSpec(const ControllerSettings& settings) {
   spec.guard.safe_input = settings.safe_input;
   std::string error;
   PNEUMID_CHECK(spec.guard.IsValid(&error), "{}", error);
+  PNEUMID_CHECK(std::isnan(settings.safe_input) || (settings.safe_input >= settings.limits.u_min &&
+                                                    settings.safe_input <= settings.limits.u_max),
+                "the safe input {} lies outside the input limits [{}, {}] (--safe-input, "
+                "--u-min, --u-max)",
+                settings.safe_input, settings.limits.u_min, settings.limits.u_max);
   spec.input_gaps = ParseInputGaps(settings.input_gaps);
   return spec;
 }

@@ -143,12 +143,14 @@ double DmcController::DoUpdate(double setpoint, double measurement) {
   const double bias = measurement - yhat_(0);
   for (int i = 0; i < P; ++i) free_(i) = yhat_(i + 1) + bias;
   double du = gain_sum_ * setpoint - gain_.dot(free_);
+  if (!std::isfinite(du)) return du;  // an overflow: a fault (Controller::Update)
   if (options_.constrained) {
     const InputLimits& lim = options_.limits;
     err_.setConstant(setpoint);
     err_ -= free_;
     g_.head(M).noalias() = -AtQ_ * err_;
     if (soft_output_) g_(M) = options_.slack_linear_weight;
+    if (!g_.allFinite()) return std::numeric_limits<double>::quiet_NaN();
     internal::FillMoveQpBounds(std::isfinite(lim.u_min) || std::isfinite(lim.u_max), lim, u_prev_,
                                options_.y_min, options_.y_max, free_, M, P, lb_, ub_);
     const QpSummary& s = qp_->Solve(g_, lb_, ub_, lbx_, ubx_);

@@ -185,6 +185,7 @@ double GpcController::DoUpdate(double setpoint, double measurement) {
   free_.noalias() = F_ * yf_hist_.head(F_.cols());
   free_.noalias() += Gamma_ * duf_hist_.head(Gamma_.cols());
   double du = gain_sum_ * setpoint - gain_.dot(free_);
+  if (!std::isfinite(du)) return du;  // an overflow: a fault (Controller::Update)
   const double u = options_.limits.Clip(u_prev_ + du, u_prev_);
   du = u - u_prev_;
   // Delta u_f(t) = Delta u(t) - sum_i t_i Delta u_f(t-i), for the next step.

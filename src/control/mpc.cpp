@@ -472,6 +472,9 @@ double MpcController::DoUpdate(double setpoint, double measurement) {
   // the cost is separable in du and e, and e = 0 minimizes rho1 e + rho2/2 e^2).
   moves_.noalias() = Fz_ * z_post_;
   moves_ += Fu_ * u_prev_ + Fr_ * setpoint + Fs_ * us;
+  // An overflow (a finite but huge measurement through the observer) is a
+  // fault (Controller::Update), not a QP of non-finite data.
+  if (!moves_.allFinite() || !z_post_.allFinite()) return std::numeric_limits<double>::quiet_NaN();
   last_active_ = false;
   if (constrained_) {
     const InputLimits& lim = options_.limits;
@@ -485,6 +488,7 @@ double MpcController::DoUpdate(double setpoint, double measurement) {
       g_.head(M).noalias() = Gz_ * z_post_;
       g_.head(M) += Gu_ * u_prev_ + Gr_ * setpoint + Gs_ * us;
       if (soft_output_) g_(M) = options_.slack_linear_weight;
+      if (!g_.allFinite()) return std::numeric_limits<double>::quiet_NaN();
       internal::FillMoveQpBounds(u_rows_, lim, u_prev_, options_.y_min, options_.y_max, free_, M, P,
                                  lb_, ub_);
       const QpSummary& s = qp_->Solve(g_, lb_, ub_, lbx_, ubx_);

@@ -110,6 +110,7 @@ double PidController::DoUpdate(double setpoint, double measurement) {
   }
   const double v =
       p + integral_ + derivative_ + options_.velocity_feedforward * (setpoint - r_prev_) / Ts_;
+  if (!std::isfinite(v)) return v;  // an overflow: a fault (Controller::Update)
   const double u = options_.limits.Clip(v, u_prev_);
   if (std::isfinite(g.Ti)) {
     integral_ += g.Kc * Ts_ / g.Ti * e + (Tt_ > 0.0 ? Ts_ / Tt_ * (u - v) : 0.0);

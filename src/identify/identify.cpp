@@ -335,11 +335,14 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
                   vsrc, ChannelNames(validation->input_channels()),
                   ChannelNames(validation->output_channels()), ChannelNames(data.input_channels()),
                   ChannelNames(data.output_channels()));
+    // Each record uniform first: a gap in the estimation data shifts its
+    // mean interval, and the comparison below blamed the validation data.
+    data.RequireUniform();
     validation->RequireUniform();
     PNEUMID_CHECK(
         std::abs(validation->SampleTime() - data.SampleTime()) <= 1e-6 * data.SampleTime(),
-        "{} are sampled at {} s, the estimation data at {} s", vsrc, validation->SampleTime(),
-        data.SampleTime());
+        "{} is sampled every {:.6g} s, the estimation data every {:.6g} s", vsrc,
+        validation->SampleTime(), data.SampleTime());
   }
 
   // The estimation part, and the held-out samples [score_from, N) of `scored`.
@@ -370,6 +373,20 @@ IdentificationSummary IdentifyModels(const std::vector<std::string>& methods, co
                   y.size(), y.size() ? y[0] : 0.0,
                   validation ? "give a validation record that excites the plant"
                              : "choose another --split or give --validation data");
+  }
+  {
+    // A constant estimation output leaves nothing to fit: every method failed
+    // on it in its own words (a map "needs finite input samples", a fit "of
+    // y = 0" after scaling), and some returned a non-finite model as best.
+    const Eigen::VectorXd y = estimation.y(request.output);
+    PNEUMID_CHECK(y.size() < 2 || y.maxCoeff() > y.minCoeff(),
+                  "{} holds a constant output ({} samples at y = {:g}): nothing to identify; "
+                  "record the output while the input moves the plant",
+                  head ? fmt::format("the first {:.0f} % of {}", 100.0 * options.split,
+                                     data.source().empty() ? "the data" : data.source())
+                       : (data.source().empty() ? std::string("the estimation data")
+                                                : data.source()),
+                  y.size(), y[0]);
   }
   std::vector<std::string> warnings;
   {

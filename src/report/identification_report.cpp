@@ -100,8 +100,10 @@ void CreateReportDirectory(const std::string& dir) {
 // Runs the methods; the models carry the report's preprocessing record.
 void IdentifyReportModels(const Dataset& data, const ReportOptions& options,
                           ReportSummary& summary) {
+  IdentifyOptions identify;
+  identify.nonlinear.choose_structure = options.choose_structure;
   const IdentificationSummary identified =
-      IdentifyModels(options.methods, data, options.request, {}, nullptr, options.progress);
+      IdentifyModels(options.methods, data, options.request, identify, nullptr, options.progress);
   summary.models = identified.models;
   summary.failures = identified.failures;
   if (options.preprocessing)

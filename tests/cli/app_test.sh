@@ -165,7 +165,11 @@ secret_toml = os.path.join(tmp, "outside.toml")
 with open(secret_toml, "w") as f:
     f.write("[secret_section]\nsecret_key_name = 1\n")
 ctl = {"model": "fopdt-paper", "Ts": 0.01, "duration": 0.2}
-for sp in ["file:" + outside + ",col=u", "file:../outside.csv,col=u", "  file:" + outside]:
+# The kind in any case and blanks around it (as the signal parser reads it):
+# "FILE:", "File :" and a leading newline read the outside file before.
+for sp in ["file:" + outside + ",col=u", "file:../outside.csv,col=u", "  file:" + outside,
+           "FILE:" + outside + ",col=u", "File :../outside.csv,col=u", "\nfile:" + outside,
+           "file: " + outside]:
     s, a = call("POST", "/api/control", dict(ctl, setpoint=sp))
     if expect(s, a, 403, f"a set-point file outside the root ({sp})") and "31337" in str(a):
         fail(f"the outside file's values leak: {str(a)[:200]}")
@@ -176,6 +180,10 @@ for plant in ["ipa:config=/etc/shadow", "ipa:config=" + secret_toml, "ipa-positi
 s, a = call("POST", "/api/run/start", {"model": "fopdt-paper", "io": "comedi:/dev/null",
                                        "setpoint": "step:to=1", "duration": 0.5})
 expect(s, a, 403, "a device not allowed on the command line")
+# An unknown controller is refused at the start, not in the run's status.
+s, a = call("POST", "/api/run/start", {"model": "fopdt-paper", "controller": "nope",
+                                       "setpoint": "step:to=1", "duration": 0.5})
+expect(s, a, 400, "run/start with an unknown controller")
 s, a = call("POST", "/api/control", dict(ctl, setpoint="file:demo.csv\u0000x,col=u"))
 expect(s, a, 400, "a NUL byte in a path")
 s, a = call("POST", "/api/control", dict(ctl, setpoint="file:" + "a/" * 3000 + "x.csv"))
@@ -366,6 +374,8 @@ if expect(s, a, 200, "control"):
     if a.get("warnings") != []:
         fail("control: no 'warnings' list, or one where pneumid control warns of nothing")
     cli = json.load(open(tmp + "/control_cli.json"))
+    if a.pop("steps_total", None) != len(a.get("steps", [])):
+        fail("control: no 'steps_total', or not the number of steps listed")
     if a != cli:
         fail(f"control: not the JSON of pneumid control --json:\n{a}\n{cli}")
     if len(trace["y"]) != len(trace["t"]) or len(trace["t"]) < 300:
@@ -437,6 +447,20 @@ if expect(s, a, 200, "commission out of reach") and (
 s, a = call("POST", "/api/export/controller", dict(scenario, model="models.json#arx"), raw=True)
 if expect(s, a, 200, "export controller"):
     open(tmp + "/controller.toml", "w").write(a)
+# The PID's gains go on the exported command line (they were dropped: the
+# exported run used the rule's PID).
+s, a = call("POST", "/api/export/controller",
+            dict(scenario, model="fopdt-paper", controller="pid", Kc=2, Ti=0.3, Td=0.01,
+                 tau_c=0.2), raw=True)
+if expect(s, a, 200, "export a PID") and not ("--Kc 2 --Ti 0.3 --Td 0.01" in a and
+                                                "tau_c = 0.2" in a):
+    fail(f"export: the PID's gains are not in the exported configuration:\n{a}")
+# A long dead time at a short Ts is refused before the MPC's design (1200
+# states took 18 s past a 2 s deadline).
+s, a = call("POST", "/api/control", {"model": "fopdt:K=1.6,tau=0.25,theta=12", "controller": "mpc",
+                                     "Ts": 0.01, "duration": 2, "setpoint": "step:to=40"})
+if expect(s, a, 422, "a model of 1201 states") and "1201 states" not in a.get("error", ""):
+    fail(f"the long dead time's error does not name the states: {a}")
 s, a = call("POST", "/api/export/report", {"data": data_id, "methods": methods}, raw=True)
 if expect(s, a, 200, "export report") and "<html" not in a.lower():
     fail("export report: not HTML")
@@ -604,11 +628,12 @@ LONG="$(dirname "${BASH_SOURCE[0]}")/app_long_request.py"
 APP2_PID=$APP_PID
 "$PY" "$LONG" "$URL2" "$APP2_PID" t2 leave || fail "a request whose client leaves"
 "$PY" "$LONG" "$URL2" "$APP2_PID" t2 deadline 4 || fail "the request deadline"
-# 2e6 samples of a DMC with P = 5000: minutes of work, within the limits.
+# 2e6 samples of a constrained DMC with P = 5000: about 15 s of work, within the limits.
 "$PY" -c "
 import json, sys, urllib.request
 req = urllib.request.Request(sys.argv[1] + '/api/control', method='POST',
     data=json.dumps({'model': 'fopdt-paper', 'controller': 'dmc', 'P': 5000, 'M': 5, 'lambda': 1,
+                     'constrained': True, 'u_min': 0, 'u_max': 100,
                      'Ts': 0.0001, 'duration': 199, 'setpoint': 'step:to=1'}).encode(),
     headers={'X-Pneumid-Token': 't2', 'Content-Type': 'application/json'})
 try:

@@ -454,47 +454,64 @@ INSTANTIATE_TEST_SUITE_P(Controllers, CodegenFaultTest, ::testing::ValuesIn(Case
                          });
 
 // The module's own guard in closed loop (float, as on the Cortex-M4F): the
-// paper's FOPDT plant in N at 60 N, NaN and Inf readings for 0.1 s during the
-// step response, then valid ones: the inputs stay finite and within 0..100 %,
-// the faults are counted, and the force is within 0.5 N of the set-point
-// 0.5 s after the valid samples return.
+// paper's FOPDT plant in N at 60 N from rest, bad readings during the step
+// response, then valid ones; the inputs stay finite and within 0..100 %. The
+// bad readings: NaN and Inf for 0.1 s (each a fault; the force within 0.5 N
+// of the set-point 0.5 s after the valid samples return), and one finite
+// reading of +-3e37 N (below FLT_MAX) that overflows the law: the PID's
+// proportional term, the prediction's bias, the observer. The clip turned
+// such an overflow into a limit and the state held it: the PID stayed at
+// 100 % for good. Now the non-finite law output is a fault, the law restarts
+// at the held input, and the force is back within 0.5 N 1.5 s later.
 TEST(CodegenFaultTest, ModuleRecoversInClosedLoop) {
-  for (const char* name : {"dmc_clipped", "qdmc", "gpc", "pid_simc", "mpc_constrained"}) {
-    SCOPED_TRACE(name);
-    Case c;
-    for (const Case& k : Cases())
-      if (k.name == name) c = k;
-    ASSERT_EQ(c.name, name);
-    auto lib = Build(c);
-    CodegenOptions o;
-    o.precision = CodegenPrecision::kFloat;
-    o.prefix = std::string("cl_") + name;
-    const CodegenResult gen = GenerateC(*lib, o);
-    TempDir dir;
-    const fs::path so = Compile(gen, dir.path());
-    ASSERT_FALSE(::testing::Test::HasFailure());
-    GeneratedController module(so, gen, true, kTs);
-    auto plant = MakePlant("fopdt-paper", kTs);
-    plant->Reset();
-    module.DoReset(0.0, 0.0);
-    std::vector<double> y_after;
-    int faults = 0;
-    for (int k = 0; k < 600; ++k) {
-      double y = plant->Measure();
-      const double y_true = y;
-      if (k >= 150 && k < 160)
-        y = k % 2 ? std::numeric_limits<double>::quiet_NaN()
-                  : std::numeric_limits<double>::infinity();
-      const double u = module.DoUpdate(60.0, y);  // the module's own guard
-      ASSERT_TRUE(std::isfinite(u)) << "step " << k;
-      ASSERT_GE(u, 0.0) << "step " << k;
-      ASSERT_LE(u, 100.0) << "step " << k;
-      if (k >= 150 && k < 160) ++faults;
-      if (k >= 210) y_after.push_back(y_true);
-      plant->Advance(u);
+  constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  struct Bad {
+    const char* what;
+    int k0, k1;          // the samples replaced: [k0, k1)
+    double even, odd;    // the reading at even and odd k
+    int settled_from;    // within 0.5 N of the set-point from here on
+  };
+  for (const Bad& bad : {Bad{"NaN and Inf", 150, 160, kInf, kNan, 210},
+                         Bad{"+3e37", 150, 151, 3e37, 3e37, 300},
+                         Bad{"-3e37", 150, 151, -3e37, -3e37, 300}}) {
+    for (const char* name : {"dmc_clipped", "qdmc", "gpc", "pid_simc", "mpc_constrained"}) {
+      SCOPED_TRACE(std::string(name) + ", " + bad.what);
+      Case c;
+      for (const Case& k : Cases())
+        if (k.name == name) c = k;
+      ASSERT_EQ(c.name, name);
+      auto lib = Build(c);
+      CodegenOptions o;
+      o.precision = CodegenPrecision::kFloat;
+      o.prefix = std::string("cl_") + name;
+      const CodegenResult gen = GenerateC(*lib, o);
+      TempDir dir;
+      const fs::path so = Compile(gen, dir.path());
+      ASSERT_FALSE(::testing::Test::HasFailure());
+      GeneratedController module(so, gen, true, kTs);
+      auto plant = MakePlant("fopdt-paper", kTs);
+      plant->Reset();
+      module.DoReset(0.0, 0.0);
+      for (int k = 0; k < 600; ++k) {
+        const double y_true = plant->Measure();
+        const bool faulty = k >= bad.k0 && k < bad.k1;
+        const double y = faulty ? (k % 2 ? bad.odd : bad.even) : y_true;
+        const double u = module.DoUpdate(60.0, y);  // the module's own guard
+        ASSERT_TRUE(std::isfinite(u)) << "step " << k;
+        ASSERT_GE(u, 0.0) << "step " << k;
+        ASSERT_LE(u, 100.0) << "step " << k;
+        if (k >= bad.settled_from) EXPECT_NEAR(y_true, 60.0, 0.5) << "step " << k;
+        plant->Advance(u);
+      }
+      if (std::isfinite(bad.even)) {
+        // The faulty sample or the next one (the DMC's bias does not overflow).
+        if (std::string(name) == "pid_simc") EXPECT_GE(module.module_faults(), 1);
+        EXPECT_LE(module.module_faults(), 2);
+      } else {
+        EXPECT_EQ(module.module_faults(), bad.k1 - bad.k0);
+      }
     }
-    EXPECT_EQ(module.module_faults(), faults);
-    for (double y : y_after) EXPECT_NEAR(y, 60.0, 0.5);
   }
 }
 
@@ -526,12 +543,12 @@ TEST(CodegenTest, RejectsAStateAboveTheRamBudget) {
   o.max_ram_bytes = gen.ram_bytes;
   EXPECT_NO_THROW(GenerateC(dmc, o));
   // Single precision halves the reals: yhat_0..yhat_N, f_1..f_P, u_prev,
-  // last_du and the guard's held input; the guard's fault code and count
-  // are two ints.
+  // last_du and the guard's held input and last valid measurement; the
+  // guard's fault code and count are two ints.
   o.precision = CodegenPrecision::kFloat;
   const CodegenResult f = GenerateC(dmc, o);
-  EXPECT_EQ(f.ram_bytes, 4 * (dmc.step_coefficients().size() + 126 + 3) + 2 * 4);
-  EXPECT_EQ(gen.ram_bytes, 8 * (dmc.step_coefficients().size() + 126 + 3) + 2 * 4);
+  EXPECT_EQ(f.ram_bytes, 4 * (dmc.step_coefficients().size() + 126 + 4) + 2 * 4);
+  EXPECT_EQ(gen.ram_bytes, 8 * (dmc.step_coefficients().size() + 126 + 4) + 2 * 4);
 }
 
 TEST(CodegenTest, RejectsBadPrefixesAndPrecisions) {

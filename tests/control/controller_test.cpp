@@ -117,6 +117,37 @@ TEST_P(ControllerGuardTest, NonFiniteMeasurementsHoldTheInputAndControlResumes) 
   }
 }
 
+// A finite reading so large that the law overflows (1.7e308 into the
+// proportional term, the prediction's bias, the observer) gave a clipped,
+// finite input and left the state at +-inf or NaN: the PID held 0 or 100 %
+// for good and the MPC's QP threw. Now the law's non-finite input is a fault
+// (output-not-finite), the law restarts at the held input, and control resumes.
+TEST_P(ControllerGuardTest, AnOverflowingReadingIsAFaultAndControlResumes) {
+  for (const double bad : {1.7e308, -1.7e308}) {
+    SCOPED_TRACE(bad);
+    BuiltController b = Build(GetParam());
+    Controller& c = *b.controller;
+    const int k0 = 150;
+    Trace t;
+    ASSERT_NO_THROW(t = RunLoop(c, k0, k0 + 1, bad));
+    for (int k = 0; k < 600; ++k) {
+      ASSERT_TRUE(std::isfinite(t.u[k])) << "sample " << k;
+      ASSERT_GE(t.u[k], 0.0) << "sample " << k;
+      ASSERT_LE(t.u[k], 100.0) << "sample " << k;
+    }
+    // The faulty sample itself, or the next one when the overflow shows only
+    // in the state, is the fault; no other sample is.
+    int faults = 0;
+    for (int k = 0; k < 600; ++k) {
+      if (t.fault[k] == ControllerFault::kNone) continue;
+      EXPECT_EQ(t.fault[k], ControllerFault::kOutputNotFinite) << "sample " << k;
+      EXPECT_TRUE(k == k0 || k == k0 + 1) << "sample " << k;
+      ++faults;
+    }
+    for (int k = k0 + 150; k < 600; ++k) EXPECT_NEAR(t.y[k], 60.0, 0.5) << "sample " << k;
+  }
+}
+
 TEST_P(ControllerGuardTest, OutOfRangeMeasurementsAndBadSetpointsAreFaults) {
   MeasurementGuard g;
   g.y_min = -5.0;
@@ -219,6 +250,14 @@ TEST(ControllerSettingsTest, GuardFromSettings) {
   s.y_valid_min = 300.0;
   EXPECT_THAT([&] { ToControllerSpec(s); },
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("y_min <= y_max")));
+  // A safe input beyond the limits would be applied as it is.
+  s.y_valid_min = 0.0;
+  s.limits.u_min = 0.0;
+  s.limits.u_max = 100.0;
+  s.safe_input = 150.0;
+  EXPECT_THAT([&] { ToControllerSpec(s); },
+              ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr(
+                  "the safe input 150 lies outside the input limits [0, 100]")));
 }
 
 }  // namespace

@@ -384,7 +384,7 @@ TEST(IdentifyModelsTest, ValidationDataMustHaveTheSameChannels) {
               ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("inputs [valve]")));
   const Dataset slow = Dataset::FromUniform(0.2, d.u(0), d.y(0));
   EXPECT_THAT([&] { IdentifyModels({"arx"}, d, {}, {}, &slow); },
-              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("sampled at 0.2 s")));
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("sampled every 0.2 s")));
   IdentifyOptions o;
   o.split = 0.5;
   EXPECT_THROW(IdentifyModels({"arx"}, d, {}, o, &d), InvalidArgument);

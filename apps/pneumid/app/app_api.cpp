@@ -36,6 +36,7 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr Eigen::Index kMaxPoints = 2000;  // signals sent for drawing
+constexpr std::size_t kMaxSteps = 1000;    // per-step metrics listed by /api/control
 
 // An error with its HTTP status.
 struct HttpError : std::runtime_error {
@@ -358,13 +359,17 @@ fs::path AppApi::Confine(const std::string& path) const {
 }
 
 std::string AppApi::SignalSpec(const std::string& spec) const {
-  std::size_t start = spec.find_first_not_of(" \t");
-  if (start == std::string::npos || spec.compare(start, 5, "file:") != 0) return spec;
-  start += 5;
-  const std::size_t end = spec.find(',', start);
-  const std::string path = spec.substr(start, end == std::string::npos ? end : end - start);
+  // The kind and the path as ParseSignal reads them: blanks trimmed, the
+  // kind in any case ("FILE:", " file :" are file signals too).
+  const std::string_view text = Trim(spec);
+  const std::size_t colon = text.find(':');
+  if (colon == std::string_view::npos || ToLower(Trim(text.substr(0, colon))) != "file")
+    return spec;
+  const std::string_view rest = text.substr(colon + 1);
+  const std::size_t comma = rest.find(',');
+  const std::string path(Trim(rest.substr(0, comma)));
   return "file:" + Confine(path).string() +
-         (end == std::string::npos ? std::string() : spec.substr(end));
+         (comma == std::string_view::npos ? std::string() : std::string(rest.substr(comma)));
 }
 
 std::string AppApi::PlantSpec(const std::string& spec) const {
@@ -583,16 +588,25 @@ nlohmann::json AppApi::Identify(const nlohmann::json& body, const std::atomic<bo
   Get(body, "detrend", args.preprocess.detrend);
   Get(body, "window", args.preprocess.window);
   Get(body, "order", args.request.order);
-  Get(body, "na", args.request.na);
-  Get(body, "nb", args.request.nb);
-  Get(body, "nk", args.request.nk);
+  // As `pneumid identify`: without na, nb, nk the nonlinear structures are chosen.
+  const bool na = Get(body, "na", args.request.na);
+  const bool nb = Get(body, "nb", args.request.nb);
+  const bool nk = Get(body, "nk", args.request.nk);
+  args.nonlinear.choose_structure = !na && !nb && !nk;
   const IdentifyWorkflowResult out =
       RunIdentifyWorkflow(args, set->data, validation ? &validation->data : nullptr,
                           [cancel](std::size_t, std::size_t, const std::string& method) {
                             if (cancel != nullptr && cancel->load())
                               throw Cancelled("identification stopped on request before " + method);
                           });
-  if (out.summary.models.empty()) throw HttpError(422, out.summary.message);
+  if (out.summary.models.empty()) {
+    // Each method's reason, as `identify --json` lists them in "failures".
+    std::string reasons;
+    for (const auto& [method, reason] : out.summary.failures)
+      reasons += fmt::format("{}{}: {}", reasons.empty() ? "" : "; ", method, reason);
+    throw HttpError(422, reasons.empty() ? out.summary.message
+                                         : fmt::format("{}: {}", out.summary.message, reasons));
+  }
   const nlohmann::json model_file = out.ToJson();
   nlohmann::json j = model_file;
   nlohmann::json responses;
@@ -715,6 +729,22 @@ void CheckWork(double Ts, double duration, int P, int M) {
                                      kMaxHorizon, P, M));
 }
 
+// A model's dead time and order become the states of the MPC's observer and
+// of the predictions, and the design's work grows with their cube (a 12 s
+// delay at Ts = 0.01 s: 1200 states, 18 s of design no deadline stops). The
+// app designs for at most kMaxModelStates of them per request.
+constexpr int kMaxModelStates = 1000;
+void CheckModelSize(const std::string& model, double Ts) {
+  const TransferFunction tf = ParseControllerModel(model);
+  const double states = std::round(tf.delay() / Ts) + tf.Order();
+  if (states > kMaxModelStates)
+    throw HttpError(422, fmt::format("the model's dead time of {:g} s and order {} make {:.0f} "
+                                     "states at Ts = {:g} s, above the app's limit of {} per "
+                                     "request (a longer Ts, or `pneumid control` without the "
+                                     "limit)",
+                                     tf.delay(), tf.Order(), states, Ts, kMaxModelStates));
+}
+
 }  // namespace
 
 nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
@@ -729,6 +759,7 @@ nlohmann::ordered_json AppApi::Tune(const nlohmann::json& b) {
   Get(b, "P", c.P);
   Get(b, "lambda", c.lambda);
   CheckWork(c.Ts, 0.0, c.P, c.M);
+  CheckModelSize(c.model, c.Ts);
   // A controller, when given, must be one (whatever the rule).
   std::string controller;
   if (Get(b, "controller", controller)) ControllerTypeFromString(controller);
@@ -769,8 +800,23 @@ nlohmann::ordered_json AppApi::Control(const nlohmann::json& b, const std::atomi
   Get(b, "seed", c.seed);
   c.load_steps = LoadSteps(b);
   std::vector<std::string> warnings;
-  const std::vector<cli::ControlRun> runs = cli::SimulateControl(c, &warnings);
+  CheckModelSize(c.model, c.Ts);
+  std::vector<cli::ControlRun> runs = cli::SimulateControl(c, &warnings);
+  // A set-point that changes at every sample (a sine, a PRBS) makes every
+  // sample a step: the answer lists the first kMaxSteps of them (the summary
+  // is over all) and says how many there were, instead of growing to
+  // hundreds of MB (2e6 samples: 663 MB, 5 GB of server memory).
+  std::vector<std::size_t> step_counts;
+  for (cli::ControlRun& r : runs) {
+    std::vector<StepMetrics>& steps = r.result.metrics.steps;
+    step_counts.push_back(steps.size());
+    if (steps.size() > kMaxSteps) steps.resize(kMaxSteps);
+  }
   nlohmann::ordered_json j = cli::ControlJson(runs, warnings);
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    nlohmann::ordered_json& run = runs.size() == 1 ? j : j["compare"][i];
+    run["steps_total"] = step_counts[i];
+  }
   j["trace"] = Trace(runs.front().result);
   return j;
 }
@@ -991,8 +1037,9 @@ Response AppApi::RunStart(const nlohmann::json& b) {
   o.safety.ApplyTo(config.safety);
   PNEUMID_CHECK(config.safety.IsValid(&error), "invalid safety settings: {}", error);
   // Errors in the settings answer here rather than in the run's status.
-  ParseControllerModel(o.model);
+  CheckModelSize(o.model, config.loop.period);
   ParseSignal(o.setpoint);
+  ToControllerSpec(o.controller);  // the controller type, rules and names
   if (!run_.Start(std::move(o), std::move(config)))
     return ErrorResponse(409, "a real-time run is going on (POST /api/run/stop ends it)");
   return JsonResponse({{"state", "running"}});
@@ -1083,7 +1130,14 @@ Response AppApi::ExportController(const nlohmann::json& b) {
   flag("aggressiveness", "aggressiveness");
   flag("constrained", "constrained");
   flag("pid_rule", "pid-rule");
+  flag("Kc", "Kc");
+  flag("Ti", "Ti");
+  flag("Td", "Td");
+  flag("Kff", "Kff");
   flag("disturbance", "disturbance");
+  flag("measurement_noise", "measurement-noise");
+  flag("state_noise", "state-noise");
+  flag("disturbance_noise", "disturbance-noise");
   flag("setpoint", "setpoint");
   for (const std::string& l : LoadSteps(b)) cmd += " --load-step " + ShellQuote(l);
 
@@ -1100,6 +1154,15 @@ Response AppApi::ExportController(const nlohmann::json& b) {
                       nlohmann::json(config.safety.u_min).dump(),
                       nlohmann::json(config.safety.u_max).dump(),
                       nlohmann::json(config.safety.rate_max).dump(), config.safety.max_overruns);
+  // Settings `run` has no flag for go in the configuration's [controller].
+  std::string controller;
+  for (const char* key : {"tau_c", "t_filter", "du_max", "y_min", "y_max"}) {
+    if (!b.contains(key) || b[key].is_null()) continue;
+    if (!b[key].is_number())
+      throw HttpError(400, fmt::format("field '{}' must be a number", key));
+    controller += fmt::format("{} = {}\n", key, b[key].dump());
+  }
+  if (!controller.empty()) toml += "\n[controller]\n" + controller;
   ParseRealtimeConfig(toml, "controller.toml");  // what `run --config` will read
   Response r;
   r.content_type = "text/plain; charset=utf-8";
@@ -1118,6 +1181,7 @@ Response AppApi::ExportReport(const nlohmann::json& b) {
       if (m.is_string()) o.methods.push_back(m.get<std::string>());
   }
   o.title = fmt::format("Identification report: {}", set->name);
+  o.choose_structure = true;  // as `pneumid report` without orders
   o.commands = {fmt::format("pneumid report {} --method {} --output-dir report",
                             ShellQuote(set->name), fmt::join(o.methods, ","))};
   std::string error;

@@ -57,8 +57,18 @@ ControllerFault ControllerFaultFromString(const std::string& name);
 /// whose set-point is not finite, is a fault: the controller's state is not
 /// updated with it, Update() returns the last valid input (or safe_input when
 /// it is set) and counts the fault, and the next valid sample resumes the
-/// control law from the state before the fault. The generated C modules do
-/// the same (c_codegen.hpp).
+/// control law from the state before the fault.
+///
+/// A valid sample whose control law gives no finite input (before the
+/// limits: a finite measurement so large that the law overflows, e.g. 1.7e308
+/// into a PID's proportional term, or 3e37 in float) is a fault too
+/// (kOutputNotFinite). The law's state may then hold the overflow, so it is
+/// restarted at rest at the held input and the last valid measurement
+/// (DoReset), and the next valid sample resumes control from there. A value
+/// huge but not overflowing still drives a model's observer far away, from
+/// which it returns only as fast as the model forgets: give the sensor's
+/// range (y_min, y_max) for a deployed loop. The generated C modules do the
+/// same (c_codegen.hpp).
 struct MeasurementGuard {
   /// The range of measurements a working sensor gives (plant units); the
   /// default accepts every finite value.
@@ -120,7 +130,8 @@ class Controller {
   /// sample; returns the input u to hold over the next period (within the
   /// controller's limits). A faulty sample (MeasurementGuard) leaves the
   /// state untouched and returns the last valid input, or the guard's safe
-  /// input. Allocates no memory.
+  /// input; a law that gives no finite input is restarted (see
+  /// MeasurementGuard). Allocates no memory.
   double Update(double setpoint, double measurement);
   /// The input actually applied after the last Update(), when a layer after
   /// the controller changed it (the plant's input range, a safety layer, a
@@ -150,6 +161,8 @@ class Controller {
  protected:
   /// The control law's Reset, Update and Applied: called with finite values
   /// (and, for DoUpdate, a measurement within the guard's range) only.
+  /// DoUpdate returns a non-finite value, never a clipped one, when its law
+  /// gives no finite input (the base class then restarts it).
   virtual void DoReset(double u0, double y0) = 0;
   virtual double DoUpdate(double setpoint, double measurement) = 0;
   /// The default does nothing (a controller without memory of its inputs).
@@ -160,6 +173,7 @@ class Controller {
   ControllerFault last_fault_ = ControllerFault::kNone;
   std::int64_t fault_count_ = 0;
   double last_u_ = 0.0;
+  double last_y_ = 0.0;  // the last valid measurement (or Reset's y0)
 };
 
 }  // namespace pneumid

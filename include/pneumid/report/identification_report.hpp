@@ -40,6 +40,10 @@ struct ReportOptions {
   /// Methods in table order (default: the paper's three).
   std::vector<std::string> methods = {"reaction-curve", "ptn", "arx"};
   IdentifyRequest request;            ///< channels and orders (default ARX(3,3,1), PTn n = 2)
+  /// The nonlinear structures (hammerstein, wiener, hw, narx) chosen on the
+  /// internal split as `pneumid identify` chooses them when no order is given
+  /// (NonlinearOptions::choose_structure); false: the request's orders.
+  bool choose_structure = false;
   std::string title;                  ///< default "Identification report: <data source>"
   int residual_max_lag = 25;          ///< largest lag of the residual figure, 1..10000
   double residual_confidence = 0.99;  ///< level of the residual band, in (0, 1)

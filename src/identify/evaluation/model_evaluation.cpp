@@ -48,6 +48,7 @@ TransferFunction FormOnDataGrid(const IdentifiedModel& model, const Dataset& dat
                 data.num_inputs());
   const TransferFunction& g = SimulatedForm(model);
   if (!g.IsDiscrete()) return g;
+  data.RequireUniform();  // a gap is named as such, not as another sample time
   const double Ts = data.SampleTime();
   PNEUMID_CHECK(std::abs(g.Ts() - Ts) <= 1e-6 * Ts,
                 "the model{} has sample time {} s, the data{} {} s",
