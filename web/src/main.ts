@@ -1279,16 +1279,20 @@ const commissionExpPlot = new TimePlot($('cm-exp-plot'));
 const commissionPlot = new TimePlot($('cm-plot'));
 const commissionUPlot = new TimePlot($('cm-u-plot'));
 
+// Only the fields filled in are sent: an empty one leaves the plant's own
+// default (a positioning drive is specified 2 % / 1 s, a force loop 5 % /
+// 0.5 s), where Number('') would send 0.
 function commissionBody(): Record<string, unknown> {
   const num = (id: string) => ($(id) as HTMLInputElement).value.trim();
   const body: Record<string, unknown> = {
     plant: num('cm-plant') || 'ipa',
-    budget: Number(num('cm-budget')),
     controller: ($('cm-ctl') as HTMLSelectElement).value,
-    overshoot: Number(num('cm-overshoot')),
-    settling: Number(num('cm-settling')),
   };
-  if (num('cm-lo') !== '' || num('cm-hi') !== '') body.range = [Number(num('cm-lo')), Number(num('cm-hi'))];
+  for (const [id, key] of [['cm-budget', 'budget'], ['cm-overshoot', 'overshoot'],
+                           ['cm-settling', 'settling']]) {
+    if (num(id) !== '') body[key] = Number(num(id));
+  }
+  if (num('cm-lo') !== '' && num('cm-hi') !== '') body.range = [Number(num('cm-lo')), Number(num('cm-hi'))];
   if (num('cm-dir') !== '') body.dir = num('cm-dir');
   return body;
 }

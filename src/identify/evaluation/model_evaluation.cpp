@@ -144,13 +144,36 @@ Eigen::VectorXd SimulateBlockFromEstimatedState(const IdentifiedModel& model, co
 
 }  // namespace
 
+namespace {
+
+// The simulation of the two whose squared error against output column
+// `output` is lower (a non-finite one never wins): the estimated start is
+// never worse than the start at rest, which is one of the states it chooses
+// from. The estimate can miss it: a Hammerstein model with a dead time of 3
+// samples scored 95.34 % from its estimate and 95.74 % from rest (the delayed
+// inputs are not among the estimated states), a Hammerstein-Wiener's
+// Gauss-Newton stalled where the output map is clamped flat (90.44 against
+// 94.39 %).
+Eigen::VectorXd BetterOf(Eigen::VectorXd estimated, Eigen::VectorXd rest, const Dataset& data,
+                         int output) {
+  const Eigen::VectorXd y = data.y(output);
+  const auto sse = [&](const Eigen::VectorXd& yhat) {
+    const double s = yhat.size() == y.size() ? (y - yhat).squaredNorm() : std::numeric_limits<double>::infinity();
+    return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
+  };
+  return sse(rest) < sse(estimated) ? rest : estimated;
+}
+
+}  // namespace
+
 Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data, int input,
                               int output, InitialCondition initial) {
   if (IsNonlinearModel(model)) {
     // A NARX simulation starts from the measured outputs in either case.
     if (initial == InitialCondition::kZero || model.narx)
       return SimulateNonlinear(model, data, input, output);
-    return SimulateBlockFromEstimatedState(model, data, input, output);
+    return BetterOf(SimulateBlockFromEstimatedState(model, data, input, output),
+                    SimulateNonlinear(model, data, input, output), data, output);
   }
   if (initial == InitialCondition::kZero) return SimulateModel(model, data, input);
   PNEUMID_CHECK(output >= 0 && output < data.num_outputs(),
@@ -161,7 +184,8 @@ Eigen::VectorXd SimulateModel(const IdentifiedModel& model, const Dataset& data,
   const Eigen::MatrixXd du = (data.u(input).array() - model.u0).matrix();
   const Eigen::MatrixXd dy = (data.y(output).array() - model.y0).matrix();
   const Eigen::VectorXd x0 = EstimateInitialState(ss, du, dy);
-  return (SimulateFromState(ss, du, x0).col(0).array() + model.y0).matrix();
+  return BetterOf((SimulateFromState(ss, du, x0).col(0).array() + model.y0).matrix(),
+                  SimulateModel(model, data, input), data, output);
 }
 
 FitMetrics EvaluateModel(const IdentifiedModel& model, const Dataset& data, int input, int output,
