@@ -267,6 +267,12 @@ s, a = call("POST", "/api/data/upload?name=up.csv", demo,
             headers={"Content-Type": "application/octet-stream"})
 if expect(s, a, 200, "upload") and a.get("samples") != 401:
     fail(f"upload: {a}")
+# A bad upload is named as the client named it, not by the app's folder.
+s, a = call("POST", "/api/data/upload?name=empty.csv", b"",
+            headers={"Content-Type": "application/octet-stream"})
+if expect(s, a, 422, "an empty upload") and (
+        "empty.csv" not in a.get("error", "") or "pneumid-app" in a.get("error", "")):
+    fail(f"the empty upload's error: {a}")
 
 # a 100 MB upload: refused from its Content-Length, before the body is read
 host, port = base[len("http://"):].split(":")

@@ -37,6 +37,7 @@ namespace {
 
 constexpr Eigen::Index kMaxPoints = 2000;  // signals sent for drawing
 constexpr std::size_t kMaxSteps = 1000;    // per-step metrics listed by /api/control
+constexpr std::size_t kMaxDataSets = 32;   // data sets held (uploaded or opened)
 
 // An error with its HTTP status.
 struct HttpError : std::runtime_error {
@@ -453,6 +454,7 @@ nlohmann::json AppApi::LoadDataSet(std::string name, const cli::DataOptions& o, 
   set.u = o.input_col;
   set.y = o.output_col;
   set.data = cli::LoadFromOptions(o);
+  set.data.set_source(set.name);  // as the client named it (not the app's folder)
   set.columns = DataFormatFromPath(o.path) == DataFormat::kMat
                     ? std::vector<std::string>{o.time_col, o.input_col, o.output_col}
                     : CsvColumns(o.path);
@@ -481,6 +483,15 @@ nlohmann::json AppApi::AddDataSet(DataSet set, bool session) {
   std::lock_guard lock(mutex_);
   const std::string id = set.id;
   data_[id] = std::make_shared<const DataSet>(std::move(set));
+  // The app holds the last kMaxDataSets data sets: every upload or open
+  // stayed in memory for the app's life (25-40 MB each for a large record).
+  while (data_.size() > kMaxDataSets) {
+    const auto oldest = std::min_element(data_.begin(), data_.end(), [](const auto& a,
+                                                                         const auto& b) {
+      return std::stoi(a.first.substr(1)) < std::stoi(b.first.substr(1));
+    });
+    data_.erase(oldest);
+  }
   if (session) {
     session_data_ = j;
     session_identify_ = nullptr;
@@ -533,6 +544,15 @@ nlohmann::json AppApi::Upload(const Request& req) {
   }
   const fs::path dir = options_.work / fmt::format("upload{}", n);
   fs::create_directories(dir);
+  // The upload is read into memory and its file removed (they stayed on disk
+  // for the app's life, failed ones too).
+  struct RemoveDir {
+    fs::path dir;
+    ~RemoveDir() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } remove{dir};
   const fs::path file = dir / name;
   {
     std::ofstream out(file, std::ios::binary);
@@ -547,7 +567,20 @@ nlohmann::json AppApi::Upload(const Request& req) {
   q("t", o.time_col);
   q("u", o.input_col);
   q("y", o.output_col);
-  return LoadDataSet(name, o);
+  // Messages name the upload as the client did, not the app's folder.
+  const auto named = [&](const std::exception& e) {
+    std::string m = e.what();
+    for (std::size_t at; (at = m.find(file.string())) != std::string::npos;)
+      m.replace(at, file.string().size(), name);
+    return m;
+  };
+  try {
+    return LoadDataSet(name, o);
+  } catch (const DataError& e) {
+    throw DataError(named(e));
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(named(e));
+  }
 }
 
 std::shared_ptr<const AppApi::DataSet> AppApi::FindDataSet(const nlohmann::json& id,
@@ -556,8 +589,9 @@ std::shared_ptr<const AppApi::DataSet> AppApi::FindDataSet(const nlohmann::json&
   std::lock_guard lock(mutex_);
   const auto it = data_.find(id.get<std::string>());
   if (it == data_.end())
-    throw HttpError(404, fmt::format("{}: no data set {} (open or upload it first)", field,
-                                     id.get<std::string>()));
+    throw HttpError(404, fmt::format("{}: no data set {} (open or upload it first; the app "
+                                     "holds the last {} opened)",
+                                     field, id.get<std::string>(), kMaxDataSets));
   return it->second;
 }
 
