@@ -700,8 +700,11 @@ namespace {
 void ReadControllerSettings(const nlohmann::json& b, ControllerSettings& s) {
   Get(b, "controller", s.controller);
   Get(b, "rule", s.rule);
-  Get(b, "P", s.P);
-  Get(b, "M", s.M);
+  // P and M as the flags take them: at least 1 (0 read as "the rule's").
+  for (const auto& [key, value] : {std::pair{"P", &s.P}, std::pair{"M", &s.M}})
+    if (Get(b, key, *value) && *value < 1)
+      throw HttpError(422, fmt::format("field '{}' must be at least 1 (as --{}), got {}", key,
+                                       key, *value));
   Get(b, "lambda", s.lambda);
   Get(b, "constrained", s.constrained);
   Get(b, "pid_rule", s.pid_rule);
