@@ -36,10 +36,15 @@ void Run(const BodeArgs& o) {
   Eigen::VectorXd omega;
   const bool has_range = o.w_min > 0.0 || o.w_max > 0.0;
   if (has_range) {
-    PNEUMID_CHECK(o.w_min > 0.0 && o.w_max > o.w_min,
-                  "--w-min and --w-max must satisfy 0 < w-min < w-max (rad/s), got {} and {}",
-                  o.w_min, o.w_max);
-    omega = LogSpace(std::log10(o.w_min), std::log10(o.w_max), o.points > 0 ? o.points : 50);
+    // A bound not given comes from the automatic grid (the poles and zeros).
+    const Eigen::VectorXd automatic = Bode(g).omega;
+    const double lo = o.w_min > 0.0 ? o.w_min : std::min(automatic[0], 0.01 * o.w_max);
+    double hi = o.w_max > 0.0 ? o.w_max
+                              : std::max(automatic[automatic.size() - 1], 100.0 * o.w_min);
+    if (o.w_max <= 0.0 && g.IsDiscrete()) hi = std::min(hi, M_PI / g.Ts());  // Nyquist
+    PNEUMID_CHECK(hi > lo, "--w-min and --w-max must satisfy 0 < w-min < w-max (rad/s), got {} and {}",
+                  lo, hi);
+    omega = LogSpace(std::log10(lo), std::log10(hi), o.points > 0 ? o.points : 50);
   } else if (o.points > 0) {
     // --points alone: that many frequencies over the automatic range.
     const Eigen::VectorXd automatic = Bode(g).omega;
@@ -111,10 +116,12 @@ const Registrar reg("bode",
                       auto o = std::make_shared<BodeArgs>();
                       AddModelOptions(app, o->model);
                       app.add_option("--w-min", o->w_min,
-                                     "Lowest frequency in rad/s (default: from the poles/zeros)")
+                                     "Lowest frequency in rad/s (default: from the poles/zeros, "
+                                     "at most --w-max / 100)")
                           ->check(Positive());
                       app.add_option("--w-max", o->w_max,
-                                     "Highest frequency in rad/s (discrete: at most pi/Ts)")
+                                     "Highest frequency in rad/s (discrete: at most pi/Ts; "
+                                     "default: from the poles/zeros, at least --w-min x 100)")
                           ->check(Positive());
                       app.add_option("--points", o->points,
                                      "Number of log-spaced frequencies (default: 50 from --w-min "

@@ -127,8 +127,12 @@ std::string TypeName(ControllerType type) {
 std::string ControllerLabel(const Run& r) {
   const BuiltController& b = r.built;
   if (b.type == ControllerType::kPid) {
-    return fmt::format("PID {} (Kc={:.3g}, Ti={:.3g} s, Td={:.3g} s)", ToString(b.pid_rule),
-                       b.pid_gains.Kc, b.pid_gains.Ti, b.pid_gains.Td);
+    return fmt::format("PID {} (Kc={:.3g}, Ti={:.3g} s, Td={:.3g} s{})",
+                       b.auto_summary.empty() ? ToString(b.pid_rule) : std::string("auto"),
+                       b.pid_gains.Kc, b.pid_gains.Ti, b.pid_gains.Td,
+                       b.pid_setpoint_weight != 1.0
+                           ? fmt::format(", b={:.3g}", b.pid_setpoint_weight)
+                           : std::string());
   }
   return fmt::format("{} {} (P={}, M={}, lambda={:.3g})", TypeName(b.type), r.label, b.tuning.P,
                      b.tuning.M, b.tuning.lambda);

@@ -21,6 +21,7 @@
 #include "pneumid/realtime/io_factory.hpp"
 #include "pneumid/realtime/realtime_config.hpp"
 #include "pneumid/realtime/realtime_session.hpp"
+#include "pneumid/workflow/run_workflow.hpp"
 
 namespace pneumid::cli {
 namespace {
@@ -69,7 +70,10 @@ void Run(const ExperimentArgs& o, CLI::App& app) {
   const bool to_mat = IsMatPath(o.output);
   SessionOptions so;
   so.loop = config.loop;
-  so.safety = config.safety;
+  // The plant's own input range, none for a simulated linear plant (its
+  // input was clipped to the safety default 0..100 %: a step from -5 to -2
+  // was recorded as u = 0, y = 0 with "success").
+  so.safety = DefaultSessionSafety(config, spec, *io);
   so.log = config.log;
   // CSV: the data set is streamed (t,u,y); .mat: the records are kept and written at the
   // end, with --log streaming the full log meanwhile.

@@ -23,6 +23,7 @@ struct OrdersArgs {
   double split = 0.0;
   int top = 0;
   bool json = false;
+  std::string operating_point = "auto";
 };
 
 void Run(const OrdersArgs& a) {
@@ -30,6 +31,7 @@ void Run(const OrdersArgs& a) {
   o.na = OrderRange::Parse(a.na);
   o.nb = OrderRange::Parse(a.nb);
   o.nk = OrderRange::Parse(a.nk);
+  o.operating_point = OperatingPointKindFromString(a.operating_point);
   std::string error;
   PNEUMID_CHECK(o.IsValid(&error), "{}", error);
   PNEUMID_CHECK(a.split == 0.0 || (a.split > 0.0 && a.split < 1.0),
@@ -55,6 +57,10 @@ void Run(const OrdersArgs& a) {
   std::cout << fmt::format("ARX order selection: {} candidates, N = {} rows, loss on {} data\n",
                            s.candidates.size(), s.num_rows,
                            s.validation ? "validation" : "estimation");
+  if (s.u0 != 0.0 || s.y0 != 0.0)
+    std::cout << fmt::format("operating point u0 = {:.6g}, y0 = {:.6g}: the models are ARX from "
+                             "u - u0 to y - y0 (--operating-point zero: the raw signals)\n",
+                             s.u0, s.y0);
   std::vector<std::size_t> order(s.candidates.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   if (a.top > 0) {
@@ -92,6 +98,20 @@ static Registrar reg(
                      "rest, e.g. 0.7 (default: all data, loss on the estimation data)");
       app.add_option("--top", args->top, "Print only the N best candidates by MDL (0 = all)")
           ->check(AtLeast(0));
+      app.add_option("--operating-point", args->operating_point,
+                     "The levels (u0, y0) the ARX models are fitted about: auto (default: zero "
+                     "for a record that starts at rest at zero, else the means of the "
+                     "estimation data), zero (the raw signals), mean, initial (the first "
+                     "samples' level)")
+          ->capture_default_str()
+          ->check([](const std::string& s) {
+            try {
+              OperatingPointKindFromString(s);
+              return std::string();
+            } catch (const InvalidArgument& e) {
+              return std::string(e.what());
+            }
+          });
       app.add_flag("--json", args->json, "Print the table and the best orders as JSON");
       app.callback([args] { Run(*args); });
     });

@@ -157,6 +157,12 @@ LoopMargins DiscreteLoopMargins(const TransferFunction& Gd, const PidGains& gain
     mag(i) = std::abs(controller) * plant.magnitude(i);
     phase(i) = std::arg(controller) * kDeg + plant.phase_deg(i);
   }
+  // The loop's phase at low frequency lies in (-180, 180] (-90 with integral
+  // action, 0 without): a reverse-acting plant and controller (K < 0, Kc < 0)
+  // each add 180 and put it a turn away, and K = -2 got a phase margin of
+  // 433 deg and a gain margin 4.4 times its mirror's (K = +2: 72.8 deg, 5.47).
+  const double turns = std::ceil((phase(0) - 180.0) / 360.0);
+  phase.array() -= 360.0 * turns;
   LoopMargins margins;
   for (int i = 1; i < count; ++i) {
     if (std::isnan(margins.crossover) && (mag(i - 1) - 1.0) * (mag(i) - 1.0) <= 0.0 &&

@@ -137,7 +137,11 @@ nlohmann::ordered_json BuiltController::SettingsToJson() const {
     j["Ti"] = std::isfinite(pid_gains.Ti) ? nlohmann::json(pid_gains.Ti) : nlohmann::json();
     j["Td"] = pid_gains.Td;
     j["Kff"] = pid_kff;
-    j["rule"] = pid_explicit ? std::string("explicit") : ToString(pid_rule);
+    j["rule"] = pid_explicit          ? std::string("explicit")
+                : !auto_summary.empty() ? std::string("auto")
+                                        : ToString(pid_rule);
+    j["b"] = pid_setpoint_weight;
+    j["N"] = pid_derivative_filter;
   } else {
     // Settings tuned to specifications say so (their tuning result is explicit).
     j["rule"] = auto_summary.empty() ? ToString(tuning.rule) : std::string("auto");
@@ -415,8 +419,8 @@ BuiltController BuildController(const TransferFunction& model, double Ts,
     b.auto_converged = a.termination == AutoTuneTermination::kConverged;
     PidOptions o;
     o.gains = a.pid;
-    o.setpoint_weight = a.setpoint_weight;
-    o.derivative_filter = a.derivative_filter;
+    o.setpoint_weight = b.pid_setpoint_weight = a.setpoint_weight;
+    o.derivative_filter = b.pid_derivative_filter = a.derivative_filter;
     if (!std::isnan(spec.pid_kff)) o.velocity_feedforward = b.pid_kff = ExplicitKff(spec);
     o.limits = spec.limits;
     b.controller = std::make_unique<PidController>(Ts, o);

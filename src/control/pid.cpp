@@ -131,9 +131,10 @@ void PidController::DoApplied(double u) {
 }
 
 std::string PidController::Describe() const {
-  const std::string ff = options_.velocity_feedforward != 0.0
-                             ? fmt::format(" Kff={:.4g}", options_.velocity_feedforward)
-                             : "";
+  std::string ff = options_.velocity_feedforward != 0.0
+                       ? fmt::format(" Kff={:.4g}", options_.velocity_feedforward)
+                       : "";
+  if (options_.setpoint_weight != 1.0) ff += fmt::format(" b={:.4g}", options_.setpoint_weight);
   return fmt::format("pid Kc={:.4g} Ti={:.4g} Td={:.4g}{}", options_.gains.Kc, options_.gains.Ti,
                      options_.gains.Td, ff);
 }

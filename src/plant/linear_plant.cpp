@@ -46,6 +46,13 @@ double LinearPlant::Measure() { return y_.front() + load_disturbance_ + noise_.v
 
 void LinearPlant::Advance(double u) {
   PNEUMID_CHECK(std::isfinite(u), "plant input must be finite, got {}", u);
+  // A direct feedthrough (no delay, b0 != 0): y_k was measured before u_k was
+  // applied, with the input then held, u_{k-1} (the output's jump by b0
+  // (u_k - u_{k-1}) comes after the sample); the model's own output at k,
+  // which the recursion needs, holds u_k. The b0 term was once taken as
+  // b0 u_k in y_{k+1} and never corrected: (s + 1)/(s + 2) ran as 0.09
+  // z^-1 / (1 - 0.82 z^-1), a slow rise to 0.5 instead of a jump to 1.
+  if (delay_ == 0 && b_[0] != 0.0) y_.front() += b_[0] / a_[0] * (u - u_.front());
   u_.push_front(u);  // now u_[m] = u_{k-m}, and y_{k+1} is computed
   u_.pop_back();
   double acc = 0.0;

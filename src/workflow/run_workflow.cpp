@@ -107,18 +107,7 @@ ControllerSpec RunControllerSpec(const RunWorkflowOptions& o, const InputLimits&
 // it) gets no clamp (+-1e300); a plant server or a rig the safety defaults.
 SafetyOptions RunSafety(const RunWorkflowOptions& o, const RealtimeConfig& config,
                         const IoSpec& spec, const IoBackend& io) {
-  SafetyOptions safety = config.safety;
-  if (!o.safety.GivesClamp() && !config.safety_range_given) {
-    const Actuator a = io.actuator();
-    if (std::isfinite(a.u_min) && std::isfinite(a.u_max) && a.u_min < a.u_max) {
-      safety.u_min = a.u_min;
-      safety.u_max = a.u_max;
-    } else if (spec.kind == IoKind::kSim && std::isinf(a.u_min) && std::isinf(a.u_max)) {
-      safety.u_min = -kUnboundedInput;
-      safety.u_max = kUnboundedInput;
-    }
-  }
-  return safety;
+  return o.safety.GivesClamp() ? config.safety : DefaultSessionSafety(config, spec, io);
 }
 
 // The closed-loop metrics of the records of a completed run (control area's
@@ -142,6 +131,21 @@ void CheckValid(const RunWorkflowOptions& o) {
 }
 
 }  // namespace
+
+SafetyOptions DefaultSessionSafety(const RealtimeConfig& config, const IoSpec& spec,
+                                   const IoBackend& io) {
+  SafetyOptions safety = config.safety;
+  if (config.safety_range_given) return safety;
+  const Actuator a = io.actuator();
+  if (std::isfinite(a.u_min) && std::isfinite(a.u_max) && a.u_min < a.u_max) {
+    safety.u_min = a.u_min;
+    safety.u_max = a.u_max;
+  } else if (spec.kind == IoKind::kSim && std::isinf(a.u_min) && std::isinf(a.u_max)) {
+    safety.u_min = -kUnboundedInput;
+    safety.u_max = kUnboundedInput;
+  }
+  return safety;
+}
 
 RunWorkflowResult RunRealtimeWorkflow(const RunWorkflowOptions& o, const RealtimeConfig& given,
                                       SpscRingBuffer<LogRecord>* live) {

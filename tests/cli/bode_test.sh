@@ -50,4 +50,10 @@ expect_error "plot extension" "must end in .png or .svg" bode --model fopdt-pape
 grep -qF "Nyquist" "$dir/err" || fail "bode above Nyquist: $(cat "$dir/err")"
 "$PNEUMID" bode --model fopdt-paper --w-min 10 --w-max 1 >"$dir/out" 2>"$dir/err" && fail "bode bad range: exit 0"
 grep -qF "w-min" "$dir/err" || fail "bode bad range: $(cat "$dir/err")"
+# One bound alone: the other from the automatic grid (it said "got 0 and 20").
+expect_ok "bode --w-max alone" bode --model fopdt-paper --w-max 100 --json
+check_json "bode --w-max alone" "abs(j['omega'][-1] - 100) < 1e-9 and j['omega'][0] < 1"
+expect_ok "bode --w-min alone" bode --model arx-paper --w-min 5 --json
+check_json "bode --w-min alone (discrete: up to Nyquist)" \
+  "abs(j['omega'][0] - 5) < 1e-9 and abs(j['omega'][-1] - 3.141592653589793 / 0.01) < 1e-6"
 finish

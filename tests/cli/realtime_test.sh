@@ -41,6 +41,12 @@ check_help plant-server --port "--Ts,--period,--sample-time"
 "$PNEUMID" experiment step --fast --duration 2 -o "$TMP/step.csv" > "$TMP/out.txt" || fail "experiment step"
 [ "$(data_rows "$TMP/step.csv")" -eq 200 ] || fail "experiment rows: $(data_rows "$TMP/step.csv")"
 grep -v '^#' "$TMP/step.csv" | head -1 | grep -qx 't,u,y' || fail "experiment header"
+# A simulated linear plant's input is unbounded (as in control and run): a
+# step from -5 to -2 was clipped to 0..100 % and recorded as u = 0, y = 0.
+"$PNEUMID" experiment --fast --plant "tf:num=1,den=1 1" --input "step:from=-5,to=-2,at=0.5" \
+  --duration 2 -o "$TMP/neg.csv" > /dev/null || fail "experiment on a linear plant"
+grep -v '^#' "$TMP/neg.csv" | tail -1 | awk -F, '$2 != -2 || $3 > -1.9 {exit 1}' ||
+  fail "experiment clipped the input of a linear plant: $(grep -v '^#' "$TMP/neg.csv" | tail -1)"
 "$PNEUMID" experiment prbs --fast --duration 1 -o "$TMP/prbs.csv" --json > "$TMP/prbs.json" || fail "experiment prbs"
 grep -q '"samples": 100' "$TMP/prbs.json" || fail "experiment prbs json"
 "$PNEUMID" experiment staircase --fast --duration 1 -o "$TMP/stairs.mat" > /dev/null || fail "experiment .mat"

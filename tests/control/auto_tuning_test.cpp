@@ -202,6 +202,23 @@ void ExpectMargins(const AutoTuneResult& r, const TransferFunction& g) {
   EXPECT_NEAR(r.phase_margin, r.phase_margin_target, 2.0);
 }
 
+// A reverse-acting plant (K < 0) gets the mirror design (Kc < 0) and the
+// same loop, hence the same margins: each sign added 180 deg to the loop's
+// phase, and K = -2 was reviewed with a phase margin of 433 deg and a gain
+// margin of 24.2 where K = +2 has 72.8 deg and 5.47.
+TEST(PidAutoTuneTest, AReverseActingPlantHasItsMirrorsMargins) {
+  AutoTuneOptions o;
+  o.controller = ControllerType::kPid;
+  const double Ts = 0.05;
+  const AutoTuneResult pos = AutoTune(TransferFunction::Fopdt(2.0, 1.0, 0.2), Ts, o);
+  const AutoTuneResult neg = AutoTune(TransferFunction::Fopdt(-2.0, 1.0, 0.2), Ts, o);
+  EXPECT_NEAR(neg.pid.Kc, -pos.pid.Kc, 1e-12);
+  EXPECT_NEAR(neg.phase_margin, pos.phase_margin, 1e-6);
+  EXPECT_NEAR(neg.gain_margin, pos.gain_margin, 1e-6 * pos.gain_margin);
+  EXPECT_GT(pos.phase_margin, 30.0);
+  EXPECT_LT(pos.phase_margin, 90.0);
+}
+
 // The loop shaped to crossover and phase margin (the SIMC alternative off).
 TEST(PidAutoTuneTest, FopdtPiMeetsPhaseMarginAndCrossover) {
   AutoTuneOptions o;

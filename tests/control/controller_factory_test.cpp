@@ -108,7 +108,8 @@ TEST(BuiltControllerTest, LabelSummaryAndSettingsJson) {
   const nlohmann::ordered_json p = pid.SettingsToJson();
   keys.clear();
   for (const auto& [key, value] : p.items()) keys.push_back(key);
-  EXPECT_THAT(keys, ::testing::ElementsAre("Kc", "Ti", "Td", "Kff", "rule"));
+  EXPECT_THAT(keys, ::testing::ElementsAre("Kc", "Ti", "Td", "Kff", "rule", "b", "N"));
+  EXPECT_EQ(p["b"], 1.0);  // the set-point weight, chosen by the rule auto only
   EXPECT_EQ(p["Kff"], 0.0);  // a stable model: no feed-forward unless asked
   EXPECT_EQ(p["rule"], "simc");
 }

@@ -48,6 +48,34 @@ TEST(OrderSelection, CriteriaPickThePaperStructure) {
   EXPECT_EQ(j["candidates"].size(), 100u);
 }
 
+// Offsets on the same record (u + 50, y + 100): the ARX models are fitted
+// about the means (operating point auto), and the criteria pick the same
+// structure as without them. Fitted to the raw signals, an ARX without an
+// intercept spends its orders on the offset: every criterion picked 5, 5, 3
+// on a helper's ARX(2,2,3) record.
+TEST(OrderSelection, OffsetsDoNotChangeTheChoice) {
+  const Dataset d = DelayedPaperData(0);
+  const Dataset shifted = Dataset::FromUniform(0.01, (d.u(0).array() + 50.0).matrix(),
+                                               (d.y(0).array() + 100.0).matrix());
+  OrderSelectionOptions o;
+  const OrderSelection a = SelectArxOrders(d, o), b = SelectArxOrders(shifted, o);
+  EXPECT_NEAR(b.u0 - a.u0, 50.0, 1e-9);
+  EXPECT_NEAR(b.y0 - a.y0, 100.0, 1e-9);
+  for (auto c : {OrderCriterion::kMdl, OrderCriterion::kAicc}) {
+    const OrderCandidate &x = a.candidates[a.Best(c)], &y = b.candidates[b.Best(c)];
+    EXPECT_EQ(y.na, 3) << ToString(c);
+    EXPECT_EQ(y.nb, 3) << ToString(c);
+    EXPECT_EQ(y.nk, 1) << ToString(c);
+    EXPECT_NEAR(y.loss, x.loss, 1e-6 * x.loss) << ToString(c);
+  }
+  // The raw signals (operating point zero) are what went wrong.
+  o.operating_point = OperatingPointKind::kZero;
+  const OrderSelection raw = SelectArxOrders(shifted, o);
+  EXPECT_EQ(raw.u0, 0.0);
+  EXPECT_GT(raw.candidates[raw.Best(OrderCriterion::kMdl)].loss,
+            b.candidates[b.Best(OrderCriterion::kMdl)].loss);
+}
+
 TEST(OrderSelection, DelayEstimation) {
   EXPECT_EQ(EstimateDelay(DelayedPaperData(0), 2, 2, 0, 8), 1);
   EXPECT_EQ(EstimateDelay(DelayedPaperData(4), 2, 2, 0, 8), 5);

@@ -69,6 +69,31 @@ TEST(LinearPlantTest, ContinuousFopdtIsSampledExactly) {
   EXPECT_LT((yl - ref).cwiseAbs().maxCoeff(), 1e-9);
 }
 
+// A direct feedthrough: (s + 1)/(s + 2) jumps with its input and decays to
+// half of it. The sample y_k is taken before u_k is applied, so it is the
+// model's output less the jump b0 (u_k - u_{k-1}) still to come; the
+// recursion runs on the model's own output. It ran as 0.09 z^-1 / (1 - 0.82
+// z^-1) (the feedthrough lost), rising slowly to 0.5.
+TEST(LinearPlantTest, ADirectFeedthroughJumpsAfterTheSample) {
+  const double Ts = 0.1;
+  const TransferFunction g = TransferFunction::Continuous({1.0, 1.0}, {1.0, 2.0});
+  LinearPlant plant(g, Ts);
+  const Eigen::VectorXd u =
+      ParseSignal("prbs:low=-1,high=2,order=5,clock=0.3")->Sample(Ts, 120);
+  const Eigen::VectorXd y = Drive(plant, u);
+  const Eigen::VectorXd model = Lsim(g, u, Ts);  // the output with u_k applied
+  const double b0 = 1.0;                          // lim s->inf of G
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    const double before = k > 0 ? u[k - 1] : 0.0;
+    EXPECT_NEAR(y[k], model[k] - b0 * (u[k] - before), 1e-9) << "k = " << k;
+  }
+  // A unit step at k = 0: 0 at the step's sample, then exp(-t) decaying from 1 to 0.5.
+  plant.Reset();
+  const Eigen::VectorXd s = Drive(plant, Eigen::VectorXd::Ones(30));
+  EXPECT_EQ(s[0], 0.0);
+  for (int k = 1; k < 30; ++k) EXPECT_NEAR(s[k], 0.5 + 0.5 * std::exp(-2.0 * k * Ts), 1e-9);
+}
+
 TEST(LinearPlantTest, NoiseIsSeededAndLoadDisturbanceAdds) {
   const TransferFunction g = PaperArxModel();
   LinearPlant a(g, 0.01, 0.5, 11), b(g, 0.01, 0.5, 11), c(g, 0.01, 0.5, 12);

@@ -196,6 +196,9 @@ struct BuiltController {
   bool pid_explicit = false;  ///< (pid) some gains given explicitly (ControllerSpec::pid_kc ...)
   FopdtEstimate fopdt;        ///< the FOPDT the PID was tuned from (pid)
   double pid_kff = 0.0;       ///< (pid) velocity feed-forward Kff (0: none)
+  /// (pid) set-point weight b of the proportional term (1 unless the rule
+  /// auto chose another) and derivative filter N.
+  double pid_setpoint_weight = 1.0, pid_derivative_filter = 10.0;
   /// Rule "auto": the auto-tuner's message (what it met or why not).
   std::string auto_summary;
   /// Rule "auto": t_r, the response time it aimed at (given, from the
@@ -216,7 +219,9 @@ struct BuiltController {
   /// or the PID rule, the FOPDT it used and the gains.
   std::string Summary() const;
   /// `settings` of `pneumid control --json`: {rule, P, M, lambda, formula}
-  /// (dmc, gpc, mpc) or {Kc, Ti, Td, Kff, rule} (pid; Ti null when infinite).
+  /// (dmc, gpc, mpc) or {Kc, Ti, Td, Kff, rule, b, N} (pid; Ti null when
+  /// infinite; rule "auto" for the rule auto; b the set-point weight, N the
+  /// derivative filter).
   nlohmann::ordered_json SettingsToJson() const;
 };
 

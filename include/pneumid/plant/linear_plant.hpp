@@ -9,8 +9,10 @@
 //   y_meas,k = y_k + load disturbance + e_k,   e_k ~ N(0, sigma^2).
 // Per the Plant protocol y_k is measured before u_k is applied; a direct
 // feedthrough term b_0 u_k (d = 0) therefore uses the input held at that time,
-// u_{k-1}. Strictly proper models (all of the paper's) are exact and equal
-// Lsim (pneumid/lti/response.hpp).
+// u_{k-1}, in the measurement (the jump b_0 (u_k - u_{k-1}) comes after the
+// sample), while the recursion runs on the model's own y_k with u_k.
+// Strictly proper models (all of the paper's) are exact and equal Lsim
+// (pneumid/lti/response.hpp).
 #pragma once
 
 #include <cstdint>

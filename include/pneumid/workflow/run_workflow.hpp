@@ -124,4 +124,13 @@ RunWorkflowResult RunRealtimeWorkflow(const RunWorkflowOptions& options,
                                       const RealtimeConfig& config,
                                       SpscRingBuffer<LogRecord>* live = nullptr);
 
+/// The safety settings of a session on `io` whose input clamp nobody gave
+/// (`config.safety_range_given` false, no --u-min/--u-max): config.safety
+/// with the plant's input range where it is finite (the IPA's 0..100 %, the
+/// position twin's -100..100 %), no clamp (+-1e300) for a simulated linear
+/// plant, whose input is unbounded as in `control`, and the safety defaults
+/// for a plant server or a rig. `run` and `experiment` use it.
+SafetyOptions DefaultSessionSafety(const RealtimeConfig& config, const IoSpec& spec,
+                                   const IoBackend& io);
+
 }  // namespace pneumid

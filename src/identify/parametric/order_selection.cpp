@@ -7,6 +7,7 @@
 #include "pneumid/common/check.hpp"
 #include "pneumid/common/enum_names.hpp"
 #include "pneumid/identify/parametric/arx.hpp"
+#include "pneumid/identify/parametric/parametric.hpp"
 
 namespace pneumid {
 
@@ -94,6 +95,7 @@ nlohmann::json OrderSelection::ToJson() const {
   nlohmann::json j;
   j["num_rows"] = num_rows;
   j["loss_on"] = validation ? "validation" : "estimation";
+  j["operating_point"] = {{"u0", u0}, {"y0", y0}};
   nlohmann::json cs = nlohmann::json::array();
   for (const auto& c : candidates)
     cs.push_back({{"na", c.na},
@@ -125,8 +127,31 @@ OrderSelection SelectArxOrders(const Dataset& data, const OrderSelectionOptions&
   PNEUMID_CHECK(o.output < data.num_outputs(), "output column {} out of range [0, {})", o.output,
                 data.num_outputs());
   data.RequireUniform();
-  const Eigen::VectorXd y = data.y(o.output);
-  const Eigen::VectorXd u = data.u(o.input);
+  // About the operating point (OrderSelectionOptions::operating_point).
+  const Eigen::VectorXd y_raw = data.y(o.output), u_raw = data.u(o.input);
+  double u0 = 0.0, y0 = 0.0;
+  const Eigen::Index n_init =
+      std::max<Eigen::Index>(1, std::min<Eigen::Index>(20, u_raw.size() / 50));
+  switch (o.operating_point) {
+    case OperatingPointKind::kAuto:
+      if (!StartsAtRestAtZero(u_raw, y_raw)) {
+        u0 = u_raw.mean();
+        y0 = y_raw.mean();
+      }
+      break;
+    case OperatingPointKind::kZero:
+      break;
+    case OperatingPointKind::kMean:
+      u0 = u_raw.mean();
+      y0 = y_raw.mean();
+      break;
+    case OperatingPointKind::kInitial:
+      u0 = u_raw.head(n_init).mean();
+      y0 = y_raw.head(n_init).mean();
+      break;
+  }
+  const Eigen::VectorXd y = (y_raw.array() - y0).matrix();
+  const Eigen::VectorXd u = (u_raw.array() - u0).matrix();
   const int max_ulag = o.nk.max + o.nb.max - 1;
   const int n0 = std::max(o.na.max, max_ulag);
   const int dmax = o.na.max + o.nb.max;
@@ -140,6 +165,8 @@ OrderSelection SelectArxOrders(const Dataset& data, const OrderSelectionOptions&
   OrderSelection sel;
   sel.num_rows = rows;
   sel.validation = validation != nullptr;
+  sel.u0 = u0;
+  sel.y0 = y0;
   const double N = static_cast<double>(rows);
   for (int na = o.na.min; na <= o.na.max; ++na) {
     for (int nb = o.nb.min; nb <= o.nb.max; ++nb) {
@@ -159,8 +186,9 @@ OrderSelection SelectArxOrders(const Dataset& data, const OrderSelectionOptions&
         c.nk = nk;
         c.num_parameters = na + nb;
         if (validation != nullptr) {
-          Eigen::MatrixXd uv = validation->u(o.input);
-          const Eigen::VectorXd eps = PredictionErrors(r.model, validation->y(o.output), uv);
+          Eigen::MatrixXd uv = (validation->u(o.input).array() - u0).matrix();
+          const Eigen::VectorXd eps = PredictionErrors(
+              r.model, (validation->y(o.output).array() - y0).matrix(), uv);
           const Eigen::Index skip = std::min<Eigen::Index>(n0, eps.size() - 1);
           c.loss =
               eps.tail(eps.size() - skip).squaredNorm() / static_cast<double>(eps.size() - skip);
@@ -189,6 +217,7 @@ int EstimateDelay(const Dataset& data, int na, int nb, int nk_min, int nk_max, i
   o.nk = {nk_min, nk_max};
   o.input = input;
   o.output = output;
+  o.operating_point = OperatingPointKind::kZero;  // the raw signals, as delayest
   const OrderSelection s = SelectArxOrders(data, o);
   return s.candidates[s.Best(OrderCriterion::kLoss)].nk;
 }

@@ -143,6 +143,19 @@ struct ChosenOperatingPoint {
   std::string rest_note;
 };
 
+}  // namespace
+
+bool StartsAtRestAtZero(const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
+  if (u.size() == 0 || y.size() == 0) return true;
+  const Eigen::Index n0 = std::max<Eigen::Index>(1, std::min<Eigen::Index>(20, u.size() / 50));
+  const double u_range = u.maxCoeff() - u.minCoeff();
+  const double y_range = y.maxCoeff() - y.minCoeff();
+  return std::abs(u.head(n0).mean()) <= 0.05 * u_range &&
+         std::abs(y.head(n0).mean()) <= 0.05 * y_range;
+}
+
+namespace {
+
 ChosenOperatingPoint ChooseOperatingPoint(const Dataset& d, OperatingPointKind kind) {
   const Eigen::VectorXd u = d.u(0);
   const Eigen::VectorXd y = d.y(0);
@@ -153,8 +166,7 @@ ChosenOperatingPoint ChooseOperatingPoint(const Dataset& d, OperatingPointKind k
   if (kind == OperatingPointKind::kAuto) {
     const double u_range = u.maxCoeff() - u.minCoeff();
     const double y_range = y.maxCoeff() - y.minCoeff();
-    const bool at_zero = std::abs(u_init) <= 0.05 * u_range && std::abs(y_init) <= 0.05 * y_range;
-    if (at_zero) return op;
+    if (StartsAtRestAtZero(u, y)) return op;
     op.ambiguous = true;
     // At rest: the input constant and the output within 2 % of its range
     // over the first samples (and the record moves after them).

@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pneumid/data/dataset.hpp"
+#include "pneumid/identify/identified_model.hpp"
 
 namespace pneumid {
 
@@ -51,6 +52,12 @@ struct OrderSelectionOptions {
   OrderRange nk{0, 3};  ///< >= 0
   int input = 0;   ///< input column (>= 0)
   int output = 0;  ///< output column (>= 0)
+  /// The operating point (u0, y0) the ARX models are fitted about, from the
+  /// estimation data (identified_model.hpp): kAuto is zero for a record that
+  /// starts at rest at zero and the means otherwise (an ARX without an
+  /// intercept spends orders on an offset: ARX(2,2,3) data with u + 50,
+  /// y + 100 chose 5, 5, 3 by every criterion), as `identify` fits about it.
+  OperatingPointKind operating_point = OperatingPointKind::kAuto;
   /// True when each range has min <= max within the bounds above and the columns are >= 0;
   /// otherwise false with the reason in *error (when error is not null).
   bool IsValid(std::string* error) const;
@@ -79,6 +86,7 @@ struct OrderSelection {
   std::vector<OrderCandidate> candidates;  ///< in sweep order (na, nb, nk nested)
   long long num_rows = 0;                  ///< N used by every candidate
   bool validation = false;                 ///< losses measured on validation data
+  double u0 = 0.0, y0 = 0.0;               ///< the operating point the models are fitted about
   /// Index of the best candidate by criterion c (the first one on ties).
   std::size_t Best(OrderCriterion c) const;
   /// {num_rows, loss_on ("estimation" or "validation"), candidates: [{na, nb, nk,

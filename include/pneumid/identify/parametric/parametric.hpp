@@ -34,6 +34,11 @@ const std::vector<std::string>& ParametricMethodNames();
 /// True when `name` is one of ParametricMethodNames().
 bool IsParametricMethod(const std::string& name);
 
+/// The test of OperatingPointKind::kAuto (identified_model.hpp): the means of
+/// u and y over the first max(1, min(20, N / 50)) samples lie within 5 % of
+/// their ranges of 0 (a step test from rest, as the paper's).
+bool StartsAtRestAtZero(const Eigen::VectorXd& u, const Eigen::VectorXd& y);
+
 /// Identifies input column request.input -> output column request.output of
 /// `data` with `method` (see above); orders from request (na, nb, nk, nc, nd, nf).
 /// @throws InvalidArgument for an unknown method or invalid orders.
