@@ -275,14 +275,7 @@ static Registrar reg(
                args->request.n4sid_weight = SubspaceWeightingFromString(s);
              },
              "n4sid weighting (MATLAB N4Weight): moesp (default), n4sid, cva")
-          ->check([](const std::string& s) {
-            try {
-              SubspaceWeightingFromString(s);
-              return std::string();
-            } catch (const InvalidArgument& e) {
-              return std::string(e.what());
-            }
-          });
+          ->check(NameOf([](const std::string& s) { SubspaceWeightingFromString(s); }));
       app.add_option_function<std::string>(
              "--operating-point",
              [args](const std::string& s) {
@@ -292,14 +285,7 @@ static Registrar reg(
              "around: auto (default: zero for a record that starts at rest at zero, else the "
              "raw signals or the means, whichever simulates the data better), zero (the raw "
              "signals), mean, initial (the first samples' level)")
-          ->check([](const std::string& s) {
-            try {
-              OperatingPointKindFromString(s);
-              return std::string();
-            } catch (const InvalidArgument& e) {
-              return std::string(e.what());
-            }
-          });
+          ->check(NameOf([](const std::string& s) { OperatingPointKindFromString(s); }));
       app.add_option(
              "--knots", args->nonlinear.block.num_knots,
              "hammerstein, wiener, hw, affine-narx: knots of the static map, spread evenly over "

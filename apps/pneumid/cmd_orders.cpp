@@ -104,14 +104,7 @@ static Registrar reg(
                      "estimation data), zero (the raw signals), mean, initial (the first "
                      "samples' level)")
           ->capture_default_str()
-          ->check([](const std::string& s) {
-            try {
-              OperatingPointKindFromString(s);
-              return std::string();
-            } catch (const InvalidArgument& e) {
-              return std::string(e.what());
-            }
-          });
+          ->check(NameOf([](const std::string& s) { OperatingPointKindFromString(s); }));
       app.add_flag("--json", args->json, "Print the table and the best orders as JSON");
       app.callback([args] { Run(*args); });
     });

@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "pneumid/common/check.hpp"
+
 namespace pneumid::cli {
 namespace {
 
@@ -52,6 +54,19 @@ CLI::Validator AtLeast(long long min) {
                    : fmt::format("must be an integer >= {}, got {}", min, text);
       },
       fmt::format(">={}", min));
+}
+
+CLI::Validator NameOf(std::function<void(const std::string&)> parse) {
+  return CLI::Validator(
+      [parse = std::move(parse)](std::string& text) -> std::string {
+        try {
+          parse(text);
+          return "";
+        } catch (const InvalidArgument& e) {
+          return e.what();
+        }
+      },
+      "NAME");
 }
 
 CLI::Option* AddSampleTimeOption(CLI::App& app, double& Ts, const std::string& help,

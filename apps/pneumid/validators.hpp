@@ -5,6 +5,7 @@
 //   app.add_option("--duration", o.duration, "...")->check(Positive());
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +20,10 @@ CLI::Validator NonNegative();
 CLI::Validator InRange(double lo, double hi);
 /// An integer >= `min`.
 CLI::Validator AtLeast(long long min);
+/// A name `parse` accepts (an enum's FromString, shared with the library
+/// and the bindings); its InvalidArgument message, listing the valid names,
+/// is the error.
+CLI::Validator NameOf(std::function<void(const std::string&)> parse);
 
 /// The sample time (loop period) in s of a command that runs or designs a
 /// sampled loop: `--Ts` and `--sample-time` (and `--period` with
