@@ -171,7 +171,10 @@ bool ClosedLoopOptions::IsValid(std::string* error) const {
 }
 
 Eigen::Index ClosedLoopOptions::Samples(double Ts) const {
-  return std::max<Eigen::Index>(2, std::llround(duration / Ts));
+  const double n = duration / Ts;
+  PNEUMID_CHECK(n < 9e18, "duration {} s at Ts = {} s is {:.3g} samples, more than a count holds",
+                duration, Ts, n);
+  return std::max<Eigen::Index>(2, std::llround(n));
 }
 
 ClosedLoopMetrics ComputeClosedLoopMetrics(const Eigen::VectorXd& t, const Eigen::VectorXd& r,
@@ -382,6 +385,16 @@ ClosedLoopResult SimulateClosedLoop(Controller& controller, Plant& plant, const 
     res.y_meas(k) = ym;
     res.u(k) = u;
     u_prev = u;
+  }
+  // A loop the controller destabilises overflows: say so, not "stepinfo: y
+  // contains NaN or Inf".
+  for (Eigen::Index k = 0; k < n; ++k) {
+    PNEUMID_CHECK(std::isfinite(res.y(k)),
+                  "the closed loop diverged: the plant's output is no longer finite from t = {:g} "
+                  "s (last finite {:.4g} at t = {:g} s); the controller '{}' destabilises the "
+                  "plant '{}': tune it more softly or check the model",
+                  res.t(k), k > 0 ? res.y(k - 1) : 0.0, k > 0 ? res.t(k - 1) : 0.0,
+                  controller.Describe(), plant.Describe());
   }
   res.metrics = ComputeClosedLoopMetrics(res.t, res.r, res.y, res.u, r_before, options.u0, options);
   res.controller = controller.Describe();

@@ -23,8 +23,55 @@ bool ControlScenarioOptions::IsValid(std::string* error) const {
   };
   if (!(Ts > 0.0 && std::isfinite(Ts))) return fail(fmt::format("--Ts must be positive, got {}", Ts));
   if (!(duration > 0.0)) return fail(fmt::format("--duration must be positive, got {}", duration));
+  // The traces hold every sample (t, r, y, u, ...): 1e308 s ran 2 samples
+  // (the count overflowed) and exited 0.
+  if (!(duration / Ts <= 1e8))
+    return fail(fmt::format("--duration {} s at --Ts {} s is {:.3g} samples; a simulation holds "
+                            "at most 1e8",
+                            duration, Ts, duration / Ts));
   return true;
 }
+
+namespace {
+
+// A loop that grows instead of settling: over the last tenth of the run the
+// error reaches 3 times the largest set-point change (or the set-point's
+// span) and more than over the first tenth. SIMC on a lightly damped model
+// (zeta 0.1) ran to y = -37 after 30 s, reported as any other run. And one
+// that keeps oscillating: over the last tenth, with the set-point constant
+// there, the output swings by half the span or more (SIMC on a lag 50 times
+// shorter than Ts swung between 0.04 and 1.98 on a step to 1, and the ripple
+// rule widened the settling band to call it settled).
+std::optional<std::string> DivergenceWarning(const std::string& label, const ClosedLoopResult& r) {
+  const Eigen::Index n = r.y.size(), tenth = std::max<Eigen::Index>(1, n / 10);
+  if (n < 20) return std::nullopt;
+  const Eigen::VectorXd e = r.r - r.y;
+  double span = r.r.maxCoeff() - r.r.minCoeff();
+  if (span == 0.0) span = std::abs(r.r(0));
+  if (!(span > 0.0)) return std::nullopt;
+  const double late = e.tail(tenth).cwiseAbs().maxCoeff();
+  const double early = e.head(tenth).cwiseAbs().maxCoeff();
+  if (!(late > 3.0 * span && late > early)) {
+    const auto rr = r.r.tail(tenth), yy = r.y.tail(tenth);
+    const double swing = yy.maxCoeff() - yy.minCoeff();
+    if (rr.maxCoeff() == rr.minCoeff() && swing >= 0.5 * span)
+      return fmt::format(
+          "the loop of {} keeps oscillating: over the last tenth of the run, at a constant "
+          "set-point, the output swings by {:.4g}, {:.0f} % of the set-point's span {:.4g}; a "
+          "step the band of such a swing calls settled is not (tune it more softly, or give "
+          "a rule that suits the model)",
+          label, swing, 100.0 * swing / span, span);
+    return std::nullopt;
+  }
+  return fmt::format(
+      "the loop of {} looks unstable: over the last tenth of the run the error reaches {:.4g}, "
+      "{:.3g} times the set-point's span {:.4g} (over the first tenth {:.4g}); the metrics "
+      "describe a loop that does not settle: tune it more softly (a rule outside its range, e.g. "
+      "SIMC on a lightly damped or very fast model) or check the model",
+      label, late, late / span, span, early);
+}
+
+}  // namespace
 
 nlohmann::ordered_json ControlScenarioRun::ToJson() const {
   nlohmann::ordered_json j;
@@ -200,6 +247,8 @@ ControlScenarioResult RunControlScenario(const ControlScenarioOptions& o) {
                     ? "pid " + o.compare_rules[i]
                     : run.built.Label();
     run.result = SimulateClosedLoop(*run.built.controller, *plant, *setpoint, loop);
+    if (std::optional<std::string> w = DivergenceWarning(run.label, run.result))
+      result.warnings.push_back(std::move(*w));
     if (!run.built.auto_summary.empty() && !run.built.auto_converged)
       result.warnings.push_back(fmt::format(
           "the rule auto found no design that meets the specification on the model and on every "

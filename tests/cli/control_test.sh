@@ -212,4 +212,15 @@ expect_error "compare pid, dmc rule" "simc, imc or auto" control --controller pi
 expect_ok "run, linear plant" run --controller mpc --model fopdt:K=-2,tau=0.5,theta=0.05 \
   --plant fopdt:K=-2,tau=0.5,theta=0.05 --fast --setpoint step:to=1,at=0.5 --duration 4 --json
 check_json "run reaches the set-point" "j['metrics']['settled'] and abs(j['metrics']['steady_state_error']) < 0.01"
+# SIMC outside its range (a lightly damped model, zeta 0.1): the loop grows,
+# and control says so; DMC on the same model settles without a word.
+expect_ok "simc on zeta 0.1" control --controller pid --pid-rule simc --model "tf:num=1,den=1 0.2 1" \
+  --Ts 0.05 --setpoint step:to=1,at=1 --duration 30 --json
+check_json "an unstable loop is named" "any('looks unstable' in w for w in j['warnings'])"
+expect_ok "dmc on zeta 0.1" control --controller dmc --model "tf:num=1,den=1 0.2 1" --Ts 0.05 \
+  --setpoint step:to=1,at=1 --duration 30 --json
+check_json "a settled loop has no such warning" "j['warnings'] == [] and j['settled']"
+# A duration no trace holds (1e308 s ran 2 samples and exited 0).
+expect_error "duration 1e308" "a simulation holds at most 1e8" control --model fopdt-paper \
+  --setpoint step:to=1 --duration 1e308
 finish
