@@ -197,8 +197,9 @@ struct BuiltController {
   FopdtEstimate fopdt;        ///< the FOPDT the PID was tuned from (pid)
   double pid_kff = 0.0;       ///< (pid) velocity feed-forward Kff (0: none)
   /// (pid) set-point weight b of the proportional term (1 unless the rule
-  /// auto chose another) and derivative filter N.
-  double pid_setpoint_weight = 1.0, pid_derivative_filter = 10.0;
+  /// auto chose another).
+  double pid_setpoint_weight = 1.0;
+  double pid_derivative_filter = 10.0;  ///< (pid) derivative filter N (Td / N)
   /// Rule "auto": the auto-tuner's message (what it met or why not).
   std::string auto_summary;
   /// Rule "auto": t_r, the response time it aimed at (given, from the

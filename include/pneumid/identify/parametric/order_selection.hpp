@@ -86,7 +86,8 @@ struct OrderSelection {
   std::vector<OrderCandidate> candidates;  ///< in sweep order (na, nb, nk nested)
   long long num_rows = 0;                  ///< N used by every candidate
   bool validation = false;                 ///< losses measured on validation data
-  double u0 = 0.0, y0 = 0.0;               ///< the operating point the models are fitted about
+  double u0 = 0.0;                         ///< input level the models are fitted about
+  double y0 = 0.0;                         ///< output level the models are fitted about
   /// Index of the best candidate by criterion c (the first one on ties).
   std::size_t Best(OrderCriterion c) const;
   /// {num_rows, loss_on ("estimation" or "validation"), candidates: [{na, nb, nk,

@@ -78,11 +78,11 @@ RobustLoss RobustLossFromString(const std::string& name);
 struct ProcessParams {
   /// Static gain; P1DI: integrator gain (output units per input unit and second).
   double K = 0.0;
-  /// Real lags (time constants), s: T1 (every structure but P2DU), T2 (P2D,
-  /// P3D), T3 (P3D).
-  double T1 = 0.0, T2 = 0.0, T3 = 0.0;
-  /// P2DU natural period Tw, s (1 / natural frequency), and damping zeta.
-  double Tw = 0.0, zeta = 0.0;
+  double T1 = 0.0;    ///< first real lag (time constant), s (every structure but P2DU)
+  double T2 = 0.0;    ///< second real lag, s (P2D, P3D)
+  double T3 = 0.0;    ///< third real lag, s (P3D)
+  double Tw = 0.0;    ///< P2DU natural period, s (1 / natural frequency)
+  double zeta = 0.0;  ///< P2DU damping
   double Tz = 0.0;                      ///< zero time constant, s
   double theta = 0.0;                   ///< delay
   double y0 = 0.0;                      ///< output offset (initial steady state)
